@@ -1,0 +1,183 @@
+# BGFN artifact -- environment, tests, notebooks -> results/<profile>/, HTML book.
+#
+#   make reproduce [PROFILE=smoke|quick|paper]   environment + data + notebooks + book (default PROFILE=quick)
+#   make test                                    pytest (fails when no test ran)
+#   make book [PROFILE=...]                      rebuild the book from already executed notebooks
+#   make bench | make strip | make clean | make distclean | make lock | make help
+#
+# Make's file dependencies keep a second `make reproduce` cheap: an executed notebook is redone only when its
+# source notebook, params/$(PROFILE).yaml, a src/bgfn/*.py file, the environment or the previous executed
+# notebook changed; the book only when an executed notebook or a book source changed.
+
+SHELL := bash
+.SHELLFLAGS := -eu -o pipefail -c
+.DELETE_ON_ERROR:
+.SUFFIXES:
+MAKEFLAGS += --no-builtin-rules --no-print-directory
+.DEFAULT_GOAL := help
+
+PROFILE ?= quick
+VENV ?= .venv
+# Interpreter that creates the venv (the project pins Python 3.11).
+PYTHON ?= $(shell command -v python3.11 2>/dev/null || command -v python3)
+# Extra pip options, e.g. off this machine: PIP_FLAGS="--extra-index-url https://download.pytorch.org/whl/cpu"
+PIP_FLAGS ?=
+# Data step (module written by bgfn.data): resolve data/raw -> mirror -> pinned URL and verify checksums.
+DATA_FETCH ?= $(PY) -m bgfn.data fetch
+# Extra papermill options; in CI (CI=true) cell output is streamed to the log.
+PAPERMILL_FLAGS ?= $(if $(filter true 1,$(CI)),--log-output,)
+PYTEST_ARGS ?=
+# pip lines that are noise on a mirror-backed machine (kept: errors and real warnings)
+PIP_NOISE := is ignored: it is neither a file nor a directory\|^Requirement already satisfied
+
+VENV_ABS := $(abspath $(VENV))
+PY := $(VENV_ABS)/bin/python
+PIP := $(PY) -m pip
+# The stamp names the lock's hash: a changed lock means a new stamp, hence a re-install (pip is idempotent).
+LOCK_HASH := $(shell sha256sum requirements.lock | cut -c1-16)
+STAMP := $(VENV)/.installed-$(LOCK_HASH)
+
+NOTEBOOKS := 01_data_prep 02_kf_baseline 03_bgfn_training 04_outage_evaluation 05_energy_estimate
+PARAMS := params/$(PROFILE).yaml
+RES := results/$(PROFILE)
+EXEC := $(NOTEBOOKS:%=$(RES)/notebooks/%.ipynb)
+SRC := $(shell find src/bgfn -name '*.py' -not -path '*/__pycache__/*' | sort)
+BOOK_SRC := $(shell find book \( -path book/_build -o -path book/notebooks -o -path book/_generated \) -prune \
+              -o -type f -print | sort)
+BOOK_STAMP := book/_build/.built-$(PROFILE)
+BOOK_HTML := book/_build/html/index.html
+
+# Every recipe sees the venv first on PATH and the venv's kernelspec first on JUPYTER_PATH, so papermill's
+# `-k python3` runs the venv's ipykernel (kernel.json says "python", which jupyter_client maps to the
+# interpreter running papermill, i.e. the venv's).
+export PATH := $(VENV_ABS)/bin:$(PATH)
+export JUPYTER_PATH := $(VENV_ABS)/share/jupyter
+export MPLBACKEND := Agg
+export PYDEVD_DISABLE_FILE_VALIDATION := 1
+export PYTHONHASHSEED := 0
+
+.PHONY: help reproduce notebooks book test bench clean distclean venv data lock strip
+
+ifneq ($(filter reproduce notebooks book,$(MAKECMDGOALS)),)
+ifeq ($(wildcard $(PARAMS)),)
+$(error unknown PROFILE '$(PROFILE)': $(PARAMS) does not exist (available: $(basename $(notdir $(wildcard params/*.yaml)))))
+endif
+endif
+
+help:
+	@sed -n '3,6p' Makefile | sed 's/^# \{0,1\}//'
+
+# ---------------------------------------------------------------- environment
+venv: $(STAMP)
+
+$(STAMP): requirements.lock
+	@echo "==> environment $(VENV) from requirements.lock ($(LOCK_HASH))"
+	@if [ ! -x "$(PY)" ]; then \
+	  echo "    creating $(VENV) with $(PYTHON)"; \
+	  "$(PYTHON)" -c 'import sys; assert sys.version_info[:2] == (3, 11), "Python 3.11 required, got " + sys.version' ; \
+	  "$(PYTHON)" -m venv "$(VENV)"; \
+	else echo "    $(VENV) exists: checking it against the lock (already satisfied = nothing to do)"; fi
+	@# --no-deps everywhere: the lock is complete; pip must never resolve (spikingjelly declares
+	@# torchvision/torchaudio, which would pull CUDA builds of torch).
+	@echo "    pip install --no-deps -r requirements.lock ($$(grep -vc '^#' requirements.lock) packages)"
+	@$(PIP) install -q $(PIP_FLAGS) --no-deps -r requirements.lock 2>&1 | { grep -v "$(PIP_NOISE)" || true; }
+	@echo "    pip install --no-deps spikingjelly==2.0.0"
+	@$(PIP) install -q $(PIP_FLAGS) --no-deps spikingjelly==2.0.0 2>&1 | { grep -v "$(PIP_NOISE)" || true; }
+	@if $(PY) -c 'import bgfn, pathlib, sys; sys.exit(pathlib.Path(bgfn.__file__).resolve().parents[1] != pathlib.Path("src").resolve())' 2>/dev/null; \
+	then echo "    bgfn already installed (editable) from ./src"; \
+	else echo "    pip install --no-deps -e ."; \
+	  $(PIP) install -q $(PIP_FLAGS) --no-deps -e . 2>&1 | { grep -v "$(PIP_NOISE)" || true; }; fi
+	@$(PY) -c 'import bgfn, torch, spikingjelly.activation_based, papermill, ipykernel, jupyter_book; \
+	  assert torch.version.cuda is None, "a CUDA build of torch is installed: expected the +cpu wheel"; \
+	  print("    ok: torch", torch.__version__, "| bgfn from", bgfn.__file__)'
+	@rm -f $(VENV)/.installed-*
+	@touch $@
+
+# Rewrite requirements.lock from the current venv (keeps the comment header).
+lock:
+	@{ grep '^#' requirements.lock; $(PIP) freeze --exclude-editable | grep -vi '^spikingjelly==' ; } > requirements.lock.tmp
+	@mv requirements.lock.tmp requirements.lock
+	@echo "requirements.lock: $$(grep -vc '^#' requirements.lock) packages"
+
+# ---------------------------------------------------------------- data
+data: $(STAMP)
+	@echo "==> data: $(DATA_FETCH)"
+	@$(DATA_FETCH)
+
+# ---------------------------------------------------------------- notebooks
+# papermill writes to a temporary name; only a complete run is renamed to the target, so a failed run leaves
+# no executed notebook behind (and Make redoes it next time).
+$(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(PARAMS) $(SRC) $(STAMP) | data
+	@mkdir -p $(@D)
+	@echo "==> [$(PROFILE)] papermill $<"
+	@tmp="$(@D)/.$*.running-$$$$.ipynb"; \
+	if $(VENV_ABS)/bin/papermill "$<" "$$tmp" -p profile $(PROFILE) --cwd "$(CURDIR)" -k python3 \
+	     --progress-bar $(PAPERMILL_FLAGS); then \
+	  mv -f "$$tmp" "$@"; \
+	else rm -f "$$tmp"; echo "error: $< failed under PROFILE=$(PROFILE); nothing written to $@" >&2; exit 1; fi
+
+# Each notebook reads what the previous one wrote.
+$(RES)/notebooks/02_kf_baseline.ipynb: $(RES)/notebooks/01_data_prep.ipynb
+$(RES)/notebooks/03_bgfn_training.ipynb: $(RES)/notebooks/02_kf_baseline.ipynb
+$(RES)/notebooks/04_outage_evaluation.ipynb: $(RES)/notebooks/03_bgfn_training.ipynb
+$(RES)/notebooks/05_energy_estimate.ipynb: $(RES)/notebooks/04_outage_evaluation.ipynb
+
+notebooks: $(EXEC)
+
+# ---------------------------------------------------------------- book
+# The book shows the executed notebooks of $(PROFILE) (copied to the gitignored book/notebooks/) and the
+# profile's tables/figures (copied to book/_generated/, for pages that include them). book/_config.yml has
+# execute_notebooks: 'off'. Warnings are errors.
+define build_book
+	@echo "==> book from $(RES)/notebooks"
+	@rm -rf book/notebooks book/_generated && mkdir -p book/notebooks book/_generated
+	@cp $(EXEC) book/notebooks/
+	@for d in tables figures; do if [ -d "$(RES)/$$d" ]; then cp -r "$(RES)/$$d" book/_generated/; fi; done
+	@printf '%s\n' "Built from the executed notebooks of profile \`$(PROFILE)\` (\`params/$(PROFILE).yaml\`)," \
+	  "commit \`$$(git rev-parse --short HEAD 2>/dev/null || echo unknown)\`." > book/_generated/build_info.md
+	@rm -f book/_build/.built-*
+	$(VENV_ABS)/bin/jupyter-book build book --all -W -n --keep-going
+	@touch $(BOOK_STAMP)
+	@echo "book: $(BOOK_HTML)"
+endef
+
+$(BOOK_STAMP): $(EXEC) $(BOOK_SRC) $(STAMP)
+	$(build_book)
+
+book: $(STAMP)
+	@missing=""; for f in $(EXEC); do [ -f "$$f" ] || missing="$$missing $$f"; done; \
+	if [ -n "$$missing" ]; then echo "error: not executed yet:$$missing -- run: make reproduce PROFILE=$(PROFILE)" >&2; exit 1; fi
+	$(build_book)
+
+reproduce: $(BOOK_STAMP)
+	@echo "==> done (PROFILE=$(PROFILE)): results in $(RES)/, book at $(BOOK_HTML)"
+
+# ---------------------------------------------------------------- tests, benchmarks
+test: $(STAMP)
+	@mkdir -p results
+	$(PY) -m pytest $(PYTEST_ARGS) --junitxml=results/pytest-junit.xml
+	@$(PY) -c 'import sys, xml.etree.ElementTree as ET; r = ET.parse("results/pytest-junit.xml").getroot(); \
+	  s = r if r.tag == "testsuite" else r.find("testsuite"); n = int(s.get("tests", 0)) - int(s.get("skipped", 0)); \
+	  sys.exit(0) if n > 0 else sys.exit("error: no test ran (all skipped or none collected)")'
+
+bench: $(STAMP)
+	@shopt -s nullglob; files=(benchmarks/bench_*.py); \
+	if [ $${#files[@]} -eq 0 ]; then echo "no benchmarks/bench_*.py yet"; exit 0; fi; \
+	for f in "$${files[@]}"; do echo "==> $$f"; $(PY) "$$f"; done; \
+	echo "==> results/bench.json"
+
+# Store notebooks without outputs: clear outputs/execution counts of notebooks/*.ipynb (rewrites only the
+# notebooks that carry some).
+strip: $(STAMP)
+	@$(PY) -c 'import sys, glob, nbformat; \
+	  paths = sorted(glob.glob("notebooks/*.ipynb")); \
+	  dirty = [p for p in paths if any(c.get("outputs") or c.get("execution_count") for c in nbformat.read(p, 4).cells if c.cell_type == "code")]; \
+	  [nbformat.write((lambda nb: ([c.update(outputs=[], execution_count=None) for c in nb.cells if c.cell_type == "code"], nb)[1])(nbformat.read(p, 4)), p) for p in dirty]; \
+	  print("stripped:", " ".join(dirty) if dirty else "nothing (all notebooks clean)")'
+
+# ---------------------------------------------------------------- cleaning
+clean:
+	rm -rf results book/_build book/notebooks book/_generated
+
+distclean: clean
+	rm -rf $(VENV) data/processed

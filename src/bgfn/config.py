@@ -1,0 +1,211 @@
+"""Profiles (``params/<profile>.yaml``) and the paths every notebook writes to.
+
+A *profile* fixes the size of a run: ``smoke`` (CI, a minute), ``quick`` (default, minutes on a laptop),
+``paper`` (the paper's settings). Every notebook starts with a ``parameters`` cell (``profile = "quick"``)
+that papermill overrides, then::
+
+    from bgfn.config import load_profile, results_dir, run_metadata
+    cfg = load_profile(profile)          # dict: profile, description, seed, data, nav, train, evaluate, energy
+    out = results_dir(profile)           # results/<profile>/ with tables/ figures/ notebooks/ models/
+
+Outputs go to ``out / "tables" / "<name>.csv"``, ``out / "figures" / "<name>.png"`` and
+``out / "<name>.json"`` (metrics), always through :mod:`bgfn.io` (atomic writes).
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import os
+import re
+import subprocess
+import sys
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+from bgfn.errors import DataError
+
+
+def _find_project_root() -> Path:
+    """Repository root, independent of the current directory.
+
+    ``BGFN_ROOT`` (environment) wins; else the checkout this file lives in (editable install:
+    ``<root>/src/bgfn/config.py``); else the first parent of the current directory holding ``params/``.
+    """
+    env = os.environ.get("BGFN_ROOT")
+    if env:
+        return Path(env).expanduser().resolve()
+    here = Path(__file__).resolve().parents[2]
+    if (here / "params").is_dir() and (here / "src" / "bgfn").is_dir():
+        return here
+    cwd = Path.cwd().resolve()
+    for candidate in (cwd, *cwd.parents):
+        if (candidate / "params").is_dir() and (candidate / "pyproject.toml").is_file():
+            return candidate
+    return here
+
+
+PROJECT_ROOT: Path = _find_project_root()
+PARAMS_DIR: Path = PROJECT_ROOT / "params"
+RESULTS_ROOT: Path = PROJECT_ROOT / "results"
+DATA_DIR: Path = PROJECT_ROOT / "data"
+
+#: Profiles shipped with the artifact (users may add their own ``params/<name>.yaml``).
+PROFILES: tuple[str, ...] = ("smoke", "quick", "paper")
+#: Top-level keys every profile file must define.
+SCALAR_KEYS: tuple[str, ...] = ("profile", "description", "seed")
+#: One section per notebook: 01 data, 02 nav (KF baseline), 03 train, 04 evaluate, 05 energy.
+SECTION_KEYS: tuple[str, ...] = ("data", "nav", "train", "evaluate", "energy")
+REQUIRED_KEYS: tuple[str, ...] = SCALAR_KEYS + SECTION_KEYS
+#: Subfolders of ``results/<profile>/``.
+RESULT_SUBDIRS: tuple[str, ...] = ("tables", "figures", "notebooks", "models")
+
+_NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]*$")
+
+#: Distributions whose versions are recorded in :func:`run_metadata`.
+_PACKAGES: tuple[str, ...] = (
+    "bgfn", "numpy", "scipy", "pandas", "torch", "spikingjelly", "numba", "matplotlib", "python-ins",
+)
+
+
+def _check_name(profile: str) -> str:
+    if not isinstance(profile, str) or not _NAME_RE.match(profile):
+        raise DataError(PARAMS_DIR, "profile", "a profile name of letters, digits, '_' or '-' "
+                        f"(one of {', '.join(PROFILES)} or params/<name>.yaml)", repr(profile))
+    return profile
+
+
+def profile_path(profile: str) -> Path:
+    """Path of ``params/<profile>.yaml`` (not checked for existence)."""
+    return PARAMS_DIR / f"{_check_name(profile)}.yaml"
+
+
+def available_profiles() -> list[str]:
+    """Names of all ``params/*.yaml`` files, sorted."""
+    return sorted(p.stem for p in PARAMS_DIR.glob("*.yaml"))
+
+
+def load_profile(profile: str) -> dict[str, Any]:
+    """Read and validate ``params/<profile>.yaml``.
+
+    Parameters
+    ----------
+    profile : str
+        Profile name (``smoke``, ``quick``, ``paper`` or a user file ``params/<name>.yaml``).
+
+    Returns
+    -------
+    dict
+        The parsed YAML: ``profile`` (str, equal to the file name), ``description`` (str), ``seed`` (int)
+        and one mapping per notebook section (``data``, ``nav``, ``train``, ``evaluate``, ``energy``;
+        an empty section is returned as ``{}``). A fresh copy on every call.
+
+    Raises
+    ------
+    bgfn.errors.DataError
+        Unknown profile (missing file), unreadable YAML, a missing required key or a wrong type.
+        The message names the file.
+    """
+    import yaml
+
+    path = profile_path(profile)
+    if not path.is_file():
+        known = ", ".join(available_profiles()) or "none"
+        raise DataError(path, "profile", f"an existing profile file (available: {known})",
+                        f"unknown profile {profile!r}: no such file")
+    try:
+        cfg = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except yaml.YAMLError as exc:
+        raise DataError(path, "<yaml>", "valid YAML", str(exc).replace("\n", " ")) from exc
+    if not isinstance(cfg, dict):
+        raise DataError(path, "<top level>", "a mapping of keys", type(cfg).__name__)
+
+    missing = [key for key in REQUIRED_KEYS if key not in cfg]
+    if missing:
+        raise DataError(path, missing[0], f"required top-level keys {', '.join(REQUIRED_KEYS)}",
+                        f"missing {', '.join(missing)}")
+    if cfg["profile"] != profile:
+        raise DataError(path, "profile", f"the file's own name {profile!r}", repr(cfg["profile"]))
+    if not isinstance(cfg["description"], str):
+        raise DataError(path, "description", "a string", type(cfg["description"]).__name__)
+    if isinstance(cfg["seed"], bool) or not isinstance(cfg["seed"], int) or cfg["seed"] < 0:
+        raise DataError(path, "seed", "a non-negative integer", repr(cfg["seed"]))
+    for key in SECTION_KEYS:
+        if cfg[key] is None:  # a section holding only comments
+            cfg[key] = {}
+        if not isinstance(cfg[key], dict):
+            raise DataError(path, key, "a mapping (section of keys)", type(cfg[key]).__name__)
+    return copy.deepcopy(cfg)
+
+
+def results_dir(profile: str, create: bool = True) -> Path:
+    """``results/<profile>/``, with ``tables/``, ``figures/``, ``notebooks/``, ``models/`` created.
+
+    Parameters
+    ----------
+    profile : str
+        Profile name.
+    create : bool
+        Create the folders (default). With ``False`` only the path is returned.
+    """
+    root = RESULTS_ROOT / _check_name(profile)
+    if create:
+        for sub in RESULT_SUBDIRS:
+            (root / sub).mkdir(parents=True, exist_ok=True)
+    return root
+
+
+def _git(*args: str) -> str | None:
+    try:
+        # GIT_OPTIONAL_LOCKS=0: `git status` must not rewrite the index (read-only query)
+        env = {**os.environ, "GIT_OPTIONAL_LOCKS": "0"}
+        res = subprocess.run(["git", *args], cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=10,
+                             env=env)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return res.stdout.strip() if res.returncode == 0 else None
+
+
+def run_metadata(profile: str) -> dict[str, Any]:
+    """What produced a table: profile, seed, code and package versions. No timestamps.
+
+    Two runs of the same profile on the same checkout and environment give the same dict, so tables that
+    embed it stay byte-identical.
+
+    Returns
+    -------
+    dict
+        ``profile``, ``seed``, ``params_file`` (relative path), ``params_sha256`` (of the YAML bytes),
+        ``git_commit`` (``None`` outside a git checkout), ``git_dirty`` (tracked files modified; ``None``
+        without git), ``python`` (``major.minor.micro``) and ``packages`` (name -> version, ``None`` if
+        not installed).
+    """
+    cfg = load_profile(profile)
+    path = profile_path(profile)
+    commit = _git("rev-parse", "HEAD")
+    status = _git("status", "--porcelain", "--untracked-files=no") if commit else None
+    packages: dict[str, str | None] = {}
+    for name in _PACKAGES:
+        try:
+            packages[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            packages[name] = None
+    return {
+        "profile": cfg["profile"],
+        "seed": cfg["seed"],
+        "params_file": path.relative_to(PROJECT_ROOT).as_posix(),
+        "params_sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
+        "git_commit": commit,
+        "git_dirty": (bool(status) if status is not None else None),
+        "python": ".".join(str(v) for v in sys.version_info[:3]),
+        "packages": packages,
+    }
+
+
+def metadata_lines(profile: str) -> list[str]:
+    """:func:`run_metadata` as ``# key: value`` lines, for a comment header above a CSV table."""
+    meta = run_metadata(profile)
+    lines = [f"# {k}: {v}" for k, v in meta.items() if k != "packages"]
+    lines += [f"# {k}: {v}" for k, v in meta["packages"].items()]
+    return lines

@@ -1,0 +1,155 @@
+"""Profiles and results layout (bgfn.config)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+from bgfn import config
+from bgfn.errors import DataError
+
+
+def _section_keys(cfg: dict) -> dict[str, set[str]]:
+    return {key: set(cfg[key]) for key in config.SECTION_KEYS}
+
+
+def test_project_root_holds_the_artifact():
+    root = config.PROJECT_ROOT
+    assert (root / "pyproject.toml").is_file()
+    assert (root / "params").is_dir()
+    assert (root / "src" / "bgfn" / "config.py").is_file()
+
+
+def test_project_root_is_independent_of_cwd(tmp_path):
+    # A fresh interpreter started elsewhere finds the same root.
+    env = {k: v for k, v in os.environ.items() if k != "BGFN_ROOT"}
+    out = subprocess.run([sys.executable, "-c", "from bgfn.config import PROJECT_ROOT; print(PROJECT_ROOT)"],
+                         cwd=tmp_path, capture_output=True, text=True, check=True, env=env)
+    assert Path(out.stdout.strip()) == config.PROJECT_ROOT
+
+
+@pytest.mark.parametrize("profile", config.PROFILES)
+def test_shipped_profiles_load(profile):
+    cfg = config.load_profile(profile)
+    assert cfg["profile"] == profile
+    assert isinstance(cfg["seed"], int)
+    assert cfg["description"].strip()
+    for key in config.SECTION_KEYS:
+        assert isinstance(cfg[key], dict)
+
+
+def test_profiles_define_the_same_keys():
+    cfgs = {p: config.load_profile(p) for p in config.PROFILES}
+    top = {p: set(c) for p, c in cfgs.items()}
+    assert len({frozenset(k) for k in top.values()}) == 1, f"top-level keys differ: {top}"
+    # A notebook reads the same keys whatever the profile: sections must agree one level down, too.
+    sections = {p: _section_keys(c) for p, c in cfgs.items()}
+    ref_name, ref = next(iter(sections.items()))
+    for name, keys in sections.items():
+        for section in config.SECTION_KEYS:
+            assert keys[section] == ref[section], (
+                f"section '{section}': params/{name}.yaml has {sorted(keys[section])}, "
+                f"params/{ref_name}.yaml has {sorted(ref[section])}")
+
+
+def test_unknown_profile_names_the_file():
+    with pytest.raises(DataError) as err:
+        config.load_profile("no_such_profile")
+    msg = str(err.value)
+    assert str(config.PARAMS_DIR / "no_such_profile.yaml") in msg
+    assert "unknown profile" in msg
+    assert "quick" in msg  # lists what is available
+    assert isinstance(err.value, ValueError)
+
+
+@pytest.mark.parametrize("bad", ["../quick", "", "a/b", ".hidden", "quick.yaml"])
+def test_profile_names_cannot_escape_params(bad):
+    with pytest.raises(DataError):
+        config.load_profile(bad)
+    with pytest.raises(DataError):
+        config.results_dir(bad, create=False)
+
+
+def _write_profile(tmp_path, monkeypatch, name, cfg):
+    monkeypatch.setattr(config, "PARAMS_DIR", tmp_path)
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(yaml.safe_dump(cfg) if not isinstance(cfg, str) else cfg)
+    return path
+
+
+def _complete(name):
+    return {"profile": name, "description": "d", "seed": 1,
+            "data": None, "nav": {}, "train": {"epochs": 2}, "evaluate": {}, "energy": {}}
+
+
+def test_missing_required_key_names_file_and_key(tmp_path, monkeypatch):
+    cfg = _complete("mine")
+    del cfg["train"]
+    path = _write_profile(tmp_path, monkeypatch, "mine", cfg)
+    with pytest.raises(DataError) as err:
+        config.load_profile("mine")
+    assert err.value.source == str(path)
+    assert err.value.field == "train"
+
+
+def test_empty_section_reads_as_mapping(tmp_path, monkeypatch):
+    _write_profile(tmp_path, monkeypatch, "mine", _complete("mine"))
+    cfg = config.load_profile("mine")
+    assert cfg["data"] == {}
+    assert cfg["train"] == {"epochs": 2}
+    cfg["train"]["epochs"] = 99  # a caller's edit must not leak into the next load
+    assert config.load_profile("mine")["train"]["epochs"] == 2
+
+
+@pytest.mark.parametrize("field,value", [("seed", "7"), ("seed", -1), ("seed", True), ("nav", [1, 2]),
+                                         ("profile", "other"), ("description", 3)])
+def test_bad_values_are_rejected(tmp_path, monkeypatch, field, value):
+    cfg = _complete("mine")
+    cfg[field] = value
+    _write_profile(tmp_path, monkeypatch, "mine", cfg)
+    with pytest.raises(DataError) as err:
+        config.load_profile("mine")
+    assert err.value.field == field
+
+
+def test_invalid_yaml_names_the_file(tmp_path, monkeypatch):
+    path = _write_profile(tmp_path, monkeypatch, "mine", "profile: [unclosed\n")
+    with pytest.raises(DataError) as err:
+        config.load_profile("mine")
+    assert str(path) in str(err.value)
+
+
+def test_results_dir_layout(tmp_path, monkeypatch):
+    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path / "results")
+    assert not config.results_dir("quick", create=False).exists()
+    out = config.results_dir("quick")
+    assert out == tmp_path / "results" / "quick"
+    assert sorted(p.name for p in out.iterdir()) == ["figures", "models", "notebooks", "tables"]
+    (out / "tables" / "keep.csv").write_text("a\n1\n")
+    assert config.results_dir("quick") == out  # idempotent, keeps content
+    assert (out / "tables" / "keep.csv").read_text() == "a\n1\n"
+
+
+def test_results_dir_default_is_under_project_root():
+    assert config.results_dir("smoke", create=False) == config.PROJECT_ROOT / "results" / "smoke"
+
+
+def test_run_metadata_is_deterministic_and_complete():
+    a = config.run_metadata("smoke")
+    b = config.run_metadata("smoke")
+    assert a == b
+    assert a["profile"] == "smoke"
+    assert a["seed"] == config.load_profile("smoke")["seed"]
+    assert a["params_file"] == "params/smoke.yaml"
+    assert len(a["params_sha256"]) == 64
+    assert a["packages"]["numpy"] is not None
+    assert a["git_commit"] is None or len(a["git_commit"]) == 40
+    flat = repr(a).lower()
+    assert "time" not in flat and "date" not in flat  # no timestamps: identical tables on rerun
+    lines = config.metadata_lines("smoke")
+    assert "# profile: smoke" in lines

@@ -1,0 +1,28 @@
+"""The NaveGo Turin drive: acquisition, truth, simulated IMUs/GNSS, datasets (``load_drive``).
+
+Public API:
+
+- :func:`load_drive` ``(name="turin-sim-ekinox", **overrides) -> Drive`` and the registry
+  :data:`DATASETS` (name -> default parameters); a CSV folder path loads a user's drive.
+- :class:`Drive`: ``name``, ``reference``, ``imu``, ``gnss`` tables, ``meta``, ``imu_bias``.
+- :func:`fetch_all` / :func:`resolve`: the NaveGo files, ``data/raw`` -> mirror -> pinned URL
+  (``python -m bgfn.data fetch``).
+- :func:`smooth_reference`, :func:`apply_imu_errors`, :func:`error_params`, :func:`simulate_fixes`,
+  :func:`load_csv_drive`, :func:`write_csv_drive`: the building blocks.
+- :mod:`bgfn.data.summary` (``summary_table``) and :mod:`bgfn.data.plots` (matplotlib; not imported here):
+  notebook 01's tables and figures.
+"""
+
+from bgfn.data.acquire import NAVEGO_FILES, MissingFileError, fetch_all, resolve
+from bgfn.data.csv_drive import load_csv_drive, write_csv_drive
+from bgfn.data.drive import Drive
+from bgfn.data.drives import DATASETS, DEFAULT_DATASET, dataset_params, load_drive
+from bgfn.data.gnss import simulate_fixes
+from bgfn.data.imu_errors import EKINOX_D, MPU6000, apply_imu_errors, error_params
+from bgfn.data.trajectory import smooth_reference
+
+__all__ = [
+    "DATASETS", "DEFAULT_DATASET", "Drive", "EKINOX_D", "MPU6000", "MissingFileError", "NAVEGO_FILES",
+    "apply_imu_errors", "dataset_params", "error_params", "fetch_all", "load_csv_drive", "load_drive",
+    "resolve", "simulate_fixes", "smooth_reference", "write_csv_drive",
+]

@@ -1,0 +1,148 @@
+"""The ``Drive`` container (reference, IMU and GNSS tables + meta) and its cache format (.npz + JSON).
+
+A cache entry is two files written atomically: ``<stem>.npz`` (one float64 array per table, no pickles)
+then ``<stem>.json`` (meta, column names, cache key). The JSON is written last, so an entry without it
+is incomplete and ignored.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from bgfn.data.navego import GNSS_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS, check_time
+from bgfn.errors import DataError
+from bgfn.io import atomic_path, atomic_write_json
+
+_TABLES = ("reference", "imu", "gnss", "imu_bias")
+
+
+@dataclass
+class Drive:
+    """One drive: truth, IMU and GNSS on a common time base (GPS time of week, s).
+
+    Attributes
+    ----------
+    name : str
+        Dataset name (``turin-sim-ekinox``, ...) or the CSV folder's name.
+    reference : DataFrame
+        Truth, reference schema (CONTRIBUTING.md), at the IMU rate.
+    imu : DataFrame
+        IMU schema; row k = mean rates over ``(time[k-1], time[k]]``.
+    gnss : DataFrame
+        GNSS schema (antenna position; ``v_*`` NaN when not given).
+    meta : dict
+        ``imu_rate_hz``, ``gnss_rate_hz``, ``lever_arm_m`` (antenna in the body frame, m),
+        ``imu_errors`` (see :mod:`bgfn.data.imu_errors`), ``source``, ``params``, and per dataset
+        diagnostics (``truth_fit``, ``gnss_residual_*``, ``cache_key``).
+    imu_bias : DataFrame or None
+        True additive IMU bias per epoch (simulated datasets): ``time``, ``gyro_bias_x/y/z`` (rad/s),
+        ``accel_bias_x/y/z`` (m/s^2).
+    """
+
+    name: str
+    reference: pd.DataFrame
+    imu: pd.DataFrame
+    gnss: pd.DataFrame
+    meta: dict = field(default_factory=dict)
+    imu_bias: pd.DataFrame | None = None
+
+    def crop(self, t_start: float | None = None, t_end: float | None = None) -> "Drive":
+        """A copy restricted to ``t_start <= time <= t_end`` (s, GPS time of week).
+
+        The IMU keeps the rows whose interval lies inside the span (``time > t_start``), so that
+        integrating from the first reference row uses exactly the IMU rows of the span.
+        """
+        lo = -np.inf if t_start is None else float(t_start)
+        hi = np.inf if t_end is None else float(t_end)
+
+        def sel(df):
+            t = df["time"].to_numpy(float)
+            return df.loc[(t >= lo) & (t <= hi)].reset_index(drop=True)
+
+        ref = sel(self.reference)
+        if len(ref) < 2:
+            raise DataError(self.name, "t_start/t_end", "a span holding at least 2 reference epochs",
+                            f"[{t_start}, {t_end}]")
+        t0 = float(ref["time"].iloc[0])
+        t1 = float(ref["time"].iloc[-1])
+
+        def sel_imu(df):  # rows whose interval (t[k-1], t[k]] lies within the reference span
+            if df is None:
+                return None
+            return df.loc[(df["time"] > t0) & (df["time"] <= t1)].reset_index(drop=True)
+
+        meta = dict(self.meta, crop=[t_start, t_end])
+        return Drive(self.name, ref, sel_imu(self.imu), sel(self.gnss), meta, sel_imu(self.imu_bias))
+
+    def validate(self, source: str | None = None) -> "Drive":
+        """Check columns, strictly increasing times and finite values; return self.
+
+        Raises
+        ------
+        DataError
+            Naming the table and the column.
+        """
+        src = source or self.name
+        for table, cols, nan_ok in (("reference", REFERENCE_COLUMNS, ()), ("imu", IMU_COLUMNS, ()),
+                                    ("gnss", GNSS_COLUMNS, ("v_n", "v_e", "v_d"))):
+            df = getattr(self, table)
+            missing = [c for c in cols if c not in df.columns]
+            if missing:
+                raise DataError(f"{src}/{table}", missing[0], f"columns {', '.join(cols)}",
+                                f"missing {', '.join(missing)}")
+            check_time(f"{src}/{table}", "time", df["time"].to_numpy(float))
+            for c in cols:
+                if c in nan_ok:
+                    continue
+                bad = ~np.isfinite(df[c].to_numpy(float))
+                if bad.any():
+                    k = int(np.argmax(bad))
+                    raise DataError(f"{src}/{table}", c, "finite values",
+                                    f"{int(bad.sum())} NaN/inf, first at row {k} (time {df['time'].iloc[k]})")
+        return self
+
+
+def save_drive(drive: Drive, stem: str | Path, key: str) -> None:
+    """Write ``<stem>.npz`` then ``<stem>.json`` atomically (see module docstring)."""
+    stem = Path(stem)
+    arrays, columns = {}, {}
+    for table in _TABLES:
+        df = getattr(drive, table)
+        if df is not None:
+            arrays[table] = df.to_numpy(dtype=np.float64)
+            columns[table] = list(df.columns)
+    with atomic_path(stem.with_suffix(".npz")) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez(fh, **arrays)
+    atomic_write_json(stem.with_suffix(".json"), {"key": key, "name": drive.name, "columns": columns,
+                                                  "meta": drive.meta})
+
+
+def load_cached(stem: str | Path, key: str) -> Drive | None:
+    """Read a cache entry written by :func:`save_drive`; None when absent, incomplete or stale."""
+    stem = Path(stem)
+    jpath, npath = stem.with_suffix(".json"), stem.with_suffix(".npz")
+    if not (jpath.is_file() and npath.is_file()):
+        return None
+    try:
+        info = json.loads(jpath.read_text())
+        if info.get("key") != key:
+            return None
+        with np.load(npath, allow_pickle=False) as npz:
+            tables = {t: pd.DataFrame(npz[t], columns=info["columns"][t]) for t in info["columns"]}
+    except (OSError, ValueError, KeyError):
+        return None
+    return Drive(info["name"], tables["reference"], tables["imu"], tables["gnss"], info["meta"],
+                 tables.get("imu_bias"))
+
+
+def horizontal_distance_m(reference: pd.DataFrame) -> float:
+    """Length of the horizontal path, m (sum of ``|v_h| dt``, trapezoid rule)."""
+    t = reference["time"].to_numpy(float)
+    speed = np.hypot(reference["v_n"].to_numpy(float), reference["v_e"].to_numpy(float))
+    return float(np.sum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t)))

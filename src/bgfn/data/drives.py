@@ -1,0 +1,318 @@
+"""Datasets of the Turin drive: ``load_drive(name, **overrides)`` with a cache in ``data/processed/``.
+
+=====================  ==========================================================================
+name                   content
+=====================  ==========================================================================
+``turin-sim-ekinox``   the paper's *dataset test* (default): smooth 100 Hz truth from NaveGo ``ref``;
+                       IMU synthesized from it (:func:`bgfn.nav.sim.imu_from_trajectory`) with the
+                       Ekinox-D error profile; GNSS = real Ekinox fixes (5 Hz, or decimated)
+``turin-sim-mpu6000``  stand-in for the paper's private *field test*: same truth, MPU-6000 errors
+                       (turn-on biases, scale factor, misalignment, vibration), GNSS simulated like a
+                       1 Hz u-blox receiver with lever arm [-0.369, 0, -0.219] m
+``navego-ekinox``      real Ekinox-D IMU (``ekinox_imu.mat``, 200 Hz -> 100 Hz) + real GNSS + truth
+``navego-mpu6000``     real MPU-6000 IMU (``mpu6000_imu.mat``, ~250 Hz -> 100 Hz) + real GNSS + truth
+a folder path          a user's drive in the CSV schema (:mod:`bgfn.data.csv_drive`)
+=====================  ==========================================================================
+
+Every random draw is seeded by the ``seed`` parameter (independent sub-streams for IMU and GNSS).
+A built dataset is cached under ``<data>/processed/<name>/<key>.npz|json``; ``key`` hashes the dataset
+name, its parameters, the raw files' checksums and the source of the data modules, so a change of any
+of them rebuilds. ``t_start``/``t_end`` crop after the cache (they are not part of the key).
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+import logging
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+
+from bgfn.data import acquire
+from bgfn.data.csv_drive import load_csv_drive
+from bgfn.data.drive import Drive, load_cached, save_drive
+from bgfn.data.gnss import antenna_position, decimate, simulate_fixes
+from bgfn.data.imu_errors import MPU6000, apply_imu_errors, error_params
+from bgfn.data.navego import read_gnss, read_imu, read_reference, resample_imu
+from bgfn.data.trajectory import smooth_reference
+from bgfn.errors import DataError
+
+log = logging.getLogger(__name__)
+
+#: Default dataset (the paper's dataset test).
+DEFAULT_DATASET = "turin-sim-ekinox"
+#: Antenna lever arm NaveGo uses with the MPU-6000 (body frame, m).
+MPU_LEVER_ARM_M = [-0.369, 0.0, -0.219]
+
+_COMMON = {
+    "seed": 0,                     # seed of every random draw
+    "imu_rate_hz": 100.0,          # IMU / truth rate, Hz
+    "smoothing_degree": 5,         # truth spline degree
+    "position_sigma_m": 0.05,      # truth smoothing of north/east/up, m (s = n sigma^2)
+    "attitude_sigma_rad": 0.002,   # truth smoothing of roll/pitch/yaw, rad
+    "t_start": None,               # crop, s (GPS time of week); applied after the cache
+    "t_end": None,
+}
+
+#: Parameters of each dataset (defaults). ``imu_errors`` holds overrides of the error profile's keys.
+DATASETS: dict[str, dict] = {
+    "turin-sim-ekinox": {**_COMMON, "gnss_rate_hz": 5.0, "imu_errors": {}},
+    "turin-sim-mpu6000": {**_COMMON, "gnss_rate_hz": 1.0, "imu_errors": {},
+                          "lever_arm_m": MPU_LEVER_ARM_M, "gnss_white_std_m": [0.3, 0.3, 0.6],
+                          "gnss_correlated_std_m": [1.0, 1.0, 2.0], "gnss_correlated_tau_s": 60.0},
+    "navego-ekinox": {**_COMMON, "gnss_rate_hz": 5.0},
+    "navego-mpu6000": {**_COMMON, "gnss_rate_hz": 5.0, "lever_arm_m": MPU_LEVER_ARM_M},
+}
+_NOT_IN_KEY = ("t_start", "t_end")
+#: Modules whose source is hashed into the cache key.
+_KEY_MODULES = ("acquire", "navego", "trajectory", "imu_errors", "gnss", "drive", "drives")
+
+
+def substream_seed(seed: int, stream: int) -> int:
+    """An independent 32-bit seed for sub-stream ``stream`` of ``seed`` (``numpy.random.SeedSequence``)."""
+    return int(np.random.SeedSequence([int(seed), int(stream)]).generate_state(1)[0])
+
+
+def dataset_params(name: str, overrides: dict | None = None) -> dict:
+    """Defaults of dataset ``name`` with ``overrides`` applied (unknown keys raise DataError)."""
+    if name not in DATASETS:
+        raise DataError("load_drive", "name", f"one of {', '.join(DATASETS)} or a CSV folder", repr(name))
+    params = copy.deepcopy(DATASETS[name])
+    for key, value in (overrides or {}).items():
+        if key not in params:
+            raise DataError(name, key, f"a parameter of {name}: {', '.join(params)}", "unknown parameter")
+        params[key] = copy.deepcopy(value)
+    if not isinstance(params["seed"], (int, np.integer)) or isinstance(params["seed"], bool):
+        raise DataError(name, "seed", "an integer", repr(params["seed"]))
+    return params
+
+
+def profile_overrides(name: str, profile: str) -> dict:
+    """Dataset parameters that profile ``params/<profile>.yaml`` sets for dataset ``name``.
+
+    The profile's ``data:`` section may hold ``seed`` (default: the profile's top-level ``seed``), the
+    common parameters (``imu_rate_hz``, ``smoothing_degree``, ``position_sigma_m``,
+    ``attitude_sigma_rad``, ``t_start``, ``t_end``) and one mapping per dataset name with that dataset's
+    parameters (e.g. ``turin-sim-ekinox: {gnss_rate_hz: 1.0}``); other keys (``datasets``, plot spans)
+    belong to notebook 01.
+
+    Returns
+    -------
+    dict
+        Overrides for :func:`dataset_params` (unknown per-dataset keys raise there).
+    """
+    from bgfn.config import load_profile, profile_path
+
+    cfg = load_profile(profile)
+    data = cfg["data"]
+    out = {"seed": data.get("seed", cfg["seed"])}
+    out.update({k: data[k] for k in _COMMON if k in data and k != "seed"})
+    section = data.get(name) or {}
+    if not isinstance(section, dict):
+        raise DataError(profile_path(profile), f"data.{name}", "a mapping of dataset parameters",
+                        type(section).__name__)
+    unknown = sorted(set(section) - set(DATASETS.get(name, {})))
+    if unknown:
+        raise DataError(profile_path(profile), f"data.{name}.{unknown[0]}",
+                        f"a parameter of {name}: {', '.join(DATASETS.get(name, {}))}", "unknown parameter")
+    out.update(section)
+    return out
+
+
+def _source_hash() -> str:
+    here = Path(__file__).resolve().parent
+    nav = here.parent / "nav"
+    h = hashlib.sha256()
+    for p in [here / f"{m}.py" for m in _KEY_MODULES] + [nav / "sim.py", nav / "earth.py", nav / "transform.py"]:
+        if p.is_file():
+            h.update(p.read_bytes())
+    return h.hexdigest()
+
+
+def cache_key(name: str, params: dict, checksums: dict) -> str:
+    """SHA-256 (hex) of the dataset name, parameters (minus crop), raw checksums and the code."""
+    keyed = {k: v for k, v in params.items() if k not in _NOT_IN_KEY}
+    blob = json.dumps({"name": name, "params": keyed, "raw": checksums, "code": _source_hash()},
+                      sort_keys=True, default=str)
+    return hashlib.sha256(blob.encode()).hexdigest()
+
+
+# ---------------------------------------------------------------------------------------------- builders
+def _truth(ref: pd.DataFrame, p: dict, t_start=None, t_end=None) -> tuple[pd.DataFrame, dict]:
+    return smooth_reference(ref, rate_hz=p["imu_rate_hz"], degree=p["smoothing_degree"],
+                            position_sigma_m=p["position_sigma_m"], attitude_sigma_rad=p["attitude_sigma_rad"],
+                            t_start=t_start, t_end=t_end)
+
+
+def _gnss_residuals(gnss: pd.DataFrame, truth: pd.DataFrame, lever_arm) -> dict:
+    """Mean and std of (fix - true antenna position), north/east/down, m, over the truth's span."""
+    from bgfn.nav.earth import curvature_radii
+
+    t = truth["time"].to_numpy(float)
+    g = gnss.loc[(gnss["time"] >= t[0]) & (gnss["time"] <= t[-1])]
+    lat, lon, h = antenna_position(truth, lever_arm)
+    tg = g["time"].to_numpy(float)
+    lat_i, lon_i, h_i = (np.interp(tg, t, x) for x in (lat, lon, h))
+    r_m, r_n = curvature_radii(lat_i)
+    d = np.column_stack([(g["lat"].to_numpy() - lat_i) * (r_m + h_i),
+                         (g["lon"].to_numpy() - lon_i) * (r_n + h_i) * np.cos(lat_i), -(g["h"].to_numpy() - h_i)])
+    return {"gnss_residual_mean_m": d.mean(axis=0).tolist(), "gnss_residual_std_m": d.std(axis=0).tolist()}
+
+
+def _speed(truth: pd.DataFrame) -> np.ndarray:
+    return np.hypot(truth["v_n"].to_numpy(float), truth["v_e"].to_numpy(float))
+
+
+def _build_sim(name: str, p: dict, paths: dict) -> Drive:
+    from bgfn.nav.sim import imu_from_trajectory
+
+    ref = read_reference(paths["ref.mat"])
+    truth, fit = _truth(ref, p)
+    imu_true = imu_from_trajectory(truth, source=f"{name} truth")
+    profile = "ekinox-d" if name == "turin-sim-ekinox" else "mpu6000"
+    params = error_params(profile, p["imu_errors"])
+    imu, imu_errors, imu_bias = apply_imu_errors(imu_true, params, substream_seed(p["seed"], 1),
+                                                 speed=_speed(truth)[1:])
+    meta = {"imu_rate_hz": float(p["imu_rate_hz"]), "gnss_rate_hz": float(p["gnss_rate_hz"]),
+            "imu_errors": imu_errors, "truth_fit": fit, "params": p}
+    if name == "turin-sim-ekinox":
+        gnss_raw, info = read_gnss(paths["ekinox_gnss.mat"])
+        gnss = decimate(gnss_raw, info["rate_hz"], p["gnss_rate_hz"])
+        meta.update(lever_arm_m=info["lever_arm_m"], gnss_source="real Ekinox fixes (ekinox_gnss.mat)",
+                    source=f"NaveGo {acquire.NAVEGO_TAG} ref.mat (smoothed truth) + simulated Ekinox-D IMU "
+                           f"+ real Ekinox GNSS")
+    else:
+        gnss, _ = simulate_fixes(truth, p["lever_arm_m"], substream_seed(p["seed"], 2), rate_hz=p["gnss_rate_hz"],
+                                 white_std_m=p["gnss_white_std_m"], correlated_std_m=p["gnss_correlated_std_m"],
+                                 correlated_tau_s=p["gnss_correlated_tau_s"])
+        meta.update(lever_arm_m=[float(x) for x in p["lever_arm_m"]],
+                    gnss_source="simulated u-blox-like receiver (white + Gauss-Markov position errors)",
+                    gnss_errors={"white_std_m": p["gnss_white_std_m"],
+                                 "correlated_std_m": p["gnss_correlated_std_m"],
+                                 "correlated_tau_s": p["gnss_correlated_tau_s"], "seed": substream_seed(p["seed"], 2)},
+                    source=f"NaveGo {acquire.NAVEGO_TAG} ref.mat (smoothed truth) + simulated MPU-6000 IMU "
+                           f"+ simulated u-blox GNSS")
+    meta.update(_gnss_residuals(gnss, truth, meta["lever_arm_m"]))
+    return Drive(name, truth, imu, gnss, meta, imu_bias)
+
+
+def _build_real(name: str, p: dict, paths: dict) -> Drive:
+    imu_file = "ekinox_imu.mat" if name == "navego-ekinox" else "mpu6000_imu.mat"
+    ref = read_reference(paths["ref.mat"])
+    imu_native, profile = read_imu(paths[imu_file])
+    t_imu = imu_native["time"].to_numpy(float)
+    t_lo = max(ref["time"].iloc[0], 2 * t_imu[0] - t_imu[1])  # row 0 covers one interval before t[0]
+    t_hi = min(ref["time"].iloc[-1], imu_native["time"].iloc[-1])
+    truth, fit = _truth(ref, p, t_lo, t_hi)
+    imu = resample_imu(imu_native, p["imu_rate_hz"], t_start=truth["time"].iloc[0], t_end=truth["time"].iloc[-1])
+    gnss_raw, info = read_gnss(paths["ekinox_gnss.mat"])
+    gnss = decimate(gnss_raw, info["rate_hz"], p["gnss_rate_hz"])
+    if name == "navego-ekinox":
+        larm = info["lever_arm_m"]
+        prof = {"model": "ekinox-d"}
+        for src, dst in (("arw", "gyro_noise_density"), ("vrw", "accel_noise_density"),
+                         ("gb_sta", "gyro_bias_fixed"), ("ab_sta", "accel_bias_fixed"),
+                         ("gb_dyn", "gyro_bias_instability"), ("ab_dyn", "accel_bias_instability"),
+                         ("gb_corr", "gyro_bias_corr_time"), ("ab_corr", "accel_bias_corr_time")):
+            if src in profile and len(profile[src]) in (1, 3):
+                prof[dst] = profile[src]
+        errors = error_params("ekinox-d", {k: v for k, v in prof.items()})
+    else:
+        larm = [float(x) for x in p["lever_arm_m"]]
+        errors = error_params(MPU6000)
+    errors["file_profile"] = profile
+    errors["realized"] = None  # real sensor: the true errors are unknown
+    meta = {"imu_rate_hz": float(p["imu_rate_hz"]), "gnss_rate_hz": float(p["gnss_rate_hz"]),
+            "native_imu_rate_hz": float(1.0 / np.median(np.diff(imu_native["time"]))),
+            "lever_arm_m": larm, "imu_errors": errors, "truth_fit": fit, "params": p,
+            "gnss_source": "real Ekinox fixes (ekinox_gnss.mat)",
+            "source": f"NaveGo {acquire.NAVEGO_TAG} {imu_file} (resampled) + real GNSS + smoothed ref.mat truth"}
+    meta.update(_gnss_residuals(gnss, truth, larm))
+    return Drive(name, truth, imu, gnss, meta)
+
+
+_BUILDERS: dict[str, tuple[tuple[str, ...], Callable]] = {
+    "turin-sim-ekinox": (("ref.mat", "ekinox_gnss.mat"), _build_sim),
+    "turin-sim-mpu6000": (("ref.mat",), _build_sim),
+    "navego-ekinox": (("ref.mat", "ekinox_gnss.mat", "ekinox_imu.mat"), _build_real),
+    "navego-mpu6000": (("ref.mat", "ekinox_gnss.mat", "mpu6000_imu.mat"), _build_real),
+}
+
+
+def load_drive(name: str | Path = DEFAULT_DATASET, *, profile: str | None = None,
+               data_dir: str | Path | None = None, mirror: str | Path | None = None, download: bool = True,
+               cache: bool = True, **overrides) -> Drive:
+    """Load a dataset of the Turin drive, or a user's CSV folder.
+
+    Parameters
+    ----------
+    name : str or Path
+        A key of ``DATASETS`` (default ``"turin-sim-ekinox"``) or a folder in the CSV schema.
+    profile : str, optional
+        Take the parameters from the ``data:`` section of ``params/<profile>.yaml``
+        (:func:`profile_overrides`); explicit ``overrides`` win.
+    data_dir : str or Path, optional
+        Data folder (raw files and cache); default ``$BGFN_DATA_DIR`` or ``<repo>/data``.
+    mirror : str or Path, optional
+        Mirror folder of the NaveGo files; default ``$BGFN_DATA_MIRROR`` or ``<repo>/../shared/data/navego``.
+    download : bool
+        Try the pinned URL when a file is neither in ``raw`` nor in the mirror.
+    cache : bool
+        Read/write the processed dataset in ``<data>/processed``.
+    **overrides
+        Dataset parameters (see ``DATASETS``): ``seed``, ``imu_rate_hz``, ``gnss_rate_hz``,
+        ``smoothing_degree``, ``position_sigma_m``, ``attitude_sigma_rad``, ``imu_errors`` (dict of
+        error-profile keys), ``lever_arm_m``, ``gnss_*_std_m``, ``gnss_correlated_tau_s``, ``t_start``,
+        ``t_end``. For a CSV folder only ``imu_rate_hz``.
+
+    Returns
+    -------
+    Drive
+
+    Raises
+    ------
+    DataError
+        Unknown name/parameter, bad file content; :class:`bgfn.data.acquire.MissingFileError` when a needed
+        file cannot be had (for the real IMU files: says that the simulated datasets stand in);
+        :class:`bgfn.errors.ChecksumError` on a checksum mismatch.
+    """
+    if isinstance(name, Path) or (isinstance(name, str) and name not in DATASETS and Path(name).is_dir()):
+        extra = set(overrides) - {"imu_rate_hz"}  # a profile does not apply to a user's drive
+        if extra:
+            raise DataError(name, sorted(extra)[0], "only imu_rate_hz for a CSV drive", "unknown parameter")
+        return load_csv_drive(name, **overrides).validate(str(name))
+    if name not in DATASETS:
+        raise DataError("load_drive", "name", f"one of {', '.join(DATASETS)} or a CSV folder", repr(name))
+    if profile is not None:
+        overrides = {**profile_overrides(name, profile), **overrides}
+    params = dataset_params(name, overrides)
+    needed, builder = _BUILDERS[name]
+    paths, checksums = {}, {}
+    for f in needed:
+        res = acquire.resolve(f, data_dir=data_dir, mirror=mirror, download=download)
+        if res.path is None:
+            hint = ("; the simulated datasets turin-sim-ekinox / turin-sim-mpu6000 stand in for it"
+                    if not acquire.NAVEGO_FILES[f].required else "")
+            raise acquire.MissingFileError(f, "file", f"NaveGo {acquire.NAVEGO_TAG} {f} (needed by {name}) in "
+                                           f"{acquire.raw_dir(data_dir)}, the mirror or the pinned URL",
+                                           f"nothing: {res.detail}{hint}")
+        paths[f], checksums[f] = res.path, res.checksum
+    key = cache_key(name, params, checksums)
+    stem = acquire.processed_dir(data_dir) / name / key[:20]
+    drive = load_cached(stem, key) if cache else None
+    if drive is None:
+        drive = builder(name, params, paths)
+        drive.meta["cache_key"] = key
+        drive.meta["raw_checksums"] = checksums
+        drive.validate()
+        if cache:
+            save_drive(drive, stem, key)
+            log.info("cached %s in %s", name, stem)
+    drive.meta["params"] = params
+    if params["t_start"] is not None or params["t_end"] is not None:
+        drive = drive.crop(params["t_start"], params["t_end"])
+    return drive

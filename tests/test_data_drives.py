@@ -11,12 +11,12 @@ import pytest
 import scipy.io
 
 from bgfn.data import DATASETS, acquire, drives, load_drive
-from bgfn.data.imu_errors import VECTOR_KEYS
+from bgfn.data.imu_errors import OPTIONAL_VECTOR_KEYS, VECTOR_KEYS
 from bgfn.errors import ChecksumError, DataError
 from bgfn.nav.sim import imu_from_trajectory
 
 REQUIRED = ("ref.mat", "ekinox_gnss.mat")
-NO_ERRORS = {k: 0.0 for k in VECTOR_KEYS if not k.endswith("corr_time")}
+NO_ERRORS = {**{k: 0.0 for k in VECTOR_KEYS if not k.endswith("corr_time")}, **dict.fromkeys(OPTIONAL_VECTOR_KEYS)}
 
 
 @pytest.fixture(scope="module")

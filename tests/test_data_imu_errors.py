@@ -6,12 +6,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bgfn.data.imu_errors import (DEG, EKINOX_D, G0, MPU6000, VECTOR_KEYS, apply_imu_errors,
+from bgfn.data.imu_errors import (DEG, EKINOX_D, G0, MPU6000, OPTIONAL_VECTOR_KEYS, VECTOR_KEYS, apply_imu_errors,
                                   band_limited_noise, error_params, gauss_markov, speed_envelope)
 from bgfn.errors import DataError
 
 RATE = 100.0
-ZERO = {k: 0.0 for k in VECTOR_KEYS if not k.endswith("corr_time")}
+ZERO = {**{k: 0.0 for k in VECTOR_KEYS if not k.endswith("corr_time")}, **dict.fromkeys(OPTIONAL_VECTOR_KEYS)}
 
 
 def still_imu(n, gyro=(0.0, 0.0, 0.0), accel=(0.0, 0.0, -9.81)):
@@ -78,7 +78,9 @@ def test_constant_terms_are_recorded_and_reproduce_the_output():
         assert np.all(np.diag(mis) == 0) and np.all(np.abs(mis) <= 0.02) and np.any(mis != 0)
         b0 = bias[[f"{sensor}_bias_{a}" for a in "xyz"]].to_numpy()[0]
         np.testing.assert_allclose(b0, r[f"{sensor}_bias_constant"])
-    assert errs["seed"] == 11 and errs["p0_gyro_bias_std"] == pytest.approx([np.radians(5.0)] * 3)
+    # the gyro's 5 deg/s turn-on bias is boot-calibrated down to a 1 deg/s residual; the accel's is not
+    assert errs["seed"] == 11 and errs["p0_gyro_bias_std"] == pytest.approx([np.radians(1.0)] * 3)
+    assert errs["p0_accel_bias_std"] == pytest.approx([60e-3 * 9.80665] * 3)
 
 
 def test_turn_on_biases_are_drawn_with_the_configured_spread():
@@ -87,6 +89,18 @@ def test_turn_on_biases_are_drawn_with_the_configured_spread():
                       ["gyro_turn_on_bias"] for s in range(300)])
     assert draws.std() == pytest.approx(5.0 * DEG, rel=0.1)  # N(0, (5 deg/s)^2) per axis
     assert abs(draws.mean()) < 0.01
+
+
+def test_boot_calibration_leaves_only_its_residual():
+    params = error_params(MPU6000)
+    real = [apply_imu_errors(still_imu(10), params, seed=s, speed=np.zeros(10))[1]["realized"] for s in range(300)]
+    const = np.array([r["gyro_bias_constant"] for r in real])
+    turn_on = np.array([r["gyro_turn_on_bias"] for r in real])
+    boot = np.array([r["gyro_boot_calibration"] for r in real])
+    np.testing.assert_allclose(const, turn_on - boot, atol=1e-15)
+    assert const.std() == pytest.approx(1.0 * DEG, rel=0.1)  # residual N(0, (1 deg/s)^2), not 5 deg/s
+    accel = np.array([r["accel_bias_constant"] for r in real])
+    assert accel.std() == pytest.approx(60e-3 * 9.80665, rel=0.1)  # no accel calibration
 
 
 def test_gm_bias_table_matches_configured_instability():

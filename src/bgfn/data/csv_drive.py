@@ -178,8 +178,8 @@ def write_csv_drive(drive: Drive, folder: str | Path) -> Path:
             "source": str(drive.meta.get("source", ""))}
     errs = drive.meta.get("imu_errors")
     if errs:
-        from bgfn.data.imu_errors import SCALAR_KEYS, VECTOR_KEYS
+        from bgfn.data.imu_errors import OPTIONAL_VECTOR_KEYS, SCALAR_KEYS, VECTOR_KEYS
 
-        meta["imu_errors"] = {k: errs[k] for k in VECTOR_KEYS + SCALAR_KEYS + ("model",) if k in errs}
+        meta["imu_errors"] = {k: errs[k] for k in VECTOR_KEYS + OPTIONAL_VECTOR_KEYS + SCALAR_KEYS + ("model",) if k in errs}
     atomic_write_text(folder / "meta.yaml", yaml.safe_dump(meta, sort_keys=True))
     return folder

@@ -12,6 +12,9 @@ term                   model
 ``n_k``                white noise, std ``noise_density / sqrt(dt)`` (noise density = ARW/VRW)
 ``b_fixed``            deterministic constant bias (the Ekinox profile's ``gb_sta``/``ab_sta``)
 ``b_turn_on``          run-to-run constant bias, drawn once ~ N(0, turn_on_bias_std^2)
+``b_boot``             (optional) boot-time calibration of that bias, as autopilots do at rest before
+                       driving: ``b_boot = b_turn_on + e``, ``e ~ N(0, boot_calibration_residual_std^2)``,
+                       subtracted from the output, so ``b_turn_on - b_boot = -e`` remains
 ``b_gm[k]``            first-order Gauss-Markov bias (bias instability): stationary std
                        ``bias_instability``, correlation time ``bias_corr_time``, started in its
                        stationary distribution; ``b_gm[k] = a b_gm[k-1] + sqrt(1-a^2) sigma w_k``,
@@ -31,6 +34,8 @@ Parameter keys (``meta['imu_errors']``, every value a list of 3 per axis x, y, z
   Continuous white-noise PSD for a KF's Q: ``noise_density**2``.
 - ``gyro_bias_fixed`` rad/s, ``accel_bias_fixed`` m/s^2.
 - ``gyro_turn_on_bias_std`` rad/s, ``accel_turn_on_bias_std`` m/s^2.
+- ``gyro_boot_calibration_residual_std`` rad/s, ``accel_boot_calibration_residual_std`` m/s^2, or
+  ``None`` (no boot calibration): std of what a boot calibration leaves of the turn-on bias.
 - ``gyro_bias_instability`` rad/s, ``accel_bias_instability`` m/s^2 (GM stationary std);
   ``gyro_bias_corr_time``, ``accel_bias_corr_time`` s (GM correlation time; driving-noise PSD for Q:
   ``2 sigma^2 / tau``).
@@ -41,11 +46,13 @@ Parameter keys (``meta['imu_errors']``, every value a list of 3 per axis x, y, z
   ``vibration_idle_fraction`` (scalars).
 - ``model`` (str), ``seed`` (int).
 - ``realized`` (dict, the draws of this run): ``gyro_turn_on_bias``, ``accel_turn_on_bias``,
-  ``gyro_bias_constant`` (= fixed + turn-on), ``accel_bias_constant``, ``gyro_scale_factor``,
+  ``gyro_boot_calibration``, ``accel_boot_calibration`` (the estimate subtracted at boot; zeros without
+  calibration), ``gyro_bias_constant`` (= fixed + turn-on - boot calibration), ``accel_bias_constant``, ``gyro_scale_factor``,
   ``accel_scale_factor`` (lists of 3), ``gyro_misalignment``, ``accel_misalignment`` (3 x 3, zero
   diagonal), ``gyro_sensor_matrix``, ``accel_sensor_matrix`` (``T``, 3 x 3).
 - ``p0_gyro_bias_std`` rad/s, ``p0_accel_bias_std`` m/s^2: prior std of the total constant-plus-GM
-  bias, ``sqrt(fixed^2 + turn_on_std^2 + instability^2)`` per axis (a KF's P0 for its bias states).
+  bias, ``sqrt(fixed^2 + turn_on_std^2 + instability^2)`` per axis (a KF's P0 for its bias states);
+  with a boot calibration, its residual std replaces ``turn_on_std``.
 
 The time series of the additive bias ``b_fixed + b_turn_on + b_gm[k]`` is returned as a table
 (``Drive.imu_bias``) for comparing estimated and true biases.
@@ -72,6 +79,8 @@ VECTOR_KEYS = (
     "gyro_bias_corr_time", "accel_bias_corr_time", "gyro_scale_factor_tol", "accel_scale_factor_tol",
     "gyro_misalignment_tol", "accel_misalignment_tol", "vibration_gyro_std", "vibration_accel_std",
 )
+#: 3-vector keys that may also be ``None`` (feature off).
+OPTIONAL_VECTOR_KEYS = ("gyro_boot_calibration_residual_std", "accel_boot_calibration_residual_std")
 #: Scalar keys.
 SCALAR_KEYS = ("vibration_freq_hz", "vibration_bandwidth_hz", "vibration_speed_ref_mps",
                "vibration_idle_fraction")
@@ -103,6 +112,9 @@ EKINOX_D: dict = {
 #: (0.005 deg/s/sqrt(Hz), 400 ug/sqrt(Hz)), sensitivity tolerance +-3 %, cross-axis +-2 %; bias
 #: instability (36 deg/h, 0.5 mg, 100 s) is our choice (not in the datasheet); vibration at the levels seen
 #: in NaveGo's MPU-6000 log (0.3-1 m/s^2, 0.02 rad/s std with motion), band 10-30 Hz.
+#: The gyro's turn-on bias is removed by a boot calibration at rest (as the Pixhawk autopilot does) that
+#: leaves a residual of 1 deg/s: an uncalibrated 5 deg/s bias makes the heading diverge within seconds
+#: in any position-only loosely coupled filter (ours and pyins' alike), because the drive starts moving.
 MPU6000: dict = {
     "model": "mpu6000",
     "gyro_noise_density": [0.005 * DEG] * 3,
@@ -110,6 +122,8 @@ MPU6000: dict = {
     "gyro_bias_fixed": _ZERO3, "accel_bias_fixed": _ZERO3,
     "gyro_turn_on_bias_std": [5.0 * DEG] * 3,
     "accel_turn_on_bias_std": [60e-3 * G0] * 3,
+    "gyro_boot_calibration_residual_std": [1.0 * DEG] * 3,
+    "accel_boot_calibration_residual_std": None,
     "gyro_bias_instability": [0.01 * DEG] * 3,
     "accel_bias_instability": [0.5e-3 * G0] * 3,
     "gyro_bias_corr_time": [100.0] * 3,
@@ -154,8 +168,9 @@ def error_params(profile: str | dict, overrides: dict | None = None) -> dict:
     else:
         params = copy.deepcopy(dict(profile))
     for key, value in (overrides or {}).items():
-        if key not in VECTOR_KEYS and key not in SCALAR_KEYS and key != "model":
-            raise DataError("imu_errors", key, f"a key of {VECTOR_KEYS + SCALAR_KEYS}", "unknown key")
+        known = VECTOR_KEYS + OPTIONAL_VECTOR_KEYS + SCALAR_KEYS
+        if key not in known and key != "model":
+            raise DataError("imu_errors", key, f"a key of {known}", "unknown key")
         params[key] = value
     out = {"model": str(params.get("model", "custom"))}
     for key in VECTOR_KEYS:
@@ -169,6 +184,15 @@ def error_params(profile: str | dict, overrides: dict | None = None) -> dict:
                 raise DataError("imu_errors", key, "positive correlation times, s", str(v.tolist()))
         elif not key.endswith("bias_fixed") and (v < 0).any():
             raise DataError("imu_errors", key, "non-negative values", str(v.tolist()))
+        out[key] = v.tolist()
+    for key in OPTIONAL_VECTOR_KEYS:
+        value = params.get(key)
+        if value is None:
+            out[key] = None
+            continue
+        v = np.broadcast_to(np.asarray(value, dtype=float).ravel(), (3,)) if np.size(value) in (1, 3) else None
+        if v is None or not np.isfinite(v).all() or (v < 0).any():
+            raise DataError("imu_errors", key, "None or 3 non-negative values (x, y, z)", str(value))
         out[key] = v.tolist()
     for key in SCALAR_KEYS:
         v = float(params.get(key, EKINOX_D[key]))
@@ -307,7 +331,10 @@ def apply_imu_errors(imu: pd.DataFrame, params: dict, seed: int, speed=None) -> 
         # Fixed draw order per sensor: turn-on bias, scale factor + misalignment, GM, white, vibration.
         turn_on = rng.standard_normal(3) * np.asarray(params[f"{sensor}_turn_on_bias_std"])
         sf, mis, mat = _draw_matrix(rng, params[f"{sensor}_scale_factor_tol"], params[f"{sensor}_misalignment_tol"])
-        b_const = np.asarray(params[f"{sensor}_bias_fixed"]) + turn_on
+        residual_std = params.get(f"{sensor}_boot_calibration_residual_std")
+        boot = (turn_on + rng.standard_normal(3) * np.asarray(residual_std) if residual_std is not None
+                else np.zeros(3))
+        b_const = np.asarray(params[f"{sensor}_bias_fixed"]) + turn_on - boot
         b_gm = gauss_markov(n, dt, params[f"{sensor}_bias_instability"], params[f"{sensor}_bias_corr_time"], rng)
         white = rng.standard_normal((n, 3)) * (np.asarray(params[f"{sensor}_noise_density"]) / np.sqrt(dt))
         y = x @ mat.T + b_const + b_gm + white
@@ -319,7 +346,8 @@ def apply_imu_errors(imu: pd.DataFrame, params: dict, seed: int, speed=None) -> 
             out[f"{sensor}_{a}"] = y[:, i]
             bias_tab[f"{sensor}_bias_{a}"] = b_const[i] + b_gm[:, i]
         realized.update({
-            f"{sensor}_turn_on_bias": turn_on.tolist(), f"{sensor}_bias_constant": b_const.tolist(),
+            f"{sensor}_turn_on_bias": turn_on.tolist(), f"{sensor}_boot_calibration": boot.tolist(),
+            f"{sensor}_bias_constant": b_const.tolist(),
             f"{sensor}_scale_factor": sf.tolist(), f"{sensor}_misalignment": mis.tolist(),
             f"{sensor}_sensor_matrix": mat.tolist(),
         })
@@ -327,7 +355,9 @@ def apply_imu_errors(imu: pd.DataFrame, params: dict, seed: int, speed=None) -> 
     errors["seed"] = int(seed)
     errors["realized"] = realized
     for sensor in ("gyro", "accel"):
+        residual_std = params.get(f"{sensor}_boot_calibration_residual_std")
+        constant_std = np.asarray(params[f"{sensor}_turn_on_bias_std"] if residual_std is None else residual_std)
         errors[f"p0_{sensor}_bias_std"] = np.sqrt(
-            np.asarray(params[f"{sensor}_bias_fixed"]) ** 2 + np.asarray(params[f"{sensor}_turn_on_bias_std"]) ** 2
+            np.asarray(params[f"{sensor}_bias_fixed"]) ** 2 + constant_std ** 2
             + np.asarray(params[f"{sensor}_bias_instability"]) ** 2).tolist()
     return (pd.DataFrame(out, columns=list(imu.columns)), errors, pd.DataFrame(bias_tab))

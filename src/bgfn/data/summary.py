@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 
 from bgfn.data.drive import Drive, horizontal_distance_m
-from bgfn.data.imu_errors import SCALAR_KEYS, VECTOR_KEYS
+from bgfn.data.imu_errors import OPTIONAL_VECTOR_KEYS, SCALAR_KEYS, VECTOR_KEYS
 
 #: Unit of each error-parameter key (SI; see bgfn.data.imu_errors).
 _UNITS = {
@@ -81,7 +81,7 @@ def summary_table(drive: Drive) -> pd.DataFrame:
     errs = meta.get("imu_errors") or {}
     if errs:
         rows.append(("imu_model", errs.get("model", ""), ""))
-        rows += [(k, errs[k], _UNITS.get(k, "")) for k in VECTOR_KEYS + SCALAR_KEYS if k in errs]
+        rows += [(k, errs[k], _UNITS.get(k, "")) for k in VECTOR_KEYS + OPTIONAL_VECTOR_KEYS + SCALAR_KEYS if k in errs]
         realized = errs.get("realized") or {}
         rows += [(f"realized_{k}", realized[k], _UNITS[k]) for k in
                  ("gyro_turn_on_bias", "accel_turn_on_bias", "gyro_bias_constant", "accel_bias_constant",

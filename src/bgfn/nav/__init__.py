@@ -1,0 +1,45 @@
+"""Navigation core (paper Sec. 2): WGS84 Earth, NED strapdown INS, 15-state loosely coupled KF.
+
+Modules (pyins style, one concept each; SI units, radians, NED, tables as in CONTRIBUTING.md):
+
+- :mod:`~bgfn.nav.earth` -- WGS84 constants ``A, E2, OMEGA_IE``; ``curvature_radii(lat) -> (r_m, r_n)``,
+  ``normal_gravity(lat, h)``, ``earth_rate_n(lat)``, ``transport_rate_n(lat, h, v_n)``,
+  ``lla_to_ecef``, ``ecef_to_lla``, ``lla_to_ned(lat, lon, h, lat0, lon0, h0) -> [..., 3]``,
+  ``ned_to_lla(ned, lat0, lon0, h0) -> (lat, lon, h)`` (exact via ECEF; all vectorized).
+- :mod:`~bgfn.nav.transform` -- ``skew``, ``dcm_from_euler(roll, pitch, yaw)`` (C_b^n, Eq. cnb,
+  shape ``(..., 3, 3)``), ``euler_from_dcm``, ``dcm_from_rotvec``, ``rotvec_from_dcm``, ``wrap_angle``.
+- :mod:`~bgfn.nav.strapdown` -- ``propagate(lat, lon, h, v_n, c_bn, gyro, accel, dt)`` one step from the
+  mean rates over the step; ``integrate(initial_row, imu) -> DataFrame`` (reference schema, row 0 = the
+  initial epoch, then one row per IMU row with ``time > t0``); numba kernel ``step_inplace``.
+  Earth rate, transport rate and gravity are taken at the start of each step.
+- :mod:`~bgfn.nav.sim` -- ``imu_from_trajectory(reference) -> imu DataFrame`` (rows for
+  ``reference.time[1:]``), the exact inverse of ``propagate``; ``positions_from_velocity(time, v_ned,
+  lat0, lon0, h0)`` makes a trajectory's positions consistent with the strapdown's trapezoid rule;
+  ``demo_trajectory(duration_s, rate_hz)`` a smooth curvy 3D test drive; ``gnss_from_trajectory``.
+- :mod:`~bgfn.nav.error_model` -- state indices of Eq. (eq13) (``PHI_E ... BG_Z``, ``N_STATES = 15``),
+  the system matrix F of Eqs. (eq9, IVE, IPE) and the discrete process noise.
+- :mod:`~bgfn.nav.state` -- ``FilterState`` (time, pos, v, c_bn, accel_bias, gyro_bias, P),
+  ``FilterNoise`` and ``noise_from_imu_errors(meta['imu_errors'])``, ``initial_covariance``,
+  ``initial_state``, ``save_states`` / ``load_states`` (.npz format in the module docstring).
+- :mod:`~bgfn.nav.filter` -- ``run_filter(imu, initial, noise, gnss, lever_arm, outage_windows,
+  pseudo_gps, t_end, snapshots) -> FilterResult`` and ``run_outage(imu, start_state, window, noise,
+  lever_arm, pseudo_gps)`` (one outage from a saved state).
+- :mod:`~bgfn.nav.outages` -- ``OutageWindow``, ``check_windows``, ``outage_windows(drive, section)``,
+  the pseudo-GPS hook (``PseudoFix``, ``PseudoGpsContext``, ``IncrementPseudoGps`` = Eq. pred-gps,
+  ``TablePseudoGps``).
+- :mod:`~bgfn.nav.metrics` -- ``navigation_errors``, ``outage_metrics`` (max |east|, max |north|,
+  horizontal RMSE, end error), ``rms_table``.
+- :mod:`~bgfn.nav.baseline` -- notebook 02: ``nav_config``, ``run_drive(drive, nav_section)``,
+  ``run_baseline``, ``save_baseline``; :mod:`~bgfn.nav.plots` -- its figures.
+"""
+
+__all__ = ["run_drive"]
+
+
+def __getattr__(name):
+    # Lazy: importing bgfn.nav.earth must not load numba, pandas plotting or the filter.
+    if name == "run_drive":
+        from .baseline import run_drive
+
+        return run_drive
+    raise AttributeError(f"module 'bgfn.nav' has no attribute {name!r}")

@@ -1,0 +1,226 @@
+"""Notebook 02 workflow: the KF baseline on a drive (full GPS/INS run, standalone INS in the outages).
+
+The ``nav:`` section of ``params/<profile>.yaml`` configures it (keys and defaults in ``NAV_DEFAULTS``):
+
+- ``datasets``: drive names for :func:`bgfn.data.load_drive` (the profile's ``data:`` section crops them);
+- ``outage_starts`` (s, time of week) and ``outage_duration_s``: the paper's two 30 s outages
+  (NaveGo's outage starts 138906 s and 139170 s);
+- ``init``: initial std ``position_std_m``, ``height_std_m``, ``velocity_std_mps``, ``level_std_deg``,
+  ``azimuth_std_deg`` (P0; the filter starts from the reference's first row);
+- ``bias_model`` (``random_walk`` | ``gauss_markov``), ``noise_scale``: see
+  :func:`bgfn.nav.state.noise_from_imu_errors`.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from ..errors import DataError
+from . import metrics
+from .filter import FilterResult, run_filter, run_outage
+from .outages import OutageWindow, check_windows
+from .state import FilterNoise, FilterState, initial_covariance, initial_state, noise_from_imu_errors
+
+#: Defaults of the ``nav:`` profile section.
+NAV_DEFAULTS: dict = {
+    "datasets": ["turin-sim-ekinox", "turin-sim-mpu6000"],
+    "outage_starts": [138906.0, 139170.0],
+    "outage_duration_s": 30.0,
+    "init": {"position_std_m": 1.0, "height_std_m": 3.0, "velocity_std_mps": 0.1, "level_std_deg": 0.5,
+             "azimuth_std_deg": 2.0},
+    "bias_model": "random_walk",
+    "noise_scale": 1.0,
+}
+
+
+def nav_config(section: dict | None) -> dict:
+    """``NAV_DEFAULTS`` updated with a profile's ``nav:`` section (unknown keys raise)."""
+    cfg = copy.deepcopy(NAV_DEFAULTS)
+    for key, value in (section or {}).items():
+        if key not in cfg:
+            raise DataError("params nav", key, f"one of {sorted(cfg)}", "unknown key")
+        if key == "init":
+            unknown = set(value) - set(cfg["init"])
+            if unknown:
+                raise DataError("params nav.init", sorted(unknown)[0], f"one of {sorted(cfg['init'])}",
+                                "unknown key")
+            cfg["init"].update(value)
+        else:
+            cfg[key] = value
+    return cfg
+
+
+def outage_windows(cfg: dict) -> list:
+    """The configured outage windows as :class:`OutageWindow` objects."""
+    return [OutageWindow(float(s), float(cfg["outage_duration_s"])) for s in cfg["outage_starts"]]
+
+
+def run_drive(drive, section: dict | None = None, snapshots: dict | None = None) -> FilterResult:
+    """GPS/INS filter over a whole drive with every GNSS fix (the paper's online-training mode).
+
+    Parameters
+    ----------
+    drive : bgfn.data.Drive
+    section : dict, optional
+        A profile's ``nav:`` section (defaults: ``NAV_DEFAULTS``).
+    snapshots : dict, optional
+        ``{name: time}`` of filter states to save (see :func:`bgfn.nav.filter.run_filter`).
+
+    Returns
+    -------
+    FilterResult
+    """
+    cfg = nav_config(section)
+    initial, noise = filter_setup(drive, cfg)
+    return run_filter(drive.imu, initial, noise, drive.gnss, drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0]),
+                      snapshots=snapshots, source=drive.name)
+
+
+def filter_setup(drive, cfg: dict) -> tuple[FilterState, FilterNoise]:
+    """Initial filter state (at the reference's first row) and noise for a drive.
+
+    Parameters
+    ----------
+    drive : bgfn.data.Drive
+    cfg : dict
+        Output of :func:`nav_config`.
+
+    Returns
+    -------
+    initial : FilterState
+    noise : FilterNoise
+    """
+    noise = noise_from_imu_errors(drive.meta["imu_errors"], cfg["bias_model"], cfg["noise_scale"],
+                                  source=f"{drive.name} meta['imu_errors']")
+    row = drive.reference.iloc[0]
+    init = cfg["init"]
+    P0 = initial_covariance(row[["lat", "lon", "h"]].to_numpy(float), noise, init["position_std_m"],
+                            init["height_std_m"], init["velocity_std_mps"], np.radians(init["level_std_deg"]),
+                            np.radians(init["azimuth_std_deg"]))
+    return initial_state(row, P0), noise
+
+
+@dataclass
+class Baseline:
+    """KF baseline of one drive.
+
+    Attributes
+    ----------
+    drive_name : str
+    full : FilterResult
+        GPS/INS over the whole drive (GNSS everywhere).
+    errors : DataFrame
+        ``metrics.navigation_errors`` of ``full``.
+    rms : DataFrame
+        ``metrics.rms_table`` of ``errors``.
+    states : dict
+        ``{"outage_1": FilterState, ...}`` at the outage starts.
+    outage_errors : dict
+        ``{"outage_1": DataFrame}``: errors of the standalone INS in each outage.
+    outage_table : DataFrame
+        One row per outage: ``dataset``, ``outage`` and ``metrics.outage_metrics``.
+    noise : FilterNoise
+    """
+
+    drive_name: str
+    full: FilterResult
+    errors: pd.DataFrame
+    rms: pd.DataFrame
+    states: dict
+    outage_errors: dict
+    outage_table: pd.DataFrame
+    noise: FilterNoise
+
+
+def run_baseline(drive, cfg: dict) -> Baseline:
+    """Full-drive GPS/INS run, then the standalone INS in each outage from the saved state at its start.
+
+    Parameters
+    ----------
+    drive : bgfn.data.Drive
+    cfg : dict
+        Output of :func:`nav_config`.
+
+    Returns
+    -------
+    Baseline
+    """
+    windows = check_windows(outage_windows(cfg), float(drive.reference["time"].iloc[0]),
+                            float(drive.imu["time"].iloc[-1]), f"{drive.name} nav.outage_starts")
+    initial, noise = filter_setup(drive, cfg)
+    lever = drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0])
+    names = [f"outage_{i + 1}" for i in range(len(windows))]
+    full = run_filter(drive.imu, initial, noise, drive.gnss, lever,
+                      snapshots={n: w.start for n, w in zip(names, windows)}, source=drive.name)
+    errors = metrics.navigation_errors(full.trajectory, drive.reference)
+    rows, outage_errors = [], {}
+    for n, w in zip(names, windows):
+        res = run_outage(drive.imu, full.states[n], w, noise, lever, source=drive.name)
+        e = metrics.navigation_errors(res.trajectory, drive.reference)
+        e.insert(1, "t_rel", e["time"] - w.start)
+        outage_errors[n] = e
+        rows.append({"dataset": drive.name, "outage": n, **metrics.outage_metrics(e, w)})
+    return Baseline(drive.name, full, errors, metrics.rms_table(errors), full.states, outage_errors,
+                    pd.DataFrame(rows), noise)
+
+
+def paper_layout(outage_table: pd.DataFrame) -> pd.DataFrame:
+    """Max-error table in the paper's layout (Tables 1-2): rows ``Outage k``, columns ``INS East/North`` (m).
+
+    Parameters
+    ----------
+    outage_table : DataFrame
+        ``Baseline.outage_table`` of one dataset.
+
+    Returns
+    -------
+    DataFrame
+        Columns ``outage``, ``INS_east_m``, ``INS_north_m``.
+    """
+    return pd.DataFrame({"outage": [f"Outage {i + 1}" for i in range(len(outage_table))],
+                         "INS_east_m": outage_table["max_abs_east"].round(2).to_numpy(),
+                         "INS_north_m": outage_table["max_abs_north"].round(2).to_numpy()})
+
+
+def save_baseline(b: Baseline, out, lat=None) -> dict:
+    """Write one drive's baseline under ``out`` (``results/<profile>``) atomically.
+
+    Files (``<d>`` = dataset name):
+
+    - ``nav_states_<d>.npz``: the filter states at the outage starts (:func:`bgfn.nav.state.save_states`,
+      names ``outage_1``, ``outage_2``, ...), the start of every outage run of notebook 04;
+    - ``tables/kf_rms_<d>.csv``: RMS / max-abs errors of the full GPS/INS run;
+    - ``tables/kf_outage_max_errors_<d>.csv``: :func:`paper_layout`;
+    - ``tables/kf_outage_metrics_<d>.csv``: all outage metrics;
+    - ``tables/kf_outage_errors_<d>.csv``: standalone-INS error series (``outage``, ``t_rel``, ``east``,
+      ``north``, ``down``, ``horizontal``, m).
+
+    Returns
+    -------
+    dict
+        JSON-ready summary (RMS, outage metrics, mean NIS) for ``kf_baseline.json``.
+    """
+    from pathlib import Path
+
+    from ..io import atomic_write_csv
+    from .state import save_states
+
+    out = Path(out)
+    d = b.drive_name
+    save_states(out / f"nav_states_{d}.npz", b.states)
+    atomic_write_csv(out / "tables" / f"kf_rms_{d}.csv", b.rms.reset_index(), float_format="%.6g")
+    atomic_write_csv(out / "tables" / f"kf_outage_max_errors_{d}.csv", paper_layout(b.outage_table))
+    atomic_write_csv(out / "tables" / f"kf_outage_metrics_{d}.csv", b.outage_table, float_format="%.6g")
+    series = pd.concat([e.assign(outage=name)[["outage", "t_rel", "east", "north", "down", "horizontal"]]
+                        for name, e in b.outage_errors.items()], ignore_index=True)
+    atomic_write_csv(out / "tables" / f"kf_outage_errors_{d}.csv", series, float_format="%.6g")
+    upd = b.full.updates
+    return {"rms": {k: float(v) for k, v in b.rms["rms"].items()},
+            "outages": b.outage_table.drop(columns=["dataset"]).to_dict(orient="records"),
+            "gnss_updates": int(len(upd)), "mean_nis": float(upd["nis"].mean()) if len(upd) else None,
+            "mean_nis_dof": float(upd["dof"].mean()) if len(upd) else None,
+            "states_file": f"nav_states_{d}.npz"}

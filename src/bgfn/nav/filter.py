@@ -1,0 +1,375 @@
+"""The paper's 15-state loosely coupled GPS/INS Kalman filter (Sec. 2) with closed-loop feedback.
+
+Per IMU row (100 Hz): bias-corrected readings drive the strapdown (:mod:`bgfn.nav.strapdown`) and the
+covariance is propagated with ``Phi = I + F dt``, ``P = Phi P Phi^T + Q_d`` (Eq. eq3;
+:mod:`bgfn.nav.error_model`). With feedback the error state is zero after every correction, so the
+time update of ``x`` is trivial and only ``P`` is propagated.
+
+At a GNSS epoch ``t_m`` (applied at the first IMU epoch ``t_j >= t_m``) the measurement is the
+difference of the INS antenna position (IMU position + ``C_bn`` lever arm, moved back by
+``v (t_j - t_m)``) and the GNSS position, in NED metres:
+``z = D (p_ins_ant - p_gnss)`` with ``D = diag(R_M + h, (R_N + h) cos L, -1)`` and
+``H = [ [C_bn l]x  on phi | D on (dL, dlambda, dh) ]``. The update (Eq. eq4) is processed one axis at a
+time (exactly the batch update for the diagonal R), with the Joseph form for ``P``. Then the errors are
+fed back: position, velocity, ``C_bn <- exp([phi]) C_bn``, bias estimates ``+= (nabla, eps)``, ``x = 0``.
+
+Outage windows remove GNSS updates; inside them a pseudo-GPS source may supply fixes
+(:mod:`bgfn.nav.outages`, Eq. pred-gps).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numba
+import numpy as np
+import pandas as pd
+
+from ..errors import DataError
+from . import error_model as em
+from .error_model import process_noise_nb, system_matrix_nb
+from .outages import OutageWindow, PseudoGpsContext, check_windows
+from .state import FilterNoise, FilterState
+from .strapdown import imu_steps, radii_nb, rotvec_to_dcm_nb, step_inplace, trajectory_frame
+
+GNSS_COLUMNS = ["time", "lat", "lon", "h", "std_n", "std_e", "std_d"]
+#: Pseudo-GPS epochs per second inside an outage (the GNSS rate of the Turin drive).
+PSEUDO_RATE_HZ = 1.0
+
+
+# ---------------------------------------------------------------------------------------------------
+# numba kernels
+# ---------------------------------------------------------------------------------------------------
+@numba.njit(cache=True)
+def _propagate_nb(i0, i1, dt, gyro, accel, pos, v, c, ba, bg, P, q_g, q_a, q_bg, q_ba, inv_tau_a,
+                  inv_tau_g, out_pos, out_v, out_c, out_sd):
+    """Steps i0..i1-1 (IMU rows); output row k+1 holds the state after step k."""
+    n = P.shape[0]
+    F = np.empty((n, n))
+    Q = np.empty((n, n))
+    phi = np.empty((n, n))
+    wb = np.empty(3)
+    fb = np.empty(3)
+    for k in range(i0, i1):
+        h = dt[k]
+        for a in range(3):
+            wb[a] = gyro[k, a] - bg[a]
+            fb[a] = accel[k, a] - ba[a]
+        # Eq. (eq3): covariance time update with F at the start of the step.
+        system_matrix_nb(pos, v, c, fb, inv_tau_a, inv_tau_g, F)
+        process_noise_nb(c, q_g, q_a, q_bg, q_ba, h, Q)
+        for r in range(n):
+            for s in range(n):
+                phi[r, s] = F[r, s] * h
+            phi[r, r] += 1.0
+        P[:, :] = phi @ P @ phi.T + Q
+        step_inplace(pos, v, c, wb, fb, h)
+        # Gauss-Markov bias estimates decay with their model (inv_tau = 0: random walk, constant).
+        for a in range(3):
+            ba[a] *= np.exp(-h * inv_tau_a[a])
+            bg[a] *= np.exp(-h * inv_tau_g[a])
+        out_pos[k + 1] = pos
+        out_v[k + 1] = v
+        out_c[k + 1] = c
+        for r in range(n):
+            out_sd[k + 1, r] = np.sqrt(max(P[r, r], 0.0))
+
+
+@numba.njit(cache=True)
+def _update_nb(pos, v, c, ba, bg, P, lever, fix, std, lag, innov):
+    """Eq. (eq4) position update (sequential scalar updates, Joseph form) and feedback.
+
+    Returns the NIS; ``innov`` receives the NED innovations (m, NaN for unused axes).
+    """
+    n = P.shape[0]
+    lat, h = pos[0], pos[2]
+    r_m, r_n = radii_nb(lat)
+    cl = np.cos(lat)
+    d = np.array([r_m + h, (r_n + h) * cl, -1.0])
+    u = c @ lever  # antenna offset, NED m
+    # INS antenna position at the measurement time, minus the fix, in NED metres.
+    dz = np.empty(3)
+    dz[0] = (lat - fix[0]) * d[0] + u[0] - v[0] * lag
+    dz[1] = (pos[1] - fix[1]) * d[1] + u[1] - v[1] * lag
+    dz[2] = (h - fix[2]) * d[2] + u[2] - v[2] * lag
+    su = np.zeros((3, 3))  # [u x]: d(antenna)/d(phi)
+    su[0, 1] = -u[2]
+    su[0, 2] = u[1]
+    su[1, 0] = u[2]
+    su[1, 2] = -u[0]
+    su[2, 0] = -u[1]
+    su[2, 1] = u[0]
+    phi_idx = np.array([em.PHI_N, em.PHI_E, em.PHI_D])
+    pos_idx = np.array([em.DLAT, em.DLON, em.DH])
+    x = np.zeros(n)
+    hrow = np.empty(n)
+    eye = np.eye(n)
+    nis = 0.0
+    for a in range(3):
+        innov[a] = np.nan
+        if not (std[a] > 0.0 and np.isfinite(std[a])):
+            continue
+        hrow[:] = 0.0
+        for b in range(3):
+            hrow[phi_idx[b]] = su[a, b]
+        hrow[pos_idx[a]] = d[a]
+        ph = P @ hrow
+        s = hrow @ ph + std[a] ** 2
+        k = ph / s
+        y = dz[a] - hrow @ x
+        innov[a] = y
+        nis += y * y / s
+        x += k * y
+        ikh = eye - np.outer(k, hrow)
+        P[:, :] = ikh @ P @ ikh.T + np.outer(k, k) * std[a] ** 2
+    # Closed-loop feedback (errors are computed - true).
+    pos[0] -= x[em.DLAT]
+    pos[1] -= x[em.DLON]
+    pos[2] -= x[em.DH]
+    v[0] -= x[em.DV_N]
+    v[1] -= x[em.DV_E]
+    v[2] -= x[em.DV_D]
+    rv = np.array([x[em.PHI_N], x[em.PHI_E], x[em.PHI_D]])
+    dc = np.empty((3, 3))
+    rotvec_to_dcm_nb(rv, dc)  # C_true = (I - [phi])^-1 C_computed ~ exp([phi]) C_computed
+    c[:, :] = dc @ c
+    for a in range(3):
+        ba[a] += x[em.BA_X + a]
+        bg[a] += x[em.BG_X + a]
+    return nis
+
+
+# ---------------------------------------------------------------------------------------------------
+# results
+# ---------------------------------------------------------------------------------------------------
+@dataclass
+class FilterResult:
+    """Output of :func:`run_filter`.
+
+    Attributes
+    ----------
+    trajectory : DataFrame
+        Reference schema, one row per epoch from the initial one (row 0) to the end.
+    bias : DataFrame
+        ``time``, ``accel_bias_x/y/z`` (m/s^2), ``gyro_bias_x/y/z`` (rad/s) at every epoch.
+    sd : DataFrame
+        ``time`` and the std of the 15 error states (names of ``error_model.STATE_NAMES``).
+    updates : DataFrame
+        One row per fused fix: ``time``, ``kind`` ('gnss' or 'pseudo'), ``innov_n/e/d`` (m), ``nis``,
+        ``dof``.
+    P_updates : ndarray, shape (M, 15, 15)
+        Covariance after each fused fix.
+    states : dict
+        ``{name: FilterState}`` saved at the requested snapshot times.
+    final : FilterState
+        State at the last epoch.
+    """
+
+    trajectory: pd.DataFrame
+    bias: pd.DataFrame
+    sd: pd.DataFrame
+    updates: pd.DataFrame
+    P_updates: np.ndarray
+    states: dict = field(default_factory=dict)
+    final: FilterState | None = None
+
+
+def _noise_arrays(noise: FilterNoise):
+    inv = [np.where(np.isfinite(t), 1.0 / np.asarray(t, float), 0.0) for t in
+           (noise.accel_bias_tau, noise.gyro_bias_tau)]
+    return (np.asarray(noise.gyro_noise, float) ** 2, np.asarray(noise.accel_noise, float) ** 2,
+            np.asarray(noise.gyro_bias_walk, float) ** 2, np.asarray(noise.accel_bias_walk, float) ** 2,
+            inv[0], inv[1])
+
+
+def _check_gnss(gnss, source):
+    missing = [c for c in GNSS_COLUMNS if c not in gnss.columns]
+    if missing:
+        raise DataError(source, ",".join(missing), "gnss columns " + ", ".join(GNSS_COLUMNS), "missing")
+    t = gnss["time"].to_numpy(dtype=float)
+    if t.size > 1 and not np.all(np.diff(t) > 0):
+        raise DataError(source, "time", "strictly increasing GNSS times")
+
+
+def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss: pd.DataFrame | None = None,
+               lever_arm=(0.0, 0.0, 0.0), outage_windows=(), pseudo_gps=None, t_end: float | None = None,
+               snapshots: dict | None = None, pseudo_rate_hz: float = PSEUDO_RATE_HZ,
+               source: str = "drive") -> FilterResult:
+    """Run the closed-loop GPS/INS filter from ``initial`` over the IMU rows after ``initial.time``.
+
+    Parameters
+    ----------
+    imu : DataFrame
+        IMU table (CONTRIBUTING.md schema); gaps over 5 samples raise.
+    initial : FilterState
+        State (navigation solution, bias estimates, P) at the start.
+    noise : FilterNoise
+        Process noise (:func:`bgfn.nav.state.noise_from_imu_errors`).
+    gnss : DataFrame, optional
+        GNSS table (``time, lat, lon, h, std_n, std_e, std_d``); None = standalone INS (prediction only).
+    lever_arm : array_like, shape (3,)
+        GNSS antenna position in the body frame from the IMU, m.
+    outage_windows : iterable of (start, duration)
+        GNSS outages (s); validated against the IMU span.
+    pseudo_gps : callable, optional
+        ``pseudo_gps(PseudoGpsContext) -> PseudoFix | None``, called at ``start + k / pseudo_rate_hz``
+        inside each outage window (:mod:`bgfn.nav.outages`).
+    t_end : float, optional
+        Last time to process, s (default: the last IMU row).
+    snapshots : dict, optional
+        ``{name: time}``: save the filter state at the IMU epoch nearest to each time (within one sample).
+    pseudo_rate_hz : float
+        Rate of the pseudo-GPS epochs, Hz.
+    source : str
+        Name used in error messages.
+
+    Returns
+    -------
+    FilterResult
+    """
+    t0 = float(initial.time)
+    time, gyro, accel, dt = imu_steps(imu, t0, source + ":imu")
+    if t_end is not None:
+        keep = time <= t_end + 1e-9
+        if not keep.any():
+            raise DataError(source, "t_end", f"a time after the initial epoch {t0}", str(t_end))
+        time, gyro, accel, dt = time[keep], gyro[keep], accel[keep], dt[keep]
+    times = np.concatenate([[t0], time])  # output rows
+    n_rows = times.size
+    windows = check_windows(outage_windows, t0, times[-1], source + ":outage_windows")
+    lever = np.asarray(lever_arm, dtype=float).reshape(3)
+
+    # Events: (row, kind, payload). Rows index `times`; a fix at t_m goes to the first row >= t_m.
+    events = []
+    if gnss is not None and len(gnss):
+        _check_gnss(gnss, source + ":gnss")
+        g = gnss[GNSS_COLUMNS].to_numpy(dtype=float)
+        inside = (g[:, 0] > t0 + 1e-9) & (g[:, 0] <= times[-1] + 1e-9)
+        for w in windows:
+            inside &= ~w.contains(g[:, 0])
+        g = g[inside & np.all(np.isfinite(g[:, 1:4]), axis=1)]
+        rows = np.searchsorted(times, g[:, 0] - 1e-9, side="left")
+        for r, fix in zip(rows, g):
+            events.append((int(r), 1, fix))
+    if pseudo_gps is not None:
+        for w in windows:
+            k = np.arange(1, int(np.floor(w.duration * pseudo_rate_hz + 1e-9)) + 1)
+            tk = w.start + k / pseudo_rate_hz
+            tk = tk[(tk > t0 + 1e-9) & (tk <= times[-1] + 1e-9)]
+            for i, t in zip(k, tk):
+                events.append((int(np.searchsorted(times, t - 1e-9)), 2, (float(t), w, int(i))))
+    for w in windows:  # state at each window start for the pseudo-GPS context
+        r = int(np.argmin(np.abs(times - w.start)))
+        events.append((r, 0, ("__window__", w)))
+    for name, t in (snapshots or {}).items():
+        r = int(np.argmin(np.abs(times - t)))
+        if abs(times[r] - t) > max(dt.max(), 1e-9):
+            raise DataError(source, f"snapshots[{name}]", f"a time within the IMU span [{t0}, {times[-1]}]",
+                            str(t))
+        events.append((r, 3, name))
+    events.sort(key=lambda e: (e[0], e[1]))
+
+    pos, v, c = initial.pos.astype(float).copy(), initial.v.astype(float).copy(), np.ascontiguousarray(
+        initial.c_bn, dtype=float).copy()
+    ba, bg = initial.accel_bias.astype(float).copy(), initial.gyro_bias.astype(float).copy()
+    P = np.ascontiguousarray(initial.P, dtype=float).copy()
+    q = _noise_arrays(noise)
+    out_pos, out_v = np.empty((n_rows, 3)), np.empty((n_rows, 3))
+    out_c, out_sd = np.empty((n_rows, 3, 3)), np.empty((n_rows, em.N_STATES))
+    out_bias = np.empty((n_rows, 6))
+    out_pos[0], out_v[0], out_c[0] = pos, v, c
+    out_sd[0] = np.sqrt(np.clip(np.diag(P), 0, None))
+    bias_rows, bias_vals = [0], [np.concatenate([ba, bg])]
+    upd, P_upd = [], []
+    states, window_start = {}, {}
+    innov = np.empty(3)
+
+    def current(row):
+        return FilterState(float(times[row]), pos.copy(), v.copy(), c.copy(), ba.copy(), bg.copy(), P.copy())
+
+    row = 0
+    for r, kind, payload in events:
+        if r > row:
+            _propagate_nb(row, r, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd)
+            row = r
+        if kind == 0:
+            window_start[payload[1]] = current(row)
+            continue
+        if kind == 3:
+            states[payload] = current(row)
+            continue
+        if kind == 1:
+            t_m, fix, std, label = payload[0], payload[1:4], payload[4:7], "gnss"
+        else:
+            t_m, w, i = payload
+            ctx = PseudoGpsContext(t_m, w, i, current(row), window_start.get(w), lever)
+            pf = pseudo_gps(ctx)
+            if pf is None:
+                continue
+            fix, std, label = np.array(pf[:3], float), np.array(pf[3:6], float), "pseudo"
+        nis = _update_nb(pos, v, c, ba, bg, P, lever, np.asarray(fix, float), np.asarray(std, float),
+                         float(times[row] - t_m), innov)
+        out_pos[row], out_v[row], out_c[row] = pos, v, c
+        out_sd[row] = np.sqrt(np.clip(np.diag(P), 0, None))
+        bias_rows.append(row)
+        bias_vals.append(np.concatenate([ba, bg]))
+        upd.append((t_m, label, *innov, nis, int(np.sum(np.isfinite(innov)))))
+        P_upd.append(P.copy())
+    if row < n_rows - 1:
+        _propagate_nb(row, n_rows - 1, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd)
+
+    # Bias estimates are piecewise constant between updates (random walk) or decay (Gauss-Markov).
+    idx = np.searchsorted(np.array(bias_rows), np.arange(n_rows), side="right") - 1
+    bias = np.array(bias_vals)[idx]
+    inv_a, inv_g = q[4], q[5]
+    if np.any(inv_a > 0) or np.any(inv_g > 0):
+        age = times - times[np.array(bias_rows)[idx]]
+        bias = bias * np.exp(-age[:, None] * np.concatenate([inv_a, inv_g])[None, :])
+    bias_df = pd.DataFrame(bias, columns=["accel_bias_x", "accel_bias_y", "accel_bias_z",
+                                          "gyro_bias_x", "gyro_bias_y", "gyro_bias_z"])
+    bias_df.insert(0, "time", times)
+    sd_df = pd.DataFrame(out_sd, columns=list(em.STATE_NAMES))
+    sd_df.insert(0, "time", times)
+    updates = pd.DataFrame(upd, columns=["time", "kind", "innov_n", "innov_e", "innov_d", "nis", "dof"])
+    return FilterResult(trajectory=trajectory_frame(times, out_pos, out_v, out_c), bias=bias_df, sd=sd_df,
+                        updates=updates,
+                        P_updates=np.array(P_upd).reshape(-1, em.N_STATES, em.N_STATES),
+                        states=states, final=current(n_rows - 1))
+
+
+def run_outage(imu: pd.DataFrame, start_state: FilterState, window, noise: FilterNoise,
+               lever_arm=(0.0, 0.0, 0.0), pseudo_gps=None, pseudo_rate_hz: float = PSEUDO_RATE_HZ,
+               source: str = "drive") -> FilterResult:
+    """One outage from a saved filter state: only the window's own IMU rows are processed.
+
+    Without ``pseudo_gps`` this is the standalone INS (prediction only, biases held at their last
+    estimates); with it, the pseudo fixes of Eq. (pred-gps) are fused at ``pseudo_rate_hz``.
+
+    Parameters
+    ----------
+    imu : DataFrame
+        IMU table covering the window.
+    start_state : FilterState
+        State at the window start (e.g. from :func:`bgfn.nav.state.load_states`).
+    window : OutageWindow or (start, duration)
+    noise : FilterNoise
+    lever_arm : array_like, shape (3,)
+        Antenna lever arm, body, m.
+    pseudo_gps : callable, optional
+        See :func:`run_filter`.
+    pseudo_rate_hz : float
+    source : str
+
+    Returns
+    -------
+    FilterResult
+        Rows from the window start to its end.
+    """
+    w = window if isinstance(window, OutageWindow) else OutageWindow(*map(float, window))
+    if abs(start_state.time - w.start) > 0.5:
+        raise DataError(source, "start_state.time", f"the outage start {w.start} s", str(start_state.time))
+    return run_filter(imu, start_state, noise, None, lever_arm, [(start_state.time, w.end - start_state.time)],
+                      pseudo_gps, t_end=w.end, pseudo_rate_hz=pseudo_rate_hz, source=source)
+
+
+__all__ = ["FilterResult", "run_filter", "run_outage", "GNSS_COLUMNS"]

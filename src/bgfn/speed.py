@@ -1,0 +1,89 @@
+"""CPU timing helpers: latency per prediction, throughput, and whether a model keeps up with the sensor rates.
+
+BGFN predicts the GNSS position increment from the last ``N`` IMU samples (paper Sec. 3.2). Run on line, a
+prediction is due at every GNSS epoch during an outage (1 Hz here) and, if the network is to follow every IMU
+sample, at the IMU rate (100 Hz). A model *keeps up* with a rate ``f`` if one prediction (batch 1) takes at
+most ``1 / f``: 10 ms for the 100 Hz IMU, 1 s for 1 Hz GNSS.
+
+The figures quoted in the book come from ``make bench`` (``benchmarks/bench_models.py`` for the latency,
+``benchmarks/bench_speed.py`` for the throughput and the real-time flags, both into ``results/bench.json``),
+never from tests: timings depend on the machine.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import statistics
+import time
+from typing import Callable, Iterator
+
+import torch
+from torch import nn
+
+#: IMU rate of the Turin drive, Hz.
+IMU_RATE_HZ = 100.0
+#: GNSS rate of the low-cost receiver (and of the pseudo-GNSS predictions during an outage), Hz.
+GNSS_RATE_HZ = 1.0
+
+
+@contextlib.contextmanager
+def torch_threads(n: int | None) -> Iterator[None]:
+    """Run the block with ``n`` torch CPU threads (``None``: leave as is); restore the old number after."""
+    old = torch.get_num_threads()
+    if n:
+        torch.set_num_threads(int(n))
+    try:
+        yield
+    finally:
+        torch.set_num_threads(old)
+
+
+def median_time(fn: Callable[[], object], repeats: int, warmup: int = 1) -> float:
+    """Median wall time of ``fn()`` over ``repeats`` calls after ``warmup`` untimed calls, s."""
+    if repeats < 1:
+        raise ValueError(f"repeats must be >= 1, got {repeats}")
+    for _ in range(warmup):
+        fn()
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def _infer(model: nn.Module, x: torch.Tensor) -> Callable[[], object]:
+    model.eval()
+
+    def run():
+        with torch.no_grad():
+            return model(x)            # BGFN resets its membranes at the start of every forward pass
+    return run
+
+
+def latency_ms(model: nn.Module, window: int, in_channels: int = 9, repeats: int = 20, threads: int | None = 1,
+               seed: int = 0) -> float:
+    """Median time of one prediction (batch 1, eval mode, no autograd), ms."""
+    x = torch.randn(1, window, in_channels, generator=torch.Generator().manual_seed(seed))
+    with torch_threads(threads):
+        return 1e3 * median_time(_infer(model, x), repeats)
+
+
+def throughput(model: nn.Module, window: int, batch: int = 64, in_channels: int = 9, repeats: int = 5,
+               threads: int | None = 1, seed: int = 0) -> float:
+    """Windows predicted per second in batches of ``batch`` (eval mode, no autograd; median batch time)."""
+    x = torch.randn(batch, window, in_channels, generator=torch.Generator().manual_seed(seed))
+    with torch_threads(threads):
+        return batch / median_time(_infer(model, x), repeats)
+
+
+def realtime_flags(latency_ms_value: float, imu_rate_hz: float = IMU_RATE_HZ,
+                   gnss_rate_hz: float = GNSS_RATE_HZ) -> dict[str, bool]:
+    """Whether a batch-1 latency (ms) keeps up with the IMU and the GNSS rates.
+
+    Returns ``{'imu': latency <= 1000 / imu_rate_hz, 'gnss': latency <= 1000 / gnss_rate_hz}``.
+    """
+    lat = float(latency_ms_value)
+    if not lat >= 0:
+        raise ValueError(f"latency must be a non-negative number of ms, got {latency_ms_value!r}")
+    return {"imu": lat <= 1e3 / imu_rate_hz, "gnss": lat <= 1e3 / gnss_rate_hz}

@@ -1,0 +1,91 @@
+"""Training throughput and inference latency of BGFN and the baselines at the quick and paper sizes.
+
+Adds to ``results/bench.json``:
+
+- ``train_windows_per_s.<model>.<size>``: training windows per second (forward + BPTT backward + AdamW step),
+  batch = the profile's batch size, window N = the profile's window, torch's default CPU threads;
+- ``infer_ms.<model>.<size>``: latency of one window (batch 1, eval mode, 1 CPU thread), ms;
+- ``models_bench``: what ran (threads, device, batch, window, parameter counts, repeats).
+
+Sizes come from ``train.sizes`` of ``params/<size>.yaml`` (the same blocks in every profile). Median of a
+few repeats after a warm-up; the paper size gets fewer repeats so that the whole script runs in minutes.
+"""
+
+from __future__ import annotations
+
+import statistics
+import sys
+import time
+
+import torch
+
+from bgfn.config import PROJECT_ROOT, load_profile
+from bgfn.io import update_json
+from bgfn.models import METHODS, build_model, count_parameters
+
+SIZES = ("quick", "paper")
+#: (training steps, inference calls) measured per size, after one warm-up each.
+REPEATS = {"quick": (5, 30), "paper": (2, 5)}
+
+
+def _median_time(fn, n: int) -> float:
+    fn()                                                   # warm-up (allocations, first call)
+    times = []
+    for _ in range(n):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def bench(model_name: str, size: str) -> tuple[float, float, int, dict]:
+    cfg = load_profile(size)["train"]
+    size_cfg = dict(cfg["sizes"][model_name][size])
+    batch, window = int(cfg["optimizer"]["batch_size"]), int(cfg["window"])
+    n_train, n_infer = REPEATS[size]
+    torch.manual_seed(0)
+    model = build_model(model_name, size_cfg)
+    opt = torch.optim.AdamW(model.parameters(), lr=1e-3)
+    x, y = torch.randn(batch, window, 9), torch.randn(batch, 2)
+
+    def step():
+        model.train()
+        opt.zero_grad(set_to_none=True)
+        torch.nn.functional.mse_loss(model(x), y).backward()
+        opt.step()
+
+    threads = torch.get_num_threads()
+    train_s = _median_time(step, n_train)
+    x1 = torch.randn(1, window, 9)
+    model.eval()
+    torch.set_num_threads(1)
+    try:
+        with torch.no_grad():
+            infer_s = _median_time(lambda: model(x1), n_infer)
+    finally:
+        torch.set_num_threads(threads)
+    return batch / train_s, 1e3 * infer_s, count_parameters(model), {"batch": batch, "window": window,
+                                                                      "repeats": [n_train, n_infer]}
+
+
+def main(sizes=SIZES, methods=METHODS) -> dict:
+    train_rate: dict = {m: {} for m in methods}
+    infer_ms: dict = {m: {} for m in methods}
+    info: dict = {"threads_train": torch.get_num_threads(), "threads_infer": 1, "device": "cpu",
+                  "torch": torch.__version__, "params": {m: {} for m in methods}, "problem": {}}
+    for size in sizes:
+        for m in methods:
+            rate, ms, n_params, prob = bench(m, size)
+            train_rate[m][size] = rate
+            infer_ms[m][size] = ms
+            info["params"][m][size] = n_params
+            info["problem"][size] = prob
+            print(f"{m:>12} {size:>6}: {rate:9.1f} train windows/s, {ms:8.2f} ms/window inference, "
+                  f"{n_params} parameters", flush=True)
+    update_json(PROJECT_ROOT / "results" / "bench.json",
+                {"train_windows_per_s": train_rate, "infer_ms": infer_ms, "models_bench": info})
+    return {"train_windows_per_s": train_rate, "infer_ms": infer_ms}
+
+
+if __name__ == "__main__":
+    main(sizes=tuple(sys.argv[1:]) or SIZES)

@@ -1,0 +1,213 @@
+"""BGFN: the spiking Transformer of paper Sec. 3.2 (Eqs. eq:bgfn_net, eq:spike_input, eq:spiking_embedding).
+
+Data flow (shapes as comments; T = T_s SNN steps per IMU step, B = batch, N = window length in IMU samples,
+C = 9 input channels, D = embedding width)::
+
+    x [B, N, C] --spike_encoder--> [T, B, N, C] spikes        Eq. (eq:spike_input)  S = SN(BN(Conv(S_k)))
+      --embedding--> [T, B, N, D] spikes                       Eq. (eq:spiking_embedding)  S_emb = SN(Linear(S))
+      --L x Block (SSA + spiking MLP, residuals)--> [T, B, N, D]
+      --mean over T and N--> [B, D] --Linear--> [B, 2]         delta_p_gps (north, east), Eq. (eq:bgfn_net)
+
+How the T_s axis is made (paper: "each IMU step dT is divided into T_s segments ... the input is expanded to
+T_s x T x C"): the encoder is a 1-D convolution along the window with ``T_s`` kernels per sensor channel
+(``groups=C``), followed by BatchNorm; its ``C*T_s`` output maps are read as ``T_s`` SNN time steps of ``C``
+channels, so every SNN step of an IMU sample gets its own learned current and the LIF turns the sequence of
+``T_s`` currents into a spike pattern. This is the convolutional spike encoder of SeqSNN (Lv et al. 2024, the
+Spikformer-for-time-series code BGFN builds on), there ``Conv2d(1, T_s, (1, k))`` shared by all channels; we
+give each channel its own kernels because the nine channels have different units and dynamics.
+
+Spiking blocks follow Spikformer's ``model.py``: Q, K, V = SN(BN(Linear(x))); attention ``Q K^T V * scale``
+without softmax (all factors are non-negative spikes), then an LIF with threshold 0.5, then
+SN(BN(Linear(.))); spiking MLP = two SN(BN(Linear)) layers; residual additions around both. Since there is no
+softmax, ``(Q K^T) V == Q (K^T V)``; we evaluate the cheaper order (N*dh^2 instead of N^2*dh per head), the
+result is the same (exact for binary spikes up to float32 summation of small integers).
+
+Readout: the paper passes "the output sequence of the last block through a projection layer"; we average the
+last block's output over the T_s steps and the N tokens (as SeqSNN's Spikformer does) and apply one Linear
+layer (``readout='mean'``); ``readout='last'`` uses the last token only (averaged over T_s).
+
+The membrane potentials are reset (``functional.reset_net``) at the start of every forward pass, so a batch
+never sees the state left by the previous one.
+"""
+
+from __future__ import annotations
+
+import torch
+from spikingjelly.activation_based import functional
+from torch import nn
+
+from .lif import DEFAULT_ALPHA, DEFAULT_ATTN_THRESHOLD, DEFAULT_TAU, DEFAULT_THRESHOLD, make_lif
+
+
+def _bn(bn: nn.BatchNorm1d, x: torch.Tensor) -> torch.Tensor:
+    """BatchNorm over the last axis of ``x`` [..., D] (statistics over all leading axes: T, B, N)."""
+    shape = x.shape
+    return bn(x.reshape(-1, shape[-1])).reshape(shape)
+
+
+class LinearBNLIF(nn.Module):
+    """SN(BN(Linear(x))): the basic spiking layer of Spikformer. [T, B, N, Din] -> [T, B, N, Dout] spikes."""
+
+    def __init__(self, d_in: int, d_out: int, tau: float, v_threshold: float, alpha: float):
+        super().__init__()
+        self.linear = nn.Linear(d_in, d_out)
+        self.bn = nn.BatchNorm1d(d_out)
+        self.lif = make_lif(tau, v_threshold, alpha)
+
+    def forward(self, x):                               # [T, B, N, Din]
+        return self.lif(_bn(self.bn, self.linear(x)))   # [T, B, N, Dout]
+
+
+class SpikeEncoder(nn.Module):
+    """Convolutional spike encoder, Eq. (eq:spike_input): S = SN(BN(Conv(S_k))). [B, N, C] -> [T_s, B, N, C]."""
+
+    def __init__(self, in_channels: int, time_steps: int, kernel_size: int, tau: float, v_threshold: float,
+                 alpha: float):
+        super().__init__()
+        self.in_channels, self.time_steps = in_channels, time_steps
+        # T_s kernels per channel (groups=C); 'same' padding keeps one token per IMU sample
+        self.conv = nn.Conv1d(in_channels, in_channels * time_steps, kernel_size, padding=kernel_size // 2,
+                              groups=in_channels)
+        self.bn = nn.BatchNorm1d(in_channels * time_steps)
+        self.lif = make_lif(tau, v_threshold, alpha)
+
+    def forward(self, x):                                # [B, N, C]
+        B, N, C = x.shape
+        cur = self.bn(self.conv(x.transpose(1, 2)))      # [B, C*T, N]  (channel-major: c*T + t)
+        cur = cur.reshape(B, C, self.time_steps, N)      # [B, C, T, N]
+        cur = cur.permute(2, 0, 3, 1).contiguous()       # [T, B, N, C]
+        return self.lif(cur)                             # [T, B, N, C] spikes
+
+
+class SpikingEmbedding(nn.Module):
+    """Channel-wise spiking embedding, Eq. (eq:spiking_embedding): S_emb = SN(BN(Linear(S))).
+
+    The paper writes SN(Linear(S)); a BatchNorm is added, as in every other spiking layer, so that the LIF input
+    is at unit scale and the neurons fire from the first step of training.
+    """
+
+    def __init__(self, in_channels: int, dim: int, tau: float, v_threshold: float, alpha: float):
+        super().__init__()
+        self.layer = LinearBNLIF(in_channels, dim, tau, v_threshold, alpha)
+
+    def forward(self, s):                                # [T, B, N, C]
+        return self.layer(s)                             # [T, B, N, D]
+
+
+class SSA(nn.Module):
+    """Spiking self-attention (Spikformer): SN(BN(Linear(SN_attn(Q K^T V * scale)))), no softmax."""
+
+    def __init__(self, dim: int, heads: int, scale: float, tau: float, v_threshold: float,
+                 attn_threshold: float, alpha: float):
+        super().__init__()
+        if dim % heads:
+            raise ValueError(f"dim {dim} is not divisible by heads {heads}")
+        self.heads, self.scale = heads, scale
+        self.q = LinearBNLIF(dim, dim, tau, v_threshold, alpha)
+        self.k = LinearBNLIF(dim, dim, tau, v_threshold, alpha)
+        self.v = LinearBNLIF(dim, dim, tau, v_threshold, alpha)
+        self.attn_lif = make_lif(tau, attn_threshold, alpha)
+        self.proj = LinearBNLIF(dim, dim, tau, v_threshold, alpha)
+
+    def _split(self, x):                                 # [T, B, N, D]
+        T, B, N, D = x.shape
+        return x.reshape(T, B, N, self.heads, D // self.heads).transpose(2, 3)   # [T, B, H, N, dh]
+
+    def attend(self, q, k, v):
+        """Q K^T V * scale per head, no softmax. q, k, v: [T, B, H, N, dh] -> [T, B, H, N, dh]."""
+        N, dh = q.shape[-2], q.shape[-1]
+        if dh < N:
+            return (q @ (k.transpose(-2, -1) @ v)) * self.scale    # K^T V: [T, B, H, dh, dh]
+        return ((q @ k.transpose(-2, -1)) @ v) * self.scale         # Q K^T: [T, B, H, N, N]
+
+    def forward(self, x):                                # [T, B, N, D]
+        T, B, N, D = x.shape
+        q, k, v = self._split(self.q(x)), self._split(self.k(x)), self._split(self.v(x))  # [T, B, H, N, dh]
+        a = self.attend(q, k, v)                         # [T, B, H, N, dh]
+        a = a.transpose(2, 3).reshape(T, B, N, D)        # [T, B, N, D]
+        return self.proj(self.attn_lif(a))               # [T, B, N, D] spikes
+
+
+class SpikingMLP(nn.Module):
+    """Spiking feed-forward block: SN(BN(Linear(SN(BN(Linear(x)))))). [T, B, N, D] -> [T, B, N, D]."""
+
+    def __init__(self, dim: int, hidden: int, tau: float, v_threshold: float, alpha: float):
+        super().__init__()
+        self.fc1 = LinearBNLIF(dim, hidden, tau, v_threshold, alpha)
+        self.fc2 = LinearBNLIF(hidden, dim, tau, v_threshold, alpha)
+
+    def forward(self, x):                                # [T, B, N, D]
+        return self.fc2(self.fc1(x))                     # [T, B, N, D]
+
+
+class Block(nn.Module):
+    """Spiking Transformer block: x + SSA(x), then + SpikingMLP(.). [T, B, N, D] -> [T, B, N, D]."""
+
+    def __init__(self, dim: int, ffn_dim: int, heads: int, scale: float, tau: float, v_threshold: float,
+                 attn_threshold: float, alpha: float):
+        super().__init__()
+        self.attn = SSA(dim, heads, scale, tau, v_threshold, attn_threshold, alpha)
+        self.mlp = SpikingMLP(dim, ffn_dim, tau, v_threshold, alpha)
+
+    def forward(self, x):                                # [T, B, N, D]
+        x = x + self.attn(x)                             # residual (integer-valued, as in Spikformer)
+        return x + self.mlp(x)                           # [T, B, N, D]
+
+
+class BGFN(nn.Module):
+    """Brain-inspired GPS/INS fusion network, Eq. (eq:bgfn_net): IMU window -> delta_p_gps.
+
+    Parameters
+    ----------
+    in_channels : int
+        Input channels per IMU sample (9, Eq. eq21).
+    dim : int
+        Embedding width D (paper: 256).
+    ffn_dim : int
+        Hidden width of the spiking MLP (paper: 256).
+    depth : int
+        Number of spiking Transformer blocks L (paper: 4).
+    heads : int
+        Attention heads; must divide ``dim`` (paper: 6, which does not divide 256; default 8).
+    time_steps : int
+        T_s, SNN steps per IMU step (not given in the paper; default 4).
+    kernel_size : int
+        Temporal kernel of the spike encoder (odd).
+    attn_scale : float
+        Scale of Q K^T V (Spikformer: 0.125).
+    tau, v_threshold, attn_threshold, alpha : float
+        LIF time constant (beta = 1 - 1/tau), thresholds, ATan steepness.
+    readout : {'mean', 'last'}
+        Average over T_s and all tokens, or over T_s at the last token only.
+    out_dim : int
+        2 outputs: north and east increment.
+    """
+
+    spiking = True
+
+    def __init__(self, in_channels: int = 9, dim: int = 256, ffn_dim: int = 256, depth: int = 4, heads: int = 8,
+                 time_steps: int = 4, kernel_size: int = 3, attn_scale: float = 0.125, tau: float = DEFAULT_TAU,
+                 v_threshold: float = DEFAULT_THRESHOLD, attn_threshold: float = DEFAULT_ATTN_THRESHOLD,
+                 alpha: float = DEFAULT_ALPHA, readout: str = "mean", out_dim: int = 2):
+        super().__init__()
+        if readout not in ("mean", "last"):
+            raise ValueError(f"readout must be 'mean' or 'last', got {readout!r}")
+        self.readout = readout
+        self.spike_encoder = SpikeEncoder(in_channels, time_steps, kernel_size, tau, v_threshold, alpha)
+        self.embedding = SpikingEmbedding(in_channels, dim, tau, v_threshold, alpha)
+        self.blocks = nn.ModuleList([Block(dim, ffn_dim, heads, attn_scale, tau, v_threshold, attn_threshold, alpha)
+                                     for _ in range(depth)])
+        self.head = nn.Linear(dim, out_dim)
+
+    def features(self, x):                               # [B, N, C]
+        functional.reset_net(self)                       # membrane state starts at 0 for every batch
+        s = self.spike_encoder(x)                        # [T, B, N, C]
+        s = self.embedding(s)                            # [T, B, N, D]
+        for blk in self.blocks:
+            s = blk(s)                                   # [T, B, N, D]
+        return s
+
+    def forward(self, x):                                # [B, N, C]
+        s = self.features(x)                             # [T, B, N, D]
+        z = s.mean(dim=(0, 2)) if self.readout == "mean" else s[:, :, -1].mean(0)   # [B, D]
+        return self.head(z)                              # [B, 2]

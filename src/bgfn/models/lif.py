@@ -1,0 +1,112 @@
+"""LIF neurons of the paper (Eq. eq:LIF) on SpikingJelly, with the ATan surrogate (Eq. eq:surrogate_gradient).
+
+The paper writes the leaky integrate-and-fire neuron as (Eq. eq:LIF)::
+
+    U(t) = H(t - dt) + I(t)                         # charge
+    S(t) = 1 if U(t) >= U_thr else 0                # fire (Heaviside)
+    H(t) = V_reset S(t) + (1 - S(t)) beta U(t)      # hard reset or leak
+
+SpikingJelly's ``LIFNode(decay_input=False)`` charges ``H_sj[t] = V[t-1] - (V[t-1] - V_reset)/tau + X[t]``,
+fires ``S = Heaviside(H_sj - v_threshold)`` and hard-resets ``V[t] = (1 - S) H_sj + S V_reset``.
+With ``V_reset = 0`` the two are the same recursion:
+
+    paper U(t)        == SpikingJelly H_sj[t]   (the membrane potential that is compared with the threshold)
+    paper I(t)        == SpikingJelly X[t]      (``decay_input=False``: the input current is not scaled by 1/tau)
+    paper beta        == 1 - 1/tau              (tau = 2 -> beta = 0.5, Spikformer's setting)
+    paper H(t)        == beta * V[t]            (SpikingJelly stores the potential before the leak)
+
+(With ``V_reset != 0`` SpikingJelly leaks toward ``V_reset`` while the paper leaks toward 0, so every layer
+here uses ``V_reset = 0``, the default of SpikingJelly and Spikformer.) :func:`lif_reference` is the paper's
+equation written out literally; the tests check SpikingJelly's node against it.
+
+The backward pass replaces dS/dU by the derivative of the ATan surrogate (Eq. eq:surrogate_gradient)
+``g(x) = arctan(pi/2 alpha x)/pi + 1/2`` at ``x = U - U_thr``, i.e. ``g'(x) = alpha / (2 (1 + (pi/2 alpha x)^2))``
+(:func:`atan_surrogate_grad`). Training is BPTT through the ``T_s`` SNN steps (multi-step mode ``'m'``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import torch
+from spikingjelly.activation_based import neuron, surrogate
+
+#: Membrane time constant of every LIF layer (SpikingJelly ``tau``); beta = 1 - 1/tau = 0.5.
+DEFAULT_TAU = 2.0
+#: Firing threshold U_thr of the LIF layers.
+DEFAULT_THRESHOLD = 1.0
+#: Threshold of the LIF after the attention product (Spikformer uses half the common threshold).
+DEFAULT_ATTN_THRESHOLD = 0.5
+#: Steepness alpha of the ATan surrogate (SpikingJelly's default).
+DEFAULT_ALPHA = 2.0
+
+
+def beta_from_tau(tau: float) -> float:
+    """Decay factor beta of Eq. (eq:LIF) for a SpikingJelly time constant ``tau`` (``decay_input=False``)."""
+    return 1.0 - 1.0 / tau
+
+
+def tau_from_beta(beta: float) -> float:
+    """SpikingJelly time constant for the paper's decay factor ``beta`` in (0, 1)."""
+    if not 0.0 < beta < 1.0:
+        raise ValueError(f"beta must lie in (0, 1), got {beta}")
+    return 1.0 / (1.0 - beta)
+
+
+def make_lif(tau: float = DEFAULT_TAU, v_threshold: float = DEFAULT_THRESHOLD, alpha: float = DEFAULT_ALPHA,
+             detach_reset: bool = True) -> neuron.LIFNode:
+    """A multi-step LIF layer of Eq. (eq:LIF): input ``[T, ...]`` currents, output ``[T, ...]`` spikes in {0, 1}.
+
+    Parameters
+    ----------
+    tau : float
+        Membrane time constant (> 1); beta = 1 - 1/tau.
+    v_threshold : float
+        Firing threshold U_thr.
+    alpha : float
+        Steepness of the ATan surrogate gradient, Eq. (eq:surrogate_gradient).
+    detach_reset : bool
+        Stop the gradient through the reset term (as in Spikformer/SeqSNN); the forward pass is unchanged.
+    """
+    return neuron.LIFNode(tau=float(tau), decay_input=False, v_threshold=float(v_threshold), v_reset=0.0,
+                          surrogate_function=surrogate.ATan(alpha=float(alpha)), detach_reset=detach_reset,
+                          step_mode="m")
+
+
+def lif_reference(current: torch.Tensor, beta: float, u_thr: float = DEFAULT_THRESHOLD,
+                  v_reset: float = 0.0) -> tuple[torch.Tensor, torch.Tensor]:
+    """The paper's Eq. (eq:LIF), step by step, starting from H(0) = 0.
+
+    Parameters
+    ----------
+    current : Tensor, shape [T, ...]
+        Input current I(t).
+    beta, u_thr, v_reset : float
+        Decay factor, threshold and reset potential.
+
+    Returns
+    -------
+    spikes : Tensor, shape [T, ...]
+        S(t) in {0, 1}.
+    potential : Tensor, shape [T, ...]
+        U(t) before the reset.
+    """
+    h = torch.zeros_like(current[0])
+    spikes, potential = [], []
+    for i_t in current:
+        u = h + i_t                                   # U(t) = H(t - dt) + I(t)
+        s = (u >= u_thr).to(current.dtype)            # S(t) = Heaviside(U - U_thr)
+        h = v_reset * s + (1.0 - s) * beta * u        # H(t) = V_reset S + (1 - S) beta U
+        spikes.append(s)
+        potential.append(u)
+    return torch.stack(spikes), torch.stack(potential)
+
+
+def atan_surrogate_grad(x: torch.Tensor, alpha: float = DEFAULT_ALPHA) -> torch.Tensor:
+    """Derivative of Eq. (eq:surrogate_gradient) ``arctan(pi/2 alpha x)/pi + 1/2`` at ``x = U - U_thr``."""
+    return alpha / (2.0 * (1.0 + (math.pi / 2.0 * alpha * x) ** 2))
+
+
+def lif_modules(model: torch.nn.Module) -> list[neuron.LIFNode]:
+    """All LIF layers of ``model`` (for spike hooks and firing-rate counts)."""
+    return [m for m in model.modules() if isinstance(m, neuron.LIFNode)]

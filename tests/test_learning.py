@@ -1,0 +1,167 @@
+"""The learning problem (bgfn.learning): windows, GNSS increment targets, outage-free split, normalization."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from bgfn import learning as L
+from bgfn.errors import DataError
+from bgfn.nav.earth import curvature_radii
+
+
+@pytest.fixture(scope="module")
+def tables():
+    return L.synthetic_tables(duration_s=200.0, noise=0.1, seed=3)
+
+
+def test_position_increment_hand_computed():
+    lat, h = np.deg2rad(45.0), 300.0
+    r_m, r_n = curvature_radii(lat)
+    d = L.position_increment(lat, 0.2, h, lat + 1e-6, 0.2 + 2e-6, h)
+    assert d[0] == pytest.approx(1e-6 * (r_m + h), rel=1e-6)                  # ~6.37 m north
+    assert d[1] == pytest.approx(2e-6 * (r_n + h) * np.cos(lat), rel=1e-5)    # ~9.0 m east
+    assert 6.3 < d[0] < 6.4 and 8.9 < d[1] < 9.1
+    # across the +-180 deg meridian the longitude difference is wrapped
+    d = L.position_increment(lat, np.pi - 1e-6, h, lat, -np.pi + 1e-6, h)
+    assert d[1] == pytest.approx(2e-6 * (r_n + h) * np.cos(lat), rel=1e-5)
+
+
+def test_windows_inputs_and_targets(tables):
+    imu, att, gnss = tables
+    ws = L.make_windows(imu, att, gnss, window=200)
+    assert ws.x.shape[1:] == (200, 9) and ws.x.dtype == np.float32
+    assert ws.channels == L.CHANNELS
+    t = imu["time"].to_numpy()
+    # 'ending': the window's last sample is the GNSS epoch t_to itself (causal: nothing after it)
+    assert np.all(ws.t_end <= ws.t_to + 1e-9) and np.allclose(ws.t_end, ws.t_to)
+    # the first usable epoch needs 200 samples (+ the one before) of history
+    assert ws.t_to.min() >= t[200]
+    # inputs are the raw IMU rows
+    k = int(np.searchsorted(t, ws.t_end[5]))
+    assert np.allclose(ws.x[5, -1, 3:6], imu.loc[k, ["accel_x", "accel_y", "accel_z"]].to_numpy(), atol=1e-5)
+    assert np.allclose(ws.x[5, -1, 6:9], imu.loc[k, ["gyro_x", "gyro_y", "gyro_z"]].to_numpy(), atol=1e-6)
+    assert np.allclose(ws.x[5, 0, 3], imu.loc[k - 199, "accel_x"], atol=1e-5)
+    # targets: GNSS increments; on the toy circle, chord from the true heading
+    inc = L.gnss_increments(gnss)
+    row = inc.index[np.isclose(inc["t_to"], ws.t_to[5])][0]
+    assert np.allclose(ws.y[5], inc.loc[row, ["dn", "de"]].to_numpy())
+    assert np.allclose(ws.y_last[6], ws.y[5])                     # previous increment
+    speed = np.hypot(*ws.y.T)
+    assert 6.0 < speed.min() and speed.max() < 14.0               # 10 m/s +- 30 % over 1 s
+    nxt = L.make_windows(imu, att, gnss, window=200, alignment="next")
+    assert np.allclose(nxt.t_end, nxt.t_from)
+    common = np.isin(nxt.t_from, ws.t_from)
+    assert np.allclose(nxt.y[common], ws.y[np.isin(ws.t_from, nxt.t_from)])
+
+
+def test_yaw_encodings_handle_the_wrap(tables):
+    imu, att, gnss = tables
+    raw = L.make_windows(imu, att, gnss, window=200, yaw_encoding="raw")
+    unw = L.make_windows(imu, att, gnss, window=200, yaw_encoding="unwrap")
+    rel = L.make_windows(imu, att, gnss, window=200, yaw_encoding="relative")
+    jumps_raw = np.abs(np.diff(raw.x[..., 2], axis=1)).max(axis=1)
+    crossing = jumps_raw > np.pi                                   # windows that hold the +-pi wrap
+    assert crossing.any()
+    assert np.abs(np.diff(unw.x[..., 2], axis=1)).max() < 0.1      # yaw rate ~0.07 rad/s * 0.01 s
+    assert np.allclose(unw.x[:, -1, 2], raw.x[:, -1, 2])           # absolute heading kept at the last sample
+    assert np.all(np.abs(unw.x[:, -1, 2]) <= np.pi)
+    assert np.allclose(rel.x[:, -1, 2], 0.0)
+    assert np.abs(np.diff(rel.x[..., 2], axis=1)).max() < 0.1
+    assert raw.x.shape == unw.x.shape == rel.x.shape               # 9 channels in every encoding
+    with pytest.raises(DataError):
+        L.make_windows(imu, att, gnss, yaw_encoding="sincos")
+
+
+def test_no_window_touches_an_outage(tables):
+    imu, att, gnss = tables
+    outages = [(1080.0, 30.0), (1150.0, 10.0)]
+    margin = 5.0
+    data = L.build_learning_data(imu, att, gnss, outages, window=200, margin_s=margin, val_fraction=0.25,
+                                 val_position="middle")
+    forb = np.array([[s - margin, s + d + margin] for s, d in outages])
+    for ws in (data.train, data.val):
+        assert len(ws) > 0
+        lo, hi = ws.span
+        # inputs: first sample interval starts at t_start; target interval [t_from, t_to]
+        for a, b in forb:
+            assert np.all((hi < a) | (lo > b)), "a window overlaps an outage"
+            assert np.all((ws.t_to < a) | (ws.t_from > b))
+            assert np.all((ws.t_end < a) | (ws.t_start > b))
+    # training and validation windows share no time (inputs or targets)
+    vlo, vhi = data.val.span
+    tlo, thi = data.train.span
+    assert np.all((thi < vlo.min()) | (tlo > vhi.max()))
+    # the validation block is one contiguous block in the middle
+    assert data.train.t_to.min() < data.val.t_to.min() and data.train.t_to.max() > data.val.t_to.max()
+    assert data.info["n_outage_excluded"] > 0 and data.info["n_purged"] > 0
+    # without the outages, windows inside them would exist
+    all_ws = L.make_windows(imu, att, gnss, window=200)
+    assert np.any((all_ws.t_to > 1080.0) & (all_ws.t_to < 1110.0))
+
+
+def test_normalization_uses_training_windows_only(tables):
+    imu, att, gnss = tables
+    data = L.build_learning_data(imu, att, gnss, [], window=100, val_fraction=0.3)
+    x = data.train.x.reshape(-1, 9).astype(float)
+    assert np.allclose(data.norm.x_mean, x.mean(0)) and np.allclose(data.norm.x_std[3:6], x.std(0)[3:6])
+    assert np.allclose(data.norm.y_mean, data.train.y.mean(0))
+    # corrupting the validation inputs does not change the statistics
+    gnss2 = gnss.copy()
+    late = gnss2["time"] > data.info["val_block"][0] + 5
+    gnss2.loc[late, "lat"] += 1e-3
+    data2 = L.build_learning_data(imu, att, gnss2, [], window=100, val_fraction=0.3)
+    assert np.allclose(data2.norm.y_mean, data.norm.y_mean) and np.allclose(data2.norm.y_std, data.norm.y_std)
+    z = data.norm.x(data.train.x)
+    assert np.allclose(z.reshape(-1, 9).mean(0)[3:], 0.0, atol=1e-3)
+    assert np.allclose(data.norm.y_inverse(data.norm.y(data.val.y)), data.val.y, atol=1e-4)
+    assert L.Normalizer.from_dict(data.norm.to_dict()).y_std.tolist() == data.norm.y_std.tolist()
+
+
+def test_prediction_windows_match_training_windows(tables):
+    imu, att, gnss = tables
+    ws = L.make_windows(imu, att, gnss, window=150)
+    epochs = np.concatenate([ws.t_from[20:21], ws.t_to[20:50]])   # last fix, then 30 pseudo-GNSS epochs
+    pw = L.prediction_windows(imu, att, epochs, window=150)
+    assert len(pw) == 30 and np.isnan(pw.y).all()
+    assert np.array_equal(pw.x, ws.x[20:50])                      # same inputs as in training
+    assert np.allclose(pw.t_from, ws.t_from[20:50]) and np.allclose(pw.t_to, ws.t_to[20:50])
+    with pytest.raises(DataError):
+        L.prediction_windows(imu, att, [imu["time"].iloc[10], imu["time"].iloc[20]], window=150)
+
+
+def test_gaps_and_bad_tables_are_rejected(tables):
+    imu, att, gnss = tables
+    holed = imu.drop(index=range(5000, 5003)).reset_index(drop=True)   # 30 ms IMU gap
+    ws = L.make_windows(holed, att, gnss, window=200)
+    t_gap = imu["time"].iloc[5001]
+    assert not np.any((ws.t_start < t_gap) & (ws.t_end > t_gap))
+    with pytest.raises(DataError, match="gyro_z"):
+        L.make_windows(imu.drop(columns="gyro_z"), att, gnss)
+    with pytest.raises(DataError):
+        L.split_windows(ws, [], val_fraction=1.5)
+
+
+def test_reference_predictors(tables):
+    imu, att, gnss = tables
+    ws = L.make_windows(imu, att, gnss, window=200)
+    ref = L.reference_rmse(ws)
+    assert ref["zero"] == pytest.approx(np.sqrt(np.mean(np.sum(ws.y ** 2, axis=1))))
+    assert ref["last"] < 0.2 * ref["zero"]                         # smooth toy motion: last increment is good
+
+
+def test_heading_target_frame(tables):
+    imu, att, gnss = tables
+    ws = L.make_windows(imu, att, gnss, window=100)
+    assert np.allclose(ws.yaw_ref, att.set_index("time").loc[ws.t_end, "yaw"].to_numpy())
+    z = L.to_target_frame(ws.y, ws.yaw_ref, "heading")
+    # on the toy circle the 1 s chord points ahead, slightly to the right (half the heading change)
+    assert np.all(z[:, 0] > 5.0)
+    assert np.all(np.abs(z[:, 1]) < 0.1 * z[:, 0])
+    assert np.allclose(L.from_target_frame(z, ws.yaw_ref, "heading"), ws.y)
+    assert np.allclose(np.hypot(*z.T), np.hypot(*ws.y.T))
+    assert np.array_equal(L.to_target_frame(ws.y, ws.yaw_ref, "ned"), ws.y)
+    data = L.build_learning_data(imu, att, gnss, [], window=100, target_frame="heading")
+    assert data.norm.y_mean[0] > 5.0                                # statistics of the along-track target
+    with pytest.raises(DataError):
+        L.build_learning_data(imu, att, gnss, [], window=100, target_frame="body")

@@ -1,0 +1,162 @@
+"""The training loop (bgfn.train): artifacts, references, early stopping, determinism and resume."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import torch
+
+from bgfn import learning as L
+from bgfn import train as T
+
+torch.set_num_threads(1)
+
+
+@pytest.fixture(scope="module")
+def data():
+    imu, att, gnss = L.synthetic_tables(duration_s=300.0, noise=0.05, seed=1)
+    return L.build_learning_data(imu, att, gnss, [(1060.0, 20.0)], window=40, margin_s=2.0, val_fraction=0.25)
+
+
+def _cfg(**opt):
+    base = {"epochs": 3, "batch_size": 16, "lr": 3e-3, "patience": 50, "schedule": "plateau"}
+    return {"optimizer": {**base, **opt}}
+
+
+def test_card_checkpoint_and_references(data, tmp_path):
+    card = T.train_model("mlp", data, {"n_recent": 5, "hidden": 16}, _cfg(), seed=0, out_dir=tmp_path,
+                         progress=False, extra_card={"dataset": "toy"})
+    for key in ("params", "epochs_run", "best_val_loss", "wall_time_s", "device", "history", "val_rmse_m",
+                "val_rmse_zero_m", "val_rmse_last_m", "n_train", "n_val", "dataset"):
+        assert key in card
+    assert card["epochs_run"] == 3 and len(card["history"]) == 3
+    assert {"train_loss", "val_loss", "val_rmse_m"} <= set(card["history"][0])
+    assert card["val_rmse_zero_m"] == pytest.approx(L.reference_rmse(data.val)["zero"])
+    assert card["val_rmse_last_m"] == pytest.approx(L.reference_rmse(data.val)["last"])
+    assert json.loads((tmp_path / "mlp_seed0.json").read_text())["val_rmse_m"] == pytest.approx(card["val_rmse_m"])
+    assert not (tmp_path / "mlp_seed0.last.pt").exists()
+    # the checkpoint reproduces the card's validation error
+    tm = T.load_trained(tmp_path / "mlp_seed0.pt")
+    assert L.rmse(tm.predict_windows(data.val), data.val.y) == pytest.approx(card["val_rmse_m"], rel=1e-5)
+    # a completed run is not redone
+    mtime = (tmp_path / "mlp_seed0.pt").stat().st_mtime_ns
+    again = T.train_model("mlp", data, {"n_recent": 5, "hidden": 16}, _cfg(), seed=0, out_dir=tmp_path,
+                          progress=False)
+    assert again["history"] == card["history"] and (tmp_path / "mlp_seed0.pt").stat().st_mtime_ns == mtime
+
+
+@pytest.mark.parametrize("method,size", [("mlp", {"n_recent": 10, "hidden": 32}), ("at_lstm", {"hidden": 16})])
+def test_training_learns_and_beats_zero(data, method, size):
+    card = T.train_model(method, data, size, _cfg(epochs=15), seed=0, progress=False)
+    h = card["history"]
+    assert h[-1]["train_loss"] < 0.5 * h[0]["train_loss"]
+    assert card["val_rmse_m"] < 0.8 * card["val_rmse_zero_m"]
+    assert card["best_epoch"] > 0
+
+
+def test_early_stopping(data):
+    card = T.train_model("mlp", data, {"hidden": 8}, _cfg(epochs=20, lr=0.0, patience=2, schedule="none"),
+                         seed=0, progress=False)
+    assert card["epochs_run"] == 3 and card["stopped_early"] and card["best_epoch"] == 0
+
+
+def test_bgfn_resets_and_is_deterministic(data):
+    size = {"dim": 16, "ffn_dim": 16, "depth": 1, "heads": 2, "time_steps": 2}
+    a = T.train_model("bgfn", data, size, _cfg(epochs=2, max_train_windows=48), seed=5, progress=False)
+    b = T.train_model("bgfn", data, size, _cfg(epochs=2, max_train_windows=48), seed=5, progress=False)
+    assert a["history"][-1]["val_loss"] == b["history"][-1]["val_loss"]
+    assert a["n_train"] == 48
+
+
+class _Interrupt(Exception):
+    pass
+
+
+def test_resume_after_interruption_gives_the_same_run(data, tmp_path):
+    size = {"hidden": 8, "n_recent": 4}
+    full = T.train_model("mlp", data, size, _cfg(epochs=4), seed=2, progress=False)
+    calls = {"n": 0}
+    orig = T.predict_normalized
+
+    def flaky(*args, **kwargs):                       # dies in the validation of the 3rd epoch
+        calls["n"] += 1
+        if calls["n"] == 3:
+            raise _Interrupt
+        return orig(*args, **kwargs)
+
+    T.predict_normalized = flaky
+    try:
+        with pytest.raises(_Interrupt):
+            T.train_model("mlp", data, size, _cfg(epochs=4), seed=2, out_dir=tmp_path, progress=False)
+    finally:
+        T.predict_normalized = orig
+    assert (tmp_path / "mlp_seed2.last.pt").exists() and not (tmp_path / "mlp_seed2.json").exists()
+    resumed = T.train_model("mlp", data, size, _cfg(epochs=4), seed=2, out_dir=tmp_path, progress=False)
+    assert resumed["epochs_run"] == 4
+    assert [h["val_loss"] for h in resumed["history"]] == pytest.approx([h["val_loss"] for h in full["history"]],
+                                                                         rel=1e-6)
+
+
+def test_predict_increments_for_an_outage(data, tmp_path):
+    T.train_model("at_lstm", data, {"hidden": 8}, _cfg(epochs=1), seed=0, out_dir=tmp_path, progress=False)
+    tm = T.load_trained(tmp_path / "at_lstm_seed0.pt")
+    imu, att, _ = L.synthetic_tables(duration_s=300.0, noise=0.05, seed=1)
+    epochs = np.arange(1060.0, 1081.0)
+    dp = tm.predict_increments(imu, att, epochs)
+    assert dp.shape == (20, 2) and np.isfinite(dp).all()
+
+
+def test_profile_helpers():
+    tc = {"size": "quick", "sizes": {"mlp": {"quick": {"hidden": 4}}}, "lr": {"bgfn": 5e-4},
+          "optimizer": {"lr": 1e-3}}
+    assert T.size_config(tc, "mlp") == {"hidden": 4}
+    assert T.method_lr(tc, "bgfn") == 5e-4 and T.method_lr(tc, "mlp") == 1e-3
+    with pytest.raises(ValueError):
+        T.size_config(tc, "bgfn")
+    with pytest.raises(ValueError):
+        T.optimizer_options({"optimizer": {"epoch": 3}})
+
+
+def test_heading_frame_predictions_come_back_in_ned(tmp_path):
+    imu, att, gnss = L.synthetic_tables(duration_s=300.0, noise=0.05, seed=1)
+    data = L.build_learning_data(imu, att, gnss, [], window=40, val_fraction=0.25, target_frame="heading")
+    card = T.train_model("mlp", data, {"n_recent": 10, "hidden": 16}, _cfg(epochs=8), seed=0, out_dir=tmp_path,
+                         progress=False)
+    tm = T.load_trained(tmp_path / "mlp_seed0.pt")
+    pred = tm.predict_windows(data.val)
+    assert L.rmse(pred, data.val.y) == pytest.approx(card["val_rmse_m"], rel=1e-5)
+    assert card["val_rmse_m"] < 0.3 * card["val_rmse_zero_m"]      # heading frame: only the speed to learn
+    table = tm.increment_table(imu, att, np.arange(1100.0, 1111.0))
+    assert list(table.columns) == ["time", "delta_p_n", "delta_p_e"] and len(table) == 10
+
+
+def test_profile_train_sections_are_complete_and_consistent():
+    from bgfn.config import PROFILES, load_profile
+    from bgfn.models import METHODS, build_model
+
+    sections = {p: load_profile(p)["train"] for p in PROFILES}
+    sizes = [s["sizes"] for s in sections.values()]
+    assert all(s == sizes[0] for s in sizes), "train.sizes must be the same blocks in every profile"
+    for name, tc in sections.items():
+        T.optimizer_options(tc)
+        assert set(L.learning_options(tc)) == set(L.LEARNING_DEFAULTS)
+        assert set(tc["methods"]) == set(METHODS)
+        for m in METHODS:
+            assert T.method_lr(tc, m) > 0
+            build_model(m, T.size_config(tc, m))
+    paper = sections["paper"]
+    assert paper["window"] == 200 and paper["optimizer"]["batch_size"] == 8 and paper["optimizer"]["epochs"] == 1000
+    assert {k: T.size_config(paper, "bgfn")[k] for k in ("dim", "ffn_dim", "depth")} == {"dim": 256, "ffn_dim": 256,
+                                                                                           "depth": 4}
+
+
+def test_summary_table_aggregates_seeds():
+    base = {"dataset": "d", "method": "bgfn", "params": 10, "epochs_run": 4, "best_epoch": 2, "n_train": 5,
+            "n_val": 2, "val_rmse_zero_m": 3.0, "val_rmse_last_m": 1.0, "device": "cpu"}
+    cards = [{**base, "seed": 0, "wall_time_s": 1.0, "val_rmse_m": 2.0},
+             {**base, "seed": 1, "wall_time_s": 3.0, "val_rmse_m": 2.5}]
+    s = T.summary_table(cards)
+    assert len(s) == 1 and s.loc[0, "seeds"] == 2
+    assert s.loc[0, "val_rmse_m_mean"] == pytest.approx(2.25) and s.loc[0, "train_time_s_total"] == 4.0

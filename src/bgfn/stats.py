@@ -1,0 +1,120 @@
+"""Statistics of the outage sweep: bootstrap confidence intervals and paired comparisons.
+
+- :func:`bootstrap_ci`: percentile bootstrap interval of a statistic (default the median), optionally a
+  *cluster* bootstrap that resamples whole groups (e.g. outage starts, keeping all training seeds of a start
+  together, since runs of the same start share the trajectory and are not independent).
+- :func:`paired_comparison`: how often method A beats method B on paired runs, the median paired difference
+  and the Wilcoxon signed-rank test (two-sided) of ``A - B``.
+
+Every random draw takes a seed (``numpy.random.default_rng(seed)``).
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+from bgfn.errors import DataError
+
+
+def bootstrap_ci(values, stat: Callable = np.median, n_boot: int = 2000, level: float = 0.95, seed: int = 0,
+                 groups=None) -> tuple[float, float]:
+    """Percentile bootstrap interval of ``stat(values)``.
+
+    Parameters
+    ----------
+    values : array_like [n]
+        Sample (NaNs are dropped, with their group labels).
+    stat : callable
+        Statistic with an ``axis`` keyword (``np.median``, ``np.mean``).
+    n_boot : int
+        Bootstrap replicates.
+    level : float
+        Coverage of the interval, in (0, 1).
+    seed : int
+        Seed of the resampling.
+    groups : array_like [n], optional
+        Cluster labels: with them whole clusters are resampled with replacement (cluster bootstrap).
+
+    Returns
+    -------
+    (lo, hi) : tuple of float
+        NaN, NaN for an empty sample.
+    """
+    x = np.asarray(values, dtype=float).ravel()
+    if not 0.0 < level < 1.0:
+        raise DataError("bootstrap_ci", "level", "a coverage in (0, 1)", repr(level))
+    if n_boot < 1:
+        raise DataError("bootstrap_ci", "n_boot", "a positive number of replicates", repr(n_boot))
+    g = None if groups is None else np.asarray(groups).ravel()
+    if g is not None and len(g) != len(x):
+        raise DataError("bootstrap_ci", "groups", f"one label per value ({len(x)})", str(len(g)))
+    ok = np.isfinite(x)
+    x = x[ok]
+    if g is not None:
+        g = g[ok]
+    if len(x) == 0:
+        return float("nan"), float("nan")
+    rng = np.random.default_rng(seed)
+    alpha = 1.0 - level
+    if g is None:
+        idx = rng.integers(0, len(x), size=(n_boot, len(x)))           # [B, n]
+        reps = stat(x[idx], axis=1)                                       # [B]
+    else:
+        labels, inverse = np.unique(g, return_inverse=True)
+        members = [x[inverse == i] for i in range(len(labels))]
+        pick = rng.integers(0, len(labels), size=(n_boot, len(labels)))  # [B, n_groups]
+        reps = np.array([stat(np.concatenate([members[j] for j in row])) for row in pick])
+    lo, hi = np.quantile(reps, [alpha / 2.0, 1.0 - alpha / 2.0])
+    return float(lo), float(hi)
+
+
+def wilcoxon_p(diff) -> float:
+    """Two-sided p-value of the Wilcoxon signed-rank test that ``diff`` is symmetric about 0.
+
+    Zero differences are dropped (Wilcox's convention); NaN when fewer than one non-zero difference.
+    """
+    from scipy.stats import wilcoxon
+
+    d = np.asarray(diff, dtype=float)
+    d = d[np.isfinite(d)]
+    d = d[d != 0.0]
+    if len(d) == 0:
+        return float("nan")
+    return float(wilcoxon(d, zero_method="wilcox", alternative="two-sided").pvalue)
+
+
+def paired_comparison(a, b) -> dict:
+    """Compare paired errors ``a`` (method A) and ``b`` (method B): smaller is better.
+
+    Parameters
+    ----------
+    a, b : array_like [n]
+        Paired values (same outage start and seed at the same position); pairs with a NaN are dropped.
+
+    Returns
+    -------
+    dict
+        ``n`` pairs, ``wins`` (A < B), ``ties``, ``win_rate`` (wins / n), ``median_diff`` (median of A - B),
+        ``median_ratio`` (median of A / B), ``p_value`` (Wilcoxon signed-rank, two-sided).
+    """
+    a, b = np.asarray(a, dtype=float).ravel(), np.asarray(b, dtype=float).ravel()
+    if a.shape != b.shape:
+        raise DataError("paired_comparison", "a/b", "two arrays of the same length", f"{a.shape} and {b.shape}")
+    ok = np.isfinite(a) & np.isfinite(b)
+    a, b = a[ok], b[ok]
+    n = int(len(a))
+    if n == 0:
+        return {"n": 0, "wins": 0, "ties": 0, "win_rate": float("nan"), "median_diff": float("nan"),
+                "median_ratio": float("nan"), "p_value": float("nan")}
+    d = a - b
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(b != 0, a / b, np.nan)
+    return {"n": n, "wins": int(np.sum(d < 0)), "ties": int(np.sum(d == 0)), "win_rate": float(np.mean(d < 0)),
+            "median_diff": float(np.median(d)),
+            "median_ratio": float(np.nanmedian(ratio)) if np.isfinite(ratio).any() else float("nan"),
+            "p_value": wilcoxon_p(d)}
+
+
+__all__ = ["bootstrap_ci", "paired_comparison", "wilcoxon_p"]

@@ -1,0 +1,345 @@
+"""Outage evaluation (bgfn.evaluate) and its statistics (bgfn.stats).
+
+A small synthetic drive (demo trajectory, Ekinox-grade IMU errors, 5 Hz GNSS) keeps every test fast.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from bgfn import evaluate as ev
+from bgfn import learning as L
+from bgfn import stats
+from bgfn.config import PROFILES, load_profile
+from bgfn.data import Drive
+from bgfn.data import imu_errors as ie
+from bgfn.errors import DataError
+from bgfn.nav import earth, metrics, sim
+from bgfn.nav.filter import run_filter, run_outage
+from bgfn.nav.outages import OutageWindow, TablePseudoGps
+
+LEVER = [0.4, -0.2, -1.0]
+WINDOWS = [(60.0, 20.0), (110.0, 20.0)]
+NAV = {"init": {"position_std_m": 1.0, "height_std_m": 2.0, "velocity_std_mps": 0.1, "level_std_deg": 0.2,
+                "azimuth_std_deg": 1.0}}
+
+
+def _drive(gnss_rate=5.0, duration=150.0, seed=3) -> Drive:
+    ref = sim.demo_trajectory(duration)
+    imu_true = sim.imu_from_trajectory(ref)
+    params = ie.error_params("ekinox-d", {"gyro_bias_fixed": [2e-4, -3e-4, 4e-4],
+                                          "accel_bias_fixed": [0.03, -0.02, 0.02]})
+    speed = np.hypot(ref["v_n"], ref["v_e"]).to_numpy()[1:]
+    imu, errs, _ = ie.apply_imu_errors(imu_true, params, seed=seed, speed=speed)
+    gnss = sim.gnss_from_trajectory(ref, gnss_rate, 1.0, 2.0, LEVER, seed=seed + 1)
+    meta = {"lever_arm_m": LEVER, "imu_errors": errs, "gnss_rate_hz": gnss_rate, "imu_rate_hz": 100.0}
+    return Drive("synthetic", ref, imu, gnss, meta)
+
+
+class Heading:
+    """Fake network: dead reckoning at a fixed speed along the input yaw; records its inputs."""
+
+    def __init__(self, window=20, speed=8.0, interval=0.2, zero=False):
+        self.options = {"window": window, "alignment": "ending", "yaw_encoding": "unwrap", "extra_channels": [],
+                        "target_frame": "ned"}
+        self.speed, self.interval, self.zero = speed, interval, zero
+        self.seen = []
+
+    def predict_windows(self, ws):
+        self.seen.append(ws)
+        d = self.speed * self.interval * np.column_stack([np.cos(ws.yaw_ref), np.sin(ws.yaw_ref)])
+        return np.zeros_like(d) if self.zero else d
+
+
+@pytest.fixture(scope="module")
+def drive5():
+    return _drive(5.0)
+
+
+@pytest.fixture(scope="module")
+def ctx5(drive5):
+    return ev.navigation_context(drive5, NAV, [s for s, _ in WINDOWS])
+
+
+# ----------------------------------------------------------------------------------------------- Eq. pred-gps
+def test_pseudo_gps_accumulates_known_increments():
+    p0 = np.array([np.radians(45.06), np.radians(7.66), 250.0])
+    inc = np.tile([1.0, 2.0], (10, 1))                        # 1 m north, 2 m east per epoch
+    inc[4] = [-3.0, 0.5]
+    p = ev.pseudo_gps_positions(p0, inc)
+    ned = earth.lla_to_ned(p[:, 0], p[:, 1], p[:, 2], *p0)
+    expect = np.cumsum(inc, axis=0)                            # P_GPS(k) - P_GPS0 = sum_{i<=k} dP_i
+    np.testing.assert_allclose(ned[:, :2], expect, atol=1e-6)
+    assert expect[-1].tolist() == [6.0, 18.5]                  # 9*1 - 3 ; 9*2 + 0.5
+    assert np.all(np.abs(p[:, 2] - 250.0) < 1e-3)              # height is not moved by 2-D increments
+
+
+def test_fused_fixes_follow_eq_pred_gps(ctx5):
+    f = Heading(window=20)
+    run = ev.run_outages(ctx5, [WINDOWS[0]], f, "BGFN", 0, {"std_m": 1.0, "fusion_rate_hz": 1.0})[0]
+    # 5 Hz GNSS: five 0.2 s increments per 1 Hz fusion epoch, 20 fusion epochs
+    assert len(run.increments) == 100 and len(run.pseudo) == 20
+    np.testing.assert_allclose(np.diff(run.increments["time"]), 0.2, atol=1e-9)
+    cum = np.cumsum(run.increments[["dn", "de"]].to_numpy(), axis=0)[4::5]
+    np.testing.assert_allclose(run.pseudo[["cum_dn", "cum_de"]].to_numpy(), cum, atol=1e-9)
+    p0 = ctx5.state_at(WINDOWS[0][0]).antenna_position(ctx5.lever)
+    ned = earth.lla_to_ned(run.pseudo["lat"].to_numpy(), run.pseudo["lon"].to_numpy(), run.pseudo["h"].to_numpy(),
+                           *p0)
+    np.testing.assert_allclose(ned[:, :2], cum, atol=1e-6)
+    # each increment is 8 m/s * 0.2 s long
+    np.testing.assert_allclose(np.hypot(run.increments["dn"], run.increments["de"]), 1.6, atol=1e-9)
+
+
+# ----------------------------------------------------------------------------------------------- filter runs
+def test_ins_run_is_the_filters_standalone_ins(ctx5):
+    run = ev.run_outages(ctx5, [WINDOWS[1]], None)[0]
+    s, d = WINDOWS[1]
+    ref = run_outage(ctx5.drive.imu, ctx5.state_at(s), OutageWindow(s, d), ctx5.noise, ctx5.lever)
+    np.testing.assert_allclose(run.trajectory[["lat", "lon"]].to_numpy(), ref.trajectory[["lat", "lon"]].to_numpy(),
+                               rtol=0, atol=1e-12)
+    np.testing.assert_allclose(run.trajectory[["v_n", "v_e", "yaw"]].to_numpy(),
+                               ref.trajectory[["v_n", "v_e", "yaw"]].to_numpy(), rtol=0, atol=1e-9)
+    # INS errors grow through the outage
+    e = run.errors
+    assert e["horizontal"].iloc[-1] > 3 * e["horizontal"].iloc[:50].max()
+
+
+def test_hybrid_equals_run_filter_fed_with_the_same_fixes(ctx5):
+    f = Heading(window=20)
+    run = ev.run_outages(ctx5, [WINDOWS[0]], f, "BGFN", 0, {"std_m": 1.5, "fusion_rate_hz": 1.0})[0]
+    fx = run.pseudo.rename(columns={"std_m": "std_n"}).assign(std_e=lambda d: d["std_n"], std_d=np.nan)
+    s, d = WINDOWS[0]
+    ref = run_filter(ctx5.drive.imu, ctx5.state_at(s), ctx5.noise, None, ctx5.lever, [(s, d)],
+                     pseudo_gps=TablePseudoGps(fx), t_end=s + d, pseudo_rate_hz=1.0)
+    assert (ref.updates["kind"] == "pseudo").sum() == 20
+    np.testing.assert_allclose(run.trajectory[["lat", "lon", "h"]].to_numpy(),
+                               ref.trajectory[["lat", "lon", "h"]].to_numpy(), rtol=0, atol=1e-11)
+    np.testing.assert_allclose(run.trajectory[["v_n", "v_e", "roll", "yaw"]].to_numpy(),
+                               ref.trajectory[["v_n", "v_e", "roll", "yaw"]].to_numpy(), rtol=0, atol=1e-8)
+
+
+def test_inputs_use_the_runs_own_attitude(ctx5, drive5):
+    """Windows = Eq. eq21 inputs from the solution being computed (pre-outage: GPS-aided run), no truth."""
+    f = Heading(window=20, zero=True)
+    run = ev.run_outages(ctx5, [WINDOWS[0]], f, "BGFN", 0, {"std_m": 1e9, "fusion_rate_hz": 1.0})[0]
+    s = WINDOWS[0][0]
+    full = ctx5.full.trajectory
+    t0 = run.trajectory["time"].iloc[0]                        # state: last IMU epoch before the start
+    assert s - 0.011 < t0 < s
+    pre = full[(full["time"] <= t0 + 1e-9) & (full["time"] > s - 1.0)]
+    att = pd.concat([pre[["time", "roll", "pitch", "yaw"]], run.trajectory[["time", "roll", "pitch", "yaw"]].iloc[1:]])
+    epochs = np.concatenate([[s], run.increments["time"].to_numpy()])
+    expect = L.prediction_windows(drive5.imu, att, epochs, window=20)
+    got = np.concatenate([w.x for w in f.seen])
+    np.testing.assert_allclose(got, expect.x, rtol=0, atol=2e-6)
+    np.testing.assert_allclose(np.concatenate([w.yaw_ref for w in f.seen]), expect.yaw_ref, atol=1e-9)
+    # the attitude inside the outage is the INS solution's, not the truth
+    truth = drive5.reference.set_index("time").loc[run.increments["time"].round(6), "yaw"].to_numpy()
+    assert np.max(np.abs(L.wrap_angle(expect.yaw_ref - truth))) > 1e-5
+
+
+def test_evaluation_never_reads_gnss_inside_an_outage(drive5):
+    """NaN GNSS inside an outage changes nothing of that outage's INS and hybrid runs (only the GPS row)."""
+    for s, d in WINDOWS:
+        g = drive5.gnss.copy()
+        inside = OutageWindow(s, d).contains(g["time"])
+        assert inside.sum() == 100 and np.isclose(g["time"][inside].min(), s)     # a fix at t = start too
+        g.loc[inside, ["lat", "lon", "h", "std_n", "std_e", "std_d"]] = np.nan
+        blind = Drive(drive5.name, drive5.reference, drive5.imu, g, drive5.meta)
+        out = {}
+        for name, drv in (("with", drive5), ("nan", blind)):
+            ctx = ev.navigation_context(drv, NAV, [s])
+            runs = ev.run_outages(ctx, [(s, d)], None) + ev.run_outages(ctx, [(s, d)], Heading(), "BGFN", 0)
+            out[name] = [r.trajectory for r in runs] + [r.pseudo for r in runs[1:]], ev.gps_run(ctx, s, d).trajectory
+        for a, b in zip(out["with"][0], out["nan"][0]):
+            pd.testing.assert_frame_equal(a, b, check_exact=True)
+        # the GPS row (the lower bound) does use them: it changes
+        assert not np.allclose(out["with"][1]["lat"].to_numpy(), out["nan"][1]["lat"].to_numpy(), rtol=0,
+                               atol=1e-12)
+
+
+def test_window_metrics_match_nav_metrics(ctx5):
+    run = ev.run_outages(ctx5, [WINDOWS[0]], None)[0]
+    s, d = WINDOWS[0]
+    m = ev.window_metrics(run.errors, s, d)
+    ref = metrics.outage_metrics(run.errors, OutageWindow(s, d))
+    assert m["max_east_m"] == pytest.approx(ref["max_abs_east"])
+    assert m["max_north_m"] == pytest.approx(ref["max_abs_north"])
+    assert m["rmse_h_m"] == pytest.approx(ref["rmse_horizontal"])
+    assert m["final_h_m"] == pytest.approx(ref["end_horizontal"])
+    assert m["max_h_m"] == pytest.approx(ref["max_horizontal"])
+    # a prefix of a long run is the short outage (causal): same numbers as a 5 s run
+    short = ev.run_outages(ctx5, [(s, 5.0)], None)[0]
+    assert ev.window_metrics(run.errors, s, 5.0) == pytest.approx(ev.window_metrics(short.errors, s, 5.0))
+
+
+def test_prefix_of_a_hybrid_run_is_the_shorter_outage(ctx5):
+    s = WINDOWS[0][0]
+    long = ev.run_outages(ctx5, [(s, 20.0)], Heading(), "BGFN", 0)[0]
+    short = ev.run_outages(ctx5, [(s, 7.0)], Heading(), "BGFN", 0)[0]
+    assert ev.window_metrics(long.errors, s, 7.0) == pytest.approx(ev.window_metrics(short.errors, s, 7.0),
+                                                                   abs=1e-9)
+
+
+def test_gps_row_is_the_smallest_and_fusion_rate_must_divide_gnss_rate(ctx5):
+    s, d = WINDOWS[0]
+    gps = ev.window_metrics(ev.gps_run(ctx5, s, d).errors, s, d)
+    ins = ev.window_metrics(ev.run_outages(ctx5, [(s, d)], None)[0].errors, s, d)
+    assert gps["max_h_m"] < ins["max_h_m"]
+    with pytest.raises(DataError):
+        ev.run_outages(ctx5, [(s, d)], Heading(), "BGFN", 0, {"fusion_rate_hz": 2.0 / 3.0})
+
+
+# ----------------------------------------------------------------------------------------------- tables
+def test_aggregate_seeds_reduction_and_layout():
+    rows = []
+    for seed, val in ((0, 1.0), (1, 3.0), (2, 2.0)):
+        rows.append({"outage": 1, "method": "BGFN", "seed": seed, "max_east_m": val, "max_north_m": 2 * val,
+                     "rmse_h_m": val, "final_h_m": val, "max_h_m": val})
+    rows.append({"outage": 1, "method": "INS", "seed": None, "max_east_m": 10.0, "max_north_m": 8.0,
+                 "rmse_h_m": 5.0, "final_h_m": 9.0, "max_h_m": 11.0})
+    t = ev.aggregate_seeds(pd.DataFrame(rows))
+    assert list(t.columns) == list(ev.TABLE_COLUMNS) and list(t["method"]) == ["INS", "BGFN"]
+    assert t.loc[t["method"] == "BGFN", "max_east_m"].item() == 2.0          # median of 1, 3, 2
+    red = ev.error_reduction(t)
+    assert red["east_pct"].item() == pytest.approx(80.0) and red["north_pct"].item() == pytest.approx(50.0)
+    assert ev.aggregate_seeds(pd.DataFrame(rows), "first").loc[1, "max_east_m"] == 1.0
+    lay = ev.paper_layout(t, ev.paper_values("dataset"))
+    assert lay.loc[("Outage 1", "paper"), ("BGFN", "East")] == 4.7
+    assert lay.loc[("Outage 1", "ours"), ("INS", "North")] == 8.0
+    # the paper's quoted reduction (claims.yaml) is its Table 1 arithmetic
+    p = ev.error_reduction(ev.paper_values("dataset"))
+    c = ev.paper_claims()["bgfn_reduction_vs_ins_pct"]["dataset_outage1"]
+    got = p[(p["outage"] == 1) & (p["method"] == "BGFN")]
+    assert got["east_pct"].item() == pytest.approx(c["east"], abs=0.1)
+
+
+@pytest.mark.parametrize("profile", PROFILES)
+def test_profiles_have_a_valid_evaluate_section(profile):
+    cfg = load_profile(profile)
+    e = ev.evaluate_config(cfg["evaluate"], cfg["train"])
+    assert set(cfg["evaluate"]) == set(ev.EVALUATE_DEFAULTS)
+    assert e["sweep"]["n_starts"] >= 1 and e["seeds"]
+    if profile == "quick":
+        assert e["sweep"]["n_starts"] >= 20 and len(e["sweep"]["seeds"]) >= 3 and len(e["sweep"]["durations_s"]) >= 4
+    if profile == "paper":
+        assert len(e["sweep"]["seeds"]) >= 5
+
+
+def test_evaluate_config_rejects_unknown_keys():
+    with pytest.raises(DataError):
+        ev.evaluate_config({"no_such_key": 1})
+    with pytest.raises(DataError):
+        ev.evaluate_config({"sweep": {"n_starts": 2, "folds": 3}})
+
+
+def test_sweep_plan_spreads_starts_in_contiguous_folds(drive5):
+    sw = {"n_starts": 7, "folds": 3, "durations_s": [10.0, 30.0], "warmup_s": 20.0}
+    plan = ev.sweep_plan(drive5, sw, window_samples=50)
+    assert len(plan) == 7 and plan["start_s"].is_monotonic_increasing
+    assert plan["start_s"].min() >= 20.0 and plan["start_s"].max() + 30.0 <= drive5.imu["time"].iloc[-1]
+    assert plan["fold"].tolist() == [0, 0, 0, 1, 1, 2, 2]
+
+
+# ----------------------------------------------------------------------------------------------- statistics
+def test_bootstrap_interval_covers_the_known_median():
+    rng = np.random.default_rng(0)
+    x = 3.0 + rng.standard_normal(400)                    # true median 3
+    lo, hi = stats.bootstrap_ci(x, n_boot=1000, seed=1)
+    assert lo < 3.0 < hi and hi - lo < 0.4
+    # coverage over repeated samples is close to 95 %
+    hits = 0
+    for i in range(200):
+        y = rng.exponential(2.0, 40)                      # true median 2 ln 2
+        lo, hi = stats.bootstrap_ci(y, n_boot=400, seed=i)
+        hits += lo <= 2.0 * np.log(2.0) <= hi
+    assert 0.88 <= hits / 200 <= 0.99
+
+
+def test_cluster_bootstrap_is_wider_with_correlated_clusters():
+    rng = np.random.default_rng(2)
+    centres = rng.standard_normal(20)                     # 20 starts, 5 nearly equal seeds each
+    x = np.repeat(centres, 5) + 0.01 * rng.standard_normal(100)
+    g = np.repeat(np.arange(20), 5)
+    lo_i, hi_i = stats.bootstrap_ci(x, n_boot=1000, seed=0)
+    lo_c, hi_c = stats.bootstrap_ci(x, n_boot=1000, seed=0, groups=g)
+    assert (hi_c - lo_c) > 1.5 * (hi_i - lo_i)
+
+
+def test_paired_test_detects_a_shift_and_not_a_null():
+    rng = np.random.default_rng(4)
+    b = rng.lognormal(1.0, 0.5, 60)
+    a = b - 0.5 + 0.3 * rng.standard_normal(60)           # A better by 0.5 m on average
+    r = stats.paired_comparison(a, b)
+    assert r["p_value"] < 1e-6 and r["win_rate"] > 0.8 and r["median_diff"] < 0
+    rejections = 0
+    for i in range(200):
+        b = rng.lognormal(1.0, 0.5, 60)
+        a = b + 0.3 * rng.standard_normal(60)             # no shift
+        rejections += stats.paired_comparison(a, b)["p_value"] < 0.05
+    assert rejections / 200 < 0.10
+    assert np.isnan(stats.paired_comparison([1.0, 2.0], [1.0, 2.0])["p_value"])
+
+
+def test_sweep_summary_and_comparisons():
+    rows = []
+    rng = np.random.default_rng(1)
+    for start in range(12):
+        ins = 10.0 + rng.random()
+        for seed in range(3):
+            for m, v in (("INS", ins), ("BGFN", 0.5 * ins + 0.1 * rng.random()), ("MLP", ins + 1.0)):
+                rows.append({"dataset": "d", "start_s": float(start), "duration_s": 30.0, "method": m,
+                             "seed": seed, "fold": 0, "max_h_m": v})
+    df = pd.DataFrame(rows)
+    s = ev.sweep_summary(df, n_boot=300)
+    ins = s[s["method"] == "INS"].iloc[0]
+    assert ins["n"] == 12 and ins["ci_lo_m"] <= ins["median_m"] <= ins["ci_hi_m"]
+    c = ev.sweep_comparisons(df).set_index("baseline")
+    assert c.loc["INS", "win_rate"] == 1.0 and c.loc["MLP", "wins"] == 36 and c.loc["INS", "p_value"] < 1e-6
+    assert c.loc["INS", "n_starts"] == 12 and c.loc["INS", "p_value_by_start"] < 1e-2
+
+
+def test_validation_std_grows_with_the_accumulated_increments(ctx5):
+    f = Heading(window=20)
+    f.val_rmse_m = 0.5 * np.sqrt(2.0)                          # 0.5 m per axis and increment
+    run = ev.run_outages(ctx5, [WINDOWS[0]], f, "BGFN", 0, {"std_m": "validation", "fusion_rate_hz": 1.0})[0]
+    k = np.arange(1, 21)
+    np.testing.assert_allclose(run.pseudo["std_m"], 0.5 * np.sqrt(5 * k))   # 5 increments per fix
+    with pytest.raises(DataError):
+        ev.run_outages(ctx5, [WINDOWS[0]], Heading(), "BGFN", 0, {"std_m": "validation"})
+
+
+def test_saved_tables_have_the_schema(ctx5, tmp_path):
+    runs = ev.run_outages(ctx5, WINDOWS, None) + [ev.gps_run(ctx5, s, d) for s, d in WINDOWS]
+    runs += ev.run_outages(ctx5, WINDOWS, Heading(), "BGFN", 0)
+    per_seed = pd.DataFrame([{"outage": 1 + WINDOWS.index((r.start, r.duration)), "start_s": r.start,
+                              "method": r.method, "seed": r.seed, **ev.window_metrics(r.errors, r.start, r.duration)}
+                             for r in runs])
+    res = ev.TableResult("synthetic", "dataset", per_seed, ev.aggregate_seeds(per_seed), runs)
+    paths = ev.save_table_result(tmp_path, res, series_rate_hz=5.0)
+    t = pd.read_csv(paths["table"])
+    assert list(t.columns) == list(ev.TABLE_COLUMNS) and paths["table"].name == "outage_dataset.csv"
+    assert t.groupby("outage")["method"].apply(list).tolist() == [["INS", "BGFN", "GPS"]] * 2
+    assert np.all(np.isfinite(t[list(ev.METRIC_COLUMNS)].to_numpy())) and (t[list(ev.METRIC_COLUMNS)] > 0).all().all()
+    s = pd.read_csv(paths["series"])
+    ins = s[(s["method"] == "INS") & (s["outage"] == 1)]
+    assert np.allclose(np.diff(ins["t_rel"]), 0.2) and ins["h_m"].iloc[-1] > ins["h_m"].iloc[0]
+
+
+def test_real_imu_switch_falls_back_to_the_simulated_datasets(monkeypatch, tmp_path):
+    from bgfn.data import acquire
+
+    present = {"ekinox_imu.mat"}
+
+    def fake_resolve(name, **kw):
+        path = tmp_path / name if name in present else None
+        return acquire.Resolved(name, path, "raw" if path else "missing", None, "test")
+
+    monkeypatch.setattr(acquire, "resolve", fake_resolve)
+    names, notes = ev.choose_datasets(["turin-sim-ekinox", "turin-sim-mpu6000"], real_imu=True)
+    assert names == ["navego-ekinox", "turin-sim-mpu6000"]
+    assert "absent" in notes[1] and "navego-mpu6000" in notes[1]
+    assert ev.choose_datasets(["turin-sim-ekinox"], real_imu=False) == (["turin-sim-ekinox"], [])
+    assert ev.PAPER_TESTS["navego-ekinox"] == "dataset" and ev.PAPER_TESTS["navego-mpu6000"] == "field"

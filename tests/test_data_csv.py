@@ -11,20 +11,7 @@ from bgfn.data.imu_errors import error_params
 from bgfn.errors import DataError
 from bgfn.nav.sim import demo_trajectory, imu_from_trajectory
 
-
-@pytest.fixture(autouse=True)
-def repo_untouched(tmp_path, monkeypatch):
-    """Default data/ and results/ locations point to sentinels that must stay absent.
-
-    (The repository's own data/ and results/ are shared with concurrent runs, so they are not diffed.)
-    """
-    from bgfn import config
-
-    monkeypatch.setenv("BGFN_DATA_DIR", str(tmp_path / "default-data"))
-    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path / "default-results")
-    yield
-    assert not (tmp_path / "default-data").exists(), "a test wrote to the default data folder"
-    assert not (tmp_path / "default-results").exists(), "a test wrote to the default results folder"
+pytestmark = pytest.mark.usefixtures("repo_untouched")
 
 
 @pytest.fixture(scope="module")

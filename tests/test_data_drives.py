@@ -14,34 +14,11 @@ from bgfn.data import DATASETS, acquire, drives, load_drive
 from bgfn.data.imu_errors import OPTIONAL_VECTOR_KEYS, VECTOR_KEYS
 from bgfn.errors import ChecksumError, DataError
 from bgfn.nav.sim import imu_from_trajectory
+from conftest import REQUIRED
 
-REQUIRED = ("ref.mat", "ekinox_gnss.mat")
+pytestmark = pytest.mark.usefixtures("repo_untouched")
+
 NO_ERRORS = {**{k: 0.0 for k in VECTOR_KEYS if not k.endswith("corr_time")}, **dict.fromkeys(OPTIONAL_VECTOR_KEYS)}
-
-
-@pytest.fixture(scope="module")
-def mirror():
-    for folder in (acquire.raw_dir(), acquire.mirror_dir()):
-        if folder is not None and all((folder / f).is_file() for f in REQUIRED):
-            return folder
-    pytest.skip("NaveGo mirror not available (set BGFN_DATA_MIRROR)")
-
-
-@pytest.fixture(autouse=True)
-def repo_untouched(tmp_path, monkeypatch):
-    """Default data/ and results/ locations point to sentinels that must stay absent.
-
-    (The repository's own data/ and results/ are shared with concurrent runs, so they are not diffed.)
-    """
-    from bgfn import config
-
-    monkeypatch.setenv("BGFN_DATA_DIR", str(tmp_path / "default-data"))
-    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path / "default-results")
-    monkeypatch.setattr(acquire, "_download",
-                        lambda url, timeout_s: (_ for _ in ()).throw(ConnectionError(f"{url}: offline test")))
-    yield
-    assert not (tmp_path / "default-data").exists(), "a test wrote to the default data folder"
-    assert not (tmp_path / "default-results").exists(), "a test wrote to the default results folder"
 
 
 @pytest.fixture()

@@ -11,28 +11,7 @@ from bgfn.data.navego import (GNSS_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS, read
                               read_reference, resample_imu)
 from bgfn.errors import DataError
 
-
-@pytest.fixture(autouse=True)
-def repo_untouched(tmp_path, monkeypatch):
-    """Default data/ and results/ locations point to sentinels that must stay absent.
-
-    (The repository's own data/ and results/ are shared with concurrent runs, so they are not diffed.)
-    """
-    from bgfn import config
-
-    monkeypatch.setenv("BGFN_DATA_DIR", str(tmp_path / "default-data"))
-    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path / "default-results")
-    yield
-    assert not (tmp_path / "default-data").exists(), "a test wrote to the default data folder"
-    assert not (tmp_path / "default-results").exists(), "a test wrote to the default results folder"
-
-
-@pytest.fixture(scope="module")
-def navego():
-    for folder in (acquire.raw_dir(), acquire.mirror_dir()):
-        if folder is not None and all((folder / f).is_file() for f in ("ref.mat", "ekinox_gnss.mat")):
-            return folder
-    pytest.skip("NaveGo mirror not available (set BGFN_DATA_MIRROR)")
+pytestmark = pytest.mark.usefixtures("repo_untouched")
 
 
 def imu_struct(n=400, rate=200.0, t0=138001.0, seed=0):
@@ -47,13 +26,13 @@ def write_mat(path, name, struct):
     return path
 
 
-def test_real_reference_and_gnss(navego):
-    ref = read_reference(navego / "ref.mat")
+def test_real_reference_and_gnss(mirror):
+    ref = read_reference(mirror / "ref.mat")
     assert list(ref.columns) == list(REFERENCE_COLUMNS) and len(ref) == 1260
     assert ref["time"].iloc[0] == 138001.0 and ref["time"].iloc[-1] == 139260.0
     assert np.all(np.diff(ref["time"]) == 1.0) and np.abs(ref["yaw"]).max() <= np.pi
     assert np.degrees(ref["lat"].iloc[0]) == pytest.approx(45.06, abs=0.05)  # Turin
-    gnss, info = read_gnss(navego / "ekinox_gnss.mat")
+    gnss, info = read_gnss(mirror / "ekinox_gnss.mat")
     assert list(gnss.columns) == list(GNSS_COLUMNS) and len(gnss) == 6295
     assert info["rate_hz"] == 5.0 and info["lever_arm_m"] == [0.0, 0.0, -0.219]
     assert (gnss["std_n"] == 1.0).all() and (gnss["std_d"] == 3.0).all()  # from stdm = [1 1 3]
@@ -116,8 +95,8 @@ def test_bad_imu_struct_names_file_and_field(tmp_path, case, field):
         assert "t[99]" in str(exc.value)
 
 
-def test_truncated_or_garbage_mat_is_a_data_error(tmp_path, navego):
-    data = (navego / "ref.mat").read_bytes()
+def test_truncated_or_garbage_mat_is_a_data_error(tmp_path, mirror):
+    data = (mirror / "ref.mat").read_bytes()
     trunc = tmp_path / "ref.mat"
     trunc.write_bytes(data[: len(data) // 3])
     with pytest.raises(DataError) as exc:
@@ -130,8 +109,8 @@ def test_truncated_or_garbage_mat_is_a_data_error(tmp_path, navego):
         read_reference(garbage)
 
 
-def test_reference_missing_field_and_bad_units(tmp_path, navego):
-    ref = scipy.io.loadmat(navego / "ref.mat", squeeze_me=True, struct_as_record=False)["ref"]
+def test_reference_missing_field_and_bad_units(tmp_path, mirror):
+    ref = scipy.io.loadmat(mirror / "ref.mat", squeeze_me=True, struct_as_record=False)["ref"]
     s = {f: getattr(ref, f) for f in ref._fieldnames}
     del s["vel"]
     path = write_mat(tmp_path / "ref.mat", "ref", s)

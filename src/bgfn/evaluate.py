@@ -261,18 +261,15 @@ def navigation_context(drive, nav_section: dict | None, starts: Sequence[float])
     """
     from bgfn.nav import baseline
     from bgfn.nav.filter import run_filter
+    from bgfn.nav.outages import epochs_before
 
     cfg = baseline.nav_config(nav_section)
     initial, noise = baseline.filter_setup(drive, cfg)
     lever = np.asarray(drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0]), dtype=float)
     starts = sorted({float(s) for s in starts})
     imu_time = drive.imu["time"].to_numpy(float)
-    # The state is taken at the last IMU epoch *before* the start: a fix at t = start belongs to the outage
-    # (windows are [start, end)), and a snapshot at the start row would already hold it.
-    before = np.searchsorted(imu_time, np.asarray(starts) - 1e-6, side="left") - 1
-    if len(starts) and before.min() < 0:
-        raise DataError(drive.name, "start", "outage starts after the first IMU sample", str(starts[0]))
-    snaps = {f"start_{i}": float(imu_time[j]) for i, j in enumerate(before)}
+    # The state is taken at the last IMU epoch *before* the start (bgfn.nav.outages.epochs_before).
+    snaps = {f"start_{i}": float(t) for i, t in enumerate(epochs_before(imu_time, starts, drive.name))}
     full = run_filter(drive.imu, initial, noise, drive.gnss, lever, snapshots=snaps, source=drive.name)
     states = {s: full.states[f"start_{i}"] for i, s in enumerate(starts)}
     imu = drive.imu[["accel_x", "accel_y", "accel_z", "gyro_x", "gyro_y", "gyro_z"]].to_numpy(float)

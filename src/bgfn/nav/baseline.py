@@ -22,7 +22,7 @@ import pandas as pd
 from ..errors import DataError
 from . import metrics
 from .filter import FilterResult, run_filter, run_outage
-from .outages import OutageWindow, check_windows
+from .outages import OutageWindow, check_windows, epochs_before
 from .state import FilterNoise, FilterState, initial_covariance, initial_state, noise_from_imu_errors
 
 #: Defaults of the ``nav:`` profile section.
@@ -154,8 +154,9 @@ def run_baseline(drive, cfg: dict) -> Baseline:
     initial, noise = filter_setup(drive, cfg)
     lever = drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0])
     names = [f"outage_{i + 1}" for i in range(len(windows))]
+    starts = epochs_before(drive.imu["time"], [w.start for w in windows], drive.name)
     full = run_filter(drive.imu, initial, noise, drive.gnss, lever,
-                      snapshots={n: w.start for n, w in zip(names, windows)}, source=drive.name)
+                      snapshots=dict(zip(names, starts)), source=drive.name)
     errors = metrics.navigation_errors(full.trajectory, drive.reference)
     rows, outage_errors = [], {}
     for n, w in zip(names, windows):

@@ -88,6 +88,30 @@ NAVEGO_OUTAGE_STARTS = (138906.0, 139170.0)
 OUTAGE_DURATION_S = 30.0
 
 
+def epochs_before(imu_time, starts, source: str = "outage_windows") -> np.ndarray:
+    """The last IMU epoch strictly before each outage start, s.
+
+    An outage run starts from the GPS-aided filter state at this epoch: windows are ``[start, end)``, so a
+    fix at ``t = start`` belongs to the outage, and a state taken at the start row would already hold it.
+
+    Parameters
+    ----------
+    imu_time : array_like, shape (n,)
+        IMU epochs, s, increasing.
+    starts : array_like
+        Outage starts, s.
+    source : str
+        Name used in error messages.
+    """
+    imu_time = np.asarray(imu_time, dtype=float)
+    starts = np.atleast_1d(np.asarray(starts, dtype=float))
+    before = np.searchsorted(imu_time, starts - 1e-6, side="left") - 1
+    if starts.size and before.min() < 0:
+        raise DataError(source, "start", f"outage starts after the first IMU epoch {imu_time[0]}",
+                        str(starts.min()))
+    return imu_time[before]
+
+
 def outage_windows(drive=None, section: dict | None = None) -> list:
     """The evaluation outages ``[(start, duration), ...]`` (s) of a profile section.
 

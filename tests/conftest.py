@@ -1,0 +1,32 @@
+"""Fixtures shared by the data tests."""
+
+import pytest
+
+from bgfn.data import acquire
+
+#: The two public NaveGo files every simulated dataset needs.
+REQUIRED = ("ref.mat", "ekinox_gnss.mat")
+
+
+@pytest.fixture
+def repo_untouched(tmp_path, monkeypatch):
+    """Default data/ and results/ locations point to sentinels that must stay absent.
+
+    (The repository's own data/ and results/ are shared with concurrent runs, so they are not diffed.)
+    """
+    from bgfn import config
+
+    monkeypatch.setenv("BGFN_DATA_DIR", str(tmp_path / "default-data"))
+    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path / "default-results")
+    yield
+    assert not (tmp_path / "default-data").exists(), "a test wrote to the default data folder"
+    assert not (tmp_path / "default-results").exists(), "a test wrote to the default results folder"
+
+
+@pytest.fixture(scope="module")
+def mirror():
+    """A folder holding verified copies of the two public files (data/raw or the shared mirror), else skip."""
+    for folder in (acquire.raw_dir(), acquire.mirror_dir()):
+        if folder is not None and all((folder / f).is_file() for f in REQUIRED):
+            return folder
+    pytest.skip("NaveGo mirror not available (set BGFN_DATA_MIRROR)")

@@ -37,7 +37,7 @@ PIP := $(PY) -m pip
 LOCK_HASH := $(shell sha256sum requirements.lock | cut -c1-16)
 STAMP := $(VENV)/.installed-$(LOCK_HASH)
 
-NOTEBOOKS := 01_data_prep 02_kf_baseline 03_bgfn_training 04_outage_evaluation 05_energy_estimate
+NOTEBOOKS := 01_data_prep 02_kf_baseline 03_bgfn_training 04_outage_evaluation 05_energy_estimate 06_results
 PARAMS := params/$(PROFILE).yaml
 RES := results/$(PROFILE)
 EXEC := $(NOTEBOOKS:%=$(RES)/notebooks/%.ipynb)
@@ -121,6 +121,9 @@ $(RES)/notebooks/02_kf_baseline.ipynb: $(RES)/notebooks/01_data_prep.ipynb
 $(RES)/notebooks/03_bgfn_training.ipynb: $(RES)/notebooks/02_kf_baseline.ipynb
 $(RES)/notebooks/04_outage_evaluation.ipynb: $(RES)/notebooks/03_bgfn_training.ipynb
 $(RES)/notebooks/05_energy_estimate.ipynb: $(RES)/notebooks/04_outage_evaluation.ipynb
+# 06 (the results page) reads every earlier output and the paper's published values.
+$(RES)/notebooks/06_results.ipynb: $(RES)/notebooks/05_energy_estimate.ipynb data/paper/outage_max_errors.csv \
+  data/paper/claims.yaml
 
 notebooks: $(EXEC)
 

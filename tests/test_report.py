@@ -1,0 +1,336 @@
+"""bgfn.report (the results page's tables and sentences), the book's sources and tools/check_book.py.
+
+The book must never show a result typed by hand: :func:`test_book_pages_type_no_results` scans the Markdown
+pages (and notebook 06's Markdown cells) for numbers with a unit of length, energy or a percentage, and
+accepts only the paper's and the profiles' *settings* listed in :data:`ALLOWED`.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import math
+import re
+from pathlib import Path
+
+import nbformat
+import numpy as np
+import pandas as pd
+import pytest
+
+from bgfn import report
+from bgfn.config import PROJECT_ROOT
+
+BOOK = PROJECT_ROOT / "book"
+
+
+def table(rows):
+    return pd.DataFrame(rows, columns=["outage", "method", "max_east_m", "max_north_m"])
+
+
+OURS = table([(2, "BGFN", 3.0, 4.0), (1, "INS", 20.0, 10.0), (1, "BGFN", 5.0, 12.0), (2, "INS", 6.0, 8.0),
+              (1, "MLP", 7.0, 9.0), (1, "GPS", 1.0, 1.0)])
+PAPER = table([(1, "INS", 23.1, 23.2), (1, "BGFN", 4.7, 4.8), (2, "BGFN", 1.8, 4.2), (2, "INS", 10.6, 19.6),
+               (1, "AT-LSTM", 7.9, 7.7)])
+
+
+# ----------------------------------------------------------------------------------------------- tables
+def test_paper_layout_joins_on_outage_and_method():
+    lay = report.paper_layout(OURS, PAPER, ours_label="ours (t)")
+    assert list(lay.index) == ["Outage 1", "Outage 2"]
+    assert list(lay.columns.get_level_values(0).unique()) == ["ours (t)", "paper"]
+    assert lay.loc["Outage 1", ("ours (t)", "BGFN", "North")] == 12.0
+    assert lay.loc["Outage 2", ("ours (t)", "INS", "East")] == 6.0
+    assert lay.loc["Outage 2", ("paper", "BGFN", "North")] == 4.2
+    assert lay.loc["Outage 1", ("paper", "AT-LSTM", "East")] == 7.9
+    # a value one side lacks is NaN, never another row's value
+    assert math.isnan(lay.loc["Outage 2", ("ours (t)", "MLP", "East")])
+    assert math.isnan(lay.loc["Outage 1", ("paper", "MLP", "North")])
+    assert math.isnan(lay.loc["Outage 2", ("paper", "AT-LSTM", "North")])
+    # the paper's four methods in its order; the extra GPS row stays out of this layout
+    assert list(lay.columns.get_level_values(1).unique()) == list(report.PAPER_METHODS)
+
+
+def test_paper_layout_without_our_table_keeps_the_papers_values():
+    lay = report.paper_layout(None, PAPER)
+    assert lay[("ours", "BGFN", "East")].isna().all()
+    assert lay.loc["Outage 1", ("paper", "INS", "North")] == 23.2
+
+
+def test_paper_table_read_from_the_transcription():
+    raw = pd.read_csv(PROJECT_ROOT / "data" / "paper" / "outage_max_errors.csv")
+    for test in report.TESTS:
+        p = report.paper_outage_table(test)
+        lay = report.paper_layout(None, p)
+        for r in raw[raw["test"] == test].itertuples():
+            assert lay.loc[f"Outage {r.outage}", ("paper", r.method, "East")] == r.max_east_m
+            assert lay.loc[f"Outage {r.outage}", ("paper", r.method, "North")] == r.max_north_m
+    with pytest.raises(ValueError):
+        report.paper_outage_table("no-such-test")
+
+
+def test_best_mask_marks_the_smallest_per_source_and_axis():
+    mask = report.best_mask(report.paper_layout(OURS, PAPER))
+    assert mask.loc["Outage 1", ("ours", "BGFN", "East")]            # 5 < 7 < 20
+    assert mask.loc["Outage 1", ("ours", "MLP", "North")]            # 9 < 10 < 12
+    assert not mask.loc["Outage 1", ("ours", "BGFN", "North")]
+    assert mask.loc["Outage 1", ("paper", "BGFN", "East")] and mask.loc["Outage 1", ("paper", "BGFN", "North")]
+    html = report.style_layout(report.paper_layout(OURS, PAPER), "cap").to_html()
+    assert "cap" in html and "font-weight: bold" in html and "<table" in html
+
+
+def test_reductions_by_hand():
+    red = report.reductions(OURS).set_index(["outage", "method"])
+    # outage 1: INS 20 / 10 -> BGFN 5 / 12: east 100 (20 - 5) / 20 = 75 %, north 100 (10 - 12) / 10 = -20 %
+    assert red.loc[(1, "BGFN"), "east_pct"] == pytest.approx(75.0)
+    assert red.loc[(1, "BGFN"), "north_pct"] == pytest.approx(-20.0)
+    # MLP 7 / 9: 65 % and 10 %; outage 2: INS 6 / 8 -> BGFN 3 / 4: 50 % and 50 %
+    assert red.loc[(1, "MLP"), "east_pct"] == pytest.approx(65.0)
+    assert red.loc[(1, "MLP"), "north_pct"] == pytest.approx(10.0)
+    assert red.loc[(2, "BGFN"), ["east_pct", "north_pct"]].tolist() == pytest.approx([50.0, 50.0])
+    assert (1, "INS") not in red.index
+
+
+def test_reduction_comparison_ours_paper_table_and_text():
+    claims = {"bgfn_reduction_vs_ins_pct": {"dataset_outage1": {"east": 79.7, "north": 79.3}}}
+    comp = report.reduction_comparison(OURS, PAPER, claims, "dataset")
+    assert comp.loc["Outage 1", ("ours", "East")] == pytest.approx(75.0)
+    assert comp.loc["Outage 1", ("paper (table)", "East")] == pytest.approx(100 * (23.1 - 4.7) / 23.1)
+    assert comp.loc["Outage 1", ("paper (text)", "North")] == 79.3
+    assert math.isnan(comp.loc["Outage 2", ("paper (text)", "East")])
+    lines = report.reduction_sentences(comp)
+    assert "Outage 1, east: with BGFN the max error of INS is reduced by 75.0 %" in lines[0]
+    assert "increased by 20.0 %" in lines[1]
+
+
+def test_the_papers_text_agrees_with_its_tables():
+    # a consistency check of the transcription: each percentage of Sec. 4 follows from the tables
+    claims = report.paper_claims()
+    for key, stated in claims["bgfn_reduction_vs_ins_pct"].items():
+        test, outage = key.split("_outage")
+        comp = report.reduction_comparison(None, report.paper_outage_table(test), claims, test)
+        for axis in ("East", "North"):
+            assert comp.loc[f"Outage {outage}", ("paper (table)", axis)] == pytest.approx(
+                stated[axis.lower()], abs=0.05)
+
+
+def test_energy_table_and_sentences():
+    energy = {"energy_uj_per_prediction": {"bgfn": 0.25, "transformer": 1.0}, "reduction_pct": 75.0,
+              "macs": {"bgfn": 10.0, "transformer": 100.0}, "sops": {"bgfn": 5.0}, "e_mac_pj": 4.6,
+              "e_ac_pj": 0.9, "time_steps": 4}
+    claims = {"energy_reduction_vs_transformer_pct": 66.3}
+    t = report.energy_table(energy, claims)
+    assert t.loc["energy reduction (%)", "ours"] == 75.0 and t.loc["energy reduction (%)", "paper"] == 66.3
+    assert t.loc["BGFN energy per prediction (µJ)", "ours"] == 0.25
+    assert math.isnan(t.loc["BGFN energy per prediction (µJ)", "paper"])
+    s = report.energy_sentences(energy, claims)[0]
+    assert "75.0 % less" in s and "66.3 %" in s and "8.7 percentage points higher" in s
+    missing = report.energy_table(None, claims)
+    assert missing["ours"].isna().all() and missing.loc["energy reduction (%)", "paper"] == 66.3
+    assert "missing" in report.energy_sentences(None, claims)[0]
+
+
+def test_comparison_sentences_say_who_wins():
+    lines = report.comparison_sentences("dataset", OURS, PAPER)
+    by = {(ln.split(",")[0], ln.split(" vs ")[1].split(":")[0]): ln for ln in lines}
+    ins1 = by[("Outage 1", "INS")]
+    assert "BGFN's max east error is 5.0 m vs INS's 20.0 m, its max north error 12.0 m vs 10.0 m" in ins1
+    assert "better in east, worse in north" in ins1
+    assert "paper: 4.7 m vs 23.1 m east, 4.8 m vs 23.2 m north, better on both axes" in ins1
+    assert "worse on both axes" in by[("Outage 1", "GPS")] and "lower bound" in by[("Outage 1", "GPS")]
+    assert "better on both axes" in by[("Outage 2", "INS")]
+    # equal at the tables' precision is called equal
+    tie = table([(1, "INS", 5.04, 3.0), (1, "BGFN", 5.0, 2.0)])
+    assert "equal in east, better in north" in report.comparison_sentences("field", tie, None)[0]
+
+
+def test_win_counts_and_summary():
+    assert report.win_counts(OURS)["INS"] == (3, 4)            # 5<20, 12>10, 3<6, 4<8
+    assert report.win_counts(OURS)["MLP"] == (1, 2)            # outage 1 only: 5<7, 12>9
+    assert report.win_counts(PAPER)["INS"] == (4, 4)
+    s = report.summary_sentence("dataset", OURS, PAPER)
+    assert "against INS in 3 of 4 (paper: 4 of 4)" in s and "against MLP in 1 of 2" in s
+    assert "missing" in report.summary_sentence("field", None, PAPER)
+
+
+def test_missing_inputs_are_reported_not_fatal(tmp_path):
+    assert report.read_csv(tmp_path / "nope.csv") is None
+    assert report.read_json(tmp_path / "nope.json") is None
+    assert report.kf_table(None) is None and report.training_table(None) is None
+    assert report.sweep_table(None) is None
+    assert "is missing" in report.missing_note(tmp_path / "nope.csv", "the sweep", "notebook 04")
+    (tmp_path / "a.png").write_bytes(b"x")
+    figs = report.figure_list(tmp_path, [{"label": "a", "file": "a.png", "by": "x", "caption": "c"},
+                                         {"label": "b", "file": "b_{dataset}.png", "by": "x", "caption": "{dataset}",
+                                          "datasets": "sweep"}],
+                              {"all": ["d1", "d2"], "sweep": ["d2"]})
+    assert [(f["file"], f["exists"]) for f in figs] == [("a.png", True), ("b_d2.png", False)]
+    assert figs[1]["caption"] == "d2"
+
+
+def test_read_csv_skips_metadata_comments(tmp_path):
+    p = tmp_path / "t.csv"
+    p.write_text("# profile: smoke\n# seed: 1\noutage,method,max_east_m,max_north_m\n1,INS,2.5,3.5\n")
+    t = report.read_csv(p)
+    assert list(t.columns) == ["outage", "method", "max_east_m", "max_north_m"] and t.iloc[0]["max_east_m"] == 2.5
+
+
+def test_meta_and_provenance_lines():
+    meta = {"profile": "smoke", "params_file": "params/smoke.yaml", "params_sha256": "a" * 64, "seed": 7,
+            "git_commit": "0123456789abcdef", "git_dirty": True, "packages": {"torch": "2.0", "spikingjelly": "2.0.0"}}
+    same = report.meta_line(meta, {"params_sha256": "a" * 64})
+    assert "profile `smoke`" in same and "unchanged since" in same and "commit `0123456`" in same
+    assert "uncommitted" in same and "torch 2.0" in same
+    assert "**changed since**" in report.meta_line(meta, {"params_sha256": "b" * 64})
+    line = report.provenance("results/smoke/tables/x.csv", meta, None, dataset="`d`", seeds=[0, 1, 2])
+    assert line.startswith("*Source: `results/smoke/tables/x.csv`") and "dataset `d`" in line
+    assert "seeds 0, 1, 2" in line
+    assert report.meta_line(None) == "no run metadata recorded"
+
+
+def test_cards_line_and_outage_provenance(tmp_path):
+    d = tmp_path / "p" / "models" / "ds"
+    d.mkdir(parents=True)
+    for m, seed in (("bgfn", 0), ("bgfn", 1), ("mlp", 0)):
+        card = {"method": m, "seed": seed, "size": "smoke", "epochs_run": 2 + seed, "options": {"window": 50},
+                "size_cfg": {"dim": 16, "depth": 1, "heads": 2, "time_steps": 2, "ffn_dim": 16}}
+        (d / f"{m}_seed{seed}.json").write_text(json.dumps(card))
+    (d / "fold0").mkdir()
+    (d / "fold0" / "bgfn_seed9.json").write_text(json.dumps({"method": "bgfn", "seed": 9}))
+    cards = report.model_cards("p", "ds", tmp_path)
+    assert len(cards) == 3                                      # fold models are not the tables' networks
+    line = report.cards_line(cards)
+    assert "seeds 0, 1" in line and "T_s 2" in line and "window N = 50" in line and "epochs run 2-3" in line
+    ev = {"datasets": ["turin-sim-ekinox", "turin-sim-mpu6000"], "meta": {"profile": "p"},
+          "evaluate": {"seeds": [0, 1], "seed_aggregate": "median", "outage_windows": [[100.0, 30.0]]}}
+    assert report.outage_datasets(ev) == {"dataset": "turin-sim-ekinox", "field": "turin-sim-mpu6000"}
+    prov = report.outage_provenance("p", "dataset", tmp_path / "p", ev)
+    assert "dataset `turin-sim-ekinox`" in prov and "seeds 0, 1 (median over seeds)" in prov
+
+
+def test_training_and_sweep_tables():
+    summary = pd.DataFrame({"dataset": ["d"], "method": ["at_lstm"], "params": [722], "seeds": [3],
+                            "val_rmse_m_mean": [2.2]})
+    t = report.training_table(summary)
+    assert t.index[0] == ("d", "AT-LSTM") and t.loc[("d", "AT-LSTM"), "val. RMSE (m)"] == 2.2
+    sw = pd.DataFrame({"dataset": ["d", "d"], "duration_s": [10.0, 30.0], "method": ["BGFN", "BGFN"], "n": [4, 4],
+                       "n_starts": [2, 2], "median_m": [1.23, 4.56], "ci_lo_m": [1.0, 4.0], "ci_hi_m": [2.0, 5.0]})
+    w = report.sweep_table(sw)
+    assert w.loc[("d", "BGFN"), "10 s"] == "1.2 [1.0, 2.0]" and w.loc[("d", "BGFN"), "30 s"] == "4.6 [4.0, 5.0]"
+    assert report.fmt_num(2800.0) == "2,800" and report.fmt_num(0.0133) == "0.0133" and report.fmt_num(np.nan) == "-"
+
+
+# ----------------------------------------------------------------------------------------------- the book
+#: Numbers with a unit the book may type: the paper's and the profiles' settings, never a result.
+ALLOWED: dict[str, str] = {
+    "0.05 m": "truth smoothing sigma (setting, deviations row 5)",
+    "10 %": "Ekinox run-to-run bias part (setting, row 7)",
+    "3 %": "MPU-6000 scale-factor tolerance (setting, row 8)",
+    "2 %": "MPU-6000 cross-axis tolerance (setting, row 8)",
+    "[0.3, 0.3, 0.6] m": "simulated GNSS white noise (setting, row 9)",
+    "[1, 1, 2] m": "simulated GNSS correlated noise (setting, row 9)",
+    "[-0.369, 0, -0.219] m": "lever arm (setting, row 9)",
+    "[1, 1, 3] m": "Ekinox GNSS stdm (data setting, row 10)",
+    "4.6 pJ": "45 nm float32 MAC energy (Horowitz 2014, setting, row 20)",
+    "0.9 pJ": "45 nm float32 add energy (Horowitz 2014, setting, row 20)",
+    "95 %": "bootstrap interval level (setting, row 26)",
+}
+UNIT = r"(?:%|m/s\b|m\b|km\b|cm\b|mm\b|µJ|uJ|mJ|nJ|pJ|J\b)"
+RESULT_LIKE = re.compile(r"(?<![\w.\-])(?:\[[^\]\n]*\d[^\]\n]*\]|-?\d+(?:\.\d+)?)\s*" + UNIT)
+#: Directive options (figure widths) are layout, not numbers of the paper.
+OPTION_LINE = re.compile(r"^\s*:(?:width|height|scale|align|name):.*$", re.M)
+
+
+def result_like_numbers(text: str) -> list[str]:
+    text = OPTION_LINE.sub("", text).replace("$", "").replace("−", "-").replace("\u2009", " ")
+    return [" ".join(m.group(0).split()) for m in RESULT_LIKE.finditer(text)]
+
+
+def book_texts() -> dict[str, str]:
+    pages = {p.name: p.read_text(encoding="utf-8") for p in sorted(BOOK.glob("*.md")) if p.name != "README.md"}
+    nb = nbformat.read(PROJECT_ROOT / "notebooks" / "06_results.ipynb", as_version=4)
+    pages["06_results.ipynb (markdown)"] = "\n".join(c.source for c in nb.cells if c.cell_type == "markdown")
+    return pages
+
+
+def test_scanner_finds_typed_results():
+    found = result_like_numbers("BGFN reaches 4.7 m, i.e. 79.7 % less; energy 0.013 µJ; [0.5, 0.6, -2.1] m "
+                                "off; $E = 4.6$ pJ\n:width: 90%\n")
+    assert found == ["4.7 m", "79.7 %", "0.013 µJ", "[0.5, 0.6, -2.1] m", "4.6 pJ"]
+    assert result_like_numbers("Eq. (eq13), 15 states, 100 Hz, 30 s, window N=200, item 3 mentions") == []
+
+
+def test_book_pages_type_no_results():
+    bad = [f"{page}: {num!r}" for page, text in book_texts().items() for num in result_like_numbers(text)
+           if num not in ALLOWED]
+    assert not bad, ("numbers that look like results are typed in the book (let the code produce them, or add "
+                     "a paper/profile *setting* to ALLOWED with its reason):\n  " + "\n  ".join(bad))
+
+
+def test_book_references_to_code_and_files_exist():
+    code = (BOOK / "code.md").read_text(encoding="utf-8")
+    labels = set(re.findall(r"^\(([\w-]+)\)=\s*$", code, re.M))
+    for page, text in book_texts().items():
+        for target in re.findall(r"\{ref\}`[^`<]*<(code-[\w-]+)>`", text):
+            assert target in labels, f"{page}: {{ref}} to missing label {target} (add it to book/code.md)"
+    for inc in re.findall(r"```\{literalinclude\}\s+(\S+)", code):
+        assert (BOOK / inc).resolve().is_file(), f"book/code.md includes a missing file {inc}"
+    for page in BOOK.glob("*.md"):
+        if page.name == "README.md":                            # not part of the book
+            continue
+        for fig in re.findall(r"```\{figure\}\s+(\S+)", page.read_text(encoding="utf-8")):
+            name = Path(fig).name
+            produced = name in {e["file"] for e in report.PAPER_FIGURES}
+            assert not fig.startswith("_generated/") or produced, (
+                f"{page.name}: {fig} is not one of the figures every profile produces (report.PAPER_FIGURES)")
+
+
+def test_results_notebook_is_thin_and_wired_in():
+    nb = nbformat.read(PROJECT_ROOT / "notebooks" / "06_results.ipynb", as_version=4)
+    code = [c for c in nb.cells if c.cell_type == "code"]
+    assert "parameters" in code[0].metadata.get("tags", []) and code[0].source.strip() == 'profile = "quick"'
+    assert all(not c.get("outputs") and c.get("execution_count") is None for c in code), "store it without outputs"
+    assert nb.cells[0].cell_type == "markdown" and nb.cells[0].source.startswith("# Results")
+    make = (PROJECT_ROOT / "Makefile").read_text()
+    assert re.search(r"^NOTEBOOKS :=.*\b05_energy_estimate 06_results\b", make, re.M)
+    assert re.search(r"^\$\(RES\)/notebooks/06_results\.ipynb: \$\(RES\)/notebooks/05_energy_estimate\.ipynb", make,
+                     re.M)
+    toc = (BOOK / "_toc.yml").read_text()
+    assert "file: notebooks/06_results" in toc and "file: code" in toc
+
+
+# ----------------------------------------------------------------------------------------------- check_book
+def _check_book():
+    spec = importlib.util.spec_from_file_location("check_book", PROJECT_ROOT / "tools" / "check_book.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def _site(root: Path, results_body: str, img: bytes = b"png") -> None:
+    (root / "notebooks").mkdir(parents=True)
+    (root / "_images").mkdir()
+    (root / "_images" / "a.png").write_bytes(img)
+    (root / "index.html").write_text('<meta http-equiv="Refresh" content="0; url=intro.html" />')
+    (root / "intro.html").write_text('<h1 id="top">x</h1><table><tr><td>1</td></tr></table>'
+                                     '<img src="_images/a.png"><a href="notebooks/06_results.html#res">r</a>')
+    (root / "notebooks" / "06_results.html").write_text(f'<h1 id="res">Results</h1>{results_body}')
+
+
+def test_check_book_accepts_a_good_site(tmp_path):
+    cb = _check_book()
+    _site(tmp_path, '<table><tr><td>1</td></tr></table><img src="../_images/a.png"><a href="../intro.html#top">i</a>')
+    assert cb.check(tmp_path) == [] and cb.check_content(tmp_path) == []
+    assert cb.index_page(tmp_path) == (tmp_path / "intro.html").resolve()
+    assert cb.main([str(tmp_path)]) == 0
+
+
+def test_check_book_finds_broken_images_anchors_and_bare_results(tmp_path):
+    cb = _check_book()
+    _site(tmp_path, '<img src="../_images/missing.png"><a href="../intro.html#nowhere">i</a>', img=b"")
+    problems = "\n".join(cb.check(tmp_path) + cb.check_content(tmp_path))
+    assert "missing _images/missing.png" in problems
+    assert "no anchor #nowhere" in problems
+    assert "empty file _images/a.png" in problems
+    assert "notebooks/06_results.html (results page): no <table>" in problems
+    assert cb.main([str(tmp_path)]) == 1

@@ -335,7 +335,7 @@ def _extra_columns(options: dict) -> tuple[str, ...]:
 class _Run:
     """Closed-loop filter of one outage run, advanced epoch by epoch.
 
-    It drives the numba kernels of :mod:`bgfn.nav.filter` (``_propagate_nb``, ``_update_nb``) directly, because
+    It drives the stepping kernels of :mod:`bgfn.nav.filter` (``propagate_steps``, ``update_position``) directly, because
     the network inputs at a pseudo epoch need the attitude the run itself computed up to that epoch, and one
     ``run_filter`` call per epoch costs ~2 ms of pandas overhead (the sweep has ~10^5 epochs).
     ``tests/test_evaluate.py`` checks that the result equals ``run_filter`` / ``run_outage`` fed the same fixes.
@@ -343,7 +343,7 @@ class _Run:
 
     def __init__(self, ctx: NavContext, start: float, duration: float, n_window: int, extra: tuple):
         from bgfn.nav import error_model as em
-        from bgfn.nav.filter import _noise_arrays
+        from bgfn.nav.filter import noise_arrays
 
         self.start, self.duration, self.end = float(start), float(duration), float(start) + float(duration)
         s = ctx.state_at(start)
@@ -362,7 +362,7 @@ class _Run:
         self.c = np.ascontiguousarray(s.c_bn, dtype=float).copy()
         self.ba, self.bg = s.accel_bias.astype(float).copy(), s.gyro_bias.astype(float).copy()
         self.P = np.ascontiguousarray(s.P, dtype=float).copy()
-        self.q = _noise_arrays(ctx.noise)
+        self.q = noise_arrays(ctx.noise)
         self.out_pos, self.out_v = np.empty((n, 3)), np.empty((n, 3))
         self.out_c, self.out_sd = np.empty((n, 3, 3)), np.empty((n, em.N_STATES))
         self.out_pos[0], self.out_v[0], self.out_c[0] = self.pos, self.v, self.c
@@ -408,21 +408,21 @@ class _Run:
 
     def propagate_to(self, r: int) -> None:
         """Prediction (strapdown + covariance, Eq. eq3) up to output row ``r``."""
-        from bgfn.nav.filter import _propagate_nb
+        from bgfn.nav.filter import propagate_steps
 
         r = min(int(r), len(self.times) - 1)
         if r > self.row:
-            _propagate_nb(self.row, r, self.dt, self.gyro, self.accel, self.pos, self.v, self.c, self.ba, self.bg,
+            propagate_steps(self.row, r, self.dt, self.gyro, self.accel, self.pos, self.v, self.c, self.ba, self.bg,
                           self.P, *self.q, self.out_pos, self.out_v, self.out_c, self.out_sd)
             self._fill(self.row + 1, r)
             self.row = r
 
     def update(self, t_m: float, fix: np.ndarray, std: np.ndarray) -> None:
         """Eq. (eq4) position update with a pseudo fix of time ``t_m`` at the current row, then feedback."""
-        from bgfn.nav.filter import _update_nb
+        from bgfn.nav.filter import update_position
 
         innov = np.empty(3)
-        _update_nb(self.pos, self.v, self.c, self.ba, self.bg, self.P, self.lever, np.asarray(fix, float),
+        update_position(self.pos, self.v, self.c, self.ba, self.bg, self.P, self.lever, np.asarray(fix, float),
                    np.asarray(std, float), float(self.times[self.row] - t_m), innov)
         self.out_pos[self.row], self.out_v[self.row], self.out_c[self.row] = self.pos, self.v, self.c
         if self.row >= 1:        # later windows see the corrected solution, as the training attitude does

@@ -38,10 +38,11 @@ PSEUDO_RATE_HZ = 1.0
 
 
 # ---------------------------------------------------------------------------------------------------
-# numba kernels
+# numba kernels: the low-level stepping API. run_filter/run_outage drive them from an event list; a caller
+# that decides each fix on the fly (bgfn.evaluate's closed-loop pseudo-GPS) drives them directly.
 # ---------------------------------------------------------------------------------------------------
 @numba.njit(cache=True)
-def _propagate_nb(i0, i1, dt, gyro, accel, pos, v, c, ba, bg, P, q_g, q_a, q_bg, q_ba, inv_tau_a,
+def propagate_steps(i0, i1, dt, gyro, accel, pos, v, c, ba, bg, P, q_g, q_a, q_bg, q_ba, inv_tau_a,
                   inv_tau_g, out_pos, out_v, out_c, out_sd):
     """Steps i0..i1-1 (IMU rows); output row k+1 holds the state after step k."""
     n = P.shape[0]
@@ -76,7 +77,7 @@ def _propagate_nb(i0, i1, dt, gyro, accel, pos, v, c, ba, bg, P, q_g, q_a, q_bg,
 
 
 @numba.njit(cache=True)
-def _update_nb(pos, v, c, ba, bg, P, lever, fix, std, lag, innov):
+def update_position(pos, v, c, ba, bg, P, lever, fix, std, lag, innov):
     """Eq. (eq4) position update (sequential scalar updates, Joseph form) and feedback.
 
     Returns the NIS; ``innov`` receives the NED innovations (m, NaN for unused axes).
@@ -174,7 +175,8 @@ class FilterResult:
     final: FilterState | None = None
 
 
-def _noise_arrays(noise: FilterNoise):
+def noise_arrays(noise: FilterNoise):
+    """Process-noise arrays in the order :func:`propagate_steps` takes them (PSDs, inverse correlation times)."""
     inv = [np.where(np.isfinite(t), 1.0 / np.asarray(t, float), 0.0) for t in
            (noise.accel_bias_tau, noise.gyro_bias_tau)]
     return (np.asarray(noise.gyro_noise, float) ** 2, np.asarray(noise.accel_noise, float) ** 2,
@@ -273,7 +275,7 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
         initial.c_bn, dtype=float).copy()
     ba, bg = initial.accel_bias.astype(float).copy(), initial.gyro_bias.astype(float).copy()
     P = np.ascontiguousarray(initial.P, dtype=float).copy()
-    q = _noise_arrays(noise)
+    q = noise_arrays(noise)
     out_pos, out_v = np.empty((n_rows, 3)), np.empty((n_rows, 3))
     out_c, out_sd = np.empty((n_rows, 3, 3)), np.empty((n_rows, em.N_STATES))
     out_bias = np.empty((n_rows, 6))
@@ -290,7 +292,7 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
     row = 0
     for r, kind, payload in events:
         if r > row:
-            _propagate_nb(row, r, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd)
+            propagate_steps(row, r, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd)
             row = r
         if kind == 0:
             window_start[payload[1]] = current(row)
@@ -307,7 +309,7 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
             if pf is None:
                 continue
             fix, std, label = np.array(pf[:3], float), np.array(pf[3:6], float), "pseudo"
-        nis = _update_nb(pos, v, c, ba, bg, P, lever, np.asarray(fix, float), np.asarray(std, float),
+        nis = update_position(pos, v, c, ba, bg, P, lever, np.asarray(fix, float), np.asarray(std, float),
                          float(times[row] - t_m), innov)
         out_pos[row], out_v[row], out_c[row] = pos, v, c
         out_sd[row] = np.sqrt(np.clip(np.diag(P), 0, None))
@@ -316,7 +318,7 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
         upd.append((t_m, label, *innov, nis, int(np.sum(np.isfinite(innov)))))
         P_upd.append(P.copy())
     if row < n_rows - 1:
-        _propagate_nb(row, n_rows - 1, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd)
+        propagate_steps(row, n_rows - 1, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd)
 
     # Bias estimates are piecewise constant between updates (random walk) or decay (Gauss-Markov).
     idx = np.searchsorted(np.array(bias_rows), np.arange(n_rows), side="right") - 1

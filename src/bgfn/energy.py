@@ -165,7 +165,9 @@ def ssa_sops(time_steps: int, heads: int, tokens: int, head_dim: int, rate_q: fl
     ``d_h < N`` (BGFN computes ``Q (K^T V)``): ``(min(r_k, r_v) + r_q) * T * H * N * d_h^2``;
     ``d_h >= N`` (``(Q K^T) V``): ``(min(r_q, r_k) + r_v) * T * H * N^2 * d_h``.
     """
-    if head_dim < tokens:
+    from bgfn.models.bgfn import SSA
+
+    if SSA.kv_first(tokens, head_dim):
         return (min(rate_k, rate_v) + rate_q) * time_steps * heads * tokens * head_dim ** 2
     return (min(rate_q, rate_k) + rate_v) * time_steps * heads * tokens ** 2 * head_dim
 
@@ -240,10 +242,10 @@ class _Acc:
 
 def _twin_block_type():
     try:
-        from bgfn.models.baselines import _TwinBlock
+        from bgfn.models.baselines import TwinBlock
     except ImportError:  # pragma: no cover - the twin moved: only its attention is then not counted
         return ()
-    return (_TwinBlock,)
+    return (TwinBlock,)
 
 
 def _ssa_type():
@@ -348,7 +350,7 @@ def layer_counts(model: nn.Module, windows, batch_size: int = 32) -> list[LayerC
             # integer matrix costs (spikes x fan-out); K^T V (or Q K^T) is binary only if no entry exceeds 1.
             split = lambda t: t.reshape(T, B, N, H, dh).transpose(2, 3).double()       # [T, B, H, N, dh]
             qs, ks, vs = split(q), split(k), split(v)
-            if dh < N:
+            if SSA.kv_first(N, dh):
                 kv = ks.transpose(-2, -1) @ vs                                      # [T, B, H, dh, dh]
                 second = float((qs @ kv).sum()) if float(kv.max()) <= 1 else float(qs.sum()) * dh
                 a.exact += float(kv.sum()) + second

@@ -65,7 +65,7 @@ class ATLSTM(nn.Module):
         return self.head(torch.cat([c, h[:, -1]], dim=-1))   # [B, 2]
 
 
-class _TwinBlock(nn.Module):
+class TwinBlock(nn.Module):
     """Pre-LayerNorm Transformer block: x + MHSA(LN(x)), then + FFN(LN(.)). [B, N, D] -> [B, N, D]."""
 
     def __init__(self, dim: int, ffn_dim: int, heads: int, dropout: float):
@@ -104,7 +104,7 @@ class TransformerTwin(nn.Module):
                               groups=in_channels)
         self.bn = nn.BatchNorm1d(in_channels * time_steps)
         self.embed = nn.Linear(in_channels * time_steps, dim)
-        self.blocks = nn.ModuleList([_TwinBlock(dim, ffn_dim, heads, dropout) for _ in range(depth)])
+        self.blocks = nn.ModuleList([TwinBlock(dim, ffn_dim, heads, dropout) for _ in range(depth)])
         self.ln = nn.LayerNorm(dim)
         self.head = nn.Linear(dim, out_dim)
 

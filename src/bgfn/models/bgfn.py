@@ -113,10 +113,18 @@ class SSA(nn.Module):
         T, B, N, D = x.shape
         return x.reshape(T, B, N, self.heads, D // self.heads).transpose(2, 3)   # [T, B, H, N, dh]
 
+    @staticmethod
+    def kv_first(n_tokens: int, head_dim: int) -> bool:
+        """Product order of :meth:`attend`: Q (K^T V) when the head is narrower than the window (cheaper).
+
+        The energy count (:mod:`bgfn.energy`) follows the same order.
+        """
+        return head_dim < n_tokens
+
     def attend(self, q, k, v):
         """Q K^T V * scale per head, no softmax. q, k, v: [T, B, H, N, dh] -> [T, B, H, N, dh]."""
         N, dh = q.shape[-2], q.shape[-1]
-        if dh < N:
+        if self.kv_first(N, dh):
             return (q @ (k.transpose(-2, -1) @ v)) * self.scale    # K^T V: [T, B, H, dh, dh]
         return ((q @ k.transpose(-2, -1)) @ v) * self.scale         # Q K^T: [T, B, H, N, N]
 

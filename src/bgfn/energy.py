@@ -59,6 +59,9 @@ import pandas as pd
 import torch
 from torch import nn
 
+from bgfn.models.baselines import TwinBlock
+from bgfn.models.bgfn import SSA, Block
+
 #: Horowitz (2014), 45 nm, 32-bit float: multiply 3.7 pJ + add 0.9 pJ (pJ per MAC).
 E_MAC_PJ = 4.6
 #: Horowitz (2014), 45 nm, 32-bit float add (pJ per accumulate / synaptic operation).
@@ -165,8 +168,6 @@ def ssa_sops(time_steps: int, heads: int, tokens: int, head_dim: int, rate_q: fl
     ``d_h < N`` (BGFN computes ``Q (K^T V)``): ``(min(r_k, r_v) + r_q) * T * H * N * d_h^2``;
     ``d_h >= N`` (``(Q K^T) V``): ``(min(r_q, r_k) + r_v) * T * H * N^2 * d_h``.
     """
-    from bgfn.models.bgfn import SSA
-
     if SSA.kv_first(tokens, head_dim):
         return (min(rate_k, rate_v) + rate_q) * time_steps * heads * tokens * head_dim ** 2
     return (min(rate_q, rate_k) + rate_v) * time_steps * heads * tokens ** 2 * head_dim
@@ -238,30 +239,6 @@ class _Acc:
         self.qkv_numel = 0
         self.exact = 0.0        # nonzero-product accumulates of the SSA (cross-check)
         self.trains = 1         # spike trains merged into the input (residual stream)
-
-
-def _twin_block_type():
-    try:
-        from bgfn.models.baselines import TwinBlock
-    except ImportError:  # pragma: no cover - the twin moved: only its attention is then not counted
-        return ()
-    return (TwinBlock,)
-
-
-def _ssa_type():
-    try:
-        from bgfn.models.bgfn import SSA
-    except ImportError:  # pragma: no cover
-        return ()
-    return (SSA,)
-
-
-def _block_type():
-    try:
-        from bgfn.models.bgfn import Block
-    except ImportError:  # pragma: no cover
-        return ()
-    return (Block,)
 
 
 _COUNTED = (nn.Linear, nn.Conv1d, nn.Conv2d, nn.Conv3d)
@@ -425,7 +402,7 @@ def layer_counts(model: nn.Module, windows, batch_size: int = 32) -> list[LayerC
     def model_pre(_m, _inp):
         stream.update(n=0, sum=0.0, tensor=None)
 
-    ssa_t, twin_t, block_t = _ssa_type(), _twin_block_type(), _block_type()
+    ssa_t, twin_t, block_t = (SSA,), (TwinBlock,), (Block,)
     if spiking_model:
         hooks.append(model.register_forward_pre_hook(model_pre))
     for name, mod in model.named_modules():

@@ -160,3 +160,18 @@ def test_summary_table_aggregates_seeds():
     s = T.summary_table(cards)
     assert len(s) == 1 and s.loc[0, "seeds"] == 2
     assert s.loc[0, "val_rmse_m_mean"] == pytest.approx(2.25) and s.loc[0, "train_time_s_total"] == 4.0
+
+
+def test_result_tables_leave_wall_clock_out():
+    """Saved result tables must be identical between runs: wall-clock columns go to their own table."""
+    cards = [{"dataset": "d", "method": m, "seed": s, "params": 10, "epochs_run": 3, "best_epoch": 2,
+              "wall_time_s": 1.0 + s, "val_rmse_m": 0.5, "val_rmse_zero_m": 1.0, "val_rmse_last_m": 0.2}
+             for m in ("bgfn", "mlp") for s in (0, 1)]
+    runs, summary = T.cards_table(cards), T.summary_table(cards)
+    for table in (runs, summary):
+        kept = T.without_timing(table)
+        assert not set(T.TIMING_COLUMNS) & set(kept.columns)
+        assert len(kept.columns) == len(table.columns) - len(set(T.TIMING_COLUMNS) & set(table.columns))
+    times = T.timing_table(summary)
+    assert list(times.columns) == ["dataset", "method", "train_time_s_mean", "train_time_s_total"]
+    assert times["train_time_s_total"].tolist() == [3.0, 3.0]  # 1 s + 2 s per method

@@ -295,10 +295,13 @@ def fmt_num(v) -> str:
     return f"{x:.2e}"
 
 
-def training_table(summary: pd.DataFrame | None) -> pd.DataFrame | None:
-    """``tables/training_summary.csv`` with readable labels, indexed by (dataset, method)."""
+def training_table(summary: pd.DataFrame | None, times: pd.DataFrame | None = None) -> pd.DataFrame | None:
+    """``tables/training_summary.csv`` (with the wall-clock times of ``tables/training_times.csv`` when given)
+    with readable labels, indexed by (dataset, method)."""
     if summary is None:
         return None
+    if times is not None:
+        summary = summary.merge(times, on=["dataset", "method"], how="left")
     cols = [c for c in TRAINING_COLUMNS if c in summary.columns]
     shown = summary.assign(method=summary["method"].map(lambda m: METHOD_LABELS.get(m, m)))
     return shown.set_index(["dataset", "method"])[cols].rename(columns=TRAINING_COLUMNS)

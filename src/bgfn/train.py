@@ -496,6 +496,22 @@ def cards_table(cards: list[dict]):
     return pd.DataFrame([{c: card.get(c) for c in cols} for card in cards], columns=cols)
 
 
+#: Wall-clock columns of :func:`cards_table` / :func:`summary_table`: they vary from run to run, so the result
+#: tables are saved without them (:func:`without_timing`) and the times go to a table of their own.
+TIMING_COLUMNS = ("wall_time_s", "train_time_s_mean", "train_time_s_total")
+
+
+def without_timing(table):
+    """``table`` without :data:`TIMING_COLUMNS`: the same profile run twice gives byte-identical tables."""
+    return table.drop(columns=[c for c in TIMING_COLUMNS if c in table.columns])
+
+
+def timing_table(table):
+    """The key columns of ``table`` and its :data:`TIMING_COLUMNS` (wall-clock seconds)."""
+    keys = [c for c in ("dataset", "method", "seed") if c in table.columns]
+    return table[keys + [c for c in TIMING_COLUMNS if c in table.columns]]
+
+
 def summary_table(cards: list[dict]):
     """Per dataset and method: parameters, epochs, training time and validation RMSE over seeds (mean, std)."""
     runs = cards_table(cards)

@@ -1,6 +1,6 @@
 """Theoretical inference energy of BGFN and of its ANN Transformer twin on 45 nm CMOS (paper Sec. 4.2).
 
-The paper states that BGFN needs 66.3 % less energy than a conventional Transformer "on a 45 nm
+The paper states that BGFN needs much less energy (its figure: `data/paper/claims.yaml`) than a conventional Transformer "on a 45 nm
 neuromorphic hardware platform" (Horowitz 2014). It gives no counting rule; we use the one of Spikformer
 (Zhou et al. 2023) and of the syops counter that SeqSNN (Lv et al. 2024, the code BGFN builds on) uses:
 

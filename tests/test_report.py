@@ -248,8 +248,9 @@ def result_like_numbers(text: str) -> list[str]:
 
 def book_texts() -> dict[str, str]:
     pages = {p.name: p.read_text(encoding="utf-8") for p in sorted(BOOK.glob("*.md")) if p.name != "README.md"}
-    nb = nbformat.read(PROJECT_ROOT / "notebooks" / "06_results.ipynb", as_version=4)
-    pages["06_results.ipynb (markdown)"] = "\n".join(c.source for c in nb.cells if c.cell_type == "markdown")
+    for path in sorted((PROJECT_ROOT / "notebooks").glob("*.ipynb")):  # every notebook is a book page
+        nb = nbformat.read(path, as_version=4)
+        pages[f"{path.name} (markdown)"] = "\n".join(c.source for c in nb.cells if c.cell_type == "markdown")
     return pages
 
 

@@ -21,7 +21,6 @@ import os
 import statistics
 import sys
 import time
-import warnings
 
 import numpy as np
 import pandas as pd
@@ -67,34 +66,9 @@ def _median_time(fn, n):
 
 
 def _pyins_runner(imu, gnss, init, noise, lever, time_step):
-    from pyins import filters, inertial_sensor, measurements, strapdown as pstrap
+    from bgfn.nav.pyins_bridge import feedback_filter
 
-    row = init.as_row()
-    pva = pd.Series({"lat": np.degrees(row["lat"]), "lon": np.degrees(row["lon"]), "alt": row["h"],
-                     "VN": row["v_n"], "VE": row["v_e"], "VD": row["v_d"], "roll": np.degrees(row["roll"]),
-                     "pitch": np.degrees(row["pitch"]), "heading": np.degrees(row["yaw"]) % 360}, name=row["time"])
-    t = np.concatenate([[row["time"]], imu["time"].to_numpy()])
-    inc = np.column_stack([imu[["gyro_x", "gyro_y", "gyro_z"]].to_numpy(),
-                           imu[["accel_x", "accel_y", "accel_z"]].to_numpy()]) * np.diff(t)[:, None]
-    inc = pd.DataFrame(np.vstack([inc[:1], inc]), index=pd.Index(t, name="time"),
-                       columns=["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"])
-    gdf = pd.DataFrame({"lat": np.degrees(gnss["lat"].to_numpy()), "lon": np.degrees(gnss["lon"].to_numpy()),
-                        "alt": gnss["h"].to_numpy()}, index=pd.Index(gnss["time"].to_numpy(), name="time"))
-    sd = float(np.median(gnss[["std_n", "std_e", "std_d"]].to_numpy()))  # pyins: one sd for all axes
-    increments = pstrap.compute_increments_from_imu(inc, "increment")
-
-    def run():
-        gm = inertial_sensor.EstimationModel(bias_sd=noise.gyro_bias_std, noise=noise.gyro_noise,
-                                             bias_walk=noise.gyro_bias_walk)
-        am = inertial_sensor.EstimationModel(bias_sd=noise.accel_bias_std, noise=noise.accel_noise,
-                                             bias_walk=noise.accel_bias_walk)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            return filters.run_feedback_filter(pva, 1.0, 0.1, 0.5, 2.0, increments, gm, am,
-                                               [measurements.Position(gdf, sd, np.asarray(lever, float))],
-                                               time_step=time_step)
-
-    return run
+    return feedback_filter(init, noise, imu, gnss, lever, 1.0, 0.1, 0.5, 2.0, time_step=time_step)
 
 
 def main() -> int:

@@ -1,6 +1,5 @@
 """The 15-state loosely coupled filter: consistency, pyins cross-check, outages, pseudo-GPS, bad input."""
 
-import warnings
 
 import numpy as np
 import pandas as pd
@@ -93,40 +92,15 @@ def test_biases_are_estimated_within_their_sd():
 
 
 def test_agrees_with_pyins_feedback_filter(drive300):
-    pyins = pytest.importorskip("pyins")
-    from pyins import filters, inertial_sensor, measurements, strapdown as pstrap
+    pytest.importorskip("pyins")
+    from bgfn.nav.pyins_bridge import feedback_filter
 
     ref, _, imu, errs, _, _ = drive300
     gnss = sim.gnss_from_trajectory(ref, 1.0, 1.0, 1.0, LEVER, seed=3)  # pyins: one sd for all axes
     init, noise = _setup(ref, errs, seed=4)
     ours = run_filter(imu, init, noise, gnss, LEVER, outage_windows=WINDOWS)
-
-    row = init.as_row()
-    pva = pd.Series({"lat": np.degrees(row["lat"]), "lon": np.degrees(row["lon"]), "alt": row["h"],
-                     "VN": row["v_n"], "VE": row["v_e"], "VD": row["v_d"], "roll": np.degrees(row["roll"]),
-                     "pitch": np.degrees(row["pitch"]), "heading": np.degrees(row["yaw"]) % 360}, name=row["time"])
-    t = np.concatenate([[row["time"]], imu["time"].to_numpy()])
-    inc = np.column_stack([imu[["gyro_x", "gyro_y", "gyro_z"]].to_numpy(),
-                           imu[["accel_x", "accel_y", "accel_z"]].to_numpy()]) * np.diff(t)[:, None]
-    inc = pd.DataFrame(np.vstack([inc[:1], inc]), index=pd.Index(t, name="time"),
-                       columns=["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"])
     g = gnss[~np.any([OutageWindow(*w).contains(gnss["time"]) for w in WINDOWS], axis=0)]
-    gdf = pd.DataFrame({"lat": np.degrees(g["lat"].to_numpy()), "lon": np.degrees(g["lon"].to_numpy()),
-                        "alt": g["h"].to_numpy()}, index=pd.Index(g["time"].to_numpy(), name="time"))
-    gyro_model = inertial_sensor.EstimationModel(bias_sd=noise.gyro_bias_std, noise=noise.gyro_noise,
-                                                 bias_walk=noise.gyro_bias_walk)
-    accel_model = inertial_sensor.EstimationModel(bias_sd=noise.accel_bias_std, noise=noise.accel_noise,
-                                                  bias_walk=noise.accel_bias_walk)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        theirs = filters.run_feedback_filter(
-            pva, 1.0, 0.1, 0.2, 1.0, pstrap.compute_increments_from_imu(inc, "increment"), gyro_model,
-            accel_model, [measurements.Position(gdf, 1.0, LEVER)], time_step=1.0)
-    tp = theirs.trajectory.reset_index()
-    tp = pd.DataFrame({"time": tp["time"], "lat": np.radians(tp["lat"]), "lon": np.radians(tp["lon"]),
-                       "h": tp["alt"], "v_n": tp["VN"], "v_e": tp["VE"], "v_d": tp["VD"],
-                       "roll": np.radians(tp["roll"]), "pitch": np.radians(tp["pitch"]),
-                       "yaw": np.radians(tp["heading"])})
+    tp = feedback_filter(init, noise, imu, g, LEVER, 1.0, 0.1, 0.2, 1.0, gnss_sd=1.0)()
     e_ours = metrics.navigation_errors(ours.trajectory, ref)
     e_theirs = metrics.navigation_errors(tp, ref)
     t_ = e_ours["time"].to_numpy()

@@ -335,3 +335,11 @@ def test_check_book_finds_broken_images_anchors_and_bare_results(tmp_path):
     assert "empty file _images/a.png" in problems
     assert "notebooks/06_results.html (results page): no <table>" in problems
     assert cb.main([str(tmp_path)]) == 1
+
+
+def test_source_code_page_lists_every_module():
+    code = (BOOK / "code.md").read_text(encoding="utf-8")
+    modules = [p.relative_to(PROJECT_ROOT).as_posix() for p in sorted((PROJECT_ROOT / "src" / "bgfn").rglob("*.py"))
+               if p.name not in ("__init__.py", "__main__.py")]
+    missing = [m for m in modules if f"../{m}" not in code]
+    assert not missing, f"add these modules to book/code.md: {missing}"

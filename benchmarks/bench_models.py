@@ -13,29 +13,18 @@ few repeats after a warm-up; the paper size gets fewer repeats so that the whole
 
 from __future__ import annotations
 
-import statistics
 import sys
-import time
 
 import torch
 
 from bgfn.config import PROJECT_ROOT, load_profile
 from bgfn.io import update_json
 from bgfn.models import METHODS, build_model, count_parameters
+from bgfn.speed import median_time
 
 SIZES = ("quick", "paper")
 #: (training steps, inference calls) measured per size, after one warm-up each.
 REPEATS = {"quick": (5, 30), "paper": (2, 5)}
-
-
-def _median_time(fn, n: int) -> float:
-    fn()                                                   # warm-up (allocations, first call)
-    times = []
-    for _ in range(n):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
 
 
 def bench(model_name: str, size: str) -> tuple[float, float, int, dict]:
@@ -55,13 +44,13 @@ def bench(model_name: str, size: str) -> tuple[float, float, int, dict]:
         opt.step()
 
     threads = torch.get_num_threads()
-    train_s = _median_time(step, n_train)
+    train_s = median_time(step, n_train)
     x1 = torch.randn(1, window, 9)
     model.eval()
     torch.set_num_threads(1)
     try:
         with torch.no_grad():
-            infer_s = _median_time(lambda: model(x1), n_infer)
+            infer_s = median_time(lambda: model(x1), n_infer)
     finally:
         torch.set_num_threads(threads)
     return batch / train_s, 1e3 * infer_s, count_parameters(model), {"batch": batch, "window": window,

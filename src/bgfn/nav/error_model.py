@@ -62,7 +62,8 @@ def _put(m, rows, cols, block):
 
 
 @numba.njit(cache=True)
-def _skew(a):
+def skew_nb(a):
+    """[a x], the cross-product matrix of a 3-vector (numba; bgfn.nav.transform.skew for numpy)."""
     s = np.zeros((3, 3))
     s[0, 1] = -a[2]
     s[0, 2] = a[1]
@@ -114,7 +115,7 @@ def system_matrix_nb(pos, v, c_bn, f_b, inv_tau_a, inv_tau_g, out):
     ba = np.array([BA_X, BA_Y, BA_Z])
     bg = np.array([BG_X, BG_Y, BG_Z])
     # Eq. (eq9): attitude error.
-    _put(out, phi, phi, -_skew(w_ie + w_en))
+    _put(out, phi, phi, -skew_nb(w_ie + w_en))
     _put(out, phi, dv, dwen_dv)
     for i in range(3):
         out[phi[i], DLAT] += dwie_dl[i] + dwen_dl[i]
@@ -122,9 +123,9 @@ def system_matrix_nb(pos, v, c_bn, f_b, inv_tau_a, inv_tau_g, out):
     _put(out, phi, bg, -c_bn)
     # Eq. (IVE): velocity error.
     f_n = c_bn @ f_b
-    sv = _skew(v)
-    _put(out, dv, phi, _skew(f_n))
-    _put(out, dv, dv, -_skew(2.0 * w_ie + w_en) + sv @ dwen_dv)
+    sv = skew_nb(v)
+    _put(out, dv, phi, skew_nb(f_n))
+    _put(out, dv, dv, -skew_nb(2.0 * w_ie + w_en) + sv @ dwen_dv)
     t_l = sv @ (2.0 * dwie_dl + dwen_dl)
     t_h = sv @ dwen_dh
     for i in range(3):

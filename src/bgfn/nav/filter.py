@@ -93,13 +93,7 @@ def update_position(pos, v, c, ba, bg, P, lever, fix, std, lag, innov):
     dz[0] = (lat - fix[0]) * d[0] + u[0] - v[0] * lag
     dz[1] = (pos[1] - fix[1]) * d[1] + u[1] - v[1] * lag
     dz[2] = (h - fix[2]) * d[2] + u[2] - v[2] * lag
-    su = np.zeros((3, 3))  # [u x]: d(antenna)/d(phi)
-    su[0, 1] = -u[2]
-    su[0, 2] = u[1]
-    su[1, 0] = u[2]
-    su[1, 2] = -u[0]
-    su[2, 0] = -u[1]
-    su[2, 1] = u[0]
+    su = em.skew_nb(u)  # [u x]: d(antenna)/d(phi)
     phi_idx = np.array([em.PHI_N, em.PHI_E, em.PHI_D])
     pos_idx = np.array([em.DLAT, em.DLON, em.DH])
     x = np.zeros(n)

@@ -41,9 +41,9 @@ def _drive(gnss_rate=5.0, duration=150.0, seed=3) -> Drive:
 class Heading:
     """Fake network: dead reckoning at a fixed speed along the input yaw; records its inputs."""
 
-    def __init__(self, window=20, speed=8.0, interval=0.2, zero=False):
-        self.options = {"window": window, "alignment": "ending", "yaw_encoding": "unwrap", "extra_channels": [],
-                        "target_frame": "ned"}
+    def __init__(self, window=20, speed=8.0, interval=0.2, zero=False, extra=()):
+        self.options = {"window": window, "alignment": "ending", "yaw_encoding": "unwrap",
+                        "extra_channels": list(extra), "target_frame": "ned"}
         self.speed, self.interval, self.zero = speed, interval, zero
         self.seen = []
 
@@ -138,6 +138,27 @@ def test_inputs_use_the_runs_own_attitude(ctx5, drive5):
     # the attitude inside the outage is the INS solution's, not the truth
     truth = drive5.reference.set_index("time").loc[run.increments["time"].round(6), "yaw"].to_numpy()
     assert np.max(np.abs(L.wrap_angle(expect.yaw_ref - truth))) > 1e-5
+
+
+def test_heading_frame_velocity_inputs_match_training_features(ctx5, drive5):
+    """v_along, v_cross inside an outage are computed from the run's own solution as in training."""
+    f = Heading(window=20, zero=True, extra=("v_along", "v_cross"))
+    run = ev.run_outages(ctx5, [WINDOWS[0]], f, "BGFN", 0, {"std_m": 1e9, "fusion_rate_hz": 1.0})[0]
+    s = WINDOWS[0][0]
+    t0 = run.trajectory["time"].iloc[0]
+    full = ctx5.full.trajectory
+    cols = ["time", "roll", "pitch", "yaw", "v_n", "v_e"]
+    pre = full[(full["time"] <= t0 + 1e-9) & (full["time"] > s - 1.0)]
+    sol = pd.concat([pre[cols], run.trajectory[cols].iloc[1:]])
+    epochs = np.concatenate([[s], run.increments["time"].to_numpy()])
+    expect = L.prediction_windows(drive5.imu, sol, epochs, window=20, extra_channels=("v_along", "v_cross"))
+    got = np.concatenate([w.x for w in f.seen])
+    assert got.shape[-1] == 11
+    np.testing.assert_allclose(got, expect.x, rtol=0, atol=2e-5)
+    # the demo drive moves forward: along-track speed is the horizontal speed, cross-track is near zero
+    speed = np.hypot(sol["v_n"], sol["v_e"]).to_numpy()
+    assert np.max(np.abs(got[..., 9])) <= speed.max() + 1e-6 and np.median(got[..., 9]) > 1.0
+    assert np.max(np.abs(got[..., 10])) < 0.05 * np.max(np.abs(got[..., 9]))
 
 
 def test_evaluation_never_reads_gnss_inside_an_outage(drive5):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from bgfn import learning as L
@@ -165,3 +166,29 @@ def test_heading_target_frame(tables):
     assert data.norm.y_mean[0] > 5.0                                # statistics of the along-track target
     with pytest.raises(DataError):
         L.build_learning_data(imu, att, gnss, [], window=100, target_frame="body")
+
+
+def test_heading_velocity_is_the_velocity_in_the_yaw_frame():
+    # due east at 10 m/s with yaw 90 deg: all along-track; a 2 m/s side slip to the south is cross-track -2
+    along, cross = L.heading_velocity([0.0, -2.0], [10.0, 10.0], [np.pi / 2, np.pi / 2])
+    np.testing.assert_allclose(along, [10.0, 10.0], atol=1e-12)
+    np.testing.assert_allclose(cross, [0.0, 2.0], atol=1e-12)
+    # rotating velocity and yaw together leaves both unchanged (the point of the channels)
+    rng = np.random.default_rng(0)
+    v_n, v_e, yaw = rng.normal(size=50), rng.normal(size=50), rng.uniform(-np.pi, np.pi, 50)
+    a0, c0 = L.heading_velocity(v_n, v_e, yaw)
+    rot = 1.3
+    a1, c1 = L.heading_velocity(np.cos(rot) * v_n - np.sin(rot) * v_e, np.sin(rot) * v_n + np.cos(rot) * v_e,
+                                yaw + rot)
+    np.testing.assert_allclose(a1, a0, atol=1e-12)
+    np.testing.assert_allclose(c1, c0, atol=1e-12)
+
+
+def test_derived_channels_need_velocity_and_yaw():
+    imu = pd.DataFrame({"time": [0.0, 0.01], **{c: 0.0 for c in L.CHANNELS[3:]}})
+    att = pd.DataFrame({"time": [0.0, 0.01], "roll": 0.0, "pitch": 0.0, "yaw": 0.0})
+    with pytest.raises(DataError, match="v_n"):
+        L.sample_features(imu, att, ("v_along",))
+    t, x, ch = L.sample_features(imu, att.assign(v_n=3.0, v_e=4.0), ("v_along", "v_cross"))
+    assert ch[-2:] == ("v_along", "v_cross")
+    np.testing.assert_allclose(x[:, -2:], [[3.0, 4.0], [3.0, 4.0]])

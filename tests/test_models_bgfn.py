@@ -115,6 +115,27 @@ def test_spike_encoder_shape_and_time_axis():
     assert model.embedding(s).shape == (TINY["time_steps"], 5, 20, TINY["dim"])
 
 
+def test_encoder_neurons_resolve_a_constant_input_finer():
+    """K neurons per channel: a constant input is coded by K*T_s binary values instead of T_s (population code)."""
+    torch.manual_seed(0)
+    levels = {}
+    for k in (1, 8):
+        model = BGFN(in_channels=1, **{**TINY, "encoder_neurons": k}).eval()
+        enc = model.spike_encoder
+        with torch.no_grad():                    # spread the thresholds: neuron j fires for inputs above ~j/k
+            enc.conv.weight.fill_(1.0 / 3)       # kernel 3 on a constant input: the input value
+            enc.conv.bias.copy_(-torch.linspace(0, 1, k * TINY["time_steps"]))
+        x = torch.linspace(-0.5, 1.5, 400)[:, None, None].expand(400, 5, 1)   # [B, N=5, C=1], constant in time
+        s = enc(x)                               # [T_s, B, N, K]
+        assert s.shape == (TINY["time_steps"], 400, 5, k)
+        assert torch.all((s == 0) | (s == 1))
+        codes = {tuple(c.tolist()) for c in s[:, :, 2].permute(1, 0, 2).reshape(400, -1)}
+        levels[k] = len(codes)
+    assert levels[1] <= TINY["time_steps"] + 1
+    assert levels[8] > 3 * levels[1]
+    assert BGFN(in_channels=9, **{**TINY, "encoder_neurons": 4}).embedding.layer.linear.in_features == 36
+
+
 @pytest.mark.parametrize("train_mode", [True, False])
 def test_membrane_state_is_reset_between_batches(train_mode):
     torch.manual_seed(2)

@@ -245,7 +245,7 @@ class NavContext:
         return self.states[key]
 
 
-_NAV_COLUMNS = ("roll", "pitch", "yaw", "v_n", "v_e", "v_d", "lat", "lon", "h")
+_NAV_COLUMNS = ("roll", "pitch", "yaw", "v_n", "v_e", "v_d", "lat", "lon", "h", "v_along", "v_cross")
 
 
 def navigation_context(drive, nav_section: dict | None, starts: Sequence[float]) -> NavContext:
@@ -259,6 +259,7 @@ def navigation_context(drive, nav_section: dict | None, starts: Sequence[float])
     starts : sequence of float
         Outage starts, s.
     """
+    from bgfn.learning import DERIVED_CHANNELS, with_derived_channels
     from bgfn.nav import baseline
     from bgfn.nav.filter import run_filter
     from bgfn.nav.outages import epochs_before
@@ -277,6 +278,7 @@ def navigation_context(drive, nav_section: dict | None, starts: Sequence[float])
     ttr = tr["time"].to_numpy(float)
     idx = np.clip(np.searchsorted(ttr, imu_time - 1e-6), 0, len(ttr) - 1)
     ok = np.abs(ttr[idx] - imu_time) < 1e-6
+    tr = with_derived_channels(tr, DERIVED_CHANNELS)     # v_along, v_cross for train.extra_channels
     nav_at_imu = {}
     for c in _NAV_COLUMNS:
         v = tr[c].to_numpy(float)[idx]
@@ -393,6 +395,7 @@ class _Run:
 
     def _fill(self, r0: int, r1: int) -> None:
         """Features of output rows r0..r1 (inclusive, >= 1) from the current solution."""
+        from bgfn.learning import heading_velocity
         from bgfn.nav import transform
 
         if r1 < r0:
@@ -400,9 +403,12 @@ class _Run:
         roll, pitch, yaw = transform.euler_from_dcm(self.out_c[r0:r1 + 1])
         k0, k1 = self.n_window + r0 - 1, self.n_window + r1
         self.feat[k0:k1, 0], self.feat[k0:k1, 1], self.feat[k0:k1, 2] = roll, pitch, yaw
+        v = self.out_v[r0:r1 + 1]
         for i, c in enumerate(self.extra):
             if c in ("v_n", "v_e", "v_d"):
-                self.feat[k0:k1, 9 + i] = self.out_v[r0:r1 + 1, ("v_n", "v_e", "v_d").index(c)]
+                self.feat[k0:k1, 9 + i] = v[:, ("v_n", "v_e", "v_d").index(c)]
+            elif c in ("v_along", "v_cross"):
+                self.feat[k0:k1, 9 + i] = heading_velocity(v[:, 0], v[:, 1], yaw)[("v_along", "v_cross").index(c)]
             else:
                 self.feat[k0:k1, 9 + i] = self.out_pos[r0:r1 + 1, ("lat", "lon", "h").index(c)]
 

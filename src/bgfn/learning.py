@@ -56,6 +56,10 @@ from bgfn.nav.earth import curvature_radii
 CHANNELS: tuple[str, ...] = ("roll", "pitch", "yaw", "accel_x", "accel_y", "accel_z", "gyro_x", "gyro_y", "gyro_z")
 #: The 2 outputs: north and east GPS position increment, m.
 TARGETS: tuple[str, ...] = ("dn", "de")
+#: Extra input channels computed from the INS solution rather than read from it: the horizontal INS velocity
+#: in the frame of the sample's own yaw (along-track, cross-track), m/s. Unlike ``v_n, v_e`` they do not
+#: change when the vehicle drives the same manoeuvre in another direction.
+DERIVED_CHANNELS: tuple[str, ...] = ("v_along", "v_cross")
 YAW_ENCODINGS = ("unwrap", "relative", "raw")
 TARGET_FRAMES = ("ned", "heading")
 ALIGNMENTS = ("ending", "next")
@@ -79,6 +83,26 @@ def _check_table(df: pd.DataFrame, name: str, columns: Sequence[str]) -> None:
 
 
 # ----------------------------------------------------------------------------------------------- features
+def heading_velocity(v_n, v_e, yaw) -> tuple[np.ndarray, np.ndarray]:
+    """Horizontal velocity in the heading frame: ``(v_along, v_cross)``, m/s (yaw clockwise from north, rad)."""
+    v_n, v_e, yaw = (np.asarray(a, dtype=float) for a in (v_n, v_e, yaw))
+    c, s = np.cos(yaw), np.sin(yaw)
+    return c * v_n + s * v_e, -s * v_n + c * v_e
+
+
+def with_derived_channels(attitude: pd.DataFrame, channels: Sequence[str]) -> pd.DataFrame:
+    """``attitude`` plus the :data:`DERIVED_CHANNELS` among ``channels`` (a copy; unchanged when none)."""
+    wanted = [c for c in channels if c in DERIVED_CHANNELS and c not in attitude.columns]
+    if not wanted:
+        return attitude
+    _check_table(attitude, "attitude", ("v_n", "v_e", "yaw"))
+    along, cross = heading_velocity(attitude["v_n"], attitude["v_e"], attitude["yaw"])
+    out = attitude.copy()
+    for c in wanted:
+        out[c] = along if c == "v_along" else cross
+    return out
+
+
 def sample_features(imu: pd.DataFrame, attitude: pd.DataFrame,
                     extra_channels: Sequence[str] = ()) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
     """Per-IMU-sample features of Eq. (eq21) (plus optional extra columns of ``attitude``).
@@ -92,8 +116,8 @@ def sample_features(imu: pd.DataFrame, attitude: pd.DataFrame,
         linearly interpolated to the IMU times (yaw through its unwrapped form). Must cover the IMU span
         where windows are built; IMU rows outside it get NaN (and no window uses them).
     extra_channels : sequence of str
-        Additional ``attitude`` columns appended after the 9 channels (e.g. ``('v_n', 'v_e')``); not the
-        paper's input, off by default.
+        Additional ``attitude`` columns appended after the 9 channels (e.g. ``('v_n', 'v_e')``) or
+        :data:`DERIVED_CHANNELS` (``v_along``, ``v_cross``); not the paper's input, off by default.
 
     Returns
     -------
@@ -104,6 +128,7 @@ def sample_features(imu: pd.DataFrame, attitude: pd.DataFrame,
     channels : tuple of str
     """
     _check_table(imu, "imu", ("time", "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"))
+    attitude = with_derived_channels(attitude, extra_channels)
     _check_table(attitude, "attitude", ("time", "roll", "pitch", "yaw", *extra_channels))
     t = imu["time"].to_numpy(float)
     ta = attitude["time"].to_numpy(float)

@@ -10,7 +10,8 @@ All take the same normalized input window ``x [B, N, C]`` (Eq. eq21) and return 
   (``e_t = v^T tanh(W h_t + b)``, ``alpha = softmax(e)``, ``c = sum alpha_t h_t``), and a linear head on the
   context concatenated with the last hidden state.
 - :class:`TransformerTwin` has BGFN's structure with real-valued activations: the same temporal convolution
-  (``T_s`` kernels per channel, here read as ``C*T_s`` features of one token instead of ``T_s`` SNN steps),
+  (``K*T_s`` kernels per channel, here read as ``C*K*T_s`` features of one token instead of ``T_s`` SNN steps
+  of ``C*K`` neurons),
   a Linear embedding, ``depth`` pre-LayerNorm blocks of softmax multi-head attention and a GELU feed-forward
   of the same widths, mean over tokens, Linear head. It is the ANN reference of the energy comparison.
 """
@@ -95,21 +96,21 @@ class TransformerTwin(nn.Module):
 
     def __init__(self, in_channels: int = 9, dim: int = 256, ffn_dim: int = 256, depth: int = 4, heads: int = 8,
                  time_steps: int = 4, kernel_size: int = 3, readout: str = "mean", out_dim: int = 2,
-                 dropout: float = 0.0):
+                 dropout: float = 0.0, encoder_neurons: int = 1):
         super().__init__()
         if readout not in ("mean", "last"):
             raise ValueError(f"readout must be 'mean' or 'last', got {readout!r}")
         self.readout = readout
-        self.conv = nn.Conv1d(in_channels, in_channels * time_steps, kernel_size, padding=kernel_size // 2,
-                              groups=in_channels)
-        self.bn = nn.BatchNorm1d(in_channels * time_steps)
-        self.embed = nn.Linear(in_channels * time_steps, dim)
+        width = in_channels * encoder_neurons * time_steps     # BGFN's encoder currents, as features
+        self.conv = nn.Conv1d(in_channels, width, kernel_size, padding=kernel_size // 2, groups=in_channels)
+        self.bn = nn.BatchNorm1d(width)
+        self.embed = nn.Linear(width, dim)
         self.blocks = nn.ModuleList([TwinBlock(dim, ffn_dim, heads, dropout) for _ in range(depth)])
         self.ln = nn.LayerNorm(dim)
         self.head = nn.Linear(dim, out_dim)
 
     def forward(self, x):                                # [B, N, C]
-        z = F.gelu(self.bn(self.conv(x.transpose(1, 2))))   # [B, C*T_s, N]
+        z = F.gelu(self.bn(self.conv(x.transpose(1, 2))))   # [B, C*K*T_s, N]
         z = self.embed(z.transpose(1, 2))                # [B, N, D]
         for blk in self.blocks:
             z = blk(z)                                   # [B, N, D]

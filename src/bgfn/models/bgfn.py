@@ -3,7 +3,7 @@
 Data flow (shapes as comments; T = T_s SNN steps per IMU step, B = batch, N = window length in IMU samples,
 C = 9 input channels, D = embedding width)::
 
-    x [B, N, C] --spike_encoder--> [T, B, N, C] spikes        Eq. (eq:spike_input)  S = SN(BN(Conv(S_k)))
+    x [B, N, C] --spike_encoder--> [T, B, N, C*K] spikes      Eq. (eq:spike_input)  S = SN(BN(Conv(S_k)))
       --embedding--> [T, B, N, D] spikes                       Eq. (eq:spiking_embedding)  S_emb = SN(Linear(S))
       --L x Block (SSA + spiking MLP, residuals)--> [T, B, N, D]
       --mean over T and N--> [B, D] --Linear--> [B, 2]         delta_p_gps (north, east), Eq. (eq:bgfn_net)
@@ -15,6 +15,12 @@ channels, so every SNN step of an IMU sample gets its own learned current and th
 ``T_s`` currents into a spike pattern. This is the convolutional spike encoder of SeqSNN (Lv et al. 2024, the
 Spikformer-for-time-series code BGFN builds on), there ``Conv2d(1, T_s, (1, k))`` shared by all channels; we
 give each channel its own kernels because the nine channels have different units and dynamics.
+
+Encoder width ``K`` (``encoder_neurons``, default 1 = the paper's ``T_s x T x C``): with one neuron per channel a
+token carries only ``T_s`` binary values per sensor channel, so a slowly varying input such as a velocity is
+quantized to about ``T_s + 1`` levels whatever the window length. ``K > 1`` gives each channel ``K`` neurons with
+their own kernels and BatchNorm offsets (a population code, as in the wider first layer of Spikformer's image
+stem); the spike tensor is then ``[T_s, B, N, C*K]``. Not in the paper; a deviation when set.
 
 Spiking blocks follow Spikformer's ``model.py``: Q, K, V = SN(BN(Linear(x))); attention ``Q K^T V * scale``
 without softmax (all factors are non-negative spikes), then an LIF with threshold 0.5, then
@@ -59,24 +65,28 @@ class LinearBNLIF(nn.Module):
 
 
 class SpikeEncoder(nn.Module):
-    """Convolutional spike encoder, Eq. (eq:spike_input): S = SN(BN(Conv(S_k))). [B, N, C] -> [T_s, B, N, C]."""
+    """Convolutional spike encoder, Eq. (eq:spike_input): S = SN(BN(Conv(S_k))). [B, N, C] -> [T_s, B, N, C*K].
+
+    ``neurons`` = K spiking neurons per input channel (1: the paper's encoder).
+    """
 
     def __init__(self, in_channels: int, time_steps: int, kernel_size: int, tau: float, v_threshold: float,
-                 alpha: float):
+                 alpha: float, neurons: int = 1):
         super().__init__()
-        self.in_channels, self.time_steps = in_channels, time_steps
-        # T_s kernels per channel (groups=C); 'same' padding keeps one token per IMU sample
-        self.conv = nn.Conv1d(in_channels, in_channels * time_steps, kernel_size, padding=kernel_size // 2,
+        self.in_channels, self.time_steps, self.neurons = in_channels, time_steps, neurons
+        self.out_channels = in_channels * neurons
+        # T_s kernels per channel and neuron (groups=C); 'same' padding keeps one token per IMU sample
+        self.conv = nn.Conv1d(in_channels, self.out_channels * time_steps, kernel_size, padding=kernel_size // 2,
                               groups=in_channels)
-        self.bn = nn.BatchNorm1d(in_channels * time_steps)
+        self.bn = nn.BatchNorm1d(self.out_channels * time_steps)
         self.lif = make_lif(tau, v_threshold, alpha)
 
     def forward(self, x):                                # [B, N, C]
         B, N, C = x.shape
-        cur = self.bn(self.conv(x.transpose(1, 2)))      # [B, C*T, N]  (channel-major: c*T + t)
-        cur = cur.reshape(B, C, self.time_steps, N)      # [B, C, T, N]
-        cur = cur.permute(2, 0, 3, 1).contiguous()       # [T, B, N, C]
-        return self.lif(cur)                             # [T, B, N, C] spikes
+        cur = self.bn(self.conv(x.transpose(1, 2)))      # [B, C*K*T, N]  (channel-major: (c*K + k)*T + t)
+        cur = cur.reshape(B, self.out_channels, self.time_steps, N)   # [B, C*K, T, N]
+        cur = cur.permute(2, 0, 3, 1).contiguous()       # [T, B, N, C*K]
+        return self.lif(cur)                             # [T, B, N, C*K] spikes
 
 
 class SpikingEmbedding(nn.Module):
@@ -187,6 +197,8 @@ class BGFN(nn.Module):
         LIF time constant (beta = 1 - 1/tau), thresholds, ATan steepness.
     readout : {'mean', 'last'}
         Average over T_s and all tokens, or over T_s at the last token only.
+    encoder_neurons : int
+        K spiking neurons per input channel in the spike encoder (1: the paper's; module docstring).
     out_dim : int
         2 outputs: north and east increment.
     """
@@ -196,20 +208,21 @@ class BGFN(nn.Module):
     def __init__(self, in_channels: int = 9, dim: int = 256, ffn_dim: int = 256, depth: int = 4, heads: int = 8,
                  time_steps: int = 4, kernel_size: int = 3, attn_scale: float = 0.125, tau: float = DEFAULT_TAU,
                  v_threshold: float = DEFAULT_THRESHOLD, attn_threshold: float = DEFAULT_ATTN_THRESHOLD,
-                 alpha: float = DEFAULT_ALPHA, readout: str = "mean", out_dim: int = 2):
+                 alpha: float = DEFAULT_ALPHA, readout: str = "mean", out_dim: int = 2, encoder_neurons: int = 1):
         super().__init__()
         if readout not in ("mean", "last"):
             raise ValueError(f"readout must be 'mean' or 'last', got {readout!r}")
         self.readout = readout
-        self.spike_encoder = SpikeEncoder(in_channels, time_steps, kernel_size, tau, v_threshold, alpha)
-        self.embedding = SpikingEmbedding(in_channels, dim, tau, v_threshold, alpha)
+        self.spike_encoder = SpikeEncoder(in_channels, time_steps, kernel_size, tau, v_threshold, alpha,
+                                          neurons=encoder_neurons)
+        self.embedding = SpikingEmbedding(self.spike_encoder.out_channels, dim, tau, v_threshold, alpha)
         self.blocks = nn.ModuleList([Block(dim, ffn_dim, heads, attn_scale, tau, v_threshold, attn_threshold, alpha)
                                      for _ in range(depth)])
         self.head = nn.Linear(dim, out_dim)
 
     def features(self, x):                               # [B, N, C]
         functional.reset_net(self)                       # membrane state starts at 0 for every batch
-        s = self.spike_encoder(x)                        # [T, B, N, C]
+        s = self.spike_encoder(x)                        # [T, B, N, C*K]
         s = self.embedding(s)                            # [T, B, N, D]
         for blk in self.blocks:
             s = blk(s)                                   # [T, B, N, D]

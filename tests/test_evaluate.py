@@ -364,3 +364,17 @@ def test_real_imu_switch_falls_back_to_the_simulated_datasets(monkeypatch, tmp_p
     assert "absent" in notes[1] and "navego-mpu6000" in notes[1]
     assert ev.choose_datasets(["turin-sim-ekinox"], real_imu=False) == (["turin-sim-ekinox"], [])
     assert ev.PAPER_TESTS["navego-ekinox"] == "dataset" and ev.PAPER_TESTS["navego-mpu6000"] == "field"
+
+
+def test_describe_tables_says_where_gps_is_not_the_lower_bound():
+    rows = []
+    for m, e in (("INS", 0.8), ("BGFN", 30.0), ("GPS", 1.6)):
+        rows.append({"outage": 2, "method": m, "max_east_m": e, "max_north_m": 11.0 if m != "GPS" else 1.0,
+                     "rmse_h_m": 6.0 if m != "GPS" else 1.5, "final_h_m": 11.0 if m != "GPS" else 1.7})
+    res = ev.TableResult("turin-sim-ekinox", "dataset", pd.DataFrame(), pd.DataFrame(rows), [], {})
+    (line,) = ev.describe_tables([res])
+    assert "not the lower bound" in line and "INS max east 0.8 < GPS 1.6 m" in line
+    assert "BGFN max east" not in line                       # only cells below the GPS row are named
+    rows[0]["max_east_m"] = 2.0
+    (line,) = ev.describe_tables([ev.TableResult("x", "dataset", pd.DataFrame(), pd.DataFrame(rows), [], {})])
+    assert "lower bound" not in line

@@ -289,7 +289,8 @@ def test_book_references_to_code_and_files_exist():
 def test_results_notebook_is_thin_and_wired_in():
     nb = nbformat.read(PROJECT_ROOT / "notebooks" / "06_results.ipynb", as_version=4)
     code = [c for c in nb.cells if c.cell_type == "code"]
-    assert "parameters" in code[0].metadata.get("tags", []) and code[0].source.strip() == 'profile = "quick"'
+    assert "parameters" in code[0].metadata.get("tags", [])
+    assert code[0].source.strip().splitlines()[0] == 'profile = "quick"' and "variants = [" in code[0].source
     assert all(not c.get("outputs") and c.get("execution_count") is None for c in code), "store it without outputs"
     assert nb.cells[0].cell_type == "markdown" and nb.cells[0].source.startswith("# Results")
     make = (PROJECT_ROOT / "Makefile").read_text()
@@ -343,3 +344,22 @@ def test_source_code_page_lists_every_module():
                if p.name not in ("__init__.py", "__main__.py")]
     missing = [m for m in modules if f"../{m}" not in code]
     assert not missing, f"add these modules to book/code.md: {missing}"
+
+
+def test_variant_tables_put_profiles_side_by_side():
+    def summary(bgfn, mlp):
+        return pd.DataFrame({"dataset": ["d", "d"], "method": ["bgfn", "mlp"], "val_rmse_m_mean": [bgfn, mlp],
+                             "val_rmse_zero_m": [10.0, 10.0], "val_rmse_last_m": [1.4, 1.4]})
+    t = report.variant_training_table({"quick": summary(5.0, 7.0), "quick-heading": summary(1.7, 0.8),
+                                       "absent": None})
+    assert list(t.columns) == ["val. RMSE quick", "val. RMSE quick-heading", "zero", "last increment"]
+    assert t.loc[("d", "BGFN"), "val. RMSE quick-heading"] == 1.7
+    lines = report.variant_sentences(t)
+    assert lines[0].endswith("below the last increment: no network.")
+    assert "BGFN 1.70 m against last increment 1.40 m" in lines[1] and lines[1].endswith(": MLP.")
+    out = pd.DataFrame({"outage": [1, 1], "method": ["INS", "BGFN"], "max_east_m": [8.0, 100.0],
+                        "max_north_m": [2.0, 300.0], "rmse_h_m": 1.0, "final_h_m": 1.0})
+    o = report.variant_outage_table({"quick": out, "quick-heading": out.assign(max_east_m=[8.0, 4.0])})
+    assert o.loc[(1, "INS")].tolist() == [5.0, 5.0]          # (8 + 2) / 2 in both
+    assert o.loc[(1, "BGFN")].tolist() == [200.0, 152.0]     # (100 + 300) / 2, (4 + 300) / 2
+    assert report.variant_training_table({"a": None}) is None

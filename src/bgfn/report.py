@@ -671,3 +671,57 @@ __all__ = [
     "short_source", "outage_datasets", "outage_provenance", "run_header", "win_counts", "summary_sentence",
     "comparison_sentences", "reduction_sentences", "energy_sentences", "figure_list", "rel",
 ]
+
+
+# ----------------------------------------------------------------------------------------------- variants
+def variant_training_table(summaries: dict[str, pd.DataFrame | None]) -> pd.DataFrame | None:
+    """Validation RMSE (m, mean over seeds) per (dataset, method), one column per profile, beside the two
+    references (*zero*, *last increment*), which are the same windows in every profile of one drive.
+
+    ``summaries``: ``{profile: tables/training_summary.csv}``; profiles without a table are left out.
+    """
+    cols, ref = [], None
+    for profile, s in summaries.items():
+        if s is None:
+            continue
+        s = s.assign(method=s["method"].map(lambda m: METHOD_LABELS.get(m, m))).set_index(["dataset", "method"])
+        cols.append(s["val_rmse_m_mean"].rename(f"val. RMSE {profile}"))
+        if ref is None:
+            ref = s[["val_rmse_zero_m", "val_rmse_last_m"]].rename(
+                columns={"val_rmse_zero_m": "zero", "val_rmse_last_m": "last increment"})
+    if not cols:
+        return None
+    return pd.concat(cols + [ref], axis=1)
+
+
+def variant_outage_table(tables: dict[str, pd.DataFrame | None], metric: str = "max_h") -> pd.DataFrame | None:
+    """One outage table per profile side by side: per (outage, method) the mean of the max east and max north
+    error (m, ``metric='max_h'``) or one column of :data:`bgfn.evaluate.METRIC_COLUMNS`."""
+    cols = []
+    for profile, t in tables.items():
+        if t is None:
+            continue
+        t = t.set_index(["outage", "method"])
+        v = (t["max_east_m"] + t["max_north_m"]) / 2.0 if metric == "max_h" else t[metric]
+        cols.append(v.rename(profile))
+    return pd.concat(cols, axis=1) if cols else None
+
+
+def variant_sentences(training: pd.DataFrame | None, method: str = "BGFN") -> list[str]:
+    """Per profile and dataset: which networks beat the *last increment* reference on validation RMSE."""
+    if training is None:
+        return []
+    lines = []
+    for col in [c for c in training.columns if c.startswith("val. RMSE ")]:
+        profile = col[len("val. RMSE "):]
+        for dataset, g in training.groupby(level="dataset"):
+            g = g.droplevel("dataset")
+            if g[col].isna().all():
+                continue
+            last, zero = float(g["last increment"].iloc[0]), float(g["zero"].iloc[0])
+            beat = [m for m in g.index if g.loc[m, col] < last]
+            txt = (f"`{profile}`, `{dataset}`: {method} {g.loc[method, col]:.2f} m against last increment "
+                   f"{last:.2f} m and zero {zero:.2f} m" if method in g.index else f"`{profile}`, `{dataset}`")
+            txt += f"; below the last increment: {', '.join(beat) if beat else 'no network'}."
+            lines.append(txt)
+    return lines

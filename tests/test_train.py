@@ -10,6 +10,7 @@ import torch
 
 from bgfn import learning as L
 from bgfn import train as T
+from bgfn.errors import DataError
 
 torch.set_num_threads(1)
 
@@ -175,3 +176,52 @@ def test_result_tables_leave_wall_clock_out():
     times = T.timing_table(summary)
     assert list(times.columns) == ["dataset", "method", "train_time_s_mean", "train_time_s_total"]
     assert times["train_time_s_total"].tolist() == [3.0, 3.0]  # 1 s + 2 s per method
+
+
+def test_inner_split_never_touches_the_validation_block(data):
+    inner = L.inner_split(data, 0.25)
+    lo_v, hi_v = data.val.span
+    for ws in (inner.train, inner.val):
+        lo, hi = ws.span
+        assert not L.overlaps(lo, hi, np.array([[lo_v.min(), hi_v.max()]])).any()
+    # the tuning block is the end of the training windows, and no tuning-train window overlaps it
+    assert inner.val.t_to.min() > inner.train.t_to.max()
+    lo, hi = inner.train.span
+    assert not L.overlaps(lo, hi, np.array([[inner.val.span[0].min(), inner.val.span[1].max()]])).any()
+    assert len(inner.val) == pytest.approx(0.25 * (len(inner.train) + len(inner.val)), abs=len(data.train) * 0.05)
+    # normalization from the tuning-train windows only
+    x = inner.train.x.reshape(-1, inner.train.x.shape[-1]).astype(float)
+    np.testing.assert_allclose(inner.norm.x_mean, x.mean(0),
+                               rtol=1e-9, atol=1e-12)
+
+
+def test_learning_rate_search_picks_the_lowest_tuning_loss(data, tmp_path):
+    cfg = {**_cfg(epochs=4), "lr_search": {"grid": [0.0, 3e-3], "fraction": 0.25, "seed": 0}}
+    t = T.search_learning_rates(data, ["mlp"], {**cfg, "sizes": {"mlp": {"s": {"n_recent": 5, "hidden": 16}}},
+                                              "size": "s"}, out_dir=tmp_path)
+    assert list(t.columns) == ["method", "lr", "tuning_rmse_m", "tuning_loss", "epochs_run", "selected"]
+    assert t["selected"].sum() == 1
+    # lr 0 cannot learn: the search must keep 3e-3 (lower tuning loss)
+    assert t.loc[t["selected"], "lr"].item() == 3e-3
+    assert t.loc[t["lr"] == 0.0, "tuning_loss"].item() > t.loc[t["lr"] == 3e-3, "tuning_loss"].item()
+    chosen = T.with_selected_lr({"lr": {"mlp": 1e-3, "bgfn": 1e-3}}, t)
+    assert chosen["lr"] == {"mlp": 3e-3, "bgfn": 1e-3}
+    assert T.with_selected_lr({"lr": {"mlp": 1e-3}}, None) == {"lr": {"mlp": 1e-3}}
+    with pytest.raises(DataError, match="grid"):
+        T.search_learning_rates(data, ["mlp"], {**cfg, "lr_search": {"grid": []}})
+    with pytest.raises(DataError, match="fractoin"):
+        T.lr_search_options({"lr_search": {"fractoin": 0.2}})
+
+
+def test_tuned_config_reads_the_saved_search(tmp_path, monkeypatch):
+    monkeypatch.setattr(T, "results_dir", lambda profile, create=True: tmp_path / profile)
+    cfg = {"train": {"lr": {"mlp": 1e-3}, "lr_search": {"grid": [1e-3, 1e-2]}}}
+    assert T.tuned_train_config(cfg, "p", "d1") is cfg["train"]              # not run yet
+    (tmp_path / "p" / "tables").mkdir(parents=True)
+    (tmp_path / "p" / "tables" / T.LR_SEARCH_FILE).write_text(
+        "dataset,method,lr,tuning_rmse_m,tuning_loss,epochs_run,selected\n"
+        "d1,mlp,0.001,1,1,3,False\nd1,mlp,0.01,1,0.5,3,True\nd2,mlp,0.001,1,0.1,3,True\nd2,mlp,0.01,1,1,3,False\n")
+    assert T.method_lr(T.tuned_train_config(cfg, "p", "d1"), "mlp") == 0.01
+    assert T.method_lr(T.tuned_train_config(cfg, "p", "d2"), "mlp") == 0.001
+    off = {"train": {"lr": {"mlp": 1e-3}, "lr_search": {"grid": None}}}
+    assert T.method_lr(T.tuned_train_config(off, "p", "d1"), "mlp") == 0.001   # no search in the profile

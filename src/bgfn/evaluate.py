@@ -636,7 +636,7 @@ def ensure_models(cfg: dict, profile: str, dataset: str, ctx: NavContext, method
     from bgfn import train
 
     models, data = {}, None
-    tc = cfg["train"]
+    tc = train.tuned_train_config(cfg, profile, dataset)      # notebook 03's selected learning rates
     for method in methods:
         for seed in seeds:
             path = model_path(profile, dataset, method, seed)
@@ -1065,7 +1065,8 @@ def run_sweep(cfg: dict, profile: str, dataset: str, drive=None, ecfg: dict | No
         from bgfn.data import load_drive
 
         drive = load_drive(dataset, profile=profile)
-    tc = sweep_train_config(cfg["train"], sw)
+    # the sweep's budget, with the learning rates notebook 03 selected for this dataset (same for every fold)
+    tc = sweep_train_config(train.tuned_train_config(cfg, profile, dataset), sw)
     opts = learning_options(tc)
     plan = sweep_plan(drive, sw, int(opts["window"]))
     durations = sorted(float(d) for d in sw["durations_s"])
@@ -1117,6 +1118,7 @@ def run_sweep(cfg: dict, profile: str, dataset: str, drive=None, ecfg: dict | No
     info = {"dataset": dataset, "n_starts": len(plan), "folds": int(plan["fold"].nunique()), "seeds": seeds,
             "durations_s": durations, "methods": [METHOD_LABELS[m] for m in methods],
             "window": int(opts["window"]), "size": tc.get("size"), "optimizer": train.optimizer_options(tc),
+            "lr": {METHOD_LABELS[m]: train.method_lr(tc, m) for m in methods},
             "fold_starts": {int(k): plan.loc[plan["fold"] == k, "start_s"].tolist() for k in plan["fold"].unique()},
             "train_wall_s": t_train, "eval_wall_s": t_eval + t_nav,
             "train_epochs_run": {f"{c['method']}_fold{c.get('fold')}_seed{c['seed']}": c["epochs_run"] for c in cards},

@@ -550,6 +550,19 @@ def build_learning_data(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.Data
                         options=opt)
 
 
+def inner_split(data: LearningData, fraction: float = 0.2) -> LearningData:
+    """A tuning split inside the training windows: the last ``fraction`` of ``data.train`` (one block of time)
+    becomes the validation set, training windows overlapping it are dropped, and the normalization is refit.
+
+    Hyper-parameters chosen on it never see ``data.val``, the block every reported validation error comes from.
+    """
+    tr, va, info = split_windows(data.train, (), margin_s=0.0, val_fraction=fraction, val_position="end")
+    train, val = data.train.subset(tr), data.train.subset(va)
+    frame = data.options.get("target_frame", "ned")
+    return LearningData(train=train, val=val, norm=Normalizer.fit(train, frame),
+                        info={**info, "inner_of": data.info.get("val_block")}, options=dict(data.options))
+
+
 def rmse(pred: np.ndarray, true: np.ndarray) -> float:
     """Root mean square of the horizontal error ``sqrt(mean(dN^2 + dE^2))``, m, over rows without NaN."""
     pred, true = np.asarray(pred, float), np.asarray(true, float)

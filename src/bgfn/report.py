@@ -268,7 +268,8 @@ def kf_table(kf: dict | None) -> pd.DataFrame | None:
 
 #: Columns of ``tables/training_summary.csv`` shown on the page, with their labels.
 TRAINING_COLUMNS: dict[str, str] = {
-    "params": "parameters", "seeds": "seeds", "epochs_mean": "epochs", "train_time_s_mean": "time (s)",
+    "params": "parameters", "lr": "learning rate", "seeds": "seeds", "epochs_mean": "epochs",
+    "train_time_s_mean": "time (s)",
     "val_rmse_m_mean": "val. RMSE (m)", "val_rmse_m_std": "std over seeds (m)", "val_rmse_zero_m": "zero (m)",
     "val_rmse_last_m": "last increment (m)"}
 #: Method ids of the model cards and training tables -> labels of the paper's tables.

@@ -31,9 +31,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 import torch
 from torch import nn
 
+from bgfn.config import results_dir
 from bgfn.errors import DataError
 from bgfn.io import atomic_path, atomic_write_json
 from bgfn.learning import (LearningData, Normalizer, WindowSet, from_target_frame, learning_options,
@@ -92,6 +94,77 @@ def method_lr(train_cfg: dict | None, method: str) -> float:
     """Learning rate of ``method``: ``train.lr[method]`` if set, else ``train.optimizer.lr``."""
     per = (train_cfg or {}).get("lr") or {}
     return float(per.get(method, optimizer_options(train_cfg)["lr"]))
+
+
+#: ``train.lr_search``: learning rates tried for every method on :func:`bgfn.learning.inner_split` (null: none).
+LR_SEARCH_DEFAULTS: dict[str, Any] = {"grid": None, "fraction": 0.2, "seed": 0}
+LR_SEARCH_FILE = "lr_search.csv"
+
+
+def lr_search_options(train_cfg: dict | None) -> dict:
+    """``train.lr_search`` with defaults filled in (unknown keys raise DataError)."""
+    opt = dict((train_cfg or {}).get("lr_search") or {})
+    unknown = set(opt) - set(LR_SEARCH_DEFAULTS)
+    if unknown:
+        raise DataError("train.lr_search", sorted(unknown)[0], f"one of {', '.join(LR_SEARCH_DEFAULTS)}")
+    return {**LR_SEARCH_DEFAULTS, **opt}
+
+
+def search_learning_rates(data: LearningData, methods, train_cfg: dict, out_dir: str | Path | None = None,
+                          progress: bool = False) -> pd.DataFrame:
+    """Train every method once per learning rate of ``train.lr_search.grid`` on a tuning split inside the
+    training windows (:func:`bgfn.learning.inner_split`) and mark the rate with the lowest tuning loss.
+
+    Every method gets the same grid, budget (the profile's optimizer) and seed, so none is tuned more than
+    another; the validation block of ``data`` is never used.
+
+    Returns
+    -------
+    DataFrame
+        ``method, lr, tuning_rmse_m, tuning_loss, epochs_run, selected`` (one row per method and rate).
+    """
+    from bgfn.learning import inner_split
+
+    ls = lr_search_options(train_cfg)
+    grid = [float(v) for v in (ls["grid"] or [])]
+    if not grid:
+        raise DataError("train.lr_search", "grid", "a non-empty list of learning rates", repr(ls["grid"]))
+    inner = inner_split(data, float(ls["fraction"]))
+    rows = []
+    for method in methods:
+        for lr in grid:
+            cfg = {**train_cfg, "lr": {**(train_cfg.get("lr") or {}), method: lr}}
+            sub = Path(out_dir) / f"lr{lr:g}" if out_dir is not None else None
+            card = train_model(method, inner, size_config(train_cfg, method), cfg, seed=int(ls["seed"]),
+                               out_dir=sub, progress=progress)
+            rows.append({"method": method, "lr": lr, "tuning_rmse_m": card["val_rmse_m"],
+                         "tuning_loss": card["best_val_loss"], "epochs_run": card["epochs_run"]})
+    table = pd.DataFrame(rows)
+    best = table.groupby("method", sort=False)["tuning_loss"].idxmin()
+    table["selected"] = table.index.isin(best.to_numpy())
+    return table
+
+
+def with_selected_lr(train_cfg: dict, search: pd.DataFrame | None) -> dict:
+    """``train_cfg`` with ``lr`` set to the selected rate of each method in ``search`` (unchanged if None)."""
+    if search is None or len(search) == 0:
+        return train_cfg
+    chosen = search[search["selected"].astype(bool)]
+    return {**train_cfg, "lr": {**(train_cfg.get("lr") or {}),
+                                **{str(m): float(v) for m, v in zip(chosen["method"], chosen["lr"])}}}
+
+
+def tuned_train_config(cfg: dict, profile: str, dataset: str) -> dict:
+    """The profile's ``train:`` section with the learning rates notebook 03 selected for ``dataset``
+    (``tables/lr_search.csv``); unchanged when the profile has no search or it has not run."""
+    tc = cfg["train"]
+    if not lr_search_options(tc)["grid"]:
+        return tc
+    path = results_dir(profile, create=False) / "tables" / LR_SEARCH_FILE
+    if not path.exists():
+        return tc
+    table = pd.read_csv(path)
+    return with_selected_lr(tc, table[table["dataset"] == dataset])
 
 
 def size_config(train_cfg: dict, method: str, size: str | None = None) -> dict:
@@ -164,8 +237,6 @@ class TrainedModel:
     def increment_table(self, imu, attitude, epochs):
         """:meth:`predict_increments` as the table :class:`bgfn.nav.outages.IncrementPseudoGps` reads:
         ``time`` (end of each increment, s), ``delta_p_n``, ``delta_p_e`` (m)."""
-        import pandas as pd
-
         d = self.predict_increments(imu, attitude, epochs)
         return pd.DataFrame({"time": np.asarray(epochs, float)[1:], "delta_p_n": d[:, 0], "delta_p_e": d[:, 1]})
 
@@ -374,8 +445,6 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
 # ----------------------------------------------------------------------------------------------- profiles
 def models_dir(profile: str, dataset: str) -> Path:
     """``results/<profile>/models/<dataset>/``."""
-    from bgfn.config import results_dir
-
     d = results_dir(profile) / "models" / dataset
     d.mkdir(parents=True, exist_ok=True)
     return d
@@ -427,7 +496,6 @@ def ins_attitude(drive, cfg: dict):
     coupled filter of :mod:`bgfn.nav.filter` with every GNSS fix; ``'reference'`` takes the truth attitude
     (debugging only: the outage evaluation feeds the INS attitude).
     """
-    import pandas as pd
 
     src = (cfg.get("train") or {}).get("attitude_source", "kf")
     if src == "reference":
@@ -488,10 +556,9 @@ def train_profile(profile: str, datasets=None, methods=None, seeds=None, device:
 
 # ----------------------------------------------------------------------------------------------- reporting
 def cards_table(cards: list[dict]):
-    """One row per run: dataset, method, seed, params, epochs, wall time, validation RMSE and references (m)."""
-    import pandas as pd
-
-    cols = ["dataset", "method", "seed", "params", "epochs_run", "best_epoch", "wall_time_s", "n_train", "n_val",
+    """One row per run: dataset, method, seed, params, learning rate, epochs, wall time, validation RMSE and
+    references (m)."""
+    cols = ["dataset", "method", "seed", "params", "lr", "epochs_run", "best_epoch", "wall_time_s", "n_train", "n_val",
             "val_rmse_m", "val_rmse_zero_m", "val_rmse_last_m", "device"]
     return pd.DataFrame([{c: card.get(c) for c in cols} for card in cards], columns=cols)
 
@@ -516,7 +583,8 @@ def summary_table(cards: list[dict]):
     """Per dataset and method: parameters, epochs, training time and validation RMSE over seeds (mean, std)."""
     runs = cards_table(cards)
     g = runs.groupby(["dataset", "method"], sort=False)
-    out = g.agg(params=("params", "first"), seeds=("seed", "count"), epochs_mean=("epochs_run", "mean"),
+    out = g.agg(params=("params", "first"), lr=("lr", "first"), seeds=("seed", "count"),
+                epochs_mean=("epochs_run", "mean"),
                 train_time_s_mean=("wall_time_s", "mean"), train_time_s_total=("wall_time_s", "sum"),
                 val_rmse_m_mean=("val_rmse_m", "mean"), val_rmse_m_std=("val_rmse_m", "std"),
                 val_rmse_zero_m=("val_rmse_zero_m", "first"), val_rmse_last_m=("val_rmse_last_m", "first"))

@@ -81,13 +81,18 @@ def pick_device(device: str | None = None) -> torch.device:
     return torch.device("cuda" if torch.cuda.is_available() else "cpu")
 
 
+def _subsection(train_cfg: dict | None, key: str, defaults: dict) -> dict:
+    """``train.<key>`` with ``defaults`` filled in; an unknown key raises DataError naming it."""
+    opt = dict((train_cfg or {}).get(key) or {})
+    unknown = set(opt) - set(defaults)
+    if unknown:
+        raise DataError(f"train.{key}", sorted(unknown)[0], f"one of {', '.join(defaults)}")
+    return {**defaults, **opt}
+
+
 def optimizer_options(train_cfg: dict | None) -> dict:
     """``train.optimizer`` keys with defaults filled in (unknown keys raise DataError)."""
-    opt = dict((train_cfg or {}).get("optimizer") or {})
-    unknown = set(opt) - set(OPTIMIZER_DEFAULTS)
-    if unknown:
-        raise DataError("train.optimizer", sorted(unknown)[0], f"one of {', '.join(OPTIMIZER_DEFAULTS)}")
-    return {**OPTIMIZER_DEFAULTS, **opt}
+    return _subsection(train_cfg, "optimizer", OPTIMIZER_DEFAULTS)
 
 
 def method_lr(train_cfg: dict | None, method: str) -> float:
@@ -103,11 +108,7 @@ LR_SEARCH_FILE = "lr_search.csv"
 
 def lr_search_options(train_cfg: dict | None) -> dict:
     """``train.lr_search`` with defaults filled in (unknown keys raise DataError)."""
-    opt = dict((train_cfg or {}).get("lr_search") or {})
-    unknown = set(opt) - set(LR_SEARCH_DEFAULTS)
-    if unknown:
-        raise DataError("train.lr_search", sorted(unknown)[0], f"one of {', '.join(LR_SEARCH_DEFAULTS)}")
-    return {**LR_SEARCH_DEFAULTS, **opt}
+    return _subsection(train_cfg, "lr_search", LR_SEARCH_DEFAULTS)
 
 
 def search_learning_rates(data: LearningData, methods, train_cfg: dict, out_dir: str | Path | None = None,

@@ -363,3 +363,15 @@ def test_variant_tables_put_profiles_side_by_side():
     assert o.loc[(1, "INS")].tolist() == [5.0, 5.0]          # (8 + 2) / 2 in both
     assert o.loc[(1, "BGFN")].tolist() == [200.0, 152.0]     # (100 + 300) / 2, (4 + 300) / 2
     assert report.variant_training_table({"a": None}) is None
+
+
+def test_variant_sweep_table_aligns_durations_and_methods():
+    def summary(bgfn):
+        return pd.DataFrame({"dataset": "d", "duration_s": [10.0, 10.0, 120.0, 120.0],
+                             "method": ["INS", "BGFN"] * 2, "median_m": [3.0, bgfn[0], 500.0, bgfn[1]]})
+    t = report.variant_sweep_table({"quick": summary((13.0, 390.0)), "quick-heading": summary((5.0, 110.0)),
+                                    "none": None})
+    assert list(t.columns) == ["quick", "quick-heading"]
+    assert t.loc[("d", 120.0, "BGFN")].tolist() == [390.0, 110.0]
+    assert t.loc[("d", 10.0, "INS")].tolist() == [3.0, 3.0]
+    assert report.variant_sweep_table({"x": None}) is None

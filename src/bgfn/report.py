@@ -726,3 +726,11 @@ def variant_sentences(training: pd.DataFrame | None, method: str = "BGFN") -> li
             txt += f"; below the last increment: {', '.join(beat) if beat else 'no network'}."
             lines.append(txt)
     return lines
+
+
+def variant_sweep_table(summaries: dict[str, pd.DataFrame | None]) -> pd.DataFrame | None:
+    """Median max horizontal error of the outage sweep (m) per (dataset, duration, method), one column per
+    profile (``tables/outage_sweep_summary.csv`` of each; profiles without one are left out)."""
+    cols = [s.set_index(["dataset", "duration_s", "method"])["median_m"].rename(p)
+            for p, s in summaries.items() if s is not None]
+    return pd.concat(cols, axis=1) if cols else None

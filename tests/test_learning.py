@@ -192,3 +192,21 @@ def test_derived_channels_need_velocity_and_yaw():
     t, x, ch = L.sample_features(imu, att.assign(v_n=3.0, v_e=4.0), ("v_along", "v_cross"))
     assert ch[-2:] == ("v_along", "v_cross")
     np.testing.assert_allclose(x[:, -2:], [[3.0, 4.0], [3.0, 4.0]])
+
+
+def test_motion_coverage_of_windows_and_outages():
+    # a window whose 1 s increment is 3 m north, 4 m east at yaw 90 deg: speed 5 m/s, heading 90
+    ws = L.WindowSet(x=np.zeros((2, 3, 9), np.float32), y=np.array([[3.0, 4.0], [0.0, -10.0]]),
+                     t_from=np.array([0.0, 1.0]), t_to=np.array([1.0, 2.0]), t_end=np.array([1.0, 2.0]),
+                     t_start=np.array([-1.0, 0.0]), y_last=np.full((2, 2), np.nan),
+                     yaw_ref=np.array([np.pi / 2, -np.pi / 2]))
+    m = L.motion_of_windows(ws)
+    np.testing.assert_allclose(m["speed_mps"], [5.0, 10.0])
+    np.testing.assert_allclose(m["heading_deg"], [90.0, 270.0])
+    ref = pd.DataFrame({"time": [0.0, 100.0], "yaw": [0.0, 0.0], "v_n": [10.0, 10.0], "v_e": [0.0, 0.0]})
+    o = L.motion_in_windows(ref, [(10.0, 5.0)])
+    assert len(o) == 5 and np.allclose(o["speed_mps"], 10.0) and np.allclose(o["heading_deg"], 0.0)
+    # training saw (90 deg, 5 m/s) and (270 deg, 10 m/s); the outage drives north at 10 m/s: all unseen
+    assert L.unseen_fraction(m, o) == 1.0
+    assert L.unseen_fraction(m, m) == 0.0
+    assert L.unseen_fraction(m, pd.concat([m.iloc[:1], o.iloc[:1]])) == 0.5

@@ -563,6 +563,43 @@ def inner_split(data: LearningData, fraction: float = 0.2) -> LearningData:
                         info={**info, "inner_of": data.info.get("val_block")}, options=dict(data.options))
 
 
+def motion_of_windows(ws: WindowSet) -> pd.DataFrame:
+    """Heading (INS yaw at the window end, deg in [0, 360)) and mean speed over the target interval
+    (|delta_p_gps| / interval, m/s) of every window: the two quantities the increment depends on most."""
+    dt = np.maximum(ws.t_to - ws.t_from, 1e-9)
+    return pd.DataFrame({"heading_deg": np.degrees(ws.yaw_ref) % 360.0,
+                         "speed_mps": np.hypot(ws.y[:, 0], ws.y[:, 1]) / dt})
+
+
+def motion_in_windows(reference: pd.DataFrame, windows, step_s: float = 1.0) -> pd.DataFrame:
+    """Heading (deg) and horizontal speed (m/s) of the ``reference`` every ``step_s`` inside ``windows``
+    ((start, duration) pairs, s): what the networks meet in the evaluation outages."""
+    t = reference["time"].to_numpy(float)
+    rows = []
+    for start, duration in windows:
+        ts = np.arange(float(start), float(start) + float(duration), step_s)
+        yaw = np.interp(ts, t, np.unwrap(reference["yaw"].to_numpy(float)))
+        v = np.interp(ts, t, np.hypot(reference["v_n"].to_numpy(float), reference["v_e"].to_numpy(float)))
+        rows.append(pd.DataFrame({"heading_deg": np.degrees(yaw) % 360.0, "speed_mps": v}))
+    return pd.concat(rows, ignore_index=True) if rows else pd.DataFrame(columns=["heading_deg", "speed_mps"])
+
+
+def unseen_fraction(train: pd.DataFrame, other: pd.DataFrame, heading_bin_deg: float = 30.0,
+                    speed_bin_mps: float = 2.0) -> float:
+    """Fraction of the rows of ``other`` whose (heading, speed) cell holds no training row (cells of
+    ``heading_bin_deg`` x ``speed_bin_mps``): how much of it a network must extrapolate to."""
+    if len(other) == 0:
+        return float("nan")
+
+    def cells(df):
+        return set(zip((df["heading_deg"].to_numpy() // heading_bin_deg).astype(int),
+                       (df["speed_mps"].to_numpy() // speed_bin_mps).astype(int)))
+    seen = cells(train)
+    hit = [c in seen for c in zip((other["heading_deg"].to_numpy() // heading_bin_deg).astype(int),
+                                  (other["speed_mps"].to_numpy() // speed_bin_mps).astype(int))]
+    return 1.0 - float(np.mean(hit))
+
+
 def rmse(pred: np.ndarray, true: np.ndarray) -> float:
     """Root mean square of the horizontal error ``sqrt(mean(dN^2 + dE^2))``, m, over rows without NaN."""
     pred, true = np.asarray(pred, float), np.asarray(true, float)

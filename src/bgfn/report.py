@@ -596,6 +596,9 @@ EXTRA_FIGURES: tuple[dict[str, str], ...] = (
      "caption": "Max horizontal error over many outage starts and durations ({dataset})."},
     {"label": "training curves", "file": "training_curves_{dataset}.png", "by": "notebook 03",
      "caption": "Training and validation loss per epoch ({dataset})."},
+    {"label": "headings and speeds seen", "file": "motion_coverage_{dataset}.png", "by": "notebook 03",
+     "caption": "Heading and speed of the training and validation windows and of the evaluation outages "
+                "({dataset}): what the networks must extrapolate to."},
 )
 
 

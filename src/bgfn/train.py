@@ -662,6 +662,29 @@ def plot_val_predictions(data: LearningData, predictions: dict, title: str = "",
     return fig
 
 
+def plot_motion_coverage(sets: dict, title: str = ""):
+    """Heading and speed histograms of the windows a network trains on, is validated on and meets in the
+    outages. ``sets``: ``{label: DataFrame with heading_deg, speed_mps}`` (:func:`bgfn.learning.motion_of_windows`,
+    :func:`bgfn.learning.motion_in_windows`)."""
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(11, 3.4))
+    for i, (label, df) in enumerate(sets.items()):
+        axes[0].hist(df["heading_deg"], bins=np.arange(0, 361, 15), density=True, histtype="step", lw=1.5,
+                     color=f"C{i}", label=f"{label} ({len(df)})")
+        axes[1].hist(df["speed_mps"], bins=np.arange(0, max(25.0, float(df["speed_mps"].max()) + 1), 1.0),
+                     density=True, histtype="step", lw=1.5, color=f"C{i}", label=label)
+    axes[0].set_xlabel("heading (INS yaw), deg")
+    axes[1].set_xlabel("speed over the increment, m/s")
+    for ax in axes:
+        ax.set_ylabel("density")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
 def main(argv=None) -> None:
     p = argparse.ArgumentParser(description="Train BGFN and baselines for a profile.")
     p.add_argument("--profile", default="quick")

@@ -38,7 +38,11 @@ LOCK_HASH := $(shell sha256sum requirements.lock | cut -c1-16)
 STAMP := $(VENV)/.installed-$(LOCK_HASH)
 
 NOTEBOOKS := 01_data_prep 02_kf_baseline 03_bgfn_training 04_outage_evaluation 05_energy_estimate 06_results
-PARAMS := params/$(PROFILE).yaml
+# A profile's notebooks also depend on the profile(s) it builds on (`base:` in its YAML; two levels followed).
+base_of = $(shell sed -n 's/^base:[[:space:]]*\([A-Za-z0-9_.-]*\).*/\1/p' params/$(1).yaml 2>/dev/null)
+BASE1 := $(call base_of,$(PROFILE))
+BASE2 := $(if $(BASE1),$(call base_of,$(BASE1)))
+PARAMS := params/$(PROFILE).yaml $(BASE1:%=params/%.yaml) $(BASE2:%=params/%.yaml)
 RES := results/$(PROFILE)
 EXEC := $(NOTEBOOKS:%=$(RES)/notebooks/%.ipynb)
 SRC := $(shell find src/bgfn -name '*.py' -not -path '*/__pycache__/*' | sort)

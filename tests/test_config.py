@@ -153,3 +153,48 @@ def test_run_metadata_is_deterministic_and_complete():
     assert "time" not in flat and "date" not in flat  # no timestamps: identical tables on rerun
     lines = config.metadata_lines("smoke")
     assert "# profile: smoke" in lines
+
+
+def test_a_variant_profile_holds_only_its_changes(tmp_path, monkeypatch):
+    base = _complete("mine")
+    base["train"] = {"epochs": 2, "lr": {"bgfn": 1e-3, "mlp": 1e-3}, "extra_channels": ["v_n"]}
+    base["data"] = {"seed": 5}
+    _write_profile(tmp_path, monkeypatch, "mine", base)
+    _write_profile(tmp_path, monkeypatch, "variant", {"profile": "variant", "base": "mine", "description": "v",
+                                                      "data": None, "train": {"lr": {"mlp": 3e-3},
+                                                                              "extra_channels": []}})
+    cfg = config.load_profile("variant")
+    assert cfg["profile"] == "variant" and cfg["description"] == "v" and cfg["seed"] == 1 and "base" not in cfg
+    # mappings merge key by key, lists and scalars replace, an empty section changes nothing
+    assert cfg["train"] == {"epochs": 2, "lr": {"bgfn": 1e-3, "mlp": 3e-3}, "extra_channels": []}
+    assert cfg["data"] == {"seed": 5}
+    assert config.load_profile("mine")["train"]["lr"]["mlp"] == 1e-3            # the base is untouched
+    assert [p.name for p in config.profile_chain("variant")] == ["variant.yaml", "mine.yaml"]
+
+
+def test_a_variant_must_name_its_own_description_and_a_real_base(tmp_path, monkeypatch):
+    _write_profile(tmp_path, monkeypatch, "mine", _complete("mine"))
+    path = _write_profile(tmp_path, monkeypatch, "nodesc", {"profile": "nodesc", "base": "mine"})
+    with pytest.raises(DataError) as err:
+        config.load_profile("nodesc")
+    assert err.value.source == str(path) and err.value.field == "description"
+    _write_profile(tmp_path, monkeypatch, "orphan", {"profile": "orphan", "base": "nosuch", "description": "o"})
+    with pytest.raises(DataError, match="nosuch") as err:
+        config.load_profile("orphan")
+    assert err.value.field == "base"
+    _write_profile(tmp_path, monkeypatch, "a", {"profile": "a", "base": "b", "description": "a"})
+    _write_profile(tmp_path, monkeypatch, "b", {"profile": "b", "base": "a", "description": "b"})
+    with pytest.raises(DataError, match="a -> b -> a"):
+        config.load_profile("a")
+
+
+def test_quick_heading_differs_from_quick_only_where_it_says():
+    quick, variant = config.load_profile("quick"), config.load_profile("quick-heading")
+    changed = {k for k in quick["train"] if quick["train"][k] != variant["train"][k]}
+    assert changed == {"yaw_encoding", "target_frame", "extra_channels", "sizes"}
+    for section in ("data", "nav", "evaluate", "energy"):
+        assert quick[section] == variant[section]
+    for method, sizes in variant["train"]["sizes"].items():
+        for size, kw in sizes.items():
+            extra = {k: v for k, v in kw.items() if quick["train"]["sizes"][method][size].get(k) != v}
+            assert extra == ({"encoder_neurons": 8} if method in ("bgfn", "transformer") else {})

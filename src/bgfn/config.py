@@ -86,8 +86,58 @@ def available_profiles() -> list[str]:
     return sorted(p.stem for p in PARAMS_DIR.glob("*.yaml"))
 
 
+def merge_sections(base: dict, override: dict) -> dict:
+    """``override`` laid over ``base``: mappings merge key by key (recursively); any other value, lists
+    included, replaces the base's. Neither argument is modified."""
+    out = copy.deepcopy(base)
+    for key, value in override.items():
+        if isinstance(value, dict) and isinstance(out.get(key), dict):
+            out[key] = merge_sections(out[key], value)
+        else:
+            out[key] = copy.deepcopy(value)
+    return out
+
+
+def _read_profile_file(path: Path) -> dict:
+    import yaml
+
+    try:
+        cfg = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except yaml.YAMLError as exc:
+        raise DataError(path, "<yaml>", "valid YAML", str(exc).replace("\n", " ")) from exc
+    if not isinstance(cfg, dict):
+        raise DataError(path, "<top level>", "a mapping of keys", type(cfg).__name__)
+    return cfg
+
+
+def profile_chain(profile: str) -> list[Path]:
+    """The profile's file followed by the files of its ``base:`` chain (``params/<base>.yaml``, ...)."""
+    chain: list[Path] = []
+    name = profile
+    while name is not None:
+        path = profile_path(name)
+        if not path.is_file():
+            known = ", ".join(available_profiles()) or "none"
+            where = chain[-1] if chain else path
+            raise DataError(where, "base" if chain else "profile", f"an existing profile file (available: {known})",
+                            f"unknown profile {name!r}: no such file")
+        if path in chain:
+            raise DataError(chain[0], "base", "a chain of profiles that does not lead back to itself",
+                            " -> ".join(p.stem for p in chain + [path]))
+        chain.append(path)
+        base = _read_profile_file(path).get("base")
+        if base is not None and not isinstance(base, str):
+            raise DataError(path, "base", "the name of another profile", repr(base))
+        name = base
+    return chain
+
+
 def load_profile(profile: str) -> dict[str, Any]:
     """Read and validate ``params/<profile>.yaml``.
+
+    A profile may name another one as ``base:``; it then holds only what differs: its sections are laid
+    over the base's key by key (:func:`merge_sections`), so ``params/quick-heading.yaml`` lists only the
+    settings it changes in ``params/quick.yaml``. ``profile`` and ``description`` are always the file's own.
 
     Parameters
     ----------
@@ -97,29 +147,27 @@ def load_profile(profile: str) -> dict[str, Any]:
     Returns
     -------
     dict
-        The parsed YAML: ``profile`` (str, equal to the file name), ``description`` (str), ``seed`` (int)
-        and one mapping per notebook section (``data``, ``nav``, ``train``, ``evaluate``, ``energy``;
-        an empty section is returned as ``{}``). A fresh copy on every call.
+        The parsed YAML (merged over its bases): ``profile`` (str, equal to the file name), ``description``
+        (str), ``seed`` (int) and one mapping per notebook section (``data``, ``nav``, ``train``,
+        ``evaluate``, ``energy``; an empty section is returned as ``{}``). A fresh copy on every call.
 
     Raises
     ------
     bgfn.errors.DataError
-        Unknown profile (missing file), unreadable YAML, a missing required key or a wrong type.
-        The message names the file.
+        Unknown profile (missing file), unreadable YAML, a missing required key or a wrong type, a ``base:``
+        that does not exist or leads back to the profile. The message names the file.
     """
-    import yaml
-
-    path = profile_path(profile)
-    if not path.is_file():
-        known = ", ".join(available_profiles()) or "none"
-        raise DataError(path, "profile", f"an existing profile file (available: {known})",
-                        f"unknown profile {profile!r}: no such file")
-    try:
-        cfg = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except yaml.YAMLError as exc:
-        raise DataError(path, "<yaml>", "valid YAML", str(exc).replace("\n", " ")) from exc
-    if not isinstance(cfg, dict):
-        raise DataError(path, "<top level>", "a mapping of keys", type(cfg).__name__)
+    chain = profile_chain(profile)
+    path = chain[0]
+    cfg: dict = {}
+    for p in reversed(chain):                       # the furthest base first, the profile's own file last
+        own = _read_profile_file(p)
+        own.pop("base", None)
+        if cfg:                                     # a section of only comments in a variant changes nothing
+            own = {k: v for k, v in own.items() if not (k in SECTION_KEYS and v is None)}
+        if cfg:
+            cfg = {k: v for k, v in cfg.items() if k not in ("profile", "description")}
+        cfg = merge_sections(cfg, own)
 
     missing = [key for key in REQUIRED_KEYS if key not in cfg]
     if missing:
@@ -176,7 +224,8 @@ def run_metadata(profile: str) -> dict[str, Any]:
     Returns
     -------
     dict
-        ``profile``, ``seed``, ``params_file`` (relative path), ``params_sha256`` (of the YAML bytes),
+        ``profile``, ``seed``, ``params_file`` (relative path), ``params_sha256`` (of the YAML bytes of the
+        file and of its ``base:`` chain),
         ``git_commit`` (``None`` outside a git checkout), ``git_dirty`` (tracked files modified; ``None``
         without git), ``python`` (``major.minor.micro``) and ``packages`` (name -> version, ``None`` if
         not installed).
@@ -195,7 +244,7 @@ def run_metadata(profile: str) -> dict[str, Any]:
         "profile": cfg["profile"],
         "seed": cfg["seed"],
         "params_file": path.relative_to(PROJECT_ROOT).as_posix(),
-        "params_sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
+        "params_sha256": hashlib.sha256(b"".join(p.read_bytes() for p in profile_chain(profile))).hexdigest(),
         "git_commit": commit,
         "git_dirty": (bool(status) if status is not None else None),
         "python": ".".join(str(v) for v in sys.version_info[:3]),

@@ -537,13 +537,16 @@ def evaluation_outages(cfg: dict) -> list[tuple[float, float]]:
 
 def train_profile(profile: str, datasets=None, methods=None, seeds=None, device: str | None = None,
                   progress: bool = True, outage_windows=None) -> list[dict]:
-    """Train every ``(dataset, method, seed)`` of a profile's ``train:`` section; return the cards."""
+    """Train every ``(dataset, method, seed)`` of a profile's ``train:`` section; return the cards.
+
+    The learning rates are those notebook 03 selected (:func:`tuned_train_config`) when its search has run.
+    """
     from bgfn.config import load_profile
 
     cfg = load_profile(profile)
-    tc = cfg["train"]
     cards = []
-    for dataset in datasets or tc["datasets"]:
+    for dataset in datasets or cfg["train"]["datasets"]:
+        tc = tuned_train_config(cfg, profile, dataset)
         data = prepare_learning_data(cfg, dataset, outage_windows=outage_windows)
         out = models_dir(profile, dataset)
         for method in methods or tc["methods"]:

@@ -375,3 +375,14 @@ def test_variant_sweep_table_aligns_durations_and_methods():
     assert t.loc[("d", 120.0, "BGFN")].tolist() == [390.0, 110.0]
     assert t.loc[("d", 10.0, "INS")].tolist() == [3.0, 3.0]
     assert report.variant_sweep_table({"x": None}) is None
+
+
+def test_compared_profiles_adds_the_base_and_splits_on_results(tmp_path):
+    for p in ("quick", "quick-heading"):
+        (tmp_path / p / "tables").mkdir(parents=True)
+        (tmp_path / p / "tables" / "training_summary.csv").write_text("dataset,method\n")
+    # quick-heading builds on quick: compared with it even when not listed; no profile twice
+    assert report.compared_profiles("quick-heading", ["quick-heading"], tmp_path) == (["quick-heading", "quick"], [])
+    assert report.compared_profiles("quick", ["quick-heading", "smoke"], tmp_path) == (
+        ["quick", "quick-heading"], ["smoke"])
+    assert report.profile_tables(["quick", "smoke"], "training_summary.csv", tmp_path)["smoke"] is None

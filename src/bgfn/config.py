@@ -110,26 +110,31 @@ def _read_profile_file(path: Path) -> dict:
     return cfg
 
 
-def profile_chain(profile: str) -> list[Path]:
-    """The profile's file followed by the files of its ``base:`` chain (``params/<base>.yaml``, ...)."""
-    chain: list[Path] = []
+def _read_chain(profile: str) -> list[tuple[Path, dict]]:
+    """``(file, parsed YAML)`` of the profile, then of each profile in its ``base:`` chain."""
+    chain: list[tuple[Path, dict]] = []
     name = profile
     while name is not None:
         path = profile_path(name)
+        seen = [p for p, _ in chain]
         if not path.is_file():
             known = ", ".join(available_profiles()) or "none"
-            where = chain[-1] if chain else path
-            raise DataError(where, "base" if chain else "profile", f"an existing profile file (available: {known})",
-                            f"unknown profile {name!r}: no such file")
-        if path in chain:
-            raise DataError(chain[0], "base", "a chain of profiles that does not lead back to itself",
-                            " -> ".join(p.stem for p in chain + [path]))
-        chain.append(path)
-        base = _read_profile_file(path).get("base")
-        if base is not None and not isinstance(base, str):
-            raise DataError(path, "base", "the name of another profile", repr(base))
-        name = base
+            raise DataError(seen[-1] if seen else path, "base" if seen else "profile",
+                            f"an existing profile file (available: {known})", f"unknown profile {name!r}: no such file")
+        if path in seen:
+            raise DataError(seen[0], "base", "a chain of profiles that does not lead back to itself",
+                            " -> ".join(p.stem for p in seen + [path]))
+        own = _read_profile_file(path)
+        chain.append((path, own))
+        name = own.get("base")
+        if name is not None and not isinstance(name, str):
+            raise DataError(path, "base", "the name of another profile", repr(name))
     return chain
+
+
+def profile_chain(profile: str) -> list[Path]:
+    """The profile's file followed by the files of its ``base:`` chain (``params/<base>.yaml``, ...)."""
+    return [path for path, _ in _read_chain(profile)]
 
 
 def load_profile(profile: str) -> dict[str, Any]:
@@ -157,16 +162,14 @@ def load_profile(profile: str) -> dict[str, Any]:
         Unknown profile (missing file), unreadable YAML, a missing required key or a wrong type, a ``base:``
         that does not exist or leads back to the profile. The message names the file.
     """
-    chain = profile_chain(profile)
-    path = chain[0]
+    chain = _read_chain(profile)
+    path = chain[0][0]
     cfg: dict = {}
-    for p in reversed(chain):                       # the furthest base first, the profile's own file last
-        own = _read_profile_file(p)
-        own.pop("base", None)
-        if cfg:                                     # a section of only comments in a variant changes nothing
-            own = {k: v for k, v in own.items() if not (k in SECTION_KEYS and v is None)}
-        if cfg:
+    for _, own in reversed(chain):                  # the furthest base first, the profile's own file last
+        own = {k: v for k, v in own.items() if k != "base"}
+        if cfg:   # the base's name and description are not inherited; a comments-only section changes nothing
             cfg = {k: v for k, v in cfg.items() if k not in ("profile", "description")}
+            own = {k: v for k, v in own.items() if not (k in SECTION_KEYS and v is None)}
         cfg = merge_sections(cfg, own)
 
     missing = [key for key in REQUIRED_KEYS if key not in cfg]

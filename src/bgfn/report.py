@@ -678,6 +678,35 @@ __all__ = [
 
 
 # ----------------------------------------------------------------------------------------------- variants
+def compared_profiles(profile: str, variants: Sequence[str],
+                      results_root: str | Path | None = None) -> tuple[list[str], list[str]]:
+    """The profiles the *Variants* section puts side by side: ``profile``, then ``variants`` and the profile
+    it builds on (``base:``), without repeats.
+
+    Returns
+    -------
+    shown : list of str
+        Those whose notebook 03 has run (``tables/training_summary.csv`` exists), in that order.
+    missing : list of str
+        The others, ``profile`` itself left out.
+    """
+    from bgfn.config import RESULTS_ROOT, profile_chain
+
+    base = [p.stem for p in profile_chain(profile)[1:2]]
+    names = list(dict.fromkeys([profile, *variants, *base]))
+    root = Path(results_root or RESULTS_ROOT)
+    shown = [p for p in names if (root / p / "tables" / "training_summary.csv").exists()]
+    return shown, [p for p in names[1:] if p not in shown]
+
+
+def profile_tables(profiles: Sequence[str], file: str, results_root: str | Path | None = None) -> dict:
+    """``{profile: results/<profile>/tables/<file>}`` (None where it is missing)."""
+    from bgfn.config import RESULTS_ROOT
+
+    root = Path(results_root or RESULTS_ROOT)
+    return {p: read_csv(root / p / "tables" / file) for p in profiles}
+
+
 def variant_training_table(summaries: dict[str, pd.DataFrame | None]) -> pd.DataFrame | None:
     """Validation RMSE (m, mean over seeds) per (dataset, method), one column per profile, beside the two
     references (*zero*, *last increment*), which are the same windows in every profile of one drive.

@@ -109,8 +109,10 @@ def test_normalization_uses_training_windows_only(tables):
     assert np.allclose(data.norm.y_mean, data.train.y.mean(0))
     # corrupting the validation inputs does not change the statistics
     gnss2 = gnss.copy()
-    late = gnss2["time"] > data.info["val_block"][0] + 5
-    gnss2.loc[late, "lat"] += 1e-3
+    lo, hi = data.info["val_block"]
+    inside = (gnss2["time"] > lo + 5) & (gnss2["time"] < hi - 5)
+    assert inside.sum() > 5
+    gnss2.loc[inside, "lat"] += 1e-3
     data2 = L.build_learning_data(imu, att, gnss2, [], window=100, val_fraction=0.3)
     assert np.allclose(data2.norm.y_mean, data.norm.y_mean) and np.allclose(data2.norm.y_std, data.norm.y_std)
     z = data.norm.x(data.train.x)
@@ -210,3 +212,78 @@ def test_motion_coverage_of_windows_and_outages():
     assert L.unseen_fraction(m, o) == 1.0
     assert L.unseen_fraction(m, m) == 0.0
     assert L.unseen_fraction(m, pd.concat([m.iloc[:1], o.iloc[:1]])) == 0.5
+
+
+def _slow_then_fast_windows(n: int = 100, n_slow: int = 60) -> L.WindowSet:
+    """n one-second windows heading north: 2 m/s for the first n_slow, then 15 m/s."""
+    t = np.arange(n, dtype=float)
+    speed = np.where(t < n_slow, 2.0, 15.0)
+    return L.WindowSet(x=np.zeros((n, 3, 9), np.float32), y=np.c_[speed, np.zeros(n)], t_from=t, t_to=t + 1.0,
+                       t_end=t + 1.0, t_start=t - 0.5, y_last=np.c_[speed, np.zeros(n)], yaw_ref=np.zeros(n))
+
+
+def test_val_position_coverage_shows_what_an_end_block_takes_from_training():
+    ws = _slow_then_fast_windows()
+    # the outage lies in the fast part, as the Turin drive's outages lie in its fast last 400 s
+    outage = [(80.0, 5.0)]
+    outage_motion = pd.DataFrame({"heading_deg": np.zeros(5), "speed_mps": np.full(5, 15.0)})
+    cov = L.val_position_coverage(ws, outage_motion, outage, margin_s=2.0, val_fraction=0.4,
+                                  positions=("start", "end")).set_index("val_position")
+    # a block at the end holds every fast window left: training never sees 15 m/s
+    assert cov.loc["end", "outage_unseen_fraction"] == 1.0
+    assert cov.loc["end", "train_speed_max_mps"] == pytest.approx(2.0)
+    assert cov.loc["end", "val_unseen_fraction"] > 0.5
+    # a block at the start leaves the fast windows around the outage to training
+    assert cov.loc["start", "outage_unseen_fraction"] == 0.0
+    assert cov.loc["start", "train_speed_max_mps"] == pytest.approx(15.0)
+    assert cov.loc["start", "val_unseen_fraction"] == 0.0
+    # the references are those of the block: repeating the last increment is exact here
+    assert cov.loc["start", "val_rmse_last_m"] == 0.0
+    assert cov.loc["start", "val_rmse_zero_m"] == pytest.approx(2.0)
+
+
+def _with_velocity_and_noisy_fixes(tables, noise_m: float = 0.05, seed: int = 7):
+    """The toy drive's attitude with the exact velocity (the INS/KF columns screening reads) and GNSS fixes
+    with white noise of ``noise_m`` per axis."""
+    imu, att, gnss = tables
+    att = att.assign(v_n=np.interp(att["time"], gnss["time"], gnss["v_n"]),
+                     v_e=np.interp(att["time"], gnss["time"], gnss["v_e"]))
+    r_m, r_n = curvature_radii(gnss["lat"].to_numpy())
+    rng = np.random.default_rng(seed)
+    g = gnss.copy()
+    g["lat"] += rng.normal(0.0, noise_m, len(g)) / (r_m + g["h"])
+    g["lon"] += rng.normal(0.0, noise_m, len(g)) / ((r_n + g["h"]) * np.cos(g["lat"]))
+    return imu, att, g
+
+
+def test_ins_increments_integrate_the_velocity():
+    att = pd.DataFrame({"time": np.arange(0.0, 10.01, 0.01), "v_n": 3.0, "v_e": -4.0})
+    att["v_e"] = -4.0 + 0.5 * att["time"]            # east speed ramps: distance = -4 t + t^2 / 4
+    d = L.ins_increments(att, np.array([0.0, 2.0]), np.array([1.0, 6.0]))
+    np.testing.assert_allclose(d[:, 0], [3.0, 12.0], atol=1e-9)
+    np.testing.assert_allclose(d[:, 1], [-4.0 + 0.25, -16.0 + (36.0 - 4.0) / 4.0], atol=1e-9)
+
+
+def test_screening_drops_the_windows_of_a_gnss_jump(tables):
+    imu, att, gnss = _with_velocity_and_noisy_fixes(tables)
+    clean = L.make_windows(imu, att, gnss, window=100, target_screen_sigma=5.0)
+    assert clean.n_screened == 0          # white noise of 5 cm: nothing beyond 5 robust std
+    # one fix jumps 4 m north (as the real Ekinox fixes do): its two increments are flagged, and the window
+    # after them, whose "last increment" reference is the jump, goes too
+    k = 120
+    jumped = gnss.copy()
+    jumped.loc[k, "lat"] += 4.0 / (curvature_radii(jumped.loc[k, "lat"])[0] + jumped.loc[k, "h"])
+    every = L.make_windows(imu, att, jumped, window=100)
+    screened = L.make_windows(imu, att, jumped, window=100, target_screen_sigma=5.0)
+    assert every.n_screened == 0 and screened.n_screened == 3
+    t_jump = jumped.loc[k, "time"]
+    gone = np.setdiff1d(every.t_to, screened.t_to)
+    np.testing.assert_allclose(gone, t_jump + np.array([0.0, 1.0, 2.0]))
+    def worst_residual(ws):
+        return np.abs(ws.y - L.ins_increments(att, ws.t_from, ws.t_to)).max()
+    assert worst_residual(every) > 3.0 and worst_residual(screened) < 0.5
+    # screening needs the INS velocity
+    with pytest.raises(DataError, match="v_n"):
+        L.make_windows(imu, att.drop(columns="v_n"), jumped, window=100, target_screen_sigma=5.0)
+    with pytest.raises(DataError, match="target_screen_sigma"):
+        L.screen_increments(np.zeros((3, 2)), -1.0)

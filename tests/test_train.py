@@ -18,7 +18,8 @@ torch.set_num_threads(1)
 @pytest.fixture(scope="module")
 def data():
     imu, att, gnss = L.synthetic_tables(duration_s=300.0, noise=0.05, seed=1)
-    return L.build_learning_data(imu, att, gnss, [(1060.0, 20.0)], window=40, margin_s=2.0, val_fraction=0.25)
+    return L.build_learning_data(imu, att, gnss, [(1060.0, 20.0)], window=40, margin_s=2.0, val_fraction=0.25,
+                                 val_position="end")
 
 
 def _cfg(**opt):
@@ -179,7 +180,7 @@ def test_result_tables_leave_wall_clock_out():
 
 
 def test_inner_split_never_touches_the_validation_block(data):
-    inner = L.inner_split(data, 0.25)
+    inner = L.inner_split(data, 0.25, position="end")
     lo_v, hi_v = data.val.span
     for ws in (inner.train, inner.val):
         lo, hi = ws.span
@@ -193,6 +194,21 @@ def test_inner_split_never_touches_the_validation_block(data):
     x = inner.train.x.reshape(-1, inner.train.x.shape[-1]).astype(float)
     np.testing.assert_allclose(inner.norm.x_mean, x.mean(0),
                                rtol=1e-9, atol=1e-12)
+
+
+def test_inner_split_puts_the_tuning_block_where_the_validation_block_is(data):
+    import dataclasses
+
+    for position in ("start", "middle"):
+        d = dataclasses.replace(data, options={**data.options, "val_position": position})
+        inner = L.inner_split(d, 0.25)
+        before = (inner.train.t_to < inner.val.t_from.min()).sum()
+        after = (inner.train.t_from > inner.val.t_to.max()).sum()
+        assert before + after == len(inner.train)
+        if position == "start":
+            assert before == 0 and after > 0
+        else:
+            assert before > 0 and after > 0
 
 
 def test_learning_rate_search_picks_the_lowest_tuning_loss(data, tmp_path):

@@ -211,6 +211,39 @@ def gnss_increments(gnss: pd.DataFrame, max_gap_factor: float = 1.5) -> pd.DataF
     return pd.DataFrame({"t_from": t[:-1][ok], "t_to": t[1:][ok], "dn": d[ok, 0], "de": d[ok, 1]})
 
 
+def ins_increments(attitude: pd.DataFrame, t_from, t_to) -> np.ndarray:
+    """North/east distance the INS/KF solution travels over each interval ``[t_from, t_to]``: its velocity
+    ``v_n, v_e`` integrated (trapezoid), m, [M, 2]. The position columns are not used because the filter's
+    position jumps at each GNSS update, by the very GNSS error being checked."""
+    _check_table(attitude, "attitude", ("time", "v_n", "v_e"))
+    t = attitude["time"].to_numpy(float)
+    out = np.empty((len(np.atleast_1d(t_from)), 2))
+    for k, col in enumerate(("v_n", "v_e")):
+        v = attitude[col].to_numpy(float)
+        dist = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
+        out[:, k] = np.interp(t_to, t, dist) - np.interp(t_from, t, dist)
+    return out
+
+
+def screen_increments(residual: np.ndarray, sigma: float | None) -> np.ndarray:
+    """Flag GNSS increments that disagree with the INS: ``True`` where a component of ``residual`` (GNSS
+    increment minus :func:`ins_increments`, [M, 2], m) lies more than ``sigma`` robust standard deviations
+    (1.4826 x the median absolute deviation, per component) from its median. ``sigma`` None or 0: none.
+
+    Real GNSS fixes jump now and then (multipath, satellite changes): the Ekinox fixes of the Turin drive
+    move by up to 7 m against the reference within 0.2 s. Such an increment is no motion a network can learn
+    from the IMU, and one of them outweighs thousands of ordinary ones in a squared loss.
+    """
+    residual = np.asarray(residual, float)
+    if not sigma:
+        return np.zeros(len(residual), bool)
+    if sigma < 0:
+        raise DataError("train", "target_screen_sigma", "a positive number of robust std, or null", repr(sigma))
+    dev = residual - np.median(residual, axis=0)
+    robust_std = 1.4826 * np.median(np.abs(dev), axis=0)
+    return np.any(np.abs(dev) > float(sigma) * np.maximum(robust_std, 1e-9), axis=1)
+
+
 # ----------------------------------------------------------------------------------------------- windows
 @dataclass
 class WindowSet:
@@ -234,6 +267,8 @@ class WindowSet:
     yaw_ref : ndarray [M]
         INS yaw at the window's last sample (wrapped), rad: the rotation of ``target_frame='heading'``.
     channels : tuple of str
+    n_screened : int
+        GNSS increments dropped by :func:`screen_increments` when the set was made (0 for subsets).
     """
 
     x: np.ndarray
@@ -245,6 +280,7 @@ class WindowSet:
     y_last: np.ndarray
     yaw_ref: np.ndarray
     channels: tuple[str, ...] = CHANNELS
+    n_screened: int = 0
 
     def __len__(self) -> int:
         return len(self.x)
@@ -288,7 +324,7 @@ def _gather(feats: np.ndarray, last: np.ndarray, window: int) -> np.ndarray:
 
 def make_windows(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.DataFrame, window: int = 200,
                  alignment: str = "ending", yaw_encoding: str = "unwrap", extra_channels: Sequence[str] = (),
-                 epoch_stride: int = 1) -> WindowSet:
+                 epoch_stride: int = 1, target_screen_sigma: float | None = None) -> WindowSet:
     """All windows of a drive with their GNSS increment targets (before any outage/validation split).
 
     Parameters
@@ -305,6 +341,10 @@ def make_windows(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.DataFrame, 
         Extra ``attitude`` columns (not the paper's input).
     epoch_stride : int
         Keep every ``epoch_stride``-th increment (fewer, less overlapping windows for small budgets).
+    target_screen_sigma : float or None
+        Drop every window whose target, or the previous increment (the "last increment" reference), is
+        flagged by :func:`screen_increments` against the INS velocity of ``attitude`` (``v_n``, ``v_e``
+        needed); None: keep all.
 
     Returns
     -------
@@ -323,7 +363,12 @@ def make_windows(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.DataFrame, 
     y_last = np.full_like(y, np.nan)
     contiguous = np.isclose(t_to[:-1], t_from[1:], rtol=0.0, atol=1e-9)
     y_last[1:][contiguous] = y[:-1][contiguous]
-    keep = np.arange(len(y)) % max(1, int(epoch_stride)) == 0
+    bad = np.zeros(len(y), bool)
+    if target_screen_sigma:
+        flagged = screen_increments(y - ins_increments(attitude, t_from, t_to), target_screen_sigma)
+        bad = flagged.copy()
+        bad[1:] |= flagged[:-1] & contiguous
+    keep = (np.arange(len(y)) % max(1, int(epoch_stride)) == 0) & ~bad
     t_from, t_to, y, y_last = t_from[keep], t_to[keep], y[keep], y_last[keep]
     t_end_epoch = t_to if alignment == "ending" else t_from
     last, ok = _windows_ending_at(t, feats, t_end_epoch, window)
@@ -331,7 +376,7 @@ def make_windows(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.DataFrame, 
     yaw_ref = feats[last, _YAW]
     x = encode_yaw(_gather(feats, last, window), yaw_encoding)
     return WindowSet(x=x, y=y, t_from=t_from, t_to=t_to, t_end=t[last], t_start=t[last - window],
-                     y_last=y_last, yaw_ref=yaw_ref, channels=channels)
+                     y_last=y_last, yaw_ref=yaw_ref, channels=channels, n_screened=int(bad.sum()))
 
 
 def prediction_windows(imu: pd.DataFrame, attitude: pd.DataFrame, epochs, window: int = 200,
@@ -498,7 +543,11 @@ class Normalizer:
 # ----------------------------------------------------------------------------------------------- all together
 #: Defaults of the learning-problem keys of a profile's ``train:`` section.
 LEARNING_DEFAULTS = {"window": 200, "alignment": "ending", "yaw_encoding": "unwrap", "target_frame": "ned",
-                     "extra_channels": [], "epoch_stride": 1, "margin_s": 30.0, "val_fraction": 0.2, "val_position": "end"}
+                     "extra_channels": [], "epoch_stride": 1, "margin_s": 30.0, "val_fraction": 0.2,
+                     "val_position": "middle", "target_screen_sigma": None}
+
+#: Validation-block positions compared by :func:`val_position_coverage` (notebook 03).
+VAL_POSITIONS = ("start", 0.25, "middle", 0.75, "end")
 
 
 @dataclass
@@ -518,6 +567,14 @@ def learning_options(cfg: dict | None) -> dict:
     return {k: cfg.get(k, v) for k, v in LEARNING_DEFAULTS.items()}
 
 
+def all_windows(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.DataFrame, **options) -> WindowSet:
+    """Every window of the drive with the learning options ``options`` (split not applied)."""
+    opt = learning_options(options)
+    return make_windows(imu, attitude, gnss, window=int(opt["window"]), alignment=opt["alignment"],
+                        yaw_encoding=opt["yaw_encoding"], extra_channels=tuple(opt["extra_channels"]),
+                        epoch_stride=int(opt["epoch_stride"]), target_screen_sigma=opt["target_screen_sigma"])
+
+
 def build_learning_data(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.DataFrame, outage_windows=(),
                         **options) -> LearningData:
     """Windows, split and normalization in one call.
@@ -530,33 +587,35 @@ def build_learning_data(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.Data
         Evaluation outages (s) excluded from training and validation.
     **options
         ``window``, ``alignment``, ``yaw_encoding``, ``target_frame``, ``extra_channels``, ``epoch_stride``,
-        ``margin_s``,
-        ``val_fraction``, ``val_position`` (defaults: :data:`LEARNING_DEFAULTS`).
+        ``margin_s``, ``val_fraction``, ``val_position``, ``target_screen_sigma`` (defaults:
+        :data:`LEARNING_DEFAULTS`).
     """
     unknown = set(options) - set(LEARNING_DEFAULTS)
     if unknown:
         raise DataError("train", sorted(unknown)[0], f"one of {', '.join(LEARNING_DEFAULTS)}")
     opt = learning_options(options)
-    ws = make_windows(imu, attitude, gnss, window=int(opt["window"]), alignment=opt["alignment"],
-                      yaw_encoding=opt["yaw_encoding"], extra_channels=tuple(opt["extra_channels"]),
-                      epoch_stride=int(opt["epoch_stride"]))
+    ws = all_windows(imu, attitude, gnss, **opt)
     tr, va, info = split_windows(ws, outage_windows, margin_s=float(opt["margin_s"]),
                                  val_fraction=float(opt["val_fraction"]), val_position=opt["val_position"])
     train, val = ws.subset(tr), ws.subset(va)
     info["outage_windows"] = [list(map(float, o)) for o in outage_windows]
+    info["n_screened"] = int(ws.n_screened)
     if opt["target_frame"] not in TARGET_FRAMES:
         raise DataError("train", "target_frame", f"one of {TARGET_FRAMES}", repr(opt["target_frame"]))
     return LearningData(train=train, val=val, norm=Normalizer.fit(train, opt["target_frame"]), info=info,
                         options=opt)
 
 
-def inner_split(data: LearningData, fraction: float = 0.2) -> LearningData:
-    """A tuning split inside the training windows: the last ``fraction`` of ``data.train`` (one block of time)
-    becomes the validation set, training windows overlapping it are dropped, and the normalization is refit.
+def inner_split(data: LearningData, fraction: float = 0.2, position=None) -> LearningData:
+    """A tuning split inside the training windows: a ``fraction`` of ``data.train`` (one block of time, at
+    ``position``; default: the ``val_position`` of ``data.options``, as the validation block) becomes the
+    validation set, training windows overlapping it are dropped, and the normalization is refit.
 
     Hyper-parameters chosen on it never see ``data.val``, the block every reported validation error comes from.
     """
-    tr, va, info = split_windows(data.train, (), margin_s=0.0, val_fraction=fraction, val_position="end")
+    if position is None:
+        position = data.options.get("val_position", LEARNING_DEFAULTS["val_position"])
+    tr, va, info = split_windows(data.train, (), margin_s=0.0, val_fraction=fraction, val_position=position)
     train, val = data.train.subset(tr), data.train.subset(va)
     frame = data.options.get("target_frame", "ned")
     return LearningData(train=train, val=val, norm=Normalizer.fit(train, frame),
@@ -598,6 +657,51 @@ def unseen_fraction(train: pd.DataFrame, other: pd.DataFrame, heading_bin_deg: f
     hit = [c in seen for c in zip((other["heading_deg"].to_numpy() // heading_bin_deg).astype(int),
                                   (other["speed_mps"].to_numpy() // speed_bin_mps).astype(int))]
     return 1.0 - float(np.mean(hit))
+
+
+def val_position_coverage(ws: WindowSet, outage_motion: pd.DataFrame, outage_windows=(), margin_s: float = 30.0,
+                          val_fraction: float = 0.2, positions=VAL_POSITIONS, **cells) -> pd.DataFrame:
+    """What each position of the validation block leaves to training.
+
+    The paper does not say how it validated. One block of time is held out (:func:`split_windows`); where it
+    lies decides which motions training sees. Computed from windows and the reference only, before any network
+    is trained, so the choice of ``train.val_position`` cannot follow a network's score.
+
+    Parameters
+    ----------
+    ws : WindowSet
+        Every window of the drive (:func:`make_windows`).
+    outage_motion : DataFrame
+        Heading and speed inside the evaluation outages (:func:`motion_in_windows`).
+    outage_windows, margin_s, val_fraction
+        As for :func:`split_windows`.
+    positions : sequence
+        ``val_position`` values to compare.
+    **cells
+        ``heading_bin_deg``, ``speed_bin_mps`` of :func:`unseen_fraction`.
+
+    Returns
+    -------
+    DataFrame
+        One row per position: ``val_position``, ``val_block_s``, ``train``, ``val``, ``val_unseen_fraction``,
+        ``outage_unseen_fraction`` (fractions of validation windows / outage seconds whose heading x speed
+        cell holds no training window), ``train_speed_max_mps`` and the references ``val_rmse_zero_m``,
+        ``val_rmse_last_m`` on that block.
+    """
+    rows = []
+    for pos in positions:
+        tr, va, info = split_windows(ws, outage_windows, margin_s=margin_s, val_fraction=val_fraction,
+                                     val_position=pos)
+        train, val = motion_of_windows(ws.subset(tr)), motion_of_windows(ws.subset(va))
+        refs = reference_rmse(ws.subset(va))
+        rows.append({"val_position": str(pos),
+                     "val_block_s": f"{info['val_block'][0]:.1f}..{info['val_block'][1]:.1f}",
+                     "train": int(len(tr)), "val": int(len(va)),
+                     "val_unseen_fraction": unseen_fraction(train, val, **cells),
+                     "outage_unseen_fraction": unseen_fraction(train, outage_motion, **cells),
+                     "train_speed_max_mps": float(train["speed_mps"].max()) if len(train) else float("nan"),
+                     "val_rmse_zero_m": refs["zero"], "val_rmse_last_m": refs["last"]})
+    return pd.DataFrame(rows)
 
 
 def rmse(pred: np.ndarray, true: np.ndarray) -> float:

@@ -479,6 +479,21 @@ def prepare_learning_data(cfg: dict, dataset: str, attitude=None, drive=None, ou
     return build_learning_data(drive.imu, attitude, drive.gnss, outage_windows, **opts)
 
 
+def val_position_table(cfg: dict, drive, attitude=None, outage_windows=None, positions=None):
+    """:func:`bgfn.learning.val_position_coverage` of ``drive`` with the profile's learning options: what each
+    place of the validation block would leave to training (notebook 03)."""
+    from bgfn.learning import VAL_POSITIONS, all_windows, learning_options, motion_in_windows, val_position_coverage
+
+    attitude = attitude if attitude is not None else ins_attitude(drive, cfg)
+    if outage_windows is None:
+        outage_windows = evaluation_outages(cfg)
+    opts = learning_options(cfg.get("train"))
+    ws = all_windows(drive.imu, attitude, drive.gnss, **opts)
+    return val_position_coverage(ws, motion_in_windows(drive.reference, outage_windows), outage_windows,
+                                 margin_s=float(opts["margin_s"]), val_fraction=float(opts["val_fraction"]),
+                                 positions=positions or VAL_POSITIONS)
+
+
 def _accepts(fn, name: str) -> bool:
     import inspect
 

@@ -229,6 +229,32 @@ def test_learning_rate_search_picks_the_lowest_tuning_loss(data, tmp_path):
         T.lr_search_options({"lr_search": {"fractoin": 0.2}})
 
 
+def test_next_learning_rate_steps_past_an_edge_only():
+    grid = [1e-3, 3e-3, 1e-2]
+    assert T.next_learning_rate(grid, 1e-2) == pytest.approx(1e-2 * 1e-2 / 3e-3)
+    assert T.next_learning_rate(grid, 1e-3) == pytest.approx(1e-3 / 3.0)
+    assert T.next_learning_rate(grid, 3e-3) is None
+    assert T.next_learning_rate([0.0, 1e-3], 0.0) is None          # no geometric step below 0
+    assert T.next_learning_rate([1e-3], 1e-3) is None
+
+
+def test_learning_rate_search_extends_past_the_grid_edge(data, tmp_path):
+    # two rates far too small for 4 epochs: the larger wins, at the grid's top edge
+    cfg = {**_cfg(epochs=4), "sizes": {"mlp": {"s": {"n_recent": 5, "hidden": 16}}}, "size": "s"}
+    plain = T.search_learning_rates(data, ["mlp"], {**cfg, "lr_search": {"grid": [1e-5, 1e-4], "fraction": 0.25}})
+    assert plain["lr"].tolist() == [1e-5, 1e-4] and plain.loc[plain["selected"], "lr"].item() == 1e-4
+    ext = T.search_learning_rates(data, ["mlp"], {**cfg, "lr_search": {"grid": [1e-5, 1e-4], "fraction": 0.25,
+                                                                       "extend": 2}})
+    # 1e-3 is tried because 1e-4 was best; 1e-2 only if 1e-3 beat 1e-4 in turn
+    assert ext["lr"].tolist()[:3] == pytest.approx([1e-5, 1e-4, 1e-3])
+    best3 = ext.loc[ext["lr"].isin([1e-5, 1e-4, 1e-3]), "tuning_loss"].idxmin()
+    assert (len(ext) == 4) == (ext.loc[best3, "lr"] == pytest.approx(1e-3))
+    # the first two rows are the plain search's, unchanged (same seed, same data)
+    np.testing.assert_allclose(ext["tuning_loss"].to_numpy()[:2], plain["tuning_loss"].to_numpy())
+    assert ext["selected"].sum() == 1
+    assert ext.loc[ext["selected"], "tuning_loss"].item() == ext["tuning_loss"].min()
+
+
 def test_tuned_config_reads_the_saved_search(tmp_path, monkeypatch):
     monkeypatch.setattr(T, "results_dir", lambda profile, create=True: tmp_path / profile)
     cfg = {"train": {"lr": {"mlp": 1e-3}, "lr_search": {"grid": [1e-3, 1e-2]}}}

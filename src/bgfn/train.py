@@ -102,7 +102,10 @@ def method_lr(train_cfg: dict | None, method: str) -> float:
 
 
 #: ``train.lr_search``: learning rates tried for every method on :func:`bgfn.learning.inner_split` (null: none).
-LR_SEARCH_DEFAULTS: dict[str, Any] = {"grid": None, "fraction": 0.2, "seed": 0}
+#: ``extend``: when a method's best rate is the grid's smallest or largest, up to this many further rates are
+#: tried beyond it, one grid step (the ratio of the two rates at that end) at a time, so no method's choice
+#: is cut off by the grid's ends.
+LR_SEARCH_DEFAULTS: dict[str, Any] = {"grid": None, "fraction": 0.2, "seed": 0, "extend": 0}
 LR_SEARCH_FILE = "lr_search.csv"
 
 
@@ -130,20 +133,43 @@ def search_learning_rates(data: LearningData, methods, train_cfg: dict, out_dir:
     grid = [float(v) for v in (ls["grid"] or [])]
     if not grid:
         raise DataError("train.lr_search", "grid", "a non-empty list of learning rates", repr(ls["grid"]))
+    grid = sorted(set(grid))
     inner = inner_split(data, float(ls["fraction"]))
     rows = []
     for method in methods:
-        for lr in grid:
+        def tune(lr: float) -> dict:
             cfg = {**train_cfg, "lr": {**(train_cfg.get("lr") or {}), method: lr}}
             sub = Path(out_dir) / f"lr{lr:g}" if out_dir is not None else None
             card = train_model(method, inner, size_config(train_cfg, method), cfg, seed=int(ls["seed"]),
                                out_dir=sub, progress=progress)
-            rows.append({"method": method, "lr": lr, "tuning_rmse_m": card["val_rmse_m"],
-                         "tuning_loss": card["best_val_loss"], "epochs_run": card["epochs_run"]})
+            return {"method": method, "lr": lr, "tuning_rmse_m": card["val_rmse_m"],
+                    "tuning_loss": card["best_val_loss"], "epochs_run": card["epochs_run"]}
+
+        tried = [tune(lr) for lr in grid]
+        for _ in range(int(ls["extend"])):
+            nxt = next_learning_rate([r["lr"] for r in tried], min(tried, key=lambda r: r["tuning_loss"])["lr"])
+            if nxt is None:
+                break
+            tried.append(tune(nxt))
+        rows += sorted(tried, key=lambda r: r["lr"])
     table = pd.DataFrame(rows)
     best = table.groupby("method", sort=False)["tuning_loss"].idxmin()
     table["selected"] = table.index.isin(best.to_numpy())
     return table
+
+
+def next_learning_rate(tried, best: float) -> float | None:
+    """The rate one grid step beyond ``best`` when ``best`` is the smallest or largest of ``tried``
+    (geometric step: the ratio of the two rates at that end); None when ``best`` is inside, or the step is
+    undefined (fewer than two positive rates at that end)."""
+    rates = sorted(set(float(r) for r in tried))
+    if len(rates) < 2:
+        return None
+    if best == rates[-1] and rates[-2] > 0:
+        return rates[-1] * rates[-1] / rates[-2]
+    if best == rates[0] and rates[0] > 0:
+        return rates[0] * rates[0] / rates[1]
+    return None
 
 
 def with_selected_lr(train_cfg: dict, search: pd.DataFrame | None) -> dict:

@@ -287,3 +287,8 @@ def test_screening_drops_the_windows_of_a_gnss_jump(tables):
         L.make_windows(imu, att.drop(columns="v_n"), jumped, window=100, target_screen_sigma=5.0)
     with pytest.raises(DataError, match="target_screen_sigma"):
         L.screen_increments(np.zeros((3, 2)), -1.0)
+    # residuals without an INS velocity (NaN) are never flagged and leave the others' statistics alone
+    r = np.r_[np.random.default_rng(0).normal(0.0, 0.1, (200, 2)), [[5.0, 0.0]], [[np.nan, np.nan]]]
+    flags = L.screen_increments(r, 10.0)
+    assert flags.tolist() == [False] * 200 + [True, False]
+    assert not L.screen_increments(np.full((4, 2), np.nan), 10.0).any()

@@ -239,9 +239,13 @@ def screen_increments(residual: np.ndarray, sigma: float | None) -> np.ndarray:
         return np.zeros(len(residual), bool)
     if sigma < 0:
         raise DataError("train", "target_screen_sigma", "a positive number of robust std, or null", repr(sigma))
-    dev = residual - np.median(residual, axis=0)
-    robust_std = 1.4826 * np.median(np.abs(dev), axis=0)
-    return np.any(np.abs(dev) > float(sigma) * np.maximum(robust_std, 1e-9), axis=1)
+    if not np.isfinite(residual).any():
+        return np.zeros(len(residual), bool)
+    # NaN residuals (no INS velocity there) are never flagged and do not enter the statistics
+    dev = residual - np.nanmedian(residual, axis=0)
+    robust_std = 1.4826 * np.nanmedian(np.abs(dev), axis=0)
+    with np.errstate(invalid="ignore"):
+        return np.any(np.abs(dev) > float(sigma) * np.maximum(robust_std, 1e-9), axis=1)
 
 
 # ----------------------------------------------------------------------------------------------- windows

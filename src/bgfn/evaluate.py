@@ -395,7 +395,7 @@ class _Run:
 
     def _fill(self, r0: int, r1: int) -> None:
         """Features of output rows r0..r1 (inclusive, >= 1) from the current solution."""
-        from bgfn.learning import heading_velocity
+        from bgfn.learning import DERIVED_CHANNELS, heading_velocity
         from bgfn.nav import transform
 
         if r1 < r0:
@@ -407,8 +407,8 @@ class _Run:
         for i, c in enumerate(self.extra):
             if c in ("v_n", "v_e", "v_d"):
                 self.feat[k0:k1, 9 + i] = v[:, ("v_n", "v_e", "v_d").index(c)]
-            elif c in ("v_along", "v_cross"):
-                self.feat[k0:k1, 9 + i] = heading_velocity(v[:, 0], v[:, 1], yaw)[("v_along", "v_cross").index(c)]
+            elif c in DERIVED_CHANNELS:                  # (v_along, v_cross), in that order
+                self.feat[k0:k1, 9 + i] = heading_velocity(v[:, 0], v[:, 1], yaw)[DERIVED_CHANNELS.index(c)]
             else:
                 self.feat[k0:k1, 9 + i] = self.out_pos[r0:r1 + 1, ("lat", "lon", "h").index(c)]
 

@@ -244,8 +244,7 @@ def screen_increments(residual: np.ndarray, sigma: float | None) -> np.ndarray:
     # NaN residuals (no INS velocity there) are never flagged and do not enter the statistics
     dev = residual - np.nanmedian(residual, axis=0)
     robust_std = 1.4826 * np.nanmedian(np.abs(dev), axis=0)
-    with np.errstate(invalid="ignore"):
-        return np.any(np.abs(dev) > float(sigma) * np.maximum(robust_std, 1e-9), axis=1)
+    return np.any(np.abs(dev) > float(sigma) * np.maximum(robust_std, 1e-9), axis=1)
 
 
 # ----------------------------------------------------------------------------------------------- windows

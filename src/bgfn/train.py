@@ -38,8 +38,9 @@ from torch import nn
 from bgfn.config import results_dir
 from bgfn.errors import DataError
 from bgfn.io import atomic_path, atomic_write_json
-from bgfn.learning import (LearningData, Normalizer, WindowSet, from_target_frame, learning_options,
-                           prediction_windows, reference_rmse, rmse, to_target_frame)
+from bgfn.learning import (VAL_POSITIONS, LearningData, Normalizer, WindowSet, all_windows, build_learning_data,
+                           from_target_frame, inner_split, learning_options, motion_in_windows,
+                           prediction_windows, reference_rmse, rmse, to_target_frame, val_position_coverage)
 from bgfn.models import build_model, count_parameters, is_spiking
 
 #: Defaults of the optimization keys (``train.optimizer`` of a profile).
@@ -127,8 +128,6 @@ def search_learning_rates(data: LearningData, methods, train_cfg: dict, out_dir:
     DataFrame
         ``method, lr, tuning_rmse_m, tuning_loss, epochs_run, selected`` (one row per method and rate).
     """
-    from bgfn.learning import inner_split
-
     ls = lr_search_options(train_cfg)
     grid = [float(v) for v in (ls["grid"] or [])]
     if not grid:
@@ -494,26 +493,25 @@ def prepare_learning_data(cfg: dict, dataset: str, attitude=None, drive=None, ou
         Evaluation outages; default :func:`evaluation_outages`.
     """
     from bgfn.data import load_drive
-    from bgfn.learning import build_learning_data
 
     if drive is None:
         drive = load_drive(dataset, profile=cfg["profile"]) if _accepts(load_drive, "profile") else load_drive(dataset)
+    attitude, outage_windows, opts = _learning_inputs(cfg, drive, attitude, outage_windows)
+    return build_learning_data(drive.imu, attitude, drive.gnss, outage_windows, **opts)
+
+
+def _learning_inputs(cfg: dict, drive, attitude=None, outage_windows=None) -> tuple:
+    """``(attitude, outage_windows, learning options)`` of the profile, defaults filled in."""
     attitude = attitude if attitude is not None else ins_attitude(drive, cfg)
     if outage_windows is None:
         outage_windows = evaluation_outages(cfg)
-    opts = learning_options(cfg.get("train"))
-    return build_learning_data(drive.imu, attitude, drive.gnss, outage_windows, **opts)
+    return attitude, outage_windows, learning_options(cfg.get("train"))
 
 
 def val_position_table(cfg: dict, drive, attitude=None, outage_windows=None, positions=None):
     """:func:`bgfn.learning.val_position_coverage` of ``drive`` with the profile's learning options: what each
     place of the validation block would leave to training (notebook 03)."""
-    from bgfn.learning import VAL_POSITIONS, all_windows, learning_options, motion_in_windows, val_position_coverage
-
-    attitude = attitude if attitude is not None else ins_attitude(drive, cfg)
-    if outage_windows is None:
-        outage_windows = evaluation_outages(cfg)
-    opts = learning_options(cfg.get("train"))
+    attitude, outage_windows, opts = _learning_inputs(cfg, drive, attitude, outage_windows)
     ws = all_windows(drive.imu, attitude, drive.gnss, **opts)
     return val_position_coverage(ws, motion_in_windows(drive.reference, outage_windows), outage_windows,
                                  margin_s=float(opts["margin_s"]), val_fraction=float(opts["val_fraction"]),

@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bgfn.data.gnss import antenna_position, decimate, simulate_fixes
+from bgfn.data.gnss import antenna_position, decimate, fix_errors, simulate_fixes
 from bgfn.errors import DataError
 from bgfn.nav.earth import curvature_radii
 
@@ -45,6 +45,23 @@ def test_noise_free_fixes_are_the_antenna_positions():
     np.testing.assert_allclose(gnss["h"], h, atol=1e-9)
     assert gnss[["v_n", "v_e", "v_d"]].isna().all().all()
     assert np.all(err[["err_n", "err_e", "err_d"]].to_numpy() == 0.0)
+
+
+def test_fix_errors_recover_the_simulated_errors_at_the_antenna():
+    truth = still_truth(3001, rate=100.0, yaw=1.2)
+    arm = [-0.369, 0.2, -0.219]
+    gnss, err = simulate_fixes(truth, arm, seed=4, rate_hz=1.0, white_std_m=(0.3, 0.5, 0.6),
+                               correlated_std_m=(1.0, 1.0, 2.0))
+    got = fix_errors(gnss, truth, arm)
+    assert list(got.columns) == ["time", "north_m", "east_m", "down_m"] and len(got) == 31
+    np.testing.assert_allclose(got[["north_m", "east_m", "down_m"]], err[["err_n", "err_e", "err_d"]], atol=1e-6)
+    # measured against the IMU instead of the antenna, the lever arm (rotated by the yaw) shows up
+    at_imu = fix_errors(gnss, truth, [0.0, 0.0, 0.0])
+    d = (at_imu[["north_m", "east_m"]] - got[["north_m", "east_m"]]).to_numpy()
+    c, s_ = np.cos(1.2), np.sin(1.2)
+    np.testing.assert_allclose(d, np.tile([c * arm[0] - s_ * arm[1], s_ * arm[0] + c * arm[1]], (31, 1)), atol=1e-6)
+    # fixes outside the truth's span are left out
+    assert len(fix_errors(gnss, truth.iloc[:1001], arm)) == 11
 
 
 def test_simulated_errors_have_configured_statistics():

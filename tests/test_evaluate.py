@@ -5,6 +5,8 @@ A small synthetic drive (demo trajectory, Ekinox-grade IMU errors, 5 Hz GNSS) ke
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -366,6 +368,23 @@ def test_real_imu_switch_falls_back_to_the_simulated_datasets(monkeypatch, tmp_p
     assert ev.PAPER_TESTS["navego-ekinox"] == "dataset" and ev.PAPER_TESTS["navego-mpu6000"] == "field"
 
 
+def test_fix_error_table_takes_the_largest_fix_error_inside_each_window():
+    ref = pd.DataFrame({"time": np.arange(0.0, 100.01, 0.01), "lat": 0.7, "lon": 0.13, "h": 200.0,
+                        "roll": 0.0, "pitch": 0.0, "yaw": 0.0})
+    r_m, r_n = earth.curvature_radii(0.7)
+    t = np.arange(0.0, 101.0, 1.0)
+    north = np.where((t >= 10) & (t <= 40), 0.1 * (t - 10), 0.0)       # grows to 3 m inside window 1
+    east = np.where(t == 41, 9.0, -0.5)                                # a 9 m jump just after window 1
+    fixes = pd.DataFrame({"time": t, "lat": 0.7 + north / (r_m + 200.0),
+                          "lon": 0.13 + east / ((r_n + 200.0) * np.cos(0.7)), "h": 200.0})
+    drive = SimpleNamespace(gnss=fixes, reference=ref)             # all fix_error_table reads of a Drive
+    tab = ev.fix_error_table(drive, [(10.0, 30.0), (60.0, 30.0), (200.0, 5.0)], [0.0, 0.0, 0.0])
+    assert tab["n_fixes"].tolist() == [31, 31, 0]
+    assert tab.loc[0, "max_north_m"] == pytest.approx(3.0, abs=1e-6)
+    assert tab.loc[0, "max_east_m"] == pytest.approx(0.5, abs=1e-6)   # the jump at 41 s is outside
+    assert tab.loc[1, "max_north_m"] == pytest.approx(0.0, abs=1e-6) and np.isnan(tab.loc[2, "max_east_m"])
+
+
 def test_describe_tables_says_where_gps_is_not_the_lower_bound():
     rows = []
     for m, e in (("INS", 0.8), ("BGFN", 30.0), ("GPS", 1.6)):
@@ -375,6 +394,12 @@ def test_describe_tables_says_where_gps_is_not_the_lower_bound():
     (line,) = ev.describe_tables([res])
     assert "not the lower bound" in line and "INS max east 0.8 < GPS 1.6 m" in line
     assert "BGFN max east" not in line                       # only cells below the GPS row are named
+    assert "fixes in this window" not in line               # their errors unknown: not claimed
+    fixes = pd.DataFrame({"outage": [1, 2], "start_s": [0.0, 100.0], "n_fixes": [150, 150],
+                          "max_east_m": [2.9, 1.64], "max_north_m": [1.9, 1.1]})
+    res.gnss_errors = fixes
+    (line,) = ev.describe_tables([res])
+    assert line.endswith("the fixes in this window are off by up to 1.6 m east and 1.1 m north.")
     rows[0]["max_east_m"] = 2.0
     (line,) = ev.describe_tables([ev.TableResult("x", "dataset", pd.DataFrame(), pd.DataFrame(rows), [], {})])
     assert "lower bound" not in line

@@ -292,3 +292,22 @@ def test_screening_drops_the_windows_of_a_gnss_jump(tables):
     flags = L.screen_increments(r, 10.0)
     assert flags.tolist() == [False] * 200 + [True, False]
     assert not L.screen_increments(np.full((4, 2), np.nan), 10.0).any()
+
+
+def test_ins_increment_reference_is_the_distance_travelled(tables):
+    imu, att, gnss = tables                     # exact GNSS fixes, attitude with the true velocity
+    ws = L.make_windows(imu, att, gnss, window=50)
+    refs = L.reference_rmse(ws)
+    # the velocity integrated over each 1 s interval is the chord between exact fixes (trapezoid at 100 Hz)
+    assert np.all(np.isfinite(ws.y_ins)) and refs["ins"] < 1e-2
+    assert refs["last"] > 20 * refs["ins"] and refs["zero"] > 6.0      # 10 m/s +- 30 %
+    assert L.reference_columns(refs) == {"val_rmse_zero_m": refs["zero"], "val_rmse_last_m": refs["last"],
+                                         "val_rmse_ins_m": refs["ins"]}
+    sub = ws.subset(np.array([4, 2]))
+    assert np.array_equal(sub.y_ins, ws.y_ins[[4, 2]])
+    # an attitude table without velocity: the reference is unknown (NaN), not an error
+    blind = L.make_windows(imu, att.drop(columns=["v_n", "v_e"]), gnss, window=50)
+    assert np.isnan(blind.y_ins).all() and np.isnan(L.reference_rmse(blind)["ins"])
+    assert np.array_equal(blind.y, ws.y)
+    with pytest.raises(DataError, match="v_n"):                        # screening needs the velocity
+        L.make_windows(imu, att.drop(columns=["v_n", "v_e"]), gnss, window=50, target_screen_sigma=10.0)

@@ -363,6 +363,12 @@ def test_variant_tables_put_profiles_side_by_side():
     assert o.loc[(1, "INS")].tolist() == [5.0, 5.0]          # (8 + 2) / 2 in both
     assert o.loc[(1, "BGFN")].tolist() == [200.0, 152.0]     # (100 + 300) / 2, (4 + 300) / 2
     assert report.variant_training_table({"a": None}) is None
+    # a table with the INS increment reference (newer notebooks) shows it and names it in the sentences
+    with_ins = {"quick": summary(5.0, 7.0).assign(val_rmse_ins_m=0.7)}
+    t = report.variant_training_table(with_ins)
+    assert list(t.columns) == ["val. RMSE quick", "zero", "last increment", "INS increment"]
+    assert report.variant_sentences(t)[0].endswith("no network; the INS increment (the GPS-aided INS's speed "
+                                                   "over the same interval): 0.70 m.")
 
 
 def test_variant_sweep_table_aligns_durations_and_methods():

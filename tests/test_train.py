@@ -31,12 +31,14 @@ def test_card_checkpoint_and_references(data, tmp_path):
     card = T.train_model("mlp", data, {"n_recent": 5, "hidden": 16}, _cfg(), seed=0, out_dir=tmp_path,
                          progress=False, extra_card={"dataset": "toy"})
     for key in ("params", "epochs_run", "best_val_loss", "wall_time_s", "device", "history", "val_rmse_m",
-                "val_rmse_zero_m", "val_rmse_last_m", "n_train", "n_val", "dataset"):
+                "val_rmse_zero_m", "val_rmse_last_m", "val_rmse_ins_m", "n_train", "n_val", "dataset"):
         assert key in card
     assert card["epochs_run"] == 3 and len(card["history"]) == 3
     assert {"train_loss", "val_loss", "val_rmse_m"} <= set(card["history"][0])
     assert card["val_rmse_zero_m"] == pytest.approx(L.reference_rmse(data.val)["zero"])
     assert card["val_rmse_last_m"] == pytest.approx(L.reference_rmse(data.val)["last"])
+    assert card["val_rmse_ins_m"] == pytest.approx(L.reference_rmse(data.val)["ins"])
+    assert card["val_rmse_ins_m"] < card["val_rmse_last_m"]        # toy drive: velocity known, exact fixes
     assert json.loads((tmp_path / "mlp_seed0.json").read_text())["val_rmse_m"] == pytest.approx(card["val_rmse_m"])
     assert not (tmp_path / "mlp_seed0.last.pt").exists()
     # the checkpoint reproduces the card's validation error
@@ -47,6 +49,15 @@ def test_card_checkpoint_and_references(data, tmp_path):
     again = T.train_model("mlp", data, {"n_recent": 5, "hidden": 16}, _cfg(), seed=0, out_dir=tmp_path,
                           progress=False)
     assert again["history"] == card["history"] and (tmp_path / "mlp_seed0.pt").stat().st_mtime_ns == mtime
+    # a card written before a reference existed gains it when read back, without training again
+    stale = json.loads((tmp_path / "mlp_seed0.json").read_text())
+    del stale["val_rmse_ins_m"]
+    (tmp_path / "mlp_seed0.json").write_text(json.dumps(stale))
+    again = T.train_model("mlp", data, {"n_recent": 5, "hidden": 16}, _cfg(), seed=0, out_dir=tmp_path,
+                          progress=False)
+    assert again["val_rmse_ins_m"] == pytest.approx(card["val_rmse_ins_m"])
+    assert json.loads((tmp_path / "mlp_seed0.json").read_text())["val_rmse_ins_m"] == again["val_rmse_ins_m"]
+    assert (tmp_path / "mlp_seed0.pt").stat().st_mtime_ns == mtime
 
 
 @pytest.mark.parametrize("method,size", [("mlp", {"n_recent": 10, "hidden": 32}), ("at_lstm", {"hidden": 16})])

@@ -671,6 +671,9 @@ class TableResult:
     runs : list of OutageRun
     models : dict
         ``{(method id, seed): predictor}`` used.
+    gnss_errors : DataFrame or None
+        :func:`fix_error_table`: how far the GNSS fixes themselves are from the reference in each outage
+        window, which the GPS row follows.
     """
 
     dataset: str
@@ -679,6 +682,26 @@ class TableResult:
     table: pd.DataFrame
     runs: list
     models: dict = field(default_factory=dict)
+    gnss_errors: pd.DataFrame | None = None
+
+
+def fix_error_table(drive, windows, lever_arm_m) -> pd.DataFrame:
+    """Per outage window: the largest |east| and |north| error of the GNSS fixes inside it against the true
+    antenna position (:func:`bgfn.data.gnss.fix_errors`), m, and the number of fixes.
+
+    The GPS row is the filter with these fixes: it cannot stay closer to the reference than they are for long,
+    while an INS that starts from the same state may drift less than the fixes wander.
+    """
+    from bgfn.data.gnss import fix_errors
+
+    err = fix_errors(drive.gnss, drive.reference, lever_arm_m)
+    rows = []
+    for k, (start, duration) in enumerate(windows):
+        inside = err[(err["time"] >= start) & (err["time"] <= start + duration)]
+        rows.append({"outage": k + 1, "start_s": float(start), "n_fixes": int(len(inside)),
+                     "max_east_m": float(inside["east_m"].abs().max()) if len(inside) else float("nan"),
+                     "max_north_m": float(inside["north_m"].abs().max()) if len(inside) else float("nan")})
+    return pd.DataFrame(rows)
 
 
 def aggregate_seeds(per_seed: pd.DataFrame, how: str = "median") -> pd.DataFrame:
@@ -734,7 +757,8 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
              **window_metrics(r.errors, r.start, r.duration)} for r in runs]
     per_seed = pd.DataFrame(rows)
     return TableResult(dataset, PAPER_TESTS.get(dataset, dataset), per_seed,
-                       aggregate_seeds(per_seed, ecfg["seed_aggregate"]), runs, models)
+                       aggregate_seeds(per_seed, ecfg["seed_aggregate"]), runs, models,
+                       fix_error_table(drive, windows, ctx.lever))
 
 
 def table_file(test: str) -> str:
@@ -748,7 +772,8 @@ def save_table_result(out, result: TableResult, series_rate_hz: float = 10.0) ->
 
     Files (``<t>`` = ``dataset`` / ``field``): ``tables/outage_<t>.csv`` (``TABLE_COLUMNS``, the seed
     aggregate), ``tables/outage_<t>_seeds.csv`` (every run), ``tables/outage_errors_<t>.csv`` (error
-    series, :func:`error_series`).
+    series, :func:`error_series`), ``tables/outage_<t>_gnss.csv`` (the fixes' own errors in each window,
+    :func:`fix_error_table`; when known).
 
     Returns
     -------
@@ -769,6 +794,9 @@ def save_table_result(out, result: TableResult, series_rate_hz: float = 10.0) ->
     series.insert(0, "outage", series["start_s"].map(
         dict(zip(result.per_seed["start_s"], result.per_seed["outage"]))).astype(int))
     atomic_write_csv(paths["series"], series, float_format="%.4f")
+    if result.gnss_errors is not None:
+        paths["gnss"] = out / "tables" / f"{stem}_gnss.csv"
+        atomic_write_csv(paths["gnss"], result.gnss_errors, float_format="%.4f")
     return paths
 
 
@@ -888,6 +916,10 @@ def describe_tables(results) -> list[str]:
             if below:   # the GPS row follows the GNSS fixes, whose own error against the reference can exceed a drift
                 txt += ("; the GPS row is not the lower bound in every cell (" + "; ".join(below)
                         + "): the GPS-aided solution follows the GNSS fixes' own error against the reference")
+                fixes = r.gnss_errors.set_index("outage") if r.gnss_errors is not None else pd.DataFrame()
+                if o in fixes.index and fixes.loc[o, "n_fixes"] > 0:
+                    txt += (f", and the fixes in this window are off by up to {fixes.loc[o, 'max_east_m']:.1f} m "
+                            f"east and {fixes.loc[o, 'max_north_m']:.1f} m north")
             lines.append(txt + ".")
     return lines
 
@@ -1183,7 +1215,7 @@ __all__ = [
     "COLORS", "EVALUATE_DEFAULTS", "METHOD_LABELS", "METRIC_COLUMNS", "NavContext", "OutageRun", "PAPER_TESTS",
     "SWEEP_COLUMNS", "TABLE_COLUMNS", "TABLE_FILES", "TABLE_METHODS", "TableResult", "aggregate_seeds",
     "choose_datasets", "describe_sweep", "describe_tables", "ensure_models", "error_reduction", "error_series",
-    "evaluate_config", "evaluate_dataset", "gps_run", "load_model", "model_path", "navigation_context",
+    "evaluate_config", "evaluate_dataset", "fix_error_table", "gps_run", "load_model", "model_path", "navigation_context",
     "paper_claims", "paper_layout", "paper_values", "plot_outage", "plot_sweep_boxes", "pseudo_gps_positions",
     "representative_seeds", "run_outages", "run_sweep", "save_table_result", "sweep_comparisons", "sweep_plan",
     "sweep_summary", "sweep_train_config", "table_file", "window_metrics",

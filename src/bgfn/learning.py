@@ -272,6 +272,10 @@ class WindowSet:
     channels : tuple of str
     n_screened : int
         GNSS increments dropped by :func:`screen_increments` when the set was made (0 for subsets).
+    y_ins : ndarray [M, 2] or None
+        The distance the GPS-aided INS travelled over the same interval (:func:`ins_increments`; the
+        "INS increment" reference: what knowing the velocity is worth, which the inputs of Eq. eq21 do not
+        carry); NaN where the attitude table has no velocity, None when not computed.
     """
 
     x: np.ndarray
@@ -284,6 +288,7 @@ class WindowSet:
     yaw_ref: np.ndarray
     channels: tuple[str, ...] = CHANNELS
     n_screened: int = 0
+    y_ins: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.x)
@@ -291,7 +296,8 @@ class WindowSet:
     def subset(self, idx) -> "WindowSet":
         """The windows at integer/boolean index ``idx``."""
         return WindowSet(self.x[idx], self.y[idx], self.t_from[idx], self.t_to[idx], self.t_end[idx],
-                         self.t_start[idx], self.y_last[idx], self.yaw_ref[idx], self.channels)
+                         self.t_start[idx], self.y_last[idx], self.yaw_ref[idx], self.channels,
+                         y_ins=None if self.y_ins is None else self.y_ins[idx])
 
     @property
     def span(self) -> tuple[np.ndarray, np.ndarray]:
@@ -366,20 +372,23 @@ def make_windows(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.DataFrame, 
     y_last = np.full_like(y, np.nan)
     contiguous = np.isclose(t_to[:-1], t_from[1:], rtol=0.0, atol=1e-9)
     y_last[1:][contiguous] = y[:-1][contiguous]
+    has_velocity = {"v_n", "v_e"} <= set(attitude.columns)
+    y_ins = ins_increments(attitude, t_from, t_to) if has_velocity else np.full_like(y, np.nan)
     bad = np.zeros(len(y), bool)
     if target_screen_sigma:
-        flagged = screen_increments(y - ins_increments(attitude, t_from, t_to), target_screen_sigma)
+        _check_table(attitude, "attitude", ("time", "v_n", "v_e"))
+        flagged = screen_increments(y - y_ins, target_screen_sigma)
         bad = flagged.copy()
         bad[1:] |= flagged[:-1] & contiguous
     keep = (np.arange(len(y)) % max(1, int(epoch_stride)) == 0) & ~bad
-    t_from, t_to, y, y_last = t_from[keep], t_to[keep], y[keep], y_last[keep]
+    t_from, t_to, y, y_last, y_ins = t_from[keep], t_to[keep], y[keep], y_last[keep], y_ins[keep]
     t_end_epoch = t_to if alignment == "ending" else t_from
     last, ok = _windows_ending_at(t, feats, t_end_epoch, window)
-    last, t_from, t_to, y, y_last = last[ok], t_from[ok], t_to[ok], y[ok], y_last[ok]
+    last, t_from, t_to, y, y_last, y_ins = last[ok], t_from[ok], t_to[ok], y[ok], y_last[ok], y_ins[ok]
     yaw_ref = feats[last, _YAW]
     x = encode_yaw(_gather(feats, last, window), yaw_encoding)
     return WindowSet(x=x, y=y, t_from=t_from, t_to=t_to, t_end=t[last], t_start=t[last - window],
-                     y_last=y_last, yaw_ref=yaw_ref, channels=channels, n_screened=int(bad.sum()))
+                     y_last=y_last, yaw_ref=yaw_ref, channels=channels, n_screened=int(bad.sum()), y_ins=y_ins)
 
 
 def prediction_windows(imu: pd.DataFrame, attitude: pd.DataFrame, epochs, window: int = 200,
@@ -688,8 +697,8 @@ def val_position_coverage(ws: WindowSet, outage_motion: pd.DataFrame, outage_win
     DataFrame
         One row per position: ``val_position``, ``val_block_s``, ``train``, ``val``, ``val_unseen_fraction``,
         ``outage_unseen_fraction`` (fractions of validation windows / outage seconds whose heading x speed
-        cell holds no training window), ``train_speed_max_mps`` and the references ``val_rmse_zero_m``,
-        ``val_rmse_last_m`` on that block.
+        cell holds no training window), ``train_speed_max_mps`` and the references of
+        :func:`reference_rmse` on that block (``val_rmse_zero_m``, ``val_rmse_last_m``, ``val_rmse_ins_m``).
     """
     rows = []
     for pos in positions:
@@ -703,7 +712,7 @@ def val_position_coverage(ws: WindowSet, outage_motion: pd.DataFrame, outage_win
                      "val_unseen_fraction": unseen_fraction(train, val, **cells),
                      "outage_unseen_fraction": unseen_fraction(train, outage_motion, **cells),
                      "train_speed_max_mps": float(train["speed_mps"].max()) if len(train) else float("nan"),
-                     "val_rmse_zero_m": refs["zero"], "val_rmse_last_m": refs["last"]})
+                     **reference_columns(refs)})
     return pd.DataFrame(rows)
 
 
@@ -716,9 +725,28 @@ def rmse(pred: np.ndarray, true: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.sum((pred[ok] - true[ok]) ** 2, axis=1))))
 
 
+#: The references every network's validation RMSE is read against, and their column names in cards and tables.
+REFERENCES: dict[str, str] = {"zero": "val_rmse_zero_m", "last": "val_rmse_last_m", "ins": "val_rmse_ins_m"}
+
+
 def reference_rmse(ws: WindowSet) -> dict:
-    """RMSE of predicting zero and of repeating the last GNSS increment, on the windows ``ws``."""
-    return {"zero": rmse(np.zeros_like(ws.y), ws.y), "last": rmse(ws.y_last, ws.y)}
+    """RMSE (m) of three predictors that need no training, on the windows ``ws``.
+
+    - ``zero``: no motion;
+    - ``last``: the GNSS increment of the interval before (uses GNSS, which the networks do not see);
+    - ``ins``: the GPS-aided INS's own distance over the same interval (``ws.y_ins``; its velocity, which the
+      inputs of Eq. eq21 do not carry). NaN when ``ws`` has no ``y_ins``.
+
+    A network that only sees attitude, specific force and angular rate cannot know the speed, the main part of
+    an increment; ``ins`` shows how far the GNSS increment can be predicted when the speed is known.
+    """
+    ins = ws.y_ins if ws.y_ins is not None else np.full_like(ws.y, np.nan)
+    return {"zero": rmse(np.zeros_like(ws.y), ws.y), "last": rmse(ws.y_last, ws.y), "ins": rmse(ins, ws.y)}
+
+
+def reference_columns(refs: dict) -> dict:
+    """:func:`reference_rmse` keyed by the column names of :data:`REFERENCES`."""
+    return {col: refs[key] for key, col in REFERENCES.items()}
 
 
 # ----------------------------------------------------------------------------------------------- toy drive
@@ -729,9 +757,9 @@ def synthetic_tables(duration_s: float = 120.0, imu_rate_hz: float = 100.0, gnss
 
     The vehicle drives clockwise seen from above (yaw increasing through +-pi) with speed
     ``speed_mps * (1 + 0.3 sin(2 pi t / 60))``; the IMU reads the along-track and centripetal acceleration,
-    ``accel_z = -9.81`` and the yaw rate; the attitude is level with the true heading; the GNSS positions
-    are exact. Returns ``(imu, attitude, gnss)`` DataFrames in the CONTRIBUTING.md schemas (attitude:
-    ``time, roll, pitch, yaw``).
+    ``accel_z = -9.81`` and the yaw rate; the attitude is level with the true heading and carries the true
+    velocity (as the INS solution does); the GNSS positions are exact. Returns ``(imu, attitude, gnss)``
+    DataFrames in the CONTRIBUTING.md schemas (attitude: ``time, roll, pitch, yaw, v_n, v_e``).
     """
     rng = np.random.default_rng(seed)
     n = int(round(duration_s * imu_rate_hz)) + 1
@@ -749,7 +777,8 @@ def synthetic_tables(duration_s: float = 120.0, imu_rate_hz: float = 100.0, gnss
                         "gyro_z": gyr_z + rng.normal(0, noise * 0.01, n),
                         "accel_x": acc_x + rng.normal(0, noise, n), "accel_y": acc_y + rng.normal(0, noise, n),
                         "accel_z": -9.81 + rng.normal(0, noise, n)})
-    att = pd.DataFrame({"time": t, "roll": np.zeros(n), "pitch": np.zeros(n), "yaw": wrap_angle(psi)})
+    att = pd.DataFrame({"time": t, "roll": np.zeros(n), "pitch": np.zeros(n), "yaw": wrap_angle(psi),
+                        "v_n": v * np.cos(psi), "v_e": v * np.sin(psi)})
     # circle: position from heading; centre so that start is at (0, 0)
     north = radius_m * np.sin(psi)
     east = radius_m * (1.0 - np.cos(psi))

@@ -271,7 +271,10 @@ TRAINING_COLUMNS: dict[str, str] = {
     "params": "parameters", "lr": "learning rate", "seeds": "seeds", "epochs_mean": "epochs",
     "train_time_s_mean": "time (s)",
     "val_rmse_m_mean": "val. RMSE (m)", "val_rmse_m_std": "std over seeds (m)", "val_rmse_zero_m": "zero (m)",
-    "val_rmse_last_m": "last increment (m)"}
+    "val_rmse_last_m": "last increment (m)", "val_rmse_ins_m": "INS increment (m)"}
+#: Reference columns of the training tables -> their short labels (:func:`bgfn.learning.reference_rmse`).
+REFERENCE_LABELS: dict[str, str] = {"val_rmse_zero_m": "zero", "val_rmse_last_m": "last increment",
+                                    "val_rmse_ins_m": "INS increment"}
 #: Method ids of the model cards and training tables -> labels of the paper's tables.
 METHOD_LABELS: dict[str, str] = {"bgfn": "BGFN", "transformer": "Transformer", "at_lstm": "AT-LSTM", "mlp": "MLP"}
 
@@ -708,8 +711,9 @@ def profile_tables(profiles: Sequence[str], file: str, results_root: str | Path 
 
 
 def variant_training_table(summaries: dict[str, pd.DataFrame | None]) -> pd.DataFrame | None:
-    """Validation RMSE (m, mean over seeds) per (dataset, method), one column per profile, beside the two
-    references (*zero*, *last increment*), which are the same windows in every profile of one drive.
+    """Validation RMSE (m, mean over seeds) per (dataset, method), one column per profile, beside the
+    references (*zero*, *last increment*, *INS increment*; those in the first profile's table), which are the
+    same windows in every profile of one drive.
 
     ``summaries``: ``{profile: tables/training_summary.csv}``; profiles without a table are left out.
     """
@@ -720,8 +724,7 @@ def variant_training_table(summaries: dict[str, pd.DataFrame | None]) -> pd.Data
         s = s.assign(method=s["method"].map(lambda m: METHOD_LABELS.get(m, m))).set_index(["dataset", "method"])
         cols.append(s["val_rmse_m_mean"].rename(f"val. RMSE {profile}"))
         if ref is None:
-            ref = s[["val_rmse_zero_m", "val_rmse_last_m"]].rename(
-                columns={"val_rmse_zero_m": "zero", "val_rmse_last_m": "last increment"})
+            ref = s[[c for c in REFERENCE_LABELS if c in s.columns]].rename(columns=REFERENCE_LABELS)
     if not cols:
         return None
     return pd.concat(cols + [ref], axis=1)
@@ -741,7 +744,8 @@ def variant_outage_table(tables: dict[str, pd.DataFrame | None], metric: str = "
 
 
 def variant_sentences(training: pd.DataFrame | None, method: str = "BGFN") -> list[str]:
-    """Per profile and dataset: which networks beat the *last increment* reference on validation RMSE."""
+    """Per profile and dataset: which networks beat the *last increment* reference on validation RMSE, and
+    the *INS increment* (the speed known) beside it."""
     if training is None:
         return []
     lines = []
@@ -755,8 +759,11 @@ def variant_sentences(training: pd.DataFrame | None, method: str = "BGFN") -> li
             beat = [m for m in g.index if g.loc[m, col] < last]
             txt = (f"`{profile}`, `{dataset}`: {method} {g.loc[method, col]:.2f} m against last increment "
                    f"{last:.2f} m and zero {zero:.2f} m" if method in g.index else f"`{profile}`, `{dataset}`")
-            txt += f"; below the last increment: {', '.join(beat) if beat else 'no network'}."
-            lines.append(txt)
+            txt += f"; below the last increment: {', '.join(beat) if beat else 'no network'}"
+            if "INS increment" in g.columns and np.isfinite(g["INS increment"].iloc[0]):
+                txt += f"; the INS increment (the GPS-aided INS's speed over the same interval): " \
+                       f"{float(g['INS increment'].iloc[0]):.2f} m"
+            lines.append(txt + ".")
     return lines
 
 

@@ -35,7 +35,7 @@ import pandas as pd
 from bgfn.data import acquire
 from bgfn.data.csv_drive import load_csv_drive
 from bgfn.data.drive import Drive, load_cached, save_drive
-from bgfn.data.gnss import antenna_position, decimate, simulate_fixes
+from bgfn.data.gnss import decimate, fix_errors, simulate_fixes
 from bgfn.data.imu_errors import MPU6000, apply_imu_errors, error_params
 from bgfn.data.navego import read_gnss, read_imu, read_reference, resample_imu
 from bgfn.data.trajectory import smooth_reference
@@ -150,16 +150,7 @@ def _truth(ref: pd.DataFrame, p: dict, t_start=None, t_end=None) -> tuple[pd.Dat
 
 def _gnss_residuals(gnss: pd.DataFrame, truth: pd.DataFrame, lever_arm) -> dict:
     """Mean and std of (fix - true antenna position), north/east/down, m, over the truth's span."""
-    from bgfn.nav.earth import curvature_radii
-
-    t = truth["time"].to_numpy(float)
-    g = gnss.loc[(gnss["time"] >= t[0]) & (gnss["time"] <= t[-1])]
-    lat, lon, h = antenna_position(truth, lever_arm)
-    tg = g["time"].to_numpy(float)
-    lat_i, lon_i, h_i = (np.interp(tg, t, x) for x in (lat, lon, h))
-    r_m, r_n = curvature_radii(lat_i)
-    d = np.column_stack([(g["lat"].to_numpy() - lat_i) * (r_m + h_i),
-                         (g["lon"].to_numpy() - lon_i) * (r_n + h_i) * np.cos(lat_i), -(g["h"].to_numpy() - h_i)])
+    d = fix_errors(gnss, truth, lever_arm)[["north_m", "east_m", "down_m"]].to_numpy()
     return {"gnss_residual_mean_m": d.mean(axis=0).tolist(), "gnss_residual_std_m": d.std(axis=0).tolist()}
 
 

@@ -76,6 +76,34 @@ def antenna_position(truth: pd.DataFrame, lever_arm_m) -> tuple[np.ndarray, np.n
     return _offset(lat, lon, h, d_ned)
 
 
+def fix_errors(gnss: pd.DataFrame, truth: pd.DataFrame, lever_arm_m) -> pd.DataFrame:
+    """Error of each GNSS fix against the true antenna position (:func:`antenna_position`), local NED, m.
+
+    Parameters
+    ----------
+    gnss : DataFrame
+        Fixes (``time, lat, lon, h``); those outside the span of ``truth`` are left out.
+    truth : DataFrame
+        Reference table (``time, lat, lon, h, roll, pitch, yaw``).
+    lever_arm_m : array_like, shape (3,)
+        Antenna position in the body frame, m.
+
+    Returns
+    -------
+    DataFrame
+        ``time, north_m, east_m, down_m``: fix minus truth.
+    """
+    t = truth["time"].to_numpy(float)
+    g = gnss.loc[(gnss["time"] >= t[0]) & (gnss["time"] <= t[-1])]
+    lat, lon, h = antenna_position(truth, lever_arm_m)
+    tg = g["time"].to_numpy(float)
+    lat_i, lon_i, h_i = (np.interp(tg, t, x) for x in (lat, lon, h))
+    r_m, r_n = curvature_radii(lat_i)
+    return pd.DataFrame({"time": tg, "north_m": (g["lat"].to_numpy(float) - lat_i) * (r_m + h_i),
+                         "east_m": (g["lon"].to_numpy(float) - lon_i) * (r_n + h_i) * np.cos(lat_i),
+                         "down_m": -(g["h"].to_numpy(float) - h_i)})
+
+
 def _offset(lat, lon, h, d_ned):
     r_m, r_n = curvature_radii(lat)
     return (lat + d_ned[:, 0] / (r_m + h), lon + d_ned[:, 1] / ((r_n + h) * np.cos(lat)), h - d_ned[:, 2])

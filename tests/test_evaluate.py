@@ -403,3 +403,22 @@ def test_describe_tables_says_where_gps_is_not_the_lower_bound():
     rows[0]["max_east_m"] = 2.0
     (line,) = ev.describe_tables([ev.TableResult("x", "dataset", pd.DataFrame(), pd.DataFrame(rows), [], {})])
     assert "lower bound" not in line
+
+
+def test_innovation_gate_reaches_the_gps_aided_runs(drive5):
+    from bgfn.nav import baseline
+
+    g = drive5.gnss.copy()
+    k = int(np.argmin(np.abs(g["time"].to_numpy() - (g["time"].iloc[0] + 40.0))))
+    r_m, _ = earth.curvature_radii(g.loc[k, "lat"])
+    g.loc[k, "lat"] += 25.0 / (r_m + g.loc[k, "h"])                 # one fix 25 m north
+    jumped = Drive(drive5.name, drive5.reference, drive5.imu, g, drive5.meta)
+    cfg = baseline.nav_config({**NAV, "outage_starts": [s for s, _ in WINDOWS], "outage_duration_s": 20.0})
+    table = baseline.gate_comparison(jumped, cfg, 0.999)
+    assert table["innovation_gate"].tolist() == ["none", "0.999"]
+    assert table.loc[0, "gnss_rejected"] == 0 and table.loc[1, "gnss_rejected"] >= 1
+    assert table.loc[1, "max_h_m"] < 0.5 * table.loc[0, "max_h_m"]    # the jump no longer pulls the solution
+    # the evaluation's GPS-aided run reads the same nav: key
+    ctx = ev.navigation_context(jumped, {**NAV, "innovation_gate": 0.999}, [WINDOWS[0][0]])
+    rejected = ctx.full.updates.loc[~ctx.full.updates["accepted"], "time"].to_numpy()
+    assert np.any(np.isclose(rejected, g.loc[k, "time"]))

@@ -191,3 +191,61 @@ def test_imu_gap_and_bad_tables_raise(drive300):
         st.noise_from_imu_errors({k: v for k, v in errs.items() if k != "gyro_noise_density"})
     with pytest.raises(DataError, match="snapshots"):
         run_filter(imu, init, noise, gnss, LEVER, t_end=20.0, snapshots={"x": 1000.0})
+
+
+def test_innovation_gate_rejects_a_jump_as_if_the_fix_were_missing(drive300):
+    ref, _, imu, errs, _, gnss = drive300
+    init, noise = _setup(ref, errs)
+    jumped = gnss.copy()
+    k = 150                                                     # a 20 m jump north at t = 150 s
+    r_m, _ = earth.curvature_radii(jumped.loc[k, "lat"])
+    jumped.loc[k, "lat"] += 20.0 / (r_m + jumped.loc[k, "h"])
+    gated = run_filter(imu, init, noise, jumped, LEVER, gate_probability=0.999)
+    assert gated.updates["accepted"].sum() == len(gnss) - 1
+    (bad,) = np.flatnonzero(~gated.updates["accepted"].to_numpy())
+    assert gated.updates.loc[bad, "time"] == pytest.approx(gnss.loc[k, "time"])
+    assert gated.updates.loc[bad, "nis"] > chi2.ppf(0.999, 3)
+    # rejecting the fix is exactly not having it
+    without = run_filter(imu, init, noise, gnss.drop(index=k), LEVER)
+    np.testing.assert_array_equal(gated.trajectory[["lat", "lon", "h"]].to_numpy(),
+                                  without.trajectory[["lat", "lon", "h"]].to_numpy())
+    # the paper's filter (no gate) fuses it and is pulled north by metres
+    fused = run_filter(imu, init, noise, jumped, LEVER)
+    assert fused.updates["accepted"].all()
+    e_fused = metrics.navigation_errors(fused.trajectory, ref)
+    e_gated = metrics.navigation_errors(gated.trajectory, ref)
+    at = np.argmin(np.abs(e_fused["time"].to_numpy() - gnss.loc[k, "time"]))
+    assert e_fused["north"].iloc[at] > 3.0 > abs(e_gated["north"].iloc[at])
+
+
+def test_gate_nis_is_the_sum_of_the_sequential_nis(drive300):
+    from bgfn.nav.filter import position_measurement, position_nis, update_position
+
+    ref, _, imu, errs, _, gnss = drive300
+    init, noise = _setup(ref, errs)
+    state = run_filter(imu, init, noise, gnss, LEVER, t_end=100.4).final   # P after 100 fixes
+    fix = gnss.loc[100, ["lat", "lon", "h"]].to_numpy(float) + np.array([3e-7, -2e-7, 1.5])
+    std = np.array([1.0, 1.0, 2.0])
+    dz, H = np.empty(3), np.empty((3, 15))
+    position_measurement(state.pos, state.v, state.c_bn, LEVER, fix, 0.0, dz, H)
+    batch, dof = position_nis(state.P, H, dz, std)
+    S = H @ state.P @ H.T + np.diag(std ** 2)
+    assert dof == 3 and batch == pytest.approx(dz @ np.linalg.solve(S, dz), rel=1e-12)
+    args = [a.copy() for a in (state.pos, state.v, state.c_bn, state.accel_bias, state.gyro_bias, state.P)]
+    sequential, accepted = update_position(*args, LEVER, fix, std, 0.0, np.empty(3), 0.0)
+    assert accepted and sequential == pytest.approx(batch, rel=1e-9)
+    # a gate below it rejects the fix and leaves the state untouched
+    args = [a.copy() for a in (state.pos, state.v, state.c_bn, state.accel_bias, state.gyro_bias, state.P)]
+    nis, accepted = update_position(*args, LEVER, fix, std, 0.0, np.empty(3), 0.5 * batch)
+    assert not accepted and nis == pytest.approx(batch)
+    np.testing.assert_array_equal(args[0], state.pos)
+    np.testing.assert_array_equal(args[5], state.P)
+
+
+@pytest.mark.parametrize("bad", [1.0, 1.5, -0.1, "high"])
+def test_gate_probability_must_be_a_probability(bad):
+    from bgfn.nav.baseline import nav_config
+
+    with pytest.raises(DataError, match="innovation_gate"):
+        nav_config({"innovation_gate": bad})
+    assert nav_config({"innovation_gate": None})["innovation_gate"] is None

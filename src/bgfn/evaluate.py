@@ -271,7 +271,8 @@ def navigation_context(drive, nav_section: dict | None, starts: Sequence[float])
     imu_time = drive.imu["time"].to_numpy(float)
     # The state is taken at the last IMU epoch *before* the start (bgfn.nav.outages.epochs_before).
     snaps = {f"start_{i}": float(t) for i, t in enumerate(epochs_before(imu_time, starts, drive.name))}
-    full = run_filter(drive.imu, initial, noise, drive.gnss, lever, snapshots=snaps, source=drive.name)
+    full = run_filter(drive.imu, initial, noise, drive.gnss, lever, snapshots=snaps,
+                      gate_probability=cfg["innovation_gate"], source=drive.name)
     states = {s: full.states[f"start_{i}"] for i, s in enumerate(starts)}
     imu = drive.imu[["accel_x", "accel_y", "accel_z", "gyro_x", "gyro_y", "gyro_z"]].to_numpy(float)
     tr = full.trajectory
@@ -429,7 +430,7 @@ class _Run:
 
         innov = np.empty(3)
         update_position(self.pos, self.v, self.c, self.ba, self.bg, self.P, self.lever, np.asarray(fix, float),
-                   np.asarray(std, float), float(self.times[self.row] - t_m), innov)
+                        np.asarray(std, float), float(self.times[self.row] - t_m), innov, 0.0)   # never gated
         self.out_pos[self.row], self.out_v[self.row], self.out_c[self.row] = self.pos, self.v, self.c
         if self.row >= 1:        # later windows see the corrected solution, as the training attitude does
             self._fill(self.row, self.row)

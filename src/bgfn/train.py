@@ -540,7 +540,8 @@ def ins_attitude(drive, cfg: dict):
     The other columns (``v_n``, ``v_e``, ...) are there for ``train.extra_channels`` (not the paper's input).
 
     ``train.attitude_source``: ``'kf'`` (default, the paper's online-training mode) runs the 15-state loosely
-    coupled filter of :mod:`bgfn.nav.filter` with every GNSS fix; ``'reference'`` takes the truth attitude
+    coupled filter with the GNSS fixes and the profile's ``nav:`` section (:func:`bgfn.nav.baseline.run_drive`);
+    ``'reference'`` takes the truth attitude
     (debugging only: the outage evaluation feeds the INS attitude).
     """
 
@@ -549,23 +550,9 @@ def ins_attitude(drive, cfg: dict):
         return drive.reference.copy()
     if src != "kf":
         raise DataError("train", "attitude_source", "'kf' or 'reference'", repr(src))
-    from bgfn import nav
+    from bgfn.nav import run_drive
 
-    runner = getattr(nav, "run_drive", None)        # the navigation issue's driver, when it provides one
-    if runner is not None:
-        res = runner(drive, cfg.get("nav") or {})
-        traj = getattr(res, "trajectory", res)
-    else:
-        from bgfn.nav.filter import run_filter
-        from bgfn.nav.state import initial_covariance, initial_state, noise_from_imu_errors
-
-        noise = noise_from_imu_errors(drive.meta["imu_errors"])
-        r0 = drive.reference.iloc[0]
-        P0 = initial_covariance(np.array([r0["lat"], r0["lon"], r0["h"]]), noise, position_std=1.0,
-                                height_std=3.0, velocity_std=0.1, level_std=np.deg2rad(0.5),
-                                azimuth_std=np.deg2rad(2.0))
-        traj = run_filter(drive.imu, initial_state(r0, P0), noise, drive.gnss,
-                          lever_arm=drive.meta.get("lever_arm_m", (0.0, 0.0, 0.0)), source=drive.name).trajectory
+    traj = run_drive(drive, cfg.get("nav") or {}).trajectory
     return pd.DataFrame(traj).reset_index(drop=True)
 
 

@@ -8,7 +8,9 @@ The ``nav:`` section of ``params/<profile>.yaml`` configures it (keys and defaul
 - ``init``: initial std ``position_std_m``, ``height_std_m``, ``velocity_std_mps``, ``level_std_deg``,
   ``azimuth_std_deg`` (P0; the filter starts from the reference's first row);
 - ``bias_model`` (``random_walk`` | ``gauss_markov``), ``noise_scale``: see
-  :func:`bgfn.nav.state.noise_from_imu_errors`.
+  :func:`bgfn.nav.state.noise_from_imu_errors`;
+- ``innovation_gate``: null (every GNSS fix fused, the paper's filter) or a probability ``p``: a fix whose NIS
+  exceeds the ``p`` quantile of chi-square is not fused (:func:`bgfn.nav.filter.run_filter`).
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ import pandas as pd
 
 from ..errors import DataError
 from . import metrics
-from .filter import FilterResult, run_filter, run_outage
+from .filter import FilterResult, gate_thresholds, run_filter, run_outage
 from .outages import OutageWindow, check_windows, epochs_before
 from .state import FilterNoise, FilterState, initial_covariance, initial_state, noise_from_imu_errors
 
@@ -34,6 +36,7 @@ NAV_DEFAULTS: dict = {
              "azimuth_std_deg": 2.0},
     "bias_model": "random_walk",
     "noise_scale": 1.0,
+    "innovation_gate": None,
 }
 
 
@@ -51,6 +54,7 @@ def nav_config(section: dict | None) -> dict:
             cfg["init"].update(value)
         else:
             cfg[key] = value
+    gate_thresholds(cfg["innovation_gate"], "params nav")      # a bad probability fails here, by name
     return cfg
 
 
@@ -77,7 +81,7 @@ def run_drive(drive, section: dict | None = None, snapshots: dict | None = None)
     cfg = nav_config(section)
     initial, noise = filter_setup(drive, cfg)
     return run_filter(drive.imu, initial, noise, drive.gnss, drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0]),
-                      snapshots=snapshots, source=drive.name)
+                      snapshots=snapshots, gate_probability=cfg["innovation_gate"], source=drive.name)
 
 
 def filter_setup(drive, cfg: dict) -> tuple[FilterState, FilterNoise]:
@@ -155,8 +159,8 @@ def run_baseline(drive, cfg: dict) -> Baseline:
     lever = drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0])
     names = [f"outage_{i + 1}" for i in range(len(windows))]
     starts = epochs_before(drive.imu["time"], [w.start for w in windows], drive.name)
-    full = run_filter(drive.imu, initial, noise, drive.gnss, lever,
-                      snapshots=dict(zip(names, starts)), source=drive.name)
+    full = run_filter(drive.imu, initial, noise, drive.gnss, lever, snapshots=dict(zip(names, starts)),
+                      gate_probability=cfg["innovation_gate"], source=drive.name)
     errors = metrics.navigation_errors(full.trajectory, drive.reference)
     rows, outage_errors = [], {}
     for n, w in zip(names, windows):
@@ -222,6 +226,41 @@ def save_baseline(b: Baseline, out, lat=None) -> dict:
     upd = b.full.updates
     return {"rms": {k: float(v) for k, v in b.rms["rms"].items()},
             "outages": b.outage_table.drop(columns=["dataset"]).to_dict(orient="records"),
-            "gnss_updates": int(len(upd)), "mean_nis": float(upd["nis"].mean()) if len(upd) else None,
+            "gnss_updates": int(len(upd)), "gnss_rejected": int((~upd["accepted"]).sum()) if len(upd) else 0,
+            "mean_nis": float(upd["nis"].mean()) if len(upd) else None,
             "mean_nis_dof": float(upd["dof"].mean()) if len(upd) else None,
             "states_file": f"nav_states_{d}.npz"}
+
+
+def gate_comparison(drive, cfg: dict, probability: float) -> pd.DataFrame:
+    """The baseline of ``drive`` without and with an innovation gate on the GNSS fixes (notebook 02).
+
+    Parameters
+    ----------
+    drive : bgfn.data.Drive
+    cfg : dict
+        Output of :func:`nav_config`; its ``innovation_gate`` is replaced by None and by ``probability``.
+    probability : float
+        Chi-square probability of the gate (:func:`bgfn.nav.filter.gate_thresholds`).
+
+    Returns
+    -------
+    DataFrame
+        One row per setting (``innovation_gate``: ``none`` or the probability): ``gnss_rejected`` (fixes not
+        fused), ``mean_nis``, the full-drive horizontal ``rms_h_m`` and ``max_h_m`` against the reference, and
+        the standalone INS's ``max_east_m`` / ``max_north_m`` in each outage ``k`` (``outage_k_...``), which
+        start from the filter's state.
+    """
+    rows = []
+    for gate in (None, probability):
+        b = run_baseline(drive, {**cfg, "innovation_gate": gate})
+        upd = b.full.updates
+        row = {"dataset": drive.name, "innovation_gate": "none" if gate is None else f"{gate:g}",
+               "gnss_fixes": int(len(upd)), "gnss_rejected": int((~upd["accepted"]).sum()),
+               "mean_nis": float(upd["nis"].mean()) if len(upd) else float("nan"),
+               "rms_h_m": float(b.rms.loc["horizontal", "rms"]), "max_h_m": float(b.rms.loc["horizontal", "max_abs"])}
+        for k, r in enumerate(b.outage_table.itertuples(index=False)):
+            row[f"outage_{k + 1}_max_east_m"] = float(r.max_abs_east)
+            row[f"outage_{k + 1}_max_north_m"] = float(r.max_abs_north)
+        rows.append(row)
+    return pd.DataFrame(rows)

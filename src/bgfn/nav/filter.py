@@ -77,37 +77,80 @@ def propagate_steps(i0, i1, dt, gyro, accel, pos, v, c, ba, bg, P, q_g, q_a, q_b
 
 
 @numba.njit(cache=True)
-def update_position(pos, v, c, ba, bg, P, lever, fix, std, lag, innov):
-    """Eq. (eq4) position update (sequential scalar updates, Joseph form) and feedback.
+def position_measurement(pos, v, c, lever, fix, lag, dz, H):
+    """Innovation of a position fix and its Jacobian (module docstring), filled into ``dz`` [3] and ``H`` [3, 15].
 
-    Returns the NIS; ``innov`` receives the NED innovations (m, NaN for unused axes).
+    ``dz``: INS antenna position at the measurement time minus the fix, NED metres; ``H``: its derivative with
+    respect to the error states (attitude through the lever arm, position through ``D``).
     """
-    n = P.shape[0]
     lat, h = pos[0], pos[2]
     r_m, r_n = radii_nb(lat)
     cl = np.cos(lat)
     d = np.array([r_m + h, (r_n + h) * cl, -1.0])
     u = c @ lever  # antenna offset, NED m
-    # INS antenna position at the measurement time, minus the fix, in NED metres.
-    dz = np.empty(3)
     dz[0] = (lat - fix[0]) * d[0] + u[0] - v[0] * lag
     dz[1] = (pos[1] - fix[1]) * d[1] + u[1] - v[1] * lag
     dz[2] = (h - fix[2]) * d[2] + u[2] - v[2] * lag
     su = em.skew_nb(u)  # [u x]: d(antenna)/d(phi)
     phi_idx = np.array([em.PHI_N, em.PHI_E, em.PHI_D])
     pos_idx = np.array([em.DLAT, em.DLON, em.DH])
+    H[:, :] = 0.0
+    for a in range(3):
+        for b in range(3):
+            H[a, phi_idx[b]] = su[a, b]
+        H[a, pos_idx[a]] = d[a]
+
+
+@numba.njit(cache=True)
+def position_nis(P, H, dz, std):
+    """Normalized innovation squared of a whole fix, ``dz^T (H P H^T + R)^-1 dz`` over the axes with a positive,
+    finite ``std`` (``R = diag(std^2)``), and the number of those axes (its chi-square degrees of freedom).
+    Equal to the sum of the scalar NIS of the sequential update."""
+    sel = np.empty(3, np.int64)
+    m = 0
+    for a in range(3):
+        if std[a] > 0.0 and np.isfinite(std[a]):
+            sel[m] = a
+            m += 1
+    if m == 0:
+        return 0.0, 0
+    hs = np.empty((m, P.shape[0]))
+    zs = np.empty(m)
+    for i in range(m):
+        hs[i] = H[sel[i]]
+        zs[i] = dz[sel[i]]
+    S = hs @ P @ hs.T
+    for i in range(m):
+        S[i, i] += std[sel[i]] ** 2
+    return zs @ np.linalg.solve(S, zs), m
+
+
+@numba.njit(cache=True)
+def update_position(pos, v, c, ba, bg, P, lever, fix, std, lag, innov, gate):
+    """Eq. (eq4) position update (sequential scalar updates, Joseph form) and feedback.
+
+    ``gate`` > 0: the fix is first tested as a whole; when its NIS (:func:`position_nis`) exceeds ``gate`` it is
+    rejected and the state and ``P`` are left untouched (an innovation gate; 0: every fix is fused, as in the
+    paper). Returns ``(nis, accepted)``; ``innov`` receives the NED innovations (m, NaN for unused axes).
+    """
+    n = P.shape[0]
+    dz = np.empty(3)
+    H = np.empty((3, n))
+    position_measurement(pos, v, c, lever, fix, lag, dz, H)
+    if gate > 0.0:
+        nis_fix, _ = position_nis(P, H, dz, std)
+        if nis_fix > gate:
+            for a in range(3):
+                innov[a] = dz[a] if (std[a] > 0.0 and np.isfinite(std[a])) else np.nan
+            return nis_fix, False
     x = np.zeros(n)
-    hrow = np.empty(n)
     eye = np.eye(n)
     nis = 0.0
     for a in range(3):
         innov[a] = np.nan
         if not (std[a] > 0.0 and np.isfinite(std[a])):
             continue
-        hrow[:] = 0.0
-        for b in range(3):
-            hrow[phi_idx[b]] = su[a, b]
-        hrow[pos_idx[a]] = d[a]
+        hrow = H[a].copy()
         ph = P @ hrow
         s = hrow @ ph + std[a] ** 2
         k = ph / s
@@ -131,7 +174,7 @@ def update_position(pos, v, c, ba, bg, P, lever, fix, std, lag, innov):
     for a in range(3):
         ba[a] += x[em.BA_X + a]
         bg[a] += x[em.BG_X + a]
-    return nis
+    return nis, True
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -150,10 +193,10 @@ class FilterResult:
     sd : DataFrame
         ``time`` and the std of the 15 error states (names of ``error_model.STATE_NAMES``).
     updates : DataFrame
-        One row per fused fix: ``time``, ``kind`` ('gnss' or 'pseudo'), ``innov_n/e/d`` (m), ``nis``,
-        ``dof``.
+        One row per fix offered to the filter: ``time``, ``kind`` ('gnss' or 'pseudo'), ``innov_n/e/d`` (m),
+        ``nis``, ``dof``, ``accepted`` (False: rejected by the innovation gate, not fused).
     P_updates : ndarray, shape (M, 15, 15)
-        Covariance after each fused fix.
+        Covariance after each fix (unchanged by a rejected one).
     states : dict
         ``{name: FilterState}`` saved at the requested snapshot times.
     final : FilterState
@@ -178,6 +221,22 @@ def noise_arrays(noise: FilterNoise):
             inv[0], inv[1])
 
 
+def gate_thresholds(probability: float | None, source: str = "nav") -> np.ndarray:
+    """NIS thresholds of the innovation gate for 0..3 degrees of freedom: the ``probability`` quantiles of
+    chi-square (0 = no gate). ``probability`` None or 0: no gate; otherwise it must lie in (0, 1)."""
+    if not probability:
+        return np.zeros(4)
+    try:
+        p = float(probability)
+    except (TypeError, ValueError):
+        p = float("nan")
+    if not 0.0 < p < 1.0:
+        raise DataError(source, "innovation_gate", "a probability in (0, 1), or null for no gate", repr(probability))
+    from scipy.stats import chi2
+
+    return np.array([0.0] + [float(chi2.ppf(p, k)) for k in (1, 2, 3)])
+
+
 def _check_gnss(gnss, source):
     missing = [c for c in GNSS_COLUMNS if c not in gnss.columns]
     if missing:
@@ -190,7 +249,7 @@ def _check_gnss(gnss, source):
 def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss: pd.DataFrame | None = None,
                lever_arm=(0.0, 0.0, 0.0), outage_windows=(), pseudo_gps=None, t_end: float | None = None,
                snapshots: dict | None = None, pseudo_rate_hz: float = PSEUDO_RATE_HZ,
-               source: str = "drive") -> FilterResult:
+               gate_probability: float | None = None, source: str = "drive") -> FilterResult:
     """Run the closed-loop GPS/INS filter from ``initial`` over the IMU rows after ``initial.time``.
 
     Parameters
@@ -216,6 +275,10 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
         ``{name: time}``: save the filter state at the IMU epoch nearest to each time (within one sample).
     pseudo_rate_hz : float
         Rate of the pseudo-GPS epochs, Hz.
+    gate_probability : float, optional
+        Innovation gate on the GNSS fixes: a fix whose NIS exceeds the ``gate_probability`` quantile of the
+        chi-square distribution (degrees of freedom: its axes with a std) is not fused. None: every fix is
+        fused (the paper's filter). Pseudo fixes are never gated.
     source : str
         Name used in error messages.
 
@@ -223,6 +286,7 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
     -------
     FilterResult
     """
+    gates = gate_thresholds(gate_probability, source)
     t0 = float(initial.time)
     time, gyro, accel, dt = imu_steps(imu, t0, source + ":imu")
     if t_end is not None:
@@ -294,8 +358,10 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
         if kind == 3:
             states[payload] = current(row)
             continue
+        gate = 0.0
         if kind == 1:
             t_m, fix, std, label = payload[0], payload[1:4], payload[4:7], "gnss"
+            gate = gates[int(np.sum(np.isfinite(std) & (std > 0)))]
         else:
             t_m, w, i = payload
             ctx = PseudoGpsContext(t_m, w, i, current(row), window_start.get(w), lever)
@@ -303,13 +369,13 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
             if pf is None:
                 continue
             fix, std, label = np.array(pf[:3], float), np.array(pf[3:6], float), "pseudo"
-        nis = update_position(pos, v, c, ba, bg, P, lever, np.asarray(fix, float), np.asarray(std, float),
-                         float(times[row] - t_m), innov)
+        nis, accepted = update_position(pos, v, c, ba, bg, P, lever, np.asarray(fix, float),
+                                        np.asarray(std, float), float(times[row] - t_m), innov, gate)
         out_pos[row], out_v[row], out_c[row] = pos, v, c
         out_sd[row] = np.sqrt(np.clip(np.diag(P), 0, None))
         bias_rows.append(row)
         bias_vals.append(np.concatenate([ba, bg]))
-        upd.append((t_m, label, *innov, nis, int(np.sum(np.isfinite(innov)))))
+        upd.append((t_m, label, *innov, nis, int(np.sum(np.isfinite(innov))), bool(accepted)))
         P_upd.append(P.copy())
     if row < n_rows - 1:
         propagate_steps(row, n_rows - 1, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd)
@@ -326,7 +392,7 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
     bias_df.insert(0, "time", times)
     sd_df = pd.DataFrame(out_sd, columns=list(em.STATE_NAMES))
     sd_df.insert(0, "time", times)
-    updates = pd.DataFrame(upd, columns=["time", "kind", "innov_n", "innov_e", "innov_d", "nis", "dof"])
+    updates = pd.DataFrame(upd, columns=["time", "kind", "innov_n", "innov_e", "innov_d", "nis", "dof", "accepted"])
     return FilterResult(trajectory=trajectory_frame(times, out_pos, out_v, out_c), bias=bias_df, sd=sd_df,
                         updates=updates,
                         P_updates=np.array(P_upd).reshape(-1, em.N_STATES, em.N_STATES),
@@ -368,4 +434,4 @@ def run_outage(imu: pd.DataFrame, start_state: FilterState, window, noise: Filte
                       pseudo_gps, t_end=w.end, pseudo_rate_hz=pseudo_rate_hz, source=source)
 
 
-__all__ = ["FilterResult", "run_filter", "run_outage", "GNSS_COLUMNS"]
+__all__ = ["FilterResult", "run_filter", "run_outage", "gate_thresholds", "GNSS_COLUMNS"]

@@ -1,0 +1,80 @@
+"""GPS-outage evaluation of the hybrid GPS/INS structure (paper Sec. 3.1 prediction mode, Sec. 4 Tables 1-2).
+
+Protocol (notebook 04, the ``evaluate:`` section of a profile):
+
+1. **GPS-aided run.** The 15-state loosely coupled filter (:mod:`bgfn.nav.filter`, the ``nav:`` section's
+   settings) runs over the whole drive with every GNSS fix; its state is saved at every outage start
+   (:func:`navigation_context`). Before an outage start everything the methods see comes from this causal run
+   (a filter state at ``t`` has used the fixes up to ``t`` only). Its trajectory inside the outage is the
+   **GPS** row: the lower bound, the solution had GNSS not been lost.
+2. **Prediction mode** (:func:`run_outages`), from the saved state at the outage start, no GNSS inside:
+
+   - **INS**: the filter only predicts (strapdown + covariance), its bias estimates held;
+   - **MLP / AT-LSTM / BGFN / Transformer**: at each pseudo-GNSS epoch ``t_k = start + k / fusion_rate_hz``
+     the filter is propagated to ``t_k``; the network predicts the GNSS position increments
+     ``delta_p_gps`` (north, east) of every GNSS interval ending in ``(t_{k-1}, t_k]`` from windows of the
+     ``N`` latest IMU samples (Eq. eq21: roll, pitch, yaw of *the navigation solution being computed* in
+     this run -- the hybrid's own attitude, pre-outage samples from the GPS-aided run -- and the raw
+     specific force and angular rate); the increments are accumulated into the pseudo-GPS position
+     ``P_GPS(k) = P_GPS0 + sum_i delta_p_gps_i`` (Eq. pred-gps, :func:`pseudo_gps_positions`) with
+     ``P_GPS0`` the filter's antenna position at the outage start, and fused as a north/east antenna
+     position fix with the standard deviation of ``pseudo_gps.std_m`` (height not fused: the networks
+     predict 2-D increments). Nothing inside the outage reads GNSS or the reference.
+
+   The increments have the length the networks were trained on: the drive's GNSS epoch interval (0.2 s for
+   the 5 Hz Ekinox fixes, 1 s for the 1 Hz u-blox-like receiver); ``fusion_rate_hz`` must divide the GNSS
+   rate. Runs that share a network advance in lockstep so that one forward pass serves all of them.
+3. **Metrics** (:func:`window_metrics`): errors = solution minus reference at the IMU position, local NED
+   metres; per outage max |east|, max |north| (paper Tables 1-2), horizontal RMSE, horizontal error at the
+   end, max horizontal error.
+
+The networks of the two tables are those of notebook 03 (``results/<profile>/models/<dataset>/
+<method>_seed<k>.pt``; trained here with the same code when missing). The main tables report, per
+method and metric, the **median over the training seeds** (``seed_aggregate``); the per-seed values are
+written beside them.
+
+Outage sweep (:func:`run_sweep`, beyond the paper): ``n_starts`` outage starts spread evenly over the drive,
+split into ``folds`` contiguous blocks; the networks of fold ``k`` are trained (cached under
+``models/<dataset>/fold<k>/``) with the outages of fold ``k`` (longest duration, plus the ``train.margin_s``
+margin) excluded by :func:`bgfn.learning.split_windows`, and evaluated on them only. Each start is run once
+for the longest duration; since the runs are causal the first ``d`` seconds of it *are* the run of a
+``d``-second outage (same start state, same pseudo fixes), so the metrics of every duration come from its
+prefix. :func:`sweep_summary` gives per method and duration the median max horizontal error with a cluster
+(by start) bootstrap interval, :func:`sweep_comparisons` how often BGFN beats each baseline with the
+Wilcoxon signed-rank test on the (start, seed) pairs.
+
+Modules, in the order of the protocol:
+
+- :mod:`bgfn.evaluate.config` -- method names and labels, table columns, the ``evaluate:`` defaults;
+- :mod:`bgfn.evaluate.hybrid` -- Eq. pred-gps, the GPS-aided run, the outage runs, their metrics;
+- :mod:`bgfn.evaluate.networks` -- notebook 03's checkpoints (trained here when missing);
+- :mod:`bgfn.evaluate.tables` -- the paper's Tables 1-2 and their files;
+- :mod:`bgfn.evaluate.plots` -- the paper's outage figures and the sweep's box plots;
+- :mod:`bgfn.evaluate.sweep` -- the outage sweep and its statistics.
+
+Everything public is re-exported here: ``from bgfn import evaluate as ev; ev.evaluate_dataset(...)``.
+"""
+
+from bgfn.evaluate.config import (COLORS, EVALUATE_DEFAULTS, FIGURE_METHODS, METHOD_LABELS, METRIC_COLUMNS,
+                                  PAPER_TESTS, REAL_IMU_DATASETS, SWEEP_COLUMNS, TABLE_COLUMNS, TABLE_FILES,
+                                  TABLE_METHODS, choose_datasets, evaluate_config)
+from bgfn.evaluate.hybrid import (NavContext, OutageRun, gps_run, navigation_context, pseudo_gps_positions,
+                                  run_outages, window_metrics)
+from bgfn.evaluate.networks import ensure_models, load_model, model_path
+from bgfn.evaluate.plots import plot_outage, plot_sweep_boxes
+from bgfn.evaluate.sweep import (describe_sweep, run_sweep, sweep_comparisons, sweep_plan, sweep_summary,
+                                 sweep_train_config)
+from bgfn.evaluate.tables import (TableResult, aggregate_seeds, describe_tables, error_reduction, error_series,
+                                  evaluate_dataset, fix_error_table, paper_claims, paper_layout, paper_values,
+                                  representative_seeds, save_table_result, table_file)
+
+__all__ = [
+    "COLORS", "EVALUATE_DEFAULTS", "FIGURE_METHODS", "METHOD_LABELS", "METRIC_COLUMNS", "NavContext", "OutageRun",
+    "PAPER_TESTS", "REAL_IMU_DATASETS", "SWEEP_COLUMNS", "TABLE_COLUMNS", "TABLE_FILES", "TABLE_METHODS",
+    "TableResult", "aggregate_seeds", "choose_datasets", "describe_sweep", "describe_tables", "ensure_models",
+    "error_reduction", "error_series", "evaluate_config", "evaluate_dataset", "fix_error_table", "gps_run",
+    "load_model", "model_path", "navigation_context", "paper_claims", "paper_layout", "paper_values", "plot_outage",
+    "plot_sweep_boxes", "pseudo_gps_positions", "representative_seeds", "run_outages", "run_sweep",
+    "save_table_result", "sweep_comparisons", "sweep_plan", "sweep_summary", "sweep_train_config", "table_file",
+    "window_metrics",
+]

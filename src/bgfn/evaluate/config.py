@@ -1,0 +1,121 @@
+"""Names, defaults and configuration of the outage evaluation (a profile's ``evaluate:`` section)."""
+
+from __future__ import annotations
+
+import copy
+from typing import Any, Sequence
+
+from bgfn.errors import DataError
+
+
+#: Method id (bgfn.models) -> label of the paper's tables.
+METHOD_LABELS: dict[str, str] = {"mlp": "MLP", "at_lstm": "AT-LSTM", "bgfn": "BGFN", "transformer": "Transformer"}
+#: Rows of the outage tables, in order.
+TABLE_METHODS: tuple[str, ...] = ("INS", "MLP", "AT-LSTM", "BGFN", "Transformer", "GPS")
+#: Methods of the paper's figures and their colours (red, yellow, black, blue).
+FIGURE_METHODS: tuple[str, ...] = ("INS", "MLP", "AT-LSTM", "BGFN")
+COLORS: dict[str, str] = {"INS": "red", "MLP": "goldenrod", "AT-LSTM": "black", "BGFN": "blue",
+                          "Transformer": "tab:purple", "GPS": "tab:green"}
+#: Columns of the outage tables (``tables/outage_dataset.csv``, ``outage_field.csv``).
+METRIC_COLUMNS: tuple[str, ...] = ("max_east_m", "max_north_m", "rmse_h_m", "final_h_m")
+TABLE_COLUMNS: tuple[str, ...] = ("outage", "method") + METRIC_COLUMNS
+#: Columns of ``tables/outage_sweep.csv``.
+SWEEP_COLUMNS: tuple[str, ...] = ("dataset", "start_s", "duration_s", "method", "seed", "fold", "max_east_m",
+                                  "max_north_m", "max_h_m", "rmse_h_m", "final_h_m")
+#: Dataset -> the paper's test it stands for (Table 1 = dataset test, Table 2 = field test).
+PAPER_TESTS: dict[str, str] = {"turin-sim-ekinox": "dataset", "navego-ekinox": "dataset",
+                               "turin-sim-mpu6000": "field", "navego-mpu6000": "field"}
+TABLE_FILES: dict[str, str] = {"dataset": "outage_dataset.csv", "field": "outage_field.csv"}
+#: Simulated dataset -> the dataset with NaveGo's recorded IMU, and the file it needs.
+REAL_IMU_DATASETS: dict[str, tuple[str, str]] = {"turin-sim-ekinox": ("navego-ekinox", "ekinox_imu.mat"),
+                                                 "turin-sim-mpu6000": ("navego-mpu6000", "mpu6000_imu.mat")}
+
+#: Defaults of the ``evaluate:`` section (every key of a profile's section must be one of these).
+EVALUATE_DEFAULTS: dict[str, Any] = {
+    "datasets": ["turin-sim-ekinox", "turin-sim-mpu6000"],
+    "real_imu": False,
+    "methods": ["bgfn", "transformer", "at_lstm", "mlp"],
+    "seeds": None,                       # None: train.seeds
+    "seed_aggregate": "median",          # 'median' over seeds, or 'first' (the first seed)
+    "outage_windows": [[138906.0, 30.0], [139170.0, 30.0]],   # (start, duration), s
+    "pseudo_gps": {"std_m": None, "std_growth_m_per_s": 0.0, "fusion_rate_hz": 1.0},
+    "series_rate_hz": 10.0,
+    "train_missing": True,
+    "sweep": {
+        "datasets": ["turin-sim-mpu6000"],
+        "n_starts": 20,
+        "durations_s": [10.0, 30.0, 60.0, 120.0],
+        "folds": 2,
+        "seeds": [0, 1, 2],
+        "warmup_s": 60.0,
+        "train": {},
+        "n_boot": 2000,
+        "level": 0.95,
+        "boot_seed": 0,
+    },
+}
+
+
+def merge_checked(base: dict, upd: dict, where: str, strict: bool = True) -> dict:
+    """``base`` updated with ``upd`` recursively (the ``train`` key replaced whole). Unlike
+    :func:`bgfn.config.merge_sections` it checks the keys: with ``strict`` an unknown key of ``upd`` raises a
+    DataError naming ``where``."""
+    out = copy.deepcopy(base)
+    for key, value in (upd or {}).items():
+        if strict and key not in out:
+            raise DataError(f"params {where}", key, f"one of {sorted(out)}", "unknown key")
+        if isinstance(out.get(key), dict) and isinstance(value, dict) and key != "train":
+            out[key] = merge_checked(out[key], value, f"{where}.{key}", strict)
+        else:
+            out[key] = copy.deepcopy(value)
+    return out
+
+
+def evaluate_config(section: dict | None, train_section: dict | None = None) -> dict:
+    """``EVALUATE_DEFAULTS`` updated with a profile's ``evaluate:`` section (unknown keys raise).
+
+    ``seeds: null`` takes ``train.seeds``. Checks the sweep sizes and the seed aggregate.
+    """
+    cfg = merge_checked(EVALUATE_DEFAULTS, section or {}, "evaluate")
+    if cfg["seeds"] is None:
+        cfg["seeds"] = list((train_section or {}).get("seeds") or [0])
+    if cfg["seed_aggregate"] not in ("median", "first"):
+        raise DataError("params evaluate", "seed_aggregate", "'median' or 'first'", repr(cfg["seed_aggregate"]))
+    unknown = [m for m in cfg["methods"] if m not in METHOD_LABELS]
+    if unknown:
+        raise DataError("params evaluate", "methods", f"ids among {sorted(METHOD_LABELS)}", repr(unknown))
+    sw = cfg["sweep"]
+    if int(sw["n_starts"]) < 1 or int(sw["folds"]) < 1 or int(sw["folds"]) > int(sw["n_starts"]):
+        raise DataError("params evaluate.sweep", "n_starts/folds", "1 <= folds <= n_starts",
+                        f"{sw['n_starts']} starts, {sw['folds']} folds")
+    if not sw["durations_s"] or min(sw["durations_s"]) <= 0:
+        raise DataError("params evaluate.sweep", "durations_s", "positive durations, s", repr(sw["durations_s"]))
+    return cfg
+
+
+def choose_datasets(datasets: Sequence[str], real_imu: bool) -> tuple[list[str], list[str]]:
+    """The datasets to evaluate: with ``real_imu`` the NaveGo recorded-IMU twin when its file is present.
+
+    Returns
+    -------
+    names : list of str
+    notes : list of str
+        One line per dataset saying what is used and why.
+    """
+    names, notes = [], []
+    for d in datasets:
+        if not real_imu or d not in REAL_IMU_DATASETS:
+            names.append(d)
+            continue
+        real, fname = REAL_IMU_DATASETS[d]
+        from bgfn.data import acquire
+
+        res = acquire.resolve(fname, download=False)
+        if res.path is not None:
+            names.append(real)
+            notes.append(f"{fname} present ({res.origin}): evaluating {real} instead of {d}")
+        else:
+            names.append(d)
+            notes.append(f"{fname} absent (the recorded NaveGo IMU is not available here): {d} "
+                         f"(simulated IMU) stands in for {real}")
+    return names, notes

@@ -1,0 +1,65 @@
+"""The trained networks of the evaluation: checkpoint paths, loading, and training the missing ones."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from bgfn.errors import DataError
+from bgfn.evaluate.hybrid import NavContext
+
+
+def model_path(profile: str, dataset: str, method: str, seed: int, fold: int | None = None) -> Path:
+    """``results/<profile>/models/<dataset>/[fold<k>/]<method>_seed<seed>.pt``."""
+    from bgfn.train import models_dir
+
+    d = models_dir(profile, dataset)
+    if fold is not None:
+        d = d / f"fold{fold}"
+    return d / f"{method}_seed{seed}.pt"
+
+
+def load_model(path: str | Path):
+    """A checkpoint of :mod:`bgfn.train` on the CPU, with ``val_rmse_m`` (validation RMSE of one increment,
+    m, from its JSON card; NaN without a card) attached."""
+    import json
+
+    from bgfn import train
+
+    model = train.load_trained(path, device="cpu")
+    card = Path(path).with_suffix(".json")
+    model.val_rmse_m = float(json.loads(card.read_text()).get("val_rmse_m", np.nan)) if card.exists() else np.nan
+    return model
+
+
+def ensure_models(cfg: dict, profile: str, dataset: str, ctx: NavContext, methods, seeds, windows,
+                  train_missing: bool = True, progress: bool = False) -> dict:
+    """Load notebook 03's networks of ``dataset``; train the missing ones with the same code and settings
+    (training excludes the evaluation outages ``windows``).
+
+    Returns
+    -------
+    dict
+        ``{(method, seed): TrainedModel}``.
+    """
+    from bgfn import train
+
+    models, data = {}, None
+    tc = train.tuned_train_config(cfg, profile, dataset)      # notebook 03's selected learning rates
+    for method in methods:
+        for seed in seeds:
+            path = model_path(profile, dataset, method, seed)
+            if not path.exists():
+                if not train_missing:
+                    raise DataError(path, "checkpoint", "a network trained by notebook 03 "
+                                    "(run notebooks/03_bgfn_training.ipynb first)", "missing")
+                if data is None:
+                    data = train.prepare_learning_data(cfg, dataset, attitude=ctx.attitude_table(), drive=ctx.drive,
+                                                       outage_windows=windows)
+                train.train_model(method, data, train.size_config(tc, method), tc, seed=seed, out_dir=path.parent,
+                                  progress=progress, extra_card={"dataset": dataset, "profile": profile,
+                                                                 "size": tc.get("size"),
+                                                                 "trained_by": "notebook 04 (missing)"})
+            models[(method, seed)] = load_model(path)
+    return models

@@ -1,0 +1,206 @@
+"""Outage sweep (beyond the paper): many starts and durations, networks trained without the outages they are
+tested on (k-fold), bootstrap intervals and paired tests."""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pandas as pd
+
+from bgfn.errors import DataError
+from bgfn.evaluate.config import METHOD_LABELS, SWEEP_COLUMNS, TABLE_METHODS, evaluate_config
+from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
+from bgfn.evaluate.networks import load_model, model_path
+
+
+def sweep_plan(drive, sweep: dict, window_samples: int = 200) -> pd.DataFrame:
+    """Outage starts spread evenly over the drive and their folds (contiguous blocks of starts).
+
+    The first start leaves ``warmup_s`` after the first epoch (filter convergence; at least the input window),
+    the last one room for the longest duration.
+
+    Returns
+    -------
+    DataFrame
+        ``start_s`` (rounded to 0.1 s), ``fold`` (0 .. folds-1).
+    """
+    t = drive.imu["time"].to_numpy(float)
+    rate = 1.0 / float(np.median(np.diff(t)))
+    t0 = float(drive.reference["time"].iloc[0])
+    lo = t0 + max(float(sweep["warmup_s"]), (window_samples + 1) / rate)
+    hi = float(t[-1]) - max(sweep["durations_s"]) - 1.0 / rate
+    n = int(sweep["n_starts"])
+    if hi < lo:
+        raise DataError(drive.name, "time", f"room for {n} outages of {max(sweep['durations_s'])} s after a "
+                        f"{sweep['warmup_s']} s warm-up", f"{t[-1] - t0:.0f} s of data")
+    starts = np.round(np.linspace(lo, hi, n) if n > 1 else np.array([0.5 * (lo + hi)]), 1)
+    folds = np.concatenate([np.full(len(b), k) for k, b in enumerate(np.array_split(np.arange(n),
+                                                                                     int(sweep["folds"])))])
+    return pd.DataFrame({"start_s": starts, "fold": folds.astype(int)})
+
+
+def sweep_train_config(train_section: dict, sweep: dict) -> dict:
+    """The ``train:`` section with the sweep's overrides (``sweep.train``; ``optimizer`` merged key by key)."""
+    tc = copy.deepcopy(train_section or {})
+    for key, value in (sweep.get("train") or {}).items():
+        if key == "optimizer" and isinstance(value, dict):
+            tc["optimizer"] = {**(tc.get("optimizer") or {}), **value}
+        else:
+            tc[key] = copy.deepcopy(value)
+    return tc
+
+
+def run_sweep(cfg: dict, profile: str, dataset: str, drive=None, ecfg: dict | None = None,
+              progress: bool = True) -> tuple[pd.DataFrame, dict]:
+    """The outage sweep of one dataset (module docstring).
+
+    Returns
+    -------
+    rows : DataFrame
+        ``SWEEP_COLUMNS``; INS and GPS do not depend on a network and are repeated for every seed so that
+        every (start, seed) pair has every method.
+    info : dict
+        Sizes, training and evaluation wall times, fold windows.
+    """
+    import time
+
+    from tqdm import tqdm
+
+    from bgfn import train
+    from bgfn.learning import build_learning_data, learning_options
+
+    ecfg = ecfg or evaluate_config(cfg.get("evaluate"), cfg.get("train"))
+    sw = ecfg["sweep"]
+    if drive is None:
+        from bgfn.data import load_drive
+
+        drive = load_drive(dataset, profile=profile)
+    # the sweep's budget, with the learning rates notebook 03 selected for this dataset (same for every fold)
+    tc = sweep_train_config(train.tuned_train_config(cfg, profile, dataset), sw)
+    opts = learning_options(tc)
+    plan = sweep_plan(drive, sw, int(opts["window"]))
+    durations = sorted(float(d) for d in sw["durations_s"])
+    dmax = durations[-1]
+    seeds = [int(s) for s in sw["seeds"]]
+    methods = list(ecfg["methods"])
+    t0 = time.perf_counter()
+    ctx = navigation_context(drive, cfg.get("nav"), plan["start_s"])
+    rows = []
+
+    def add(run, fold):
+        for du in durations:
+            mtr = window_metrics(run.errors, run.start, du)
+            for seed in ([run.seed] if run.seed is not None else seeds):
+                rows.append({"dataset": dataset, "start_s": run.start, "duration_s": du, "method": run.method,
+                             "seed": int(seed), "fold": int(fold), **{k: mtr[k] for k in SWEEP_COLUMNS[6:]}})
+
+    fold_of = dict(zip(plan["start_s"], plan["fold"]))
+    windows_all = [(s, dmax) for s in plan["start_s"]]
+    for r in run_outages(ctx, windows_all, None, "INS", None, ecfg["pseudo_gps"]):
+        add(r, fold_of[r.start])
+    for s in plan["start_s"]:
+        add(gps_run(ctx, s, dmax), fold_of[s])
+    t_nav = time.perf_counter() - t0
+    attitude = ctx.attitude_table()
+    t_train = t_eval = 0.0
+    jobs = [(k, m, s) for k in sorted(plan["fold"].unique()) for m in methods for s in seeds]
+    data_cache: dict = {}
+    cards = []
+    for k, method, seed in tqdm(jobs, desc=f"sweep {dataset}", disable=not progress):
+        fw = [(s, dmax) for s in plan.loc[plan["fold"] == k, "start_s"]]
+        if k not in data_cache:
+            data_cache = {k: build_learning_data(drive.imu, attitude, drive.gnss, fw, **opts)}
+        path = model_path(profile, dataset, method, seed, fold=int(k))
+        ta = time.perf_counter()
+        card = train.train_model(method, data_cache[k], train.size_config(tc, method), tc, seed=seed,
+                                 out_dir=path.parent, progress=False,
+                                 extra_card={"dataset": dataset, "profile": profile, "fold": int(k),
+                                             "fold_outages": fw, "size": tc.get("size")})
+        cards.append(card)
+        model = load_model(path)
+        tb = time.perf_counter()
+        for r in run_outages(ctx, fw, model, METHOD_LABELS[method], seed, ecfg["pseudo_gps"]):
+            add(r, k)
+        tc_ = time.perf_counter()
+        t_train += tb - ta
+        t_eval += tc_ - tb
+    df = pd.DataFrame(rows, columns=list(SWEEP_COLUMNS))
+    info = {"dataset": dataset, "n_starts": len(plan), "folds": int(plan["fold"].nunique()), "seeds": seeds,
+            "durations_s": durations, "methods": [METHOD_LABELS[m] for m in methods],
+            "window": int(opts["window"]), "size": tc.get("size"), "optimizer": train.optimizer_options(tc),
+            "lr": {METHOD_LABELS[m]: train.method_lr(tc, m) for m in methods},
+            "fold_starts": {int(k): plan.loc[plan["fold"] == k, "start_s"].tolist() for k in plan["fold"].unique()},
+            "train_wall_s": t_train, "eval_wall_s": t_eval + t_nav,
+            "train_epochs_run": {f"{c['method']}_fold{c.get('fold')}_seed{c['seed']}": c["epochs_run"] for c in cards},
+            "fold_val_rmse_m": {f"{c['method']}_fold{c.get('fold')}_seed{c['seed']}": c["val_rmse_m"] for c in cards}}
+    return df, info
+
+
+def sweep_summary(sweep: pd.DataFrame, n_boot: int = 2000, level: float = 0.95, seed: int = 0,
+                  metric: str = "max_h_m") -> pd.DataFrame:
+    """Median of ``metric`` per dataset, duration and method with a cluster-bootstrap interval (by start).
+
+    Returns
+    -------
+    DataFrame
+        ``dataset``, ``duration_s``, ``method``, ``n`` (runs), ``n_starts``, ``median_m``, ``ci_lo_m``, ``ci_hi_m``.
+    """
+    from bgfn.stats import bootstrap_ci
+
+    rows = []
+    order = {m: i for i, m in enumerate(TABLE_METHODS)}
+    for (ds, du, m), g in sweep.groupby(["dataset", "duration_s", "method"]):
+        if m in ("INS", "GPS"):          # one value per start (repeated per seed)
+            g = g.drop_duplicates("start_s")
+        lo, hi = bootstrap_ci(g[metric], n_boot=n_boot, level=level, seed=seed, groups=g["start_s"])
+        rows.append({"dataset": ds, "duration_s": du, "method": m, "n": len(g), "n_starts": g["start_s"].nunique(),
+                     "median_m": float(np.median(g[metric])), "ci_lo_m": lo, "ci_hi_m": hi})
+    out = pd.DataFrame(rows)
+    return out.sort_values(["dataset", "duration_s", "method"], key=lambda s: s.map(order) if s.name == "method"
+                           else s).reset_index(drop=True)
+
+
+def sweep_comparisons(sweep: pd.DataFrame, method: str = "BGFN", metric: str = "max_h_m") -> pd.DataFrame:
+    """How often ``method`` beats each other method, paired by (start, seed), with the Wilcoxon test.
+
+    ``p_value``: Wilcoxon signed-rank on the (start, seed) pairs; ``p_value_by_start``: on the per-start
+    medians over seeds (pairs from the same start are not independent: the more conservative number).
+
+    Returns
+    -------
+    DataFrame
+        ``dataset``, ``duration_s``, ``baseline``, ``n``, ``wins``, ``ties``, ``win_rate``, ``median_diff_m``
+        (method - baseline), ``median_ratio``, ``p_value``, ``n_starts``, ``p_value_by_start``.
+    """
+    from bgfn.stats import paired_comparison, wilcoxon_p
+
+    rows = []
+    for (ds, du), g in sweep.groupby(["dataset", "duration_s"]):
+        piv = g.pivot_table(index=["start_s", "seed"], columns="method", values=metric, aggfunc="first")
+        if method not in piv.columns:
+            continue
+        for base in [m for m in TABLE_METHODS if m in piv.columns and m != method]:
+            pc = paired_comparison(piv[method].to_numpy(), piv[base].to_numpy())
+            by_start = (piv[method] - piv[base]).groupby(level="start_s").median()
+            rows.append({"dataset": ds, "duration_s": du, "baseline": base, "n": pc["n"], "wins": pc["wins"],
+                         "ties": pc["ties"], "win_rate": pc["win_rate"], "median_diff_m": pc["median_diff"],
+                         "median_ratio": pc["median_ratio"], "p_value": pc["p_value"],
+                         "n_starts": int(by_start.notna().sum()), "p_value_by_start": wilcoxon_p(by_start)})
+    return pd.DataFrame(rows)
+
+
+def describe_sweep(summary: pd.DataFrame, pairs: pd.DataFrame, method: str = "BGFN") -> list[str]:
+    """Plain-language lines on the sweep: medians with intervals and the paired comparisons."""
+    lines = []
+    for (ds, du), g in summary.groupby(["dataset", "duration_s"]):
+        g = g.set_index("method")
+        med = ", ".join(f"{m} {g.loc[m, 'median_m']:.1f} [{g.loc[m, 'ci_lo_m']:.1f}, {g.loc[m, 'ci_hi_m']:.1f}]"
+                        for m in TABLE_METHODS if m in g.index)
+        pp = pairs[(pairs["dataset"] == ds) & (pairs["duration_s"] == du)].set_index("baseline")
+        cmp_ = "; ".join(f"vs {b}: wins {int(pp.loc[b, 'wins'])}/{int(pp.loc[b, 'n'])} "
+                         f"(p = {pp.loc[b, 'p_value']:.2g}, by start {pp.loc[b, 'p_value_by_start']:.2g})"
+                         for b in pp.index)
+        lines.append(f"{ds}, {du:g} s outages: median max horizontal error (m) [95 % interval]: {med}. "
+                     f"{method} {cmp_}.")
+    return lines

@@ -1,0 +1,283 @@
+"""The paper's Tables 1-2: every method in the evaluation outages, the seed aggregate, the result files, the
+paper's values beside ours, and plain-language lines computed from the numbers."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from bgfn.evaluate.config import (METHOD_LABELS, METRIC_COLUMNS, PAPER_TESTS, TABLE_COLUMNS, TABLE_FILES,
+                                   TABLE_METHODS, evaluate_config)
+from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
+from bgfn.evaluate.networks import ensure_models
+
+
+@dataclass
+class TableResult:
+    """Outage evaluation of one dataset (the paper's Table 1 or 2).
+
+    Attributes
+    ----------
+    dataset, test : str
+        Dataset name and the paper's test (``dataset`` / ``field``).
+    per_seed : DataFrame
+        ``outage``, ``start_s``, ``method``, ``seed`` and every metric, one row per run.
+    table : DataFrame
+        ``TABLE_COLUMNS``: per outage and method the seed aggregate.
+    runs : list of OutageRun
+    models : dict
+        ``{(method id, seed): predictor}`` used.
+    gnss_errors : DataFrame or None
+        :func:`fix_error_table`: how far the GNSS fixes themselves are from the reference in each outage
+        window, which the GPS row follows.
+    """
+
+    dataset: str
+    test: str
+    per_seed: pd.DataFrame
+    table: pd.DataFrame
+    runs: list
+    models: dict = field(default_factory=dict)
+    gnss_errors: pd.DataFrame | None = None
+
+
+def fix_error_table(drive, windows, lever_arm_m) -> pd.DataFrame:
+    """Per outage window: the largest |east| and |north| error of the GNSS fixes inside it against the true
+    antenna position (:func:`bgfn.data.gnss.fix_errors`), m, and the number of fixes.
+
+    The GPS row is the filter with these fixes: it cannot stay closer to the reference than they are for long,
+    while an INS that starts from the same state may drift less than the fixes wander.
+    """
+    from bgfn.data.gnss import fix_errors
+
+    err = fix_errors(drive.gnss, drive.reference, lever_arm_m)
+    rows = []
+    for k, (start, duration) in enumerate(windows):
+        inside = err[(err["time"] >= start) & (err["time"] <= start + duration)]
+        rows.append({"outage": k + 1, "start_s": float(start), "n_fixes": int(len(inside)),
+                     "max_east_m": float(inside["east_m"].abs().max()) if len(inside) else float("nan"),
+                     "max_north_m": float(inside["north_m"].abs().max()) if len(inside) else float("nan")})
+    return pd.DataFrame(rows)
+
+
+def aggregate_seeds(per_seed: pd.DataFrame, how: str = "median") -> pd.DataFrame:
+    """Per outage and method, the median over seeds (``how='median'``) or the first seed's row."""
+    rows = []
+    for (outage, method), g in per_seed.groupby(["outage", "method"], sort=False):
+        if how == "median":
+            vals = {c: float(np.median(g[c])) for c in METRIC_COLUMNS}
+        else:
+            vals = {c: float(g.sort_values("seed", na_position="first")[c].iloc[0]) for c in METRIC_COLUMNS}
+        rows.append({"outage": int(outage), "method": method, **vals})
+    t = pd.DataFrame(rows, columns=list(TABLE_COLUMNS))
+    order = {m: i for i, m in enumerate(TABLE_METHODS)}
+    return t.sort_values(["outage", "method"], key=lambda s: s.map(order) if s.name == "method" else s,
+                         kind="stable").reset_index(drop=True)
+
+
+def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: dict | None = None,
+                     models: dict | None = None, progress: bool = False) -> TableResult:
+    """All methods in the profile's evaluation outages of one dataset (paper Tables 1-2).
+
+    Parameters
+    ----------
+    cfg : dict
+        The profile (:func:`bgfn.config.load_profile`).
+    profile : str
+    dataset : str
+    drive : Drive, optional
+        Default ``load_drive(dataset, profile=profile)``.
+    ecfg : dict, optional
+        :func:`evaluate_config` (default: from ``cfg``).
+    models : dict, optional
+        ``{(method, seed): predictor}``; default :func:`ensure_models`.
+    """
+    from bgfn.nav import outages
+
+    ecfg = ecfg or evaluate_config(cfg.get("evaluate"), cfg.get("train"))
+    if drive is None:
+        from bgfn.data import load_drive
+
+        drive = load_drive(dataset, profile=profile)
+    windows = outages.outage_windows(drive, ecfg)
+    ctx = navigation_context(drive, cfg.get("nav"), [s for s, _ in windows])
+    if models is None:
+        models = ensure_models(cfg, profile, dataset, ctx, ecfg["methods"], ecfg["seeds"], windows,
+                               ecfg["train_missing"], progress)
+    runs = run_outages(ctx, windows, None, "INS", None, ecfg["pseudo_gps"])
+    runs += [gps_run(ctx, s, d) for s, d in windows]
+    for (method, seed), model in models.items():
+        runs += run_outages(ctx, windows, model, METHOD_LABELS[method], seed, ecfg["pseudo_gps"])
+    outage_no = {s: i + 1 for i, (s, _) in enumerate(windows)}
+    rows = [{"outage": outage_no[r.start], "start_s": r.start, "method": r.method, "seed": r.seed,
+             **window_metrics(r.errors, r.start, r.duration)} for r in runs]
+    per_seed = pd.DataFrame(rows)
+    return TableResult(dataset, PAPER_TESTS.get(dataset, dataset), per_seed,
+                       aggregate_seeds(per_seed, ecfg["seed_aggregate"]), runs, models,
+                       fix_error_table(drive, windows, ctx.lever))
+
+
+def table_file(test: str) -> str:
+    """File name of a test's table under ``tables/``: ``outage_dataset.csv``, ``outage_field.csv``, else
+    ``outage_<test>.csv``."""
+    return TABLE_FILES.get(test, f"outage_{test}.csv")
+
+
+def save_table_result(out, result: TableResult, series_rate_hz: float = 10.0) -> dict:
+    """Write one dataset's outage results under ``out`` (``results/<profile>``), atomically.
+
+    Files (``<t>`` = ``dataset`` / ``field``): ``tables/outage_<t>.csv`` (``TABLE_COLUMNS``, the seed
+    aggregate), ``tables/outage_<t>_seeds.csv`` (every run), ``tables/outage_errors_<t>.csv`` (error
+    series, :func:`error_series`), ``tables/outage_<t>_gnss.csv`` (the fixes' own errors in each window,
+    :func:`fix_error_table`; when known).
+
+    Returns
+    -------
+    dict
+        ``{kind: path}``.
+    """
+    from bgfn.io import atomic_write_csv
+
+    out = Path(out)
+    stem = table_file(result.test)[: -len(".csv")]
+    paths = {"table": out / "tables" / f"{stem}.csv", "seeds": out / "tables" / f"{stem}_seeds.csv",
+             "series": out / "tables" / f"{stem.replace('outage_', 'outage_errors_', 1)}.csv"}
+    atomic_write_csv(paths["table"], result.table[list(TABLE_COLUMNS)], float_format="%.4f")
+    seeds = result.per_seed.assign(dataset=result.dataset)
+    seeds["seed"] = seeds["seed"].astype("Int64")
+    atomic_write_csv(paths["seeds"], seeds, float_format="%.4f")
+    series = error_series(result.runs, series_rate_hz)
+    series.insert(0, "outage", series["start_s"].map(
+        dict(zip(result.per_seed["start_s"], result.per_seed["outage"]))).astype(int))
+    atomic_write_csv(paths["series"], series, float_format="%.4f")
+    if result.gnss_errors is not None:
+        paths["gnss"] = out / "tables" / f"{stem}_gnss.csv"
+        atomic_write_csv(paths["gnss"], result.gnss_errors, float_format="%.4f")
+    return paths
+
+
+def error_series(runs, rate_hz: float = 10.0) -> pd.DataFrame:
+    """East/north/horizontal error against time since the outage start, decimated to ``rate_hz``.
+
+    Returns
+    -------
+    DataFrame
+        ``start_s``, ``method``, ``seed``, ``t_rel`` (s), ``east_m``, ``north_m``, ``h_m``.
+    """
+    parts = []
+    for r in runs:
+        e = r.errors
+        t = e["t_rel"].to_numpy(float)
+        keep = (np.abs(t * rate_hz - np.round(t * rate_hz)) < 1e-3) | (np.arange(len(t)) == len(t) - 1)
+        keep &= t >= -1e-6
+        parts.append(pd.DataFrame({"start_s": r.start, "method": r.method,
+                                   "seed": pd.array([r.seed] * int(keep.sum()), dtype="Int64"),
+                                   "t_rel": np.round(t[keep], 6), "east_m": e["east"].to_numpy()[keep],
+                                   "north_m": e["north"].to_numpy()[keep],
+                                   "h_m": e["horizontal"].to_numpy()[keep]}))
+    return pd.concat(parts, ignore_index=True)
+
+
+def representative_seeds(per_seed: pd.DataFrame) -> dict:
+    """``{(outage, method): seed}``: the seed whose max horizontal error is the (lower) median."""
+    out = {}
+    for (o, m), g in per_seed.groupby(["outage", "method"]):
+        g = g.sort_values(["max_h_m", "seed"])
+        out[(int(o), m)] = g["seed"].iloc[(len(g) - 1) // 2]
+    return out
+
+
+def paper_values(test: str) -> pd.DataFrame:
+    """The paper's published max errors of ``test`` (``data/paper/outage_max_errors.csv``): columns
+    ``outage``, ``method``, ``max_east_m``, ``max_north_m``. For display beside ours only."""
+    from bgfn.config import DATA_DIR
+
+    p = pd.read_csv(DATA_DIR / "paper" / "outage_max_errors.csv")
+    return p[p["test"] == test].drop(columns="test").reset_index(drop=True)
+
+
+def paper_claims() -> dict:
+    """``data/paper/claims.yaml`` (percentages the paper states in its text)."""
+    import yaml
+
+    from bgfn.config import DATA_DIR
+
+    return yaml.safe_load((DATA_DIR / "paper" / "claims.yaml").read_text(encoding="utf-8"))
+
+
+def paper_layout(table: pd.DataFrame, paper: pd.DataFrame | None = None) -> pd.DataFrame:
+    """Max east/north errors in the paper's layout: rows ``Outage k`` (ours, then the paper's), columns
+    (method, East/North), m."""
+    methods = [m for m in TABLE_METHODS if m in set(table["method"])]
+    cols = pd.MultiIndex.from_product([methods, ["East", "North"]])
+    rows, index = [], []
+    for o in sorted(table["outage"].unique()):
+        for src, df in (("ours", table), ("paper", paper)):
+            if df is None:
+                continue
+            sub = df[df["outage"] == o].set_index("method")
+            rows.append([sub.loc[m, c] if m in sub.index else np.nan
+                         for m in methods for c in ("max_east_m", "max_north_m")])
+            index.append((f"Outage {o}", src))
+    return pd.DataFrame(rows, index=pd.MultiIndex.from_tuples(index), columns=cols)
+
+
+def error_reduction(table: pd.DataFrame, reference: str = "INS") -> pd.DataFrame:
+    """Reduction of the max east/north errors against ``reference``: ``100 (ref - method) / ref`` (%).
+
+    Returns
+    -------
+    DataFrame
+        ``outage``, ``method``, ``east_pct``, ``north_pct``.
+    """
+    rows = []
+    for o, g in table.groupby("outage"):
+        ref = g[g["method"] == reference]
+        if ref.empty:
+            continue
+        re_, rn = float(ref["max_east_m"].iloc[0]), float(ref["max_north_m"].iloc[0])
+        for _, r in g.iterrows():
+            if r["method"] in (reference,):
+                continue
+            rows.append({"outage": int(o), "method": r["method"], "east_pct": 100.0 * (re_ - r["max_east_m"]) / re_,
+                         "north_pct": 100.0 * (rn - r["max_north_m"]) / rn})
+    return pd.DataFrame(rows, columns=["outage", "method", "east_pct", "north_pct"])
+
+
+def describe_tables(results) -> list[str]:
+    """Plain-language lines on the outage tables (what beats what), computed from the numbers."""
+    lines = []
+    for r in results:
+        red = error_reduction(r.table).set_index(["outage", "method"])
+        for o, g in r.table.groupby("outage"):
+            g = g.set_index("method")
+            score = (g["max_east_m"] + g["max_north_m"]) / 2.0
+            learned = [m for m in ("MLP", "AT-LSTM", "BGFN", "Transformer") if m in g.index]
+            best = min(learned, key=lambda m: score[m]) if learned else None
+            txt = (f"{r.dataset} ({r.test} test), outage {o}: max east/north error INS "
+                   f"{g.loc['INS', 'max_east_m']:.1f}/{g.loc['INS', 'max_north_m']:.1f} m, GPS "
+                   f"{g.loc['GPS', 'max_east_m']:.1f}/{g.loc['GPS', 'max_north_m']:.1f} m")
+            if "BGFN" in g.index:
+                e, n = red.loc[(o, "BGFN"), "east_pct"], red.loc[(o, "BGFN"), "north_pct"]
+                txt += (f"; BGFN {g.loc['BGFN', 'max_east_m']:.1f}/{g.loc['BGFN', 'max_north_m']:.1f} m "
+                        f"({e:+.0f} % / {n:+.0f} % reduction against INS)")
+                beats = [m for m in ["INS"] + learned if m != "BGFN" and score["BGFN"] < score[m]]
+                loses = [m for m in ["INS"] + learned if m != "BGFN" and score["BGFN"] >= score[m]]
+                txt += (f"; on the mean of the two max errors BGFN beats {', '.join(beats) or 'none'} and does "
+                        f"not beat {', '.join(loses) or 'any'}")
+            if best is not None:
+                txt += f"; best network: {best}"
+            below = [f"{m} {c.replace('_m', '').replace('_', ' ')} {g.loc[m, c]:.1f} < GPS {g.loc['GPS', c]:.1f} m"
+                     for c in METRIC_COLUMNS for m in g.index if m != "GPS" and g.loc[m, c] < g.loc["GPS", c]]
+            if below:   # the GPS row follows the GNSS fixes, whose own error against the reference can exceed a drift
+                txt += ("; the GPS row is not the lower bound in every cell (" + "; ".join(below)
+                        + "): the GPS-aided solution follows the GNSS fixes' own error against the reference")
+                fixes = r.gnss_errors.set_index("outage") if r.gnss_errors is not None else pd.DataFrame()
+                if o in fixes.index and fixes.loc[o, "n_fixes"] > 0:
+                    txt += (f", and the fixes in this window are off by up to {fixes.loc[o, 'max_east_m']:.1f} m "
+                            f"east and {fixes.loc[o, 'max_north_m']:.1f} m north")
+            lines.append(txt + ".")
+    return lines

@@ -106,6 +106,22 @@ def test_cache_is_written_atomically_and_reused(env, monkeypatch):
         load_drive("turin-sim-ekinox", gnss_rate_hz=1.0, seed=1, **env)  # other parameters: other key
 
 
+def test_a_new_entry_removes_the_entries_of_other_code(env):
+    folder = env["data_dir"] / "processed" / "turin-sim-mpu6000"
+    folder.mkdir(parents=True)
+    for stem, code in (("old", "other code"), ("broken", None)):
+        (folder / f"{stem}.npz").write_bytes(b"x")
+    (folder / "old.json").write_text('{"key": "k", "code": "other code"}')
+    (folder / "broken.json").write_text("{not json")
+    (folder / "writing.npz").write_bytes(b"x")                   # no JSON yet: maybe being written
+    load_drive("turin-sim-mpu6000", gnss_rate_hz=1.0, seed=3, **env)
+    load_drive("turin-sim-mpu6000", gnss_rate_hz=1.0, seed=4, **env)   # same code, other key: both kept
+    names = sorted(p.name for p in folder.iterdir())
+    assert "old.json" not in names and "old.npz" not in names and "broken.json" not in names
+    assert "writing.npz" in names
+    assert sum(n.endswith(".json") for n in names) == 2 and sum(n.endswith(".npz") for n in names) == 3
+
+
 def test_crop_keeps_the_imu_intervals_inside(env):
     d = load_drive("turin-sim-ekinox", t_start=138906.0, t_end=138936.0, **env)
     assert d.reference["time"].iloc[0] == 138906.0 and d.reference["time"].iloc[-1] == 138936.0

@@ -1,8 +1,9 @@
 """The ``Drive`` container (reference, IMU and GNSS tables + meta) and its cache format (.npz + JSON).
 
 A cache entry is two files written atomically: ``<stem>.npz`` (one float64 array per table, no pickles)
-then ``<stem>.json`` (meta, column names, cache key). The JSON is written last, so an entry without it
-is incomplete and ignored.
+then ``<stem>.json`` (meta, column names, cache key, code hash). The JSON is written last, so an entry without
+it is incomplete and ignored. Entries written by other code can never be read again (the key holds the code);
+:func:`prune_stale` removes them.
 """
 
 from __future__ import annotations
@@ -107,8 +108,9 @@ class Drive:
         return self
 
 
-def save_drive(drive: Drive, stem: str | Path, key: str) -> None:
-    """Write ``<stem>.npz`` then ``<stem>.json`` atomically (see module docstring)."""
+def save_drive(drive: Drive, stem: str | Path, key: str, code: str | None = None) -> None:
+    """Write ``<stem>.npz`` then ``<stem>.json`` atomically (see module docstring); ``code``: hash of the code
+    that built it (for :func:`prune_stale`)."""
     stem = Path(stem)
     arrays, columns = {}, {}
     for table in _TABLES:
@@ -119,8 +121,8 @@ def save_drive(drive: Drive, stem: str | Path, key: str) -> None:
     with atomic_path(stem.with_suffix(".npz")) as tmp:
         with open(tmp, "wb") as fh:
             np.savez(fh, **arrays)
-    atomic_write_json(stem.with_suffix(".json"), {"key": key, "name": drive.name, "columns": columns,
-                                                  "meta": drive.meta})
+    atomic_write_json(stem.with_suffix(".json"), {"key": key, "code": code, "name": drive.name,
+                                                  "columns": columns, "meta": drive.meta})
 
 
 def load_cached(stem: str | Path, key: str) -> Drive | None:
@@ -139,6 +141,29 @@ def load_cached(stem: str | Path, key: str) -> Drive | None:
         return None
     return Drive(info["name"], tables["reference"], tables["imu"], tables["gnss"], info["meta"],
                  tables.get("imu_bias"))
+
+
+def prune_stale(folder: str | Path, code: str) -> list[Path]:
+    """Delete the cache entries in ``folder`` that other code wrote (their ``code`` differs from ``code``, or
+    their JSON cannot be read): their keys can never match again. The JSON goes first, so a half-deleted
+    entry is an incomplete one. Entries without a JSON (being written, or interrupted) are left alone.
+
+    Returns
+    -------
+    list of Path
+        The stems removed.
+    """
+    removed = []
+    for jpath in sorted(Path(folder).glob("*.json")):
+        try:
+            stale = json.loads(jpath.read_text()).get("code") != code
+        except (OSError, ValueError, AttributeError):
+            stale = True
+        if stale:
+            jpath.unlink(missing_ok=True)
+            jpath.with_suffix(".npz").unlink(missing_ok=True)
+            removed.append(jpath.with_suffix(""))
+    return removed
 
 
 def horizontal_distance_m(reference: pd.DataFrame) -> float:

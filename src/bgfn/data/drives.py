@@ -34,7 +34,7 @@ import pandas as pd
 
 from bgfn.data import acquire
 from bgfn.data.csv_drive import load_csv_drive
-from bgfn.data.drive import Drive, load_cached, save_drive
+from bgfn.data.drive import Drive, load_cached, prune_stale, save_drive
 from bgfn.data.gnss import decimate, fix_errors, simulate_fixes
 from bgfn.data.imu_errors import MPU6000, apply_imu_errors, error_params
 from bgfn.data.navego import read_gnss, read_imu, read_reference, resample_imu
@@ -301,8 +301,11 @@ def load_drive(name: str | Path = DEFAULT_DATASET, *, profile: str | None = None
         drive.meta["raw_checksums"] = checksums
         drive.validate()
         if cache:
-            save_drive(drive, stem, key)
+            code = _source_hash()
+            save_drive(drive, stem, key, code)
             log.info("cached %s in %s", name, stem)
+            for old in prune_stale(stem.parent, code):        # built by other code: unreachable
+                log.info("removed stale cache entry %s", old)
     drive.meta["params"] = params
     if params["t_start"] is not None or params["t_end"] is not None:
         drive = drive.crop(params["t_start"], params["t_end"])

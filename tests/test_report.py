@@ -368,7 +368,7 @@ def test_variant_tables_put_profiles_side_by_side():
     t = report.variant_training_table(with_ins)
     assert list(t.columns) == ["val. RMSE quick", "zero", "last increment", "INS increment"]
     assert report.variant_sentences(t)[0].endswith("no network; the INS increment (the GPS-aided INS's speed "
-                                                   "over the same interval): 0.70 m.")
+                                                   "over the same interval): 0.7 m.")
 
 
 def test_variant_sweep_table_aligns_durations_and_methods():

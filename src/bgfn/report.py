@@ -757,12 +757,14 @@ def variant_sentences(training: pd.DataFrame | None, method: str = "BGFN") -> li
                 continue
             last, zero = float(g["last increment"].iloc[0]), float(g["zero"].iloc[0])
             beat = [m for m in g.index if g.loc[m, col] < last]
-            txt = (f"`{profile}`, `{dataset}`: {method} {g.loc[method, col]:.2f} m against last increment "
-                   f"{last:.2f} m and zero {zero:.2f} m" if method in g.index else f"`{profile}`, `{dataset}`")
+            txt = f"`{profile}`, `{dataset}`"
+            if method in g.index:
+                txt += (f": {method} {fmt_num(g.loc[method, col])} m against last increment {fmt_num(last)} m "
+                        f"and zero {fmt_num(zero)} m")
             txt += f"; below the last increment: {', '.join(beat) if beat else 'no network'}"
             if "INS increment" in g.columns and np.isfinite(g["INS increment"].iloc[0]):
-                txt += f"; the INS increment (the GPS-aided INS's speed over the same interval): " \
-                       f"{float(g['INS increment'].iloc[0]):.2f} m"
+                txt += (f"; the INS increment (the GPS-aided INS's speed over the same interval): "
+                        f"{fmt_num(g['INS increment'].iloc[0])} m")
             lines.append(txt + ".")
     return lines
 

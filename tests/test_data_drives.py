@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import hashlib
-import time
 
 import numpy as np
 import pandas as pd
@@ -96,9 +95,7 @@ def test_cache_is_written_atomically_and_reused(env, monkeypatch):
         raise AssertionError("rebuilt although cached")
 
     monkeypatch.setitem(drives._BUILDERS, "turin-sim-ekinox", (REQUIRED, no_build))
-    t0 = time.perf_counter()
-    d2 = load_drive("turin-sim-ekinox", gnss_rate_hz=1.0, **env)
-    assert time.perf_counter() - t0 < 2.0  # well under a second on an idle machine
+    d2 = load_drive("turin-sim-ekinox", gnss_rate_hz=1.0, **env)     # read back: the builder is never called
     for table in ("reference", "imu", "gnss", "imu_bias"):
         pd.testing.assert_frame_equal(getattr(d1, table), getattr(d2, table), check_exact=True)
     assert d2.meta["imu_errors"]["realized"] == d1.meta["imu_errors"]["realized"]

@@ -735,7 +735,8 @@ def reference_rmse(ws: WindowSet) -> dict:
     - ``zero``: no motion;
     - ``last``: the GNSS increment of the interval before (uses GNSS, which the networks do not see);
     - ``ins``: the GPS-aided INS's own distance over the same interval (``ws.y_ins``; its velocity, which the
-      inputs of Eq. eq21 do not carry). NaN when ``ws`` has no ``y_ins``.
+      inputs of Eq. eq21 do not carry, corrected by every fix up to the one closing the interval). NaN when
+      ``ws`` has no ``y_ins``.
 
     A network that only sees attitude, specific force and angular rate cannot know the speed, the main part of
     an increment; ``ins`` shows how far the GNSS increment can be predicted when the speed is known.

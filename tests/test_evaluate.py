@@ -422,3 +422,24 @@ def test_innovation_gate_reaches_the_gps_aided_runs(drive5):
     ctx = ev.navigation_context(jumped, {**NAV, "innovation_gate": 0.999}, [WINDOWS[0][0]])
     rejected = ctx.full.updates.loc[~ctx.full.updates["accepted"], "time"].to_numpy()
     assert np.any(np.isclose(rejected, g.loc[k, "time"]))
+
+
+def test_plot_gps_row_shows_the_fixes_inside_the_window_beside_gps_and_ins():
+    import matplotlib
+    matplotlib.use("Agg")
+    t_rel = np.arange(0.0, 10.01, 0.5)
+    runs = [ev.OutageRun(m, None, 100.0, 10.0, pd.DataFrame(),
+                         errors=pd.DataFrame({"t_rel": t_rel, "east": k * t_rel, "north": -k * t_rel}))
+            for m, k in (("GPS", 0.1), ("INS", 0.3))]
+    per_seed = pd.DataFrame({"outage": [1, 1], "start_s": [100.0, 100.0], "method": ["GPS", "INS"],
+                             "seed": [None, None]})
+    res = ev.TableResult("x", "dataset", per_seed, pd.DataFrame(), runs)
+    fixes = pd.DataFrame({"time": np.arange(95.0, 116.0), "north_m": 0.0, "east_m": np.arange(95.0, 116.0) - 100})
+    fig = ev.plot_gps_row(res, 1, fixes)
+    ax_e = fig.axes[0]
+    lines = {ln.get_label(): ln for ln in ax_e.get_lines()}
+    assert {"GNSS fixes", "GPS", "INS"} <= set(lines)
+    np.testing.assert_allclose(lines["GNSS fixes"].get_xdata(), np.arange(0.0, 11.0))   # 100..110 s only
+    np.testing.assert_allclose(lines["GNSS fixes"].get_ydata(), np.arange(0.0, 11.0))
+    np.testing.assert_allclose(lines["INS"].get_ydata(), 0.3 * t_rel)
+    np.testing.assert_allclose(fig.axes[1].get_lines()[1].get_ydata(), -0.1 * t_rel)     # north, GPS

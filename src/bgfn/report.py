@@ -595,6 +595,10 @@ EXTRA_FIGURES: tuple[dict[str, str], ...] = (
      "caption": "Firing rate of every LIF layer of the trained BGFN."},
     {"label": "energy sweeps", "file": "energy_sweeps.png", "by": "notebook 05",
      "caption": "Energy reduction as a function of T_s and of the firing rate."},
+    *({"label": f"the GPS row in outage {k} of the dataset test", "file": f"outage_dataset_{k}_gps.png",
+       "by": "notebook 04",
+       "caption": "East and north error of the GPS row beside the errors of the real GNSS fixes it follows (dots) "
+                  "and the standalone INS from the same state."} for k in (1, 2)),
     {"label": "outage sweep", "file": "outage_sweep_{dataset}.png", "by": "notebook 04", "datasets": "sweep",
      "caption": "Max horizontal error over many outage starts and durations ({dataset})."},
     {"label": "training curves", "file": "training_curves_{dataset}.png", "by": "notebook 03",

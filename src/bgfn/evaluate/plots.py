@@ -71,6 +71,39 @@ def plot_outage(result: TableResult, outage: int, reference: pd.DataFrame, metho
     return fig
 
 
+def plot_gps_row(result: TableResult, outage: int, fixes: pd.DataFrame, title: str = ""):
+    """Why the GPS row is where it is: its east and north error during an outage beside the errors of the GNSS
+    fixes it follows (dots; :func:`bgfn.data.gnss.fix_errors`, fix minus true antenna position) and the
+    standalone INS started from the same state.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    start = float(result.per_seed.loc[result.per_seed["outage"] == outage, "start_s"].iloc[0])
+    runs = {r.method: r for r in result.runs if r.seed is None and abs(r.start - start) < 1e-6}
+    dur = runs["GPS"].duration
+    inside = fixes[(fixes["time"] >= start - 1e-6) & (fixes["time"] <= start + dur + 1e-6)]
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8), sharex=True)
+    for ax, axis, lab in ((axes[0], "east", "(a) east error (m)"), (axes[1], "north", "(b) north error (m)")):
+        ax.plot(inside["time"] - start, inside[f"{axis}_m"], ".", color="0.55", ms=3, label="GNSS fixes")
+        for m in ("GPS", "INS"):
+            if m in runs:
+                e = runs[m].errors
+                ax.plot(e["t_rel"], e[axis], color=COLORS[m], lw=1.4, label=m)
+        ax.axhline(0.0, color="0.7", lw=0.6)
+        ax.set_xlabel("time since outage start (s)")
+        ax.set_ylabel(lab)
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8, loc="best")
+    if title:
+        fig.suptitle(title, fontsize=11)
+    fig.tight_layout()
+    return fig
+
+
 def plot_sweep_boxes(sweep: pd.DataFrame, dataset: str, methods=TABLE_METHODS):
     """Box plots of the max horizontal error per duration and method (log scale)."""
     import matplotlib.pyplot as plt

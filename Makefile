@@ -144,6 +144,8 @@ define build_book
 	@rm -rf book/notebooks book/_generated && mkdir -p book/notebooks book/_generated
 	@cp $(EXEC) book/notebooks/
 	@for d in tables figures; do if [ -d "$(RES)/$$d" ]; then cp -r "$(RES)/$$d" book/_generated/; fi; done
+	@if [ -f "$(RES)/findings.md" ]; then cp "$(RES)/findings.md" book/_generated/; else \
+	  echo "No findings yet: notebook 06 of profile \`$(PROFILE)\` has not written them." > book/_generated/findings.md; fi
 	@printf '%s\n' "Built from the executed notebooks of profile \`$(PROFILE)\` (\`params/$(PROFILE).yaml\`)," \
 	  "commit \`$$(git rev-parse --short HEAD 2>/dev/null || echo unknown)\`." > book/_generated/build_info.md
 	@rm -f book/_build/.built-*

@@ -392,3 +392,12 @@ def test_compared_profiles_adds_the_base_and_splits_on_results(tmp_path):
     assert report.compared_profiles("quick", ["quick-heading", "smoke"], tmp_path) == (
         ["quick", "quick-heading"], ["smoke"])
     assert report.profile_tables(["quick", "smoke"], "training_summary.csv", tmp_path)["smoke"] is None
+
+
+def test_findings_for_the_first_page_are_the_glance_lines_as_a_list():
+    text = report.findings_markdown("quick", ["BGFN beats INS in 0 of 4.", "energy: 98.6 % less."])
+    head, body = text.split("\n\n")
+    assert head.startswith("From profile `quick` (`params/quick.yaml`)") and "{doc}`results page" in head
+    assert body.splitlines() == ["- BGFN beats INS in 0 of 4.", "- energy: 98.6 % less."]
+    intro = (BOOK / "intro.md").read_text(encoding="utf-8")
+    assert "_generated/findings.md" in intro                    # the first page includes them

@@ -680,8 +680,25 @@ __all__ = [
     "best_mask", "style_layout", "compact", "reductions", "reduction_comparison", "energy_table", "kf_table",
     "training_table", "sweep_table", "fmt_num", "model_cards", "cards_line", "meta_line", "provenance",
     "short_source", "outage_datasets", "outage_provenance", "run_header", "win_counts", "summary_sentence",
-    "comparison_sentences", "reduction_sentences", "energy_sentences", "figure_list", "rel",
+    "comparison_sentences", "reduction_sentences", "energy_sentences", "figure_list", "rel", "glance_lines",
+    "findings_markdown",
 ]
+
+
+def glance_lines(profile: str, ours: dict, paper: dict, energy: dict | None, claims: dict,
+                 training_summary: pd.DataFrame | None) -> list[str]:
+    """The results page's *At a glance*: per test how often BGFN beats each method (ours and the paper's), the
+    energy estimate beside the claim, BGFN's validation error against the untrained references."""
+    return ([summary_sentence(t, ours[t], paper[t]) for t in TESTS] + energy_sentences(energy, claims)
+            + variant_sentences(variant_training_table({profile: training_summary})))
+
+
+def findings_markdown(profile: str, lines: Sequence[str]) -> str:
+    """The *At a glance* lines as a Markdown list for the book's first page (``results/<profile>/findings.md``,
+    included there by the book build)."""
+    head = (f"From profile `{profile}` (`params/{profile}.yaml`); how each number is made, and the paper's beside "
+            "it, is on the {doc}`results page <notebooks/06_results>`.")
+    return head + "\n\n" + "\n".join(f"- {s}" for s in lines) + "\n"
 
 
 # ----------------------------------------------------------------------------------------------- variants

@@ -5,8 +5,6 @@ A small synthetic drive (demo trajectory, Ekinox-grade IMU errors, 5 Hz GNSS) ke
 
 from __future__ import annotations
 
-from types import SimpleNamespace
-
 import numpy as np
 import pandas as pd
 import pytest
@@ -16,6 +14,7 @@ from bgfn import learning as L
 from bgfn import stats
 from bgfn.config import PROFILES, load_profile
 from bgfn.data import Drive
+from bgfn.data.gnss import fix_errors
 from bgfn.data import imu_errors as ie
 from bgfn.errors import DataError
 from bgfn.nav import earth, metrics, sim
@@ -377,8 +376,8 @@ def test_fix_error_table_takes_the_largest_fix_error_inside_each_window():
     east = np.where(t == 41, 9.0, -0.5)                                # a 9 m jump just after window 1
     fixes = pd.DataFrame({"time": t, "lat": 0.7 + north / (r_m + 200.0),
                           "lon": 0.13 + east / ((r_n + 200.0) * np.cos(0.7)), "h": 200.0})
-    drive = SimpleNamespace(gnss=fixes, reference=ref)             # all fix_error_table reads of a Drive
-    tab = ev.fix_error_table(drive, [(10.0, 30.0), (60.0, 30.0), (200.0, 5.0)], [0.0, 0.0, 0.0])
+    err = fix_errors(fixes, ref, [0.0, 0.0, 0.0])
+    tab = ev.fix_error_table(err, [(10.0, 30.0), (60.0, 30.0), (200.0, 5.0)])
     assert tab["n_fixes"].tolist() == [31, 31, 0]
     assert tab.loc[0, "max_north_m"] == pytest.approx(3.0, abs=1e-6)
     assert tab.loc[0, "max_east_m"] == pytest.approx(0.5, abs=1e-6)   # the jump at 41 s is outside
@@ -418,6 +417,9 @@ def test_innovation_gate_reaches_the_gps_aided_runs(drive5):
     assert table["innovation_gate"].tolist() == ["none", "0.999"]
     assert table.loc[0, "gnss_rejected"] == 0 and table.loc[1, "gnss_rejected"] >= 1
     assert table.loc[1, "max_h_m"] < 0.5 * table.loc[0, "max_h_m"]    # the jump no longer pulls the solution
+    # notebook 02's own run is reused for the setting it was made with, giving the same table
+    reused = baseline.gate_comparison(jumped, cfg, 0.999, baseline=baseline.run_baseline(jumped, cfg))
+    pd.testing.assert_frame_equal(reused, table)
     # the evaluation's GPS-aided run reads the same nav: key
     ctx = ev.navigation_context(jumped, {**NAV, "innovation_gate": 0.999}, [WINDOWS[0][0]])
     rejected = ctx.full.updates.loc[~ctx.full.updates["accepted"], "time"].to_numpy()
@@ -433,9 +435,9 @@ def test_plot_gps_row_shows_the_fixes_inside_the_window_beside_gps_and_ins():
             for m, k in (("GPS", 0.1), ("INS", 0.3))]
     per_seed = pd.DataFrame({"outage": [1, 1], "start_s": [100.0, 100.0], "method": ["GPS", "INS"],
                              "seed": [None, None]})
-    res = ev.TableResult("x", "dataset", per_seed, pd.DataFrame(), runs)
     fixes = pd.DataFrame({"time": np.arange(95.0, 116.0), "north_m": 0.0, "east_m": np.arange(95.0, 116.0) - 100})
-    fig = ev.plot_gps_row(res, 1, fixes)
+    res = ev.TableResult("x", "dataset", per_seed, pd.DataFrame(), runs, fix_errors=fixes)
+    fig = ev.plot_gps_row(res, 1)
     ax_e = fig.axes[0]
     lines = {ln.get_label(): ln for ln in ax_e.get_lines()}
     assert {"GNSS fixes", "GPS", "INS"} <= set(lines)

@@ -372,11 +372,12 @@ def make_windows(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.DataFrame, 
     y_last = np.full_like(y, np.nan)
     contiguous = np.isclose(t_to[:-1], t_from[1:], rtol=0.0, atol=1e-9)
     y_last[1:][contiguous] = y[:-1][contiguous]
+    # the INS increment (a reference; the screening needs it, and ins_increments names a missing velocity)
     has_velocity = {"v_n", "v_e"} <= set(attitude.columns)
-    y_ins = ins_increments(attitude, t_from, t_to) if has_velocity else np.full_like(y, np.nan)
+    y_ins = (ins_increments(attitude, t_from, t_to) if has_velocity or target_screen_sigma
+             else np.full_like(y, np.nan))
     bad = np.zeros(len(y), bool)
     if target_screen_sigma:
-        _check_table(attitude, "attitude", ("time", "v_n", "v_e"))
         flagged = screen_increments(y - y_ins, target_screen_sigma)
         bad = flagged.copy()
         bad[1:] |= flagged[:-1] & contiguous

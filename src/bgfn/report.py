@@ -266,15 +266,15 @@ def kf_table(kf: dict | None) -> pd.DataFrame | None:
     return pd.DataFrame(rows).set_index("dataset")
 
 
+#: Reference columns of the training tables -> their short labels (:func:`bgfn.learning.reference_rmse`).
+REFERENCE_LABELS: dict[str, str] = {"val_rmse_zero_m": "zero", "val_rmse_last_m": "last increment",
+                                    "val_rmse_ins_m": "INS increment"}
 #: Columns of ``tables/training_summary.csv`` shown on the page, with their labels.
 TRAINING_COLUMNS: dict[str, str] = {
     "params": "parameters", "lr": "learning rate", "seeds": "seeds", "epochs_mean": "epochs",
     "train_time_s_mean": "time (s)",
-    "val_rmse_m_mean": "val. RMSE (m)", "val_rmse_m_std": "std over seeds (m)", "val_rmse_zero_m": "zero (m)",
-    "val_rmse_last_m": "last increment (m)", "val_rmse_ins_m": "INS increment (m)"}
-#: Reference columns of the training tables -> their short labels (:func:`bgfn.learning.reference_rmse`).
-REFERENCE_LABELS: dict[str, str] = {"val_rmse_zero_m": "zero", "val_rmse_last_m": "last increment",
-                                    "val_rmse_ins_m": "INS increment"}
+    "val_rmse_m_mean": "val. RMSE (m)", "val_rmse_m_std": "std over seeds (m)",
+    **{col: f"{label} (m)" for col, label in REFERENCE_LABELS.items()}}
 #: Method ids of the model cards and training tables -> labels of the paper's tables.
 METHOD_LABELS: dict[str, str] = {"bgfn": "BGFN", "transformer": "Transformer", "at_lstm": "AT-LSTM", "mlp": "MLP"}
 
@@ -681,7 +681,7 @@ __all__ = [
     "training_table", "sweep_table", "fmt_num", "model_cards", "cards_line", "meta_line", "provenance",
     "short_source", "outage_datasets", "outage_provenance", "run_header", "win_counts", "summary_sentence",
     "comparison_sentences", "reduction_sentences", "energy_sentences", "figure_list", "rel", "glance_lines",
-    "findings_markdown",
+    "reference_sentences", "findings_markdown",
 ]
 
 
@@ -690,7 +690,13 @@ def glance_lines(profile: str, ours: dict, paper: dict, energy: dict | None, cla
     """The results page's *At a glance*: per test how often BGFN beats each method (ours and the paper's), the
     energy estimate beside the claim, BGFN's validation error against the untrained references."""
     return ([summary_sentence(t, ours[t], paper[t]) for t in TESTS] + energy_sentences(energy, claims)
-            + variant_sentences(variant_training_table({profile: training_summary})))
+            + reference_sentences(profile, training_summary))
+
+
+def reference_sentences(profile: str, training_summary: pd.DataFrame | None) -> list[str]:
+    """:func:`variant_sentences` of one profile's ``tables/training_summary.csv``: per dataset BGFN against the
+    untrained references, and which networks beat the *last increment*."""
+    return variant_sentences(variant_training_table({profile: training_summary}))
 
 
 def findings_markdown(profile: str, lines: Sequence[str]) -> str:

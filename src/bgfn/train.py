@@ -502,7 +502,7 @@ def prepare_learning_data(cfg: dict, dataset: str, attitude=None, drive=None, ou
     from bgfn.data import load_drive
 
     if drive is None:
-        drive = load_drive(dataset, profile=cfg["profile"]) if _accepts(load_drive, "profile") else load_drive(dataset)
+        drive = load_drive(dataset, profile=cfg["profile"])
     attitude, outage_windows, opts = _learning_inputs(cfg, drive, attitude, outage_windows)
     return build_learning_data(drive.imu, attitude, drive.gnss, outage_windows, **opts)
 
@@ -523,15 +523,6 @@ def val_position_table(cfg: dict, drive, attitude=None, outage_windows=None, pos
     return val_position_coverage(ws, motion_in_windows(drive.reference, outage_windows), outage_windows,
                                  margin_s=float(opts["margin_s"]), val_fraction=float(opts["val_fraction"]),
                                  positions=positions or VAL_POSITIONS)
-
-
-def _accepts(fn, name: str) -> bool:
-    import inspect
-
-    try:
-        return name in inspect.signature(fn).parameters
-    except (TypeError, ValueError):
-        return False
 
 
 def ins_attitude(drive, cfg: dict):

@@ -71,10 +71,10 @@ def plot_outage(result: TableResult, outage: int, reference: pd.DataFrame, metho
     return fig
 
 
-def plot_gps_row(result: TableResult, outage: int, fixes: pd.DataFrame, title: str = ""):
+def plot_gps_row(result: TableResult, outage: int, title: str = ""):
     """Why the GPS row is where it is: its east and north error during an outage beside the errors of the GNSS
-    fixes it follows (dots; :func:`bgfn.data.gnss.fix_errors`, fix minus true antenna position) and the
-    standalone INS started from the same state.
+    fixes it follows (dots; ``result.fix_errors``, fix minus true antenna position) and the standalone INS
+    started from the same state.
 
     Returns
     -------
@@ -85,6 +85,7 @@ def plot_gps_row(result: TableResult, outage: int, fixes: pd.DataFrame, title: s
     start = float(result.per_seed.loc[result.per_seed["outage"] == outage, "start_s"].iloc[0])
     runs = {r.method: r for r in result.runs if r.seed is None and abs(r.start - start) < 1e-6}
     dur = runs["GPS"].duration
+    fixes = result.fix_errors
     inside = fixes[(fixes["time"] >= start - 1e-6) & (fixes["time"] <= start + dur + 1e-6)]
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8), sharex=True)
     for ax, axis, lab in ((axes[0], "east", "(a) east error (m)"), (axes[1], "north", "(b) north error (m)")):

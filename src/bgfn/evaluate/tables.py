@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from bgfn.data.gnss import fix_errors
 from bgfn.evaluate.config import (METHOD_LABELS, METRIC_COLUMNS, PAPER_TESTS, TABLE_COLUMNS, TABLE_FILES,
                                    TABLE_METHODS, evaluate_config)
 from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
@@ -30,9 +31,10 @@ class TableResult:
     runs : list of OutageRun
     models : dict
         ``{(method id, seed): predictor}`` used.
+    fix_errors : DataFrame or None
+        :func:`bgfn.data.gnss.fix_errors` of the drive: each GNSS fix's own error, which the GPS row follows.
     gnss_errors : DataFrame or None
-        :func:`fix_error_table`: how far the GNSS fixes themselves are from the reference in each outage
-        window, which the GPS row follows.
+        :func:`fix_error_table` of ``fix_errors``: their largest values in each outage window.
     """
 
     dataset: str
@@ -41,19 +43,17 @@ class TableResult:
     table: pd.DataFrame
     runs: list
     models: dict = field(default_factory=dict)
+    fix_errors: pd.DataFrame | None = None
     gnss_errors: pd.DataFrame | None = None
 
 
-def fix_error_table(drive, windows, lever_arm_m) -> pd.DataFrame:
-    """Per outage window: the largest |east| and |north| error of the GNSS fixes inside it against the true
-    antenna position (:func:`bgfn.data.gnss.fix_errors`), m, and the number of fixes.
+def fix_error_table(err: pd.DataFrame, windows) -> pd.DataFrame:
+    """Per outage window: the largest |east| and |north| error of the GNSS fixes inside it, m, and the number of
+    fixes; ``err`` from :func:`bgfn.data.gnss.fix_errors` (fix minus true antenna position).
 
     The GPS row is the filter with these fixes: it cannot stay closer to the reference than they are for long,
     while an INS that starts from the same state may drift less than the fixes wander.
     """
-    from bgfn.data.gnss import fix_errors
-
-    err = fix_errors(drive.gnss, drive.reference, lever_arm_m)
     rows = []
     for k, (start, duration) in enumerate(windows):
         inside = err[(err["time"] >= start) & (err["time"] <= start + duration)]
@@ -115,9 +115,10 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
     rows = [{"outage": outage_no[r.start], "start_s": r.start, "method": r.method, "seed": r.seed,
              **window_metrics(r.errors, r.start, r.duration)} for r in runs]
     per_seed = pd.DataFrame(rows)
+    fixes = fix_errors(drive.gnss, drive.reference, ctx.lever)
     return TableResult(dataset, PAPER_TESTS.get(dataset, dataset), per_seed,
-                       aggregate_seeds(per_seed, ecfg["seed_aggregate"]), runs, models,
-                       fix_error_table(drive, windows, ctx.lever))
+                       aggregate_seeds(per_seed, ecfg["seed_aggregate"]), runs, models, fixes,
+                       fix_error_table(fixes, windows))
 
 
 def table_file(test: str) -> str:

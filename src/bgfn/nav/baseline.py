@@ -232,7 +232,7 @@ def save_baseline(b: Baseline, out, lat=None) -> dict:
             "states_file": f"nav_states_{d}.npz"}
 
 
-def gate_comparison(drive, cfg: dict, probability: float) -> pd.DataFrame:
+def gate_comparison(drive, cfg: dict, probability: float, baseline: Baseline | None = None) -> pd.DataFrame:
     """The baseline of ``drive`` without and with an innovation gate on the GNSS fixes (notebook 02).
 
     Parameters
@@ -242,6 +242,8 @@ def gate_comparison(drive, cfg: dict, probability: float) -> pd.DataFrame:
         Output of :func:`nav_config`; its ``innovation_gate`` is replaced by None and by ``probability``.
     probability : float
         Chi-square probability of the gate (:func:`bgfn.nav.filter.gate_thresholds`).
+    baseline : Baseline, optional
+        The run with ``cfg`` as it is (notebook 02 has it already): reused for the setting it matches.
 
     Returns
     -------
@@ -253,7 +255,8 @@ def gate_comparison(drive, cfg: dict, probability: float) -> pd.DataFrame:
     """
     rows = []
     for gate in (None, probability):
-        b = run_baseline(drive, {**cfg, "innovation_gate": gate})
+        same = baseline is not None and gate == cfg["innovation_gate"]
+        b = baseline if same else run_baseline(drive, {**cfg, "innovation_gate": gate})
         upd = b.full.updates
         row = {"dataset": drive.name, "innovation_gate": "none" if gate is None else f"{gate:g}",
                "gnss_fixes": int(len(upd)), "gnss_rejected": int((~upd["accepted"]).sum()),

@@ -197,7 +197,7 @@ def test_profile_data_section_sets_the_parameters(env, tmp_path, monkeypatch):
     # a misspelt key in a profile names the file and the key
     monkeypatch.setattr(config, "PARAMS_DIR", tmp_path)
     (tmp_path / "mine.yaml").write_text(
-        "profile: mine\ndescription: d\nseed: 1\nnav: {}\ntrain: {}\nevaluate: {}\nenergy: {}\n"
+        "profile: mine\ndescription: d\nseed: 1\noutage_windows: [[139000.0, 30.0]]\nnav: {}\ntrain: {}\nevaluate: {}\nenergy: {}\n"
         "data:\n  turin-sim-ekinox:\n    gnss_rate: 1.0\n")
     with pytest.raises(DataError) as exc:
         load_drive("turin-sim-ekinox", profile="mine", **env)

@@ -7,9 +7,9 @@ import pytest
 import scipy.io
 
 from bgfn.data import acquire
-from bgfn.data.navego import (GNSS_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS, read_gnss, read_imu,
-                              read_reference, resample_imu)
+from bgfn.data.navego import read_gnss, read_imu, read_reference, resample_imu
 from bgfn.errors import DataError
+from bgfn.schema import GNSS_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS
 
 pytestmark = pytest.mark.usefixtures("repo_untouched")
 

@@ -336,11 +336,11 @@ def test_missing_checkpoint_names_the_file(tmp_path, monkeypatch):
     cfg = {"energy": {"dataset": None, "seed": None}, "train": {"datasets": ["drive-a", "drive-b"], "seeds": [3]}}
     expected = tmp_path / "smoke" / "models" / "drive-a" / "bgfn_seed3.pt"
     with pytest.raises(FileNotFoundError) as err:
-        energy.checkpoint_path("smoke", "bgfn", cfg)
+        energy.energy_checkpoint("smoke", "bgfn", cfg)
     assert str(expected) in str(err.value) and "03_bgfn_training" in str(err.value)
     expected.parent.mkdir(parents=True)
     expected.write_bytes(b"")
-    assert energy.checkpoint_path("smoke", "bgfn", cfg) == expected
+    assert energy.energy_checkpoint("smoke", "bgfn", cfg) == expected
 
 
 # ----------------------------------------------------------------------------------------------- speed helpers

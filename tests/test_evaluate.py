@@ -10,6 +10,7 @@ import pandas as pd
 import pytest
 
 from bgfn import evaluate as ev
+from bgfn import paper
 from bgfn import learning as L
 from bgfn import stats
 from bgfn.config import PROFILES, load_profile
@@ -228,12 +229,12 @@ def test_aggregate_seeds_reduction_and_layout():
     red = ev.error_reduction(t)
     assert red["east_pct"].item() == pytest.approx(80.0) and red["north_pct"].item() == pytest.approx(50.0)
     assert ev.aggregate_seeds(pd.DataFrame(rows), "first").loc[1, "max_east_m"] == 1.0
-    lay = ev.paper_layout(t, ev.paper_values("dataset"))
-    assert lay.loc[("Outage 1", "paper"), ("BGFN", "East")] == 4.7
-    assert lay.loc[("Outage 1", "ours"), ("INS", "North")] == 8.0
+    lay = paper.layout(t, paper.outage_table("dataset"), methods=ev.TABLE_METHODS)
+    assert lay.loc["Outage 1", ("paper", "BGFN", "East")] == 4.7
+    assert lay.loc["Outage 1", ("ours", "INS", "North")] == 8.0
     # the paper's quoted reduction (claims.yaml) is its Table 1 arithmetic
-    p = ev.error_reduction(ev.paper_values("dataset"))
-    c = ev.paper_claims()["bgfn_reduction_vs_ins_pct"]["dataset_outage1"]
+    p = ev.error_reduction(paper.outage_table("dataset"))
+    c = paper.claims()["bgfn_reduction_vs_ins_pct"]["dataset_outage1"]
     got = p[(p["outage"] == 1) & (p["method"] == "BGFN")]
     assert got["east_pct"].item() == pytest.approx(c["east"], abs=0.1)
 
@@ -364,7 +365,7 @@ def test_real_imu_switch_falls_back_to_the_simulated_datasets(monkeypatch, tmp_p
     assert names == ["navego-ekinox", "turin-sim-mpu6000"]
     assert "absent" in notes[1] and "navego-mpu6000" in notes[1]
     assert ev.choose_datasets(["turin-sim-ekinox"], real_imu=False) == (["turin-sim-ekinox"], [])
-    assert ev.PAPER_TESTS["navego-ekinox"] == "dataset" and ev.PAPER_TESTS["navego-mpu6000"] == "field"
+    assert paper.test_of("navego-ekinox") == "dataset" and paper.test_of("navego-mpu6000") == "field"
 
 
 def test_fix_error_table_takes_the_largest_fix_error_inside_each_window():
@@ -412,13 +413,13 @@ def test_innovation_gate_reaches_the_gps_aided_runs(drive5):
     r_m, _ = earth.curvature_radii(g.loc[k, "lat"])
     g.loc[k, "lat"] += 25.0 / (r_m + g.loc[k, "h"])                 # one fix 25 m north
     jumped = Drive(drive5.name, drive5.reference, drive5.imu, g, drive5.meta)
-    cfg = baseline.nav_config({**NAV, "outage_starts": [s for s, _ in WINDOWS], "outage_duration_s": 20.0})
-    table = baseline.gate_comparison(jumped, cfg, 0.999)
+    cfg = baseline.nav_config(NAV)
+    table = baseline.gate_comparison(jumped, cfg, WINDOWS, 0.999)
     assert table["innovation_gate"].tolist() == ["none", "0.999"]
     assert table.loc[0, "gnss_rejected"] == 0 and table.loc[1, "gnss_rejected"] >= 1
     assert table.loc[1, "max_h_m"] < 0.5 * table.loc[0, "max_h_m"]    # the jump no longer pulls the solution
     # notebook 02's own run is reused for the setting it was made with, giving the same table
-    reused = baseline.gate_comparison(jumped, cfg, 0.999, baseline=baseline.run_baseline(jumped, cfg))
+    reused = baseline.gate_comparison(jumped, cfg, WINDOWS, 0.999, baseline=baseline.run_baseline(jumped, cfg, WINDOWS))
     pd.testing.assert_frame_equal(reused, table)
     # the evaluation's GPS-aided run reads the same nav: key
     ctx = ev.navigation_context(jumped, {**NAV, "innovation_gate": 0.999}, [WINDOWS[0][0]])

@@ -7,6 +7,7 @@ import pandas as pd
 import pytest
 
 from bgfn import learning as L
+from bgfn import schema
 from bgfn.errors import DataError
 from bgfn.nav.earth import curvature_radii
 
@@ -311,3 +312,14 @@ def test_ins_increment_reference_is_the_distance_travelled(tables):
     assert np.array_equal(blind.y, ws.y)
     with pytest.raises(DataError, match="v_n"):                        # screening needs the velocity
         L.make_windows(imu, att.drop(columns=["v_n", "v_e"]), gnss, window=50, target_screen_sigma=10.0)
+
+
+def test_input_layout_places_each_group_of_eq21_where_its_slice_says():
+    t = np.arange(5) * 0.01
+    imu = pd.DataFrame({"time": t, **{c: np.full(5, k + 1.0) for k, c in enumerate(schema.IMU_COLUMNS[1:])}})
+    att = pd.DataFrame({"time": t, "roll": 0.1, "pitch": 0.2, "yaw": 0.3, "v_n": 7.0})
+    _, feats, channels = L.sample_features(imu, att, extra_channels=("v_n",))
+    np.testing.assert_allclose(feats[:, L.ATTITUDE_CHANNELS], np.tile([0.1, 0.2, 0.3], (5, 1)), atol=1e-15)  # yaw wrapped
+    np.testing.assert_array_equal(feats[:, L.ANGULAR_RATE_CHANNELS], imu[list(schema.GYRO_COLUMNS)].to_numpy())
+    np.testing.assert_array_equal(feats[:, L.SPECIFIC_FORCE_CHANNELS], imu[list(schema.ACCEL_COLUMNS)].to_numpy())
+    assert channels[L.EXTRA_START] == "v_n" and np.all(feats[:, L.EXTRA_START] == 7.0)

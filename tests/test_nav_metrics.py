@@ -17,8 +17,11 @@ def test_outage_metrics_hand_computed():
     assert m["max_abs_east"] == pytest.approx(3.0) and m["max_abs_north"] == pytest.approx(6.0)
     assert m["end_east"] == pytest.approx(-3.0) and m["end_horizontal"] == pytest.approx(np.hypot(3, 6))
     assert m["rmse_horizontal"] == pytest.approx(np.hypot(0.1, 0.2) * np.sqrt(np.mean(t ** 2)))
-    table = baseline.paper_layout(pd.DataFrame([m, m]))
+    table = baseline.ins_max_error_file(pd.DataFrame([m, m]))
     assert table["outage"].tolist() == ["Outage 1", "Outage 2"] and table["INS_north_m"].iloc[0] == 6.0
+    beside = baseline.ins_layout(pd.DataFrame([m, m]), "turin-sim-mpu6000")     # the field test's INS row
+    assert beside.loc["Outage 2", ("paper", "INS", "East")] == 477.5
+    assert beside.loc["Outage 1", ("ours", "INS", "North")] == pytest.approx(6.0)
 
 
 def test_navigation_errors_of_a_shifted_trajectory():
@@ -37,13 +40,18 @@ def test_navigation_errors_of_a_shifted_trajectory():
 
 
 def test_nav_config_and_outage_windows():
-    cfg = baseline.nav_config({"init": {"azimuth_std_deg": 5.0}, "outage_duration_s": 20.0})
+    cfg = baseline.nav_config({"init": {"azimuth_std_deg": 5.0}})
     assert cfg["init"]["azimuth_std_deg"] == 5.0 and cfg["init"]["position_std_m"] == 1.0
-    assert [(w.start, w.duration) for w in baseline.outage_windows(cfg)] == [(138906.0, 20.0), (139170.0, 20.0)]
-    assert outages.outage_windows() == [(138906.0, 30.0), (139170.0, 30.0)]
-    assert outages.outage_windows(section={"outage_windows": [[10, 5]]}) == [(10.0, 5.0)]
+    assert outages.outage_windows({"outage_windows": [[10, 5], [30, 2.5]]}) == [(10.0, 5.0), (30.0, 2.5)]
+    with pytest.raises(DataError, match="outage_windows"):
+        outages.outage_windows({"profile": "p"})
+    ref = sim.demo_trajectory(20.0)                    # 0..20 s: a window past the end fails, naming the key
+    drive = type("D", (), {"name": "demo", "reference": ref, "imu": ref[["time"]]})()
+    assert outages.outage_windows({"outage_windows": [[5, 10]]}, drive) == [(5.0, 10.0)]
+    with pytest.raises(DataError, match="outage_windows"):
+        outages.outage_windows({"outage_windows": [[15, 10]]}, drive)
     with pytest.raises(DataError, match="unknown key"):
-        baseline.nav_config({"outage_start": [1.0]})
+        baseline.nav_config({"outage_starts": [1.0]})
     with pytest.raises(DataError, match="unknown key"):
         baseline.nav_config({"init": {"pos_std": 1.0}})
 

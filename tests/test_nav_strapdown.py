@@ -8,6 +8,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from bgfn.errors import DataError
+from bgfn import schema
 from bgfn.nav import earth, sim, strapdown, transform
 
 LAT0, LON0, H0 = np.radians(45.06), np.radians(7.66), 250.0
@@ -75,7 +76,7 @@ def test_constant_speed_level_circle_within_10cm_after_60s():
     t = np.arange(int(rate * duration) + 1) / rate
     gyro = _gauss_mean(gyro_true, t[:-1], t[1:])
     accel = _gauss_mean(accel_true, t[:-1], t[1:])
-    imu = pd.DataFrame(np.column_stack([t[1:], gyro, accel]), columns=strapdown.IMU_COLUMNS)
+    imu = pd.DataFrame(np.column_stack([t[1:], gyro, accel]), columns=list(schema.IMU_COLUMNS))
     # Sanity of the analytic readings: centripetal acceleration to the right, yaw rate w.
     assert accel[:, 1].mean() == pytest.approx(speed * w, rel=1e-3)
     assert gyro[:, 2].mean() == pytest.approx(w, rel=1e-3)
@@ -98,8 +99,8 @@ def test_propagate_matches_integrate_kernel():
     r0 = ref.iloc[0]
     pos, v, c = strapdown.state_from_row(r0)
     lat, lon, h, v1, c1 = strapdown.propagate(pos[0], pos[1], pos[2], v, c,
-                                              imu.iloc[0][strapdown.GYRO_COLUMNS].to_numpy(float),
-                                              imu.iloc[0][strapdown.ACCEL_COLUMNS].to_numpy(float), 0.01)
+                                              imu.iloc[0][list(schema.GYRO_COLUMNS)].to_numpy(float),
+                                              imu.iloc[0][list(schema.ACCEL_COLUMNS)].to_numpy(float), 0.01)
     out = strapdown.integrate(r0, imu.iloc[:1])
     assert out["lat"].iloc[1] == lat and out["lon"].iloc[1] == lon and out["h"].iloc[1] == h
     np.testing.assert_array_equal(out[["v_n", "v_e", "v_d"]].iloc[1].to_numpy(), v1)
@@ -147,11 +148,11 @@ def test_against_pyins_generate_imu_and_integrator():
     traj, inc = psim.generate_imu(t, lla, rph, vel, sensor_type="increment")
     dt = np.diff(t)[:, None]
     imu = pd.DataFrame(np.column_stack([t[1:], inc.to_numpy()[1:, :3] / dt, inc.to_numpy()[1:, 3:] / dt]),
-                       columns=strapdown.IMU_COLUMNS)
+                       columns=list(schema.IMU_COLUMNS))
     ours = sim.imu_from_trajectory(ref)
     # pyins (spline, with Earth rotation in inertial frame) and our inverse agree on the mean rates.
-    np.testing.assert_allclose(imu[strapdown.GYRO_COLUMNS], ours[strapdown.GYRO_COLUMNS], atol=2e-6)
-    np.testing.assert_allclose(imu[strapdown.ACCEL_COLUMNS], ours[strapdown.ACCEL_COLUMNS], atol=2e-3)
+    np.testing.assert_allclose(imu[list(schema.GYRO_COLUMNS)], ours[list(schema.GYRO_COLUMNS)], atol=2e-6)
+    np.testing.assert_allclose(imu[list(schema.ACCEL_COLUMNS)], ours[list(schema.ACCEL_COLUMNS)], atol=2e-3)
     # Our strapdown on pyins' increments and pyins' strapdown on the same: both follow the truth.
     out = strapdown.integrate(ref.iloc[0], imu)
     err_ours = earth.lla_to_ned(out["lat"].to_numpy(), out["lon"].to_numpy(), out["h"].to_numpy(),

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bgfn import report
+from bgfn import paper, report
 from bgfn.config import PROJECT_ROOT
 
 BOOK = PROJECT_ROOT / "book"
@@ -36,7 +36,7 @@ PAPER = table([(1, "INS", 23.1, 23.2), (1, "BGFN", 4.7, 4.8), (2, "BGFN", 1.8, 4
 
 # ----------------------------------------------------------------------------------------------- tables
 def test_paper_layout_joins_on_outage_and_method():
-    lay = report.paper_layout(OURS, PAPER, ours_label="ours (t)")
+    lay = paper.layout(OURS, PAPER, ours_label="ours (t)")
     assert list(lay.index) == ["Outage 1", "Outage 2"]
     assert list(lay.columns.get_level_values(0).unique()) == ["ours (t)", "paper"]
     assert lay.loc["Outage 1", ("ours (t)", "BGFN", "North")] == 12.0
@@ -48,34 +48,34 @@ def test_paper_layout_joins_on_outage_and_method():
     assert math.isnan(lay.loc["Outage 1", ("paper", "MLP", "North")])
     assert math.isnan(lay.loc["Outage 2", ("paper", "AT-LSTM", "North")])
     # the paper's four methods in its order; the extra GPS row stays out of this layout
-    assert list(lay.columns.get_level_values(1).unique()) == list(report.PAPER_METHODS)
+    assert list(lay.columns.get_level_values(1).unique()) == list(paper.PAPER_METHODS)
 
 
 def test_paper_layout_without_our_table_keeps_the_papers_values():
-    lay = report.paper_layout(None, PAPER)
+    lay = paper.layout(None, PAPER)
     assert lay[("ours", "BGFN", "East")].isna().all()
     assert lay.loc["Outage 1", ("paper", "INS", "North")] == 23.2
 
 
 def test_paper_table_read_from_the_transcription():
     raw = pd.read_csv(PROJECT_ROOT / "data" / "paper" / "outage_max_errors.csv")
-    for test in report.TESTS:
-        p = report.paper_outage_table(test)
-        lay = report.paper_layout(None, p)
+    for test in paper.TESTS:
+        p = paper.outage_table(test)
+        lay = paper.layout(None, p)
         for r in raw[raw["test"] == test].itertuples():
             assert lay.loc[f"Outage {r.outage}", ("paper", r.method, "East")] == r.max_east_m
             assert lay.loc[f"Outage {r.outage}", ("paper", r.method, "North")] == r.max_north_m
     with pytest.raises(ValueError):
-        report.paper_outage_table("no-such-test")
+        paper.outage_table("no-such-test")
 
 
 def test_best_mask_marks_the_smallest_per_source_and_axis():
-    mask = report.best_mask(report.paper_layout(OURS, PAPER))
+    mask = report.best_mask(paper.layout(OURS, PAPER))
     assert mask.loc["Outage 1", ("ours", "BGFN", "East")]            # 5 < 7 < 20
     assert mask.loc["Outage 1", ("ours", "MLP", "North")]            # 9 < 10 < 12
     assert not mask.loc["Outage 1", ("ours", "BGFN", "North")]
     assert mask.loc["Outage 1", ("paper", "BGFN", "East")] and mask.loc["Outage 1", ("paper", "BGFN", "North")]
-    html = report.style_layout(report.paper_layout(OURS, PAPER), "cap").to_html()
+    html = report.style_layout(paper.layout(OURS, PAPER), "cap").to_html()
     assert "cap" in html and "font-weight: bold" in html and "<table" in html
 
 
@@ -105,10 +105,10 @@ def test_reduction_comparison_ours_paper_table_and_text():
 
 def test_the_papers_text_agrees_with_its_tables():
     # a consistency check of the transcription: each percentage of Sec. 4 follows from the tables
-    claims = report.paper_claims()
+    claims = paper.claims()
     for key, stated in claims["bgfn_reduction_vs_ins_pct"].items():
         test, outage = key.split("_outage")
-        comp = report.reduction_comparison(None, report.paper_outage_table(test), claims, test)
+        comp = report.reduction_comparison(None, paper.outage_table(test), claims, test)
         for axis in ("East", "North"):
             assert comp.loc[f"Outage {outage}", ("paper (table)", axis)] == pytest.approx(
                 stated[axis.lower()], abs=0.05)
@@ -202,10 +202,11 @@ def test_cards_line_and_outage_provenance(tmp_path):
     line = report.cards_line(cards)
     assert "seeds 0, 1" in line and "T_s 2" in line and "window N = 50" in line and "epochs run 2-3" in line
     ev = {"datasets": ["turin-sim-ekinox", "turin-sim-mpu6000"], "meta": {"profile": "p"},
-          "evaluate": {"seeds": [0, 1], "seed_aggregate": "median", "outage_windows": [[100.0, 30.0]]}}
+          "evaluate": {"seeds": [0, 1], "seed_aggregate": "median"}, "outage_windows": [[100.0, 30.0]]}
     assert report.outage_datasets(ev) == {"dataset": "turin-sim-ekinox", "field": "turin-sim-mpu6000"}
     prov = report.outage_provenance("p", "dataset", tmp_path / "p", ev)
     assert "dataset `turin-sim-ekinox`" in prov and "seeds 0, 1 (median over seeds)" in prov
+    assert "30 s from 100 s (GPS time of week)" in prov
 
 
 def test_training_and_sweep_tables():

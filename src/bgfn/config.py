@@ -53,11 +53,19 @@ DATA_DIR: Path = PROJECT_ROOT / "data"
 
 #: Profiles shipped with the artifact (users may add their own ``params/<name>.yaml``).
 PROFILES: tuple[str, ...] = ("smoke", "quick", "paper")
-#: Top-level keys every profile file must define.
-SCALAR_KEYS: tuple[str, ...] = ("profile", "description", "seed")
+#: Top-level keys every profile file must define (``outage_windows``: the evaluation outages, read by
+#: :func:`bgfn.nav.outages.outage_windows`, shared by notebooks 01-04).
+SCALAR_KEYS: tuple[str, ...] = ("profile", "description", "seed", "outage_windows")
 #: One section per notebook: 01 data, 02 nav (KF baseline), 03 train, 04 evaluate, 05 energy.
 SECTION_KEYS: tuple[str, ...] = ("data", "nav", "train", "evaluate", "energy")
 REQUIRED_KEYS: tuple[str, ...] = SCALAR_KEYS + SECTION_KEYS
+#: Keys of earlier versions that now live elsewhere: ``section.key`` -> the key to set instead.
+MOVED_KEYS: dict[str, str] = {
+    "nav.outage_starts": "outage_windows",
+    "nav.outage_duration_s": "outage_windows",
+    "train.outage_windows": "outage_windows",
+    "evaluate.outage_windows": "outage_windows",
+}
 #: Subfolders of ``results/<profile>/``.
 RESULT_SUBDIRS: tuple[str, ...] = ("tables", "figures", "notebooks", "models")
 
@@ -153,17 +161,20 @@ def load_profile(profile: str) -> dict[str, Any]:
     -------
     dict
         The parsed YAML (merged over its bases): ``profile`` (str, equal to the file name), ``description``
-        (str), ``seed`` (int) and one mapping per notebook section (``data``, ``nav``, ``train``,
+        (str), ``seed`` (int), ``outage_windows`` (list of [start, duration], s) and one mapping per notebook section (``data``, ``nav``, ``train``,
         ``evaluate``, ``energy``; an empty section is returned as ``{}``). A fresh copy on every call.
 
     Raises
     ------
     bgfn.errors.DataError
-        Unknown profile (missing file), unreadable YAML, a missing required key or a wrong type, a ``base:``
-        that does not exist or leads back to the profile. The message names the file.
+        Unknown profile (missing file), unreadable YAML, a missing required key or a wrong type, a key that
+        moved (:data:`MOVED_KEYS`, the message names the new one), a ``base:`` that does not exist or leads
+        back to the profile. The message names the file.
     """
     chain = _read_chain(profile)
     path = chain[0][0]
+    for file, own in chain:
+        _check_moved_keys(file, own)
     cfg: dict = {}
     for _, own in reversed(chain):                  # the furthest base first, the profile's own file last
         own = {k: v for k, v in own.items() if k != "base"}
@@ -182,12 +193,34 @@ def load_profile(profile: str) -> dict[str, Any]:
         raise DataError(path, "description", "a string", type(cfg["description"]).__name__)
     if isinstance(cfg["seed"], bool) or not isinstance(cfg["seed"], int) or cfg["seed"] < 0:
         raise DataError(path, "seed", "a non-negative integer", repr(cfg["seed"]))
+    _check_windows_form(path, cfg["outage_windows"])
     for key in SECTION_KEYS:
         if cfg[key] is None:  # a section holding only comments
             cfg[key] = {}
         if not isinstance(cfg[key], dict):
             raise DataError(path, key, "a mapping (section of keys)", type(cfg[key]).__name__)
     return copy.deepcopy(cfg)
+
+
+def _check_moved_keys(path: Path, own: dict) -> None:
+    """A key that moved (:data:`MOVED_KEYS`) fails by name, so that no setting is silently ignored."""
+    for old, new in MOVED_KEYS.items():
+        section, key = old.split(".")
+        if isinstance(own.get(section), dict) and key in own[section]:
+            raise DataError(path, old, f"the top-level key {new!r} instead (one list of [start, duration] in s "
+                            "for every notebook)", f"{old}: {own[section][key]!r}")
+
+
+def _check_windows_form(path: Path, windows: Any) -> None:
+    """``outage_windows`` is a non-empty list of ``[start, duration]`` pairs of numbers, durations > 0."""
+    expected = "a non-empty list of [start, duration] pairs in s (GPS time of week), durations > 0"
+    if not isinstance(windows, list) or not windows:
+        raise DataError(path, "outage_windows", expected, repr(windows))
+    for w in windows:
+        ok = (isinstance(w, list) and len(w) == 2
+              and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in w))
+        if not ok or not w[1] > 0:
+            raise DataError(path, "outage_windows", expected, repr(w))
 
 
 def results_dir(profile: str, create: bool = True) -> Path:

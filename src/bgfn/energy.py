@@ -622,9 +622,9 @@ def reduction_vs_time_steps(build: Callable[[int], tuple[nn.Module, nn.Module]],
 
 
 # ----------------------------------------------------------------------------------------------- checkpoints
-def checkpoint_path(profile: str, method: str, cfg: dict | None = None, dataset: str | None = None,
-                    seed: int | None = None, must_exist: bool = True):
-    """``results/<profile>/models/<dataset>/<method>_seed<k>.pt`` of the energy estimate.
+def energy_checkpoint(profile: str, method: str, cfg: dict | None = None, dataset: str | None = None,
+                      seed: int | None = None, must_exist: bool = True):
+    """The checkpoint of the energy estimate (:func:`bgfn.checkpoints.checkpoint_path`).
 
     ``dataset``/``seed`` default to the profile's ``energy.dataset``/``energy.seed`` and, when those are
     null, to the first of ``train.datasets``/``train.seeds`` (what notebook 03 trains first).
@@ -634,7 +634,8 @@ def checkpoint_path(profile: str, method: str, cfg: dict | None = None, dataset:
     FileNotFoundError
         The checkpoint is missing (``must_exist``); the message names the file and the notebook that writes it.
     """
-    from bgfn.config import load_profile, results_dir
+    from bgfn.checkpoints import checkpoint_path
+    from bgfn.config import load_profile
 
     cfg = cfg if cfg is not None else load_profile(profile)
     ecfg, tcfg = cfg.get("energy") or {}, cfg.get("train") or {}
@@ -643,7 +644,7 @@ def checkpoint_path(profile: str, method: str, cfg: dict | None = None, dataset:
     seed = seed if seed is not None else (tcfg.get("seeds") or [0])[0]
     if dataset is None:
         raise ValueError(f"profile {profile!r}: no dataset (energy.dataset and train.datasets are empty)")
-    path = results_dir(profile, create=False) / "models" / dataset / f"{method}_seed{int(seed)}.pt"
+    path = checkpoint_path(profile, dataset, method, int(seed), create=False)
     if must_exist and not path.is_file():
         raise FileNotFoundError(
             f"trained {method} model not found: {path} -- notebook 03_bgfn_training.ipynb writes it "

@@ -54,6 +54,23 @@ from bgfn.nav.earth import curvature_radii
 
 #: The 9 input channels of Eq. (eq21), in order.
 CHANNELS: tuple[str, ...] = ("roll", "pitch", "yaw", "accel_x", "accel_y", "accel_z", "gyro_x", "gyro_y", "gyro_z")
+
+
+def _span(names: Sequence[str]) -> slice:
+    """The contiguous positions of ``names`` in :data:`CHANNELS`."""
+    first = CHANNELS.index(names[0])
+    assert CHANNELS[first:first + len(names)] == tuple(names), names
+    return slice(first, first + len(names))
+
+
+#: The network input layout, used by the learning windows and by the outage runs (bgfn.evaluate.hybrid):
+#: where each group of Eq. (eq21) sits in a sample's channel vector; ``extra_channels`` follow from
+#: :data:`EXTRA_START` on.
+ATTITUDE_CHANNELS = _span(("roll", "pitch", "yaw"))                                         # rad
+IMU_CHANNELS = _span(("accel_x", "accel_y", "accel_z", "gyro_x", "gyro_y", "gyro_z"))      # as in the IMU table
+SPECIFIC_FORCE_CHANNELS = _span(("accel_x", "accel_y", "accel_z"))                          # m/s^2
+ANGULAR_RATE_CHANNELS = _span(("gyro_x", "gyro_y", "gyro_z"))                               # rad/s
+EXTRA_START = len(CHANNELS)
 #: The 2 outputs: north and east GPS position increment, m.
 TARGETS: tuple[str, ...] = ("dn", "de")
 #: Extra input channels computed from the INS solution rather than read from it: the horizontal INS velocity
@@ -127,13 +144,14 @@ def sample_features(imu: pd.DataFrame, attitude: pd.DataFrame,
         Channels ``CHANNELS + extra_channels``; yaw wrapped to (-pi, pi].
     channels : tuple of str
     """
-    _check_table(imu, "imu", ("time", "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"))
+    attitude_names, imu_names = CHANNELS[ATTITUDE_CHANNELS], CHANNELS[IMU_CHANNELS]
+    _check_table(imu, "imu", ("time", *imu_names))
     attitude = with_derived_channels(attitude, extra_channels)
-    _check_table(attitude, "attitude", ("time", "roll", "pitch", "yaw", *extra_channels))
+    _check_table(attitude, "attitude", ("time", *attitude_names, *extra_channels))
     t = imu["time"].to_numpy(float)
     ta = attitude["time"].to_numpy(float)
     cols = []
-    for name in ("roll", "pitch", "yaw", *extra_channels):
+    for name in (*attitude_names, *extra_channels):
         v = attitude[name].to_numpy(float)
         if name == "yaw":
             v = np.unwrap(v)
@@ -142,9 +160,8 @@ def sample_features(imu: pd.DataFrame, attitude: pd.DataFrame,
         else:
             c = np.interp(t, ta, v, left=np.nan, right=np.nan)
         cols.append(wrap_angle(c) if name == "yaw" else c)
-    feats = np.column_stack([cols[0], cols[1], cols[2]]
-                            + [imu[c].to_numpy(float) for c in CHANNELS[3:]]
-                            + cols[3:])
+    n_att = len(attitude_names)                  # [K, C]: attitude, IMU, extras (the layout above)
+    feats = np.column_stack(cols[:n_att] + [imu[c].to_numpy(float) for c in imu_names] + cols[n_att:])
     return t, feats, CHANNELS + tuple(extra_channels)
 
 

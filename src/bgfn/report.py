@@ -26,29 +26,16 @@ from typing import Any, Iterable, Sequence
 import numpy as np
 import pandas as pd
 
-from bgfn.config import DATA_DIR, PROJECT_ROOT
+from bgfn import checkpoints
+from bgfn.config import PROJECT_ROOT
+from bgfn.paper import AXES, DECIMALS, PAPER_METHODS, TESTS, claim_for, label, test_of
 
-#: The paper's methods, in the order of its tables.
-PAPER_METHODS: tuple[str, ...] = ("INS", "MLP", "AT-LSTM", "BGFN")
 #: Everything BGFN is compared with on this page (Transformer: ANN twin; GPS: the lower bound).
 BASELINES: tuple[str, ...] = ("INS", "MLP", "AT-LSTM", "Transformer", "GPS")
 #: Extra rows of our tables that the paper does not have, and what they are.
 EXTRA_METHODS: dict[str, str] = {"Transformer": "the ANN twin of BGFN, not in the paper",
                                  "GPS": "the GPS-aided solution over the same window: the lower bound"}
 EXTRA_TAGS: dict[str, str] = {"Transformer": "ANN twin", "GPS": "lower bound"}
-#: Max-error columns and their labels in the paper's layout.
-AXES: tuple[tuple[str, str], ...] = (("max_east_m", "East"), ("max_north_m", "North"))
-#: The paper's two outage tables.
-TESTS: dict[str, dict[str, str]] = {
-    "dataset": {"label": "tab-out1-exin", "title": "dataset test", "file": "outage_dataset.csv",
-                "caption": "The max position error (m) among different algorithms in the dataset test"},
-    "field": {"label": "tab-real", "title": "field test", "file": "outage_field.csv",
-              "caption": "The max position error among different algorithms in the real field test"},
-}
-#: Decimals of the paper's tables: values equal at this precision are called equal.
-DECIMALS = 1
-
-PAPER_DIR = DATA_DIR / "paper"
 
 
 # ----------------------------------------------------------------------------------------------- reading
@@ -82,50 +69,7 @@ def missing_note(path: str | Path, what: str, producer: str) -> str:
     return f"*`{rel(path)}` is missing: {what} was not produced for this profile ({producer}).*"
 
 
-def paper_outage_table(test: str, path: str | Path | None = None) -> pd.DataFrame:
-    """The paper's max errors of ``test`` (``dataset`` or ``field``): ``outage, method, max_east_m, max_north_m``."""
-    p = pd.read_csv(path or PAPER_DIR / "outage_max_errors.csv")
-    if test not in set(p["test"]):
-        raise ValueError(f"no test {test!r} in the paper's table (have {sorted(set(p['test']))})")
-    return p[p["test"] == test].drop(columns="test").reset_index(drop=True)
-
-
-def paper_claims(path: str | Path | None = None) -> dict:
-    """``data/paper/claims.yaml``: the percentages the paper states in its text."""
-    import yaml
-
-    return yaml.safe_load(Path(path or PAPER_DIR / "claims.yaml").read_text(encoding="utf-8"))
-
-
-def claim_for(claims: dict, test: str, outage: int) -> dict | None:
-    """The paper's stated BGFN reduction against INS (``{'east': %, 'north': %}``) for one outage, if any."""
-    return (claims.get("bgfn_reduction_vs_ins_pct") or {}).get(f"{test}_outage{int(outage)}")
-
-
 # ----------------------------------------------------------------------------------------------- tables
-def paper_layout(ours: pd.DataFrame | None, paper: pd.DataFrame | None, methods: Sequence[str] = PAPER_METHODS,
-                 ours_label: str = "ours", paper_label: str = "paper") -> pd.DataFrame:
-    """Max east/north errors in the paper's layout, ours beside the paper's.
-
-    Rows ``Outage k``; columns a MultiIndex ``(source, method, axis)`` with source ``ours_label`` then
-    ``paper_label``, methods in ``methods`` order and axis ``East``/``North``. Values are joined on
-    ``(outage, method)``; a value one side lacks is NaN.
-    """
-    frames = [(ours_label, ours), (paper_label, paper)]
-    outages = sorted({int(o) for _, df in frames if df is not None for o in df["outage"]})
-    cols, data = [], {}
-    for src, df in frames:
-        lookup = {} if df is None else {(int(r.outage), r.method): r for r in df.itertuples(index=False)}
-        for m in methods:
-            for col, axis in AXES:
-                cols.append((src, m, axis))
-                data[(src, m, axis)] = [float(getattr(lookup[(o, m)], col)) if (o, m) in lookup else np.nan
-                                        for o in outages]
-    out = pd.DataFrame(data, index=pd.Index([f"Outage {o}" for o in outages], name="Max Position Error (m)"),
-                       columns=pd.MultiIndex.from_tuples(cols, names=["source", "method", "axis"]))
-    return out
-
-
 def best_mask(layout: pd.DataFrame) -> pd.DataFrame:
     """True where a value is the smallest of its row among the methods of one source and axis (ties: all)."""
     mask = pd.DataFrame(False, index=layout.index, columns=layout.columns)
@@ -276,7 +220,6 @@ TRAINING_COLUMNS: dict[str, str] = {
     "val_rmse_m_mean": "val. RMSE (m)", "val_rmse_m_std": "std over seeds (m)",
     **{col: f"{label} (m)" for col, label in REFERENCE_LABELS.items()}}
 #: Method ids of the model cards and training tables -> labels of the paper's tables.
-METHOD_LABELS: dict[str, str] = {"bgfn": "BGFN", "transformer": "Transformer", "at_lstm": "AT-LSTM", "mlp": "MLP"}
 
 
 def fmt_num(v) -> str:
@@ -307,7 +250,7 @@ def training_table(summary: pd.DataFrame | None, times: pd.DataFrame | None = No
     if times is not None:
         summary = summary.merge(times, on=["dataset", "method"], how="left")
     cols = [c for c in TRAINING_COLUMNS if c in summary.columns]
-    shown = summary.assign(method=summary["method"].map(lambda m: METHOD_LABELS.get(m, m)))
+    shown = summary.assign(method=summary["method"].map(lambda m: label(m)))
     return shown.set_index(["dataset", "method"])[cols].rename(columns=TRAINING_COLUMNS)
 
 
@@ -334,7 +277,7 @@ def model_cards(profile: str, dataset: str, results_root: str | Path | None = No
 
     d = Path(results_root or RESULTS_ROOT) / profile / "models" / dataset
     cards = []
-    for p in sorted(d.glob("*_seed*.json")):
+    for p in checkpoints.cards(d):
         try:
             cards.append({**json.loads(p.read_text(encoding="utf-8")), "_file": rel(p)})
         except json.JSONDecodeError:
@@ -412,13 +355,11 @@ def short_source(paths: Sequence[str | Path], profile: str, **facts: Any) -> str
 
 def outage_datasets(evaluation: dict | None) -> dict[str, str]:
     """``{test: dataset}`` of the outage tables, from ``outage_evaluation.json`` (its ``datasets`` in order)."""
-    from bgfn.evaluate import PAPER_TESTS
-
     if not evaluation:
         return {}
     out = {}
     for name in evaluation.get("datasets", []):
-        test = PAPER_TESTS.get(name)
+        test = test_of(name)
         if test and test not in out:
             out[test] = name
     return out
@@ -665,7 +606,8 @@ def outage_provenance(profile: str, test: str, results: str | Path, evaluation: 
     ev = (evaluation or {}).get("evaluate", {})
     seeds = ev.get("seeds")
     agg = ev.get("seed_aggregate")
-    windows = ", ".join(f"{d:g} s from {s:g} s (GPS time of week)" for s, d in ev.get("outage_windows", []))
+    windows = ", ".join(f"{d:g} s from {s:g} s (GPS time of week)"
+                        for s, d in (evaluation or {}).get("outage_windows", []))
     return provenance(results / "tables" / TESTS[test]["file"], _meta_of(evaluation), current,
                       dataset=f"`{dataset}`" if dataset else None,
                       seeds=(f"{', '.join(map(str, seeds))} ({agg} over seeds)" if seeds else None),
@@ -674,9 +616,9 @@ def outage_provenance(profile: str, test: str, results: str | Path, evaluation: 
 
 
 __all__ = [
-    "PAPER_METHODS", "BASELINES", "EXTRA_METHODS", "EXTRA_TAGS", "METHOD_LABELS", "TESTS", "PAPER_FIGURES",
+    "BASELINES", "EXTRA_METHODS", "EXTRA_TAGS", "PAPER_FIGURES",
     "EXTRA_FIGURES", "RUN_FILES", "TABLE_STYLES",
-    "read_csv", "read_json", "missing_note", "paper_outage_table", "paper_claims", "claim_for", "paper_layout",
+    "read_csv", "read_json", "missing_note",
     "best_mask", "style_layout", "compact", "reductions", "reduction_comparison", "energy_table", "kf_table",
     "training_table", "sweep_table", "fmt_num", "model_cards", "cards_line", "meta_line", "provenance",
     "short_source", "outage_datasets", "outage_provenance", "run_header", "win_counts", "summary_sentence",
@@ -748,7 +690,7 @@ def variant_training_table(summaries: dict[str, pd.DataFrame | None]) -> pd.Data
     for profile, s in summaries.items():
         if s is None:
             continue
-        s = s.assign(method=s["method"].map(lambda m: METHOD_LABELS.get(m, m))).set_index(["dataset", "method"])
+        s = s.assign(method=s["method"].map(lambda m: label(m))).set_index(["dataset", "method"])
         cols.append(s["val_rmse_m_mean"].rename(f"val. RMSE {profile}"))
         if ref is None:
             ref = s[[c for c in REFERENCE_LABELS if c in s.columns]].rename(columns=REFERENCE_LABELS)

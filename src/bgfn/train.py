@@ -35,6 +35,7 @@ import pandas as pd
 import torch
 from torch import nn
 
+from bgfn import checkpoints
 from bgfn.config import results_dir
 from bgfn.errors import DataError
 from bgfn.io import atomic_path, atomic_write_json
@@ -43,6 +44,7 @@ from bgfn.learning import (REFERENCES, VAL_POSITIONS, LearningData, Normalizer, 
                            prediction_windows, reference_columns, reference_rmse, rmse, to_target_frame,
                            val_position_coverage)
 from bgfn.models import build_model, count_parameters, is_spiking
+from bgfn.nav import outages
 
 #: Defaults of the optimization keys (``train.optimizer`` of a profile).
 OPTIMIZER_DEFAULTS: dict[str, Any] = {
@@ -349,11 +351,10 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
               "options": data.options, "data": _data_fingerprint(data), "device": dev.type}
     chash = _config_hash(config)
 
-    stem = f"{method}_seed{seed}"
     out = Path(out_dir) if out_dir is not None else None
-    best_path = out / f"{stem}.pt" if out else None
-    card_path = out / f"{stem}.json" if out else None
-    last_path = out / f"{stem}.last.pt" if out else None
+    best_path = out / checkpoints.checkpoint_name(method, seed) if out else None
+    card_path = checkpoints.card_path(best_path) if out else None
+    last_path = checkpoints.last_path(best_path) if out else None
     if card_path is not None and card_path.exists() and best_path.exists():
         card = json.loads(card_path.read_text())
         if card.get("complete") and card.get("config_hash") == chash:
@@ -397,7 +398,7 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
             start_epoch, elapsed_before = st["epoch"] + 1, st["elapsed"]
 
     t0 = time.perf_counter()
-    bar = tqdm(range(start_epoch, int(o["epochs"])), desc=stem, disable=not progress, leave=False)
+    bar = tqdm(range(start_epoch, int(o["epochs"])), desc=f"{method} seed {seed}", disable=not progress, leave=False)
     for epoch in bar:
         if bad_epochs >= o["patience"]:
             break
@@ -476,13 +477,6 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
 
 
 # ----------------------------------------------------------------------------------------------- profiles
-def models_dir(profile: str, dataset: str) -> Path:
-    """``results/<profile>/models/<dataset>/``."""
-    d = results_dir(profile) / "models" / dataset
-    d.mkdir(parents=True, exist_ok=True)
-    return d
-
-
 def prepare_learning_data(cfg: dict, dataset: str, attitude=None, drive=None, outage_windows=None) -> LearningData:
     """Windows of drive ``dataset`` for the profile ``cfg`` (:func:`bgfn.config.load_profile`).
 
@@ -497,7 +491,7 @@ def prepare_learning_data(cfg: dict, dataset: str, attitude=None, drive=None, ou
     drive : Drive, optional
         Already loaded drive.
     outage_windows : sequence of (start, duration), optional
-        Evaluation outages; default :func:`evaluation_outages`.
+        Evaluation outages; default: the profile's (:func:`bgfn.nav.outages.outage_windows`).
     """
     from bgfn.data import load_drive
 
@@ -511,7 +505,7 @@ def _learning_inputs(cfg: dict, drive, attitude=None, outage_windows=None) -> tu
     """``(attitude, outage_windows, learning options)`` of the profile, defaults filled in."""
     attitude = attitude if attitude is not None else ins_attitude(drive, cfg)
     if outage_windows is None:
-        outage_windows = evaluation_outages(cfg)
+        outage_windows = outages.outage_windows(cfg)
     return attitude, outage_windows, learning_options(cfg.get("train"))
 
 
@@ -547,18 +541,6 @@ def ins_attitude(drive, cfg: dict):
     return pd.DataFrame(traj).reset_index(drop=True)
 
 
-def evaluation_outages(cfg: dict) -> list[tuple[float, float]]:
-    """The evaluation outages ``(start, duration)`` (s) that training must not see.
-
-    ``train.outage_windows`` if set, else ``evaluate.outage_windows``; DataError if neither is set.
-    """
-    ow = (cfg.get("train") or {}).get("outage_windows") or (cfg.get("evaluate") or {}).get("outage_windows")
-    if not ow:
-        raise DataError(f"params/{cfg.get('profile')}.yaml", "evaluate.outage_windows",
-                        "the evaluation outages as a list of (start, duration) in s (or train.outage_windows)")
-    return [(float(a), float(b)) for a, b in ow]
-
-
 def train_profile(profile: str, datasets=None, methods=None, seeds=None, device: str | None = None,
                   progress: bool = True, outage_windows=None) -> list[dict]:
     """Train every ``(dataset, method, seed)`` of a profile's ``train:`` section; return the cards.
@@ -572,7 +554,7 @@ def train_profile(profile: str, datasets=None, methods=None, seeds=None, device:
     for dataset in datasets or cfg["train"]["datasets"]:
         tc = tuned_train_config(cfg, profile, dataset)
         data = prepare_learning_data(cfg, dataset, outage_windows=outage_windows)
-        out = models_dir(profile, dataset)
+        out = checkpoints.models_dir(profile, dataset)
         for method in methods or tc["methods"]:
             for seed in seeds if seeds is not None else tc["seeds"]:
                 cards.append(train_model(method, data, size_config(tc, method), tc, seed=seed, out_dir=out,

@@ -24,13 +24,14 @@ import pandas as pd
 
 from bgfn.data.drive import Drive
 from bgfn.data.imu_errors import error_params
-from bgfn.data.navego import GNSS_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS, check_time, resample_imu
+from bgfn.data.navego import check_time, resample_imu
 from bgfn.errors import DataError
+from bgfn.schema import GNSS_COLUMNS, GNSS_FIX_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS
 
 #: Files of a CSV drive and their required columns.
 CSV_FILES = {
     "imu.csv": IMU_COLUMNS,
-    "gnss.csv": tuple(c for c in GNSS_COLUMNS if c not in ("v_n", "v_e", "v_d")),
+    "gnss.csv": GNSS_FIX_COLUMNS,
     "reference.csv": REFERENCE_COLUMNS,
 }
 _OPTIONAL = {"gnss.csv": ("v_n", "v_e", "v_d")}

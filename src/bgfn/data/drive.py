@@ -15,9 +15,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from bgfn.data.navego import GNSS_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS, check_time
+from bgfn.data.navego import check_time
 from bgfn.errors import DataError
 from bgfn.io import atomic_path, atomic_write_json
+from bgfn.schema import GNSS_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS
 
 _TABLES = ("reference", "imu", "gnss", "imu_bias")
 

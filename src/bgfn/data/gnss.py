@@ -18,10 +18,10 @@ import numpy as np
 import pandas as pd
 
 from bgfn.data.imu_errors import gauss_markov
-from bgfn.data.navego import GNSS_COLUMNS
 from bgfn.errors import DataError
 from bgfn.nav.earth import curvature_radii
 from bgfn.nav.transform import dcm_from_euler
+from bgfn.schema import GNSS_COLUMNS
 
 #: Default u-blox-like (NEO-M8/M9 class, open sky, no SBAS) receiver errors, m (north, east, down).
 UBLOX_DEFAULTS = {

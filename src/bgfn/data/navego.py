@@ -23,13 +23,8 @@ import pandas as pd
 import scipy.io
 
 from bgfn.errors import DataError
+from bgfn.schema import GNSS_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS
 
-#: Columns of the reference table (CONTRIBUTING.md).
-REFERENCE_COLUMNS = ("time", "lat", "lon", "h", "v_n", "v_e", "v_d", "roll", "pitch", "yaw")
-#: Columns of the IMU table.
-IMU_COLUMNS = ("time", "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z")
-#: Columns of the GNSS table.
-GNSS_COLUMNS = ("time", "lat", "lon", "h", "v_n", "v_e", "v_d", "std_n", "std_e", "std_d")
 #: Error-profile fields of a NaveGo IMU struct that are copied into ``meta['imu_errors']`` when present.
 IMU_PROFILE_FIELDS = ("arw", "vrw", "gb_sta", "ab_sta", "gb_dyn", "ab_dyn", "gb_corr", "ab_corr",
                       "gb_psd", "ab_psd", "freq", "ini_align", "ini_align_err")

@@ -20,9 +20,10 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import UnivariateSpline
 
-from bgfn.data.navego import REFERENCE_COLUMNS, check_time
+from bgfn.data.navego import check_time
 from bgfn.errors import DataError
 from bgfn.nav.earth import curvature_radii
+from bgfn.schema import REFERENCE_COLUMNS
 
 
 def time_grid(t_start: float, t_end: float, rate_hz: float) -> np.ndarray:

@@ -55,25 +55,25 @@ Modules, in the order of the protocol:
 Everything public is re-exported here: ``from bgfn import evaluate as ev; ev.evaluate_dataset(...)``.
 """
 
-from bgfn.evaluate.config import (COLORS, EVALUATE_DEFAULTS, FIGURE_METHODS, METHOD_LABELS, METRIC_COLUMNS,
-                                  PAPER_TESTS, REAL_IMU_DATASETS, SWEEP_COLUMNS, TABLE_COLUMNS, TABLE_FILES,
+from bgfn.evaluate.config import (COLORS, EVALUATE_DEFAULTS, FIGURE_METHODS, METRIC_COLUMNS,
+                                  REAL_IMU_DATASETS, SWEEP_COLUMNS, TABLE_COLUMNS, TABLE_FILES,
                                   TABLE_METHODS, choose_datasets, evaluate_config)
 from bgfn.evaluate.hybrid import (NavContext, OutageRun, gps_run, navigation_context, pseudo_gps_positions,
                                   run_outages, window_metrics)
-from bgfn.evaluate.networks import ensure_models, load_model, model_path
+from bgfn.evaluate.networks import ensure_models, load_model
 from bgfn.evaluate.plots import plot_gps_row, plot_outage, plot_sweep_boxes
 from bgfn.evaluate.sweep import (describe_sweep, run_sweep, sweep_comparisons, sweep_plan, sweep_summary,
                                  sweep_train_config)
 from bgfn.evaluate.tables import (TableResult, aggregate_seeds, describe_tables, error_reduction, error_series,
-                                  evaluate_dataset, fix_error_table, paper_claims, paper_layout, paper_values,
+                                  evaluate_dataset, fix_error_table,
                                   representative_seeds, save_table_result, table_file)
 
 __all__ = [
-    "COLORS", "EVALUATE_DEFAULTS", "FIGURE_METHODS", "METHOD_LABELS", "METRIC_COLUMNS", "NavContext", "OutageRun",
-    "PAPER_TESTS", "REAL_IMU_DATASETS", "SWEEP_COLUMNS", "TABLE_COLUMNS", "TABLE_FILES", "TABLE_METHODS",
+    "COLORS", "EVALUATE_DEFAULTS", "FIGURE_METHODS", "METRIC_COLUMNS", "NavContext", "OutageRun",
+    "REAL_IMU_DATASETS", "SWEEP_COLUMNS", "TABLE_COLUMNS", "TABLE_FILES", "TABLE_METHODS",
     "TableResult", "aggregate_seeds", "choose_datasets", "describe_sweep", "describe_tables", "ensure_models",
     "error_reduction", "error_series", "evaluate_config", "evaluate_dataset", "fix_error_table", "gps_run",
-    "load_model", "model_path", "navigation_context", "paper_claims", "paper_layout", "paper_values", "plot_gps_row", "plot_outage",
+    "load_model", "navigation_context", "plot_gps_row", "plot_outage",
     "plot_sweep_boxes", "pseudo_gps_positions", "representative_seeds", "run_outages", "run_sweep",
     "save_table_result", "sweep_comparisons", "sweep_plan", "sweep_summary", "sweep_train_config", "table_file",
     "window_metrics",

@@ -6,10 +6,9 @@ import copy
 from typing import Any, Sequence
 
 from bgfn.errors import DataError
+from bgfn.paper import METHOD_LABELS, TESTS
 
 
-#: Method id (bgfn.models) -> label of the paper's tables.
-METHOD_LABELS: dict[str, str] = {"mlp": "MLP", "at_lstm": "AT-LSTM", "bgfn": "BGFN", "transformer": "Transformer"}
 #: Rows of the outage tables, in order.
 TABLE_METHODS: tuple[str, ...] = ("INS", "MLP", "AT-LSTM", "BGFN", "Transformer", "GPS")
 #: Methods of the paper's figures and their colours (red, yellow, black, blue).
@@ -22,10 +21,8 @@ TABLE_COLUMNS: tuple[str, ...] = ("outage", "method") + METRIC_COLUMNS
 #: Columns of ``tables/outage_sweep.csv``.
 SWEEP_COLUMNS: tuple[str, ...] = ("dataset", "start_s", "duration_s", "method", "seed", "fold", "max_east_m",
                                   "max_north_m", "max_h_m", "rmse_h_m", "final_h_m")
-#: Dataset -> the paper's test it stands for (Table 1 = dataset test, Table 2 = field test).
-PAPER_TESTS: dict[str, str] = {"turin-sim-ekinox": "dataset", "navego-ekinox": "dataset",
-                               "turin-sim-mpu6000": "field", "navego-mpu6000": "field"}
-TABLE_FILES: dict[str, str] = {"dataset": "outage_dataset.csv", "field": "outage_field.csv"}
+#: The paper's test -> our outage table file (``results/<profile>/tables/``).
+TABLE_FILES: dict[str, str] = {test: spec["file"] for test, spec in TESTS.items()}
 #: Simulated dataset -> the dataset with NaveGo's recorded IMU, and the file it needs.
 REAL_IMU_DATASETS: dict[str, tuple[str, str]] = {"turin-sim-ekinox": ("navego-ekinox", "ekinox_imu.mat"),
                                                  "turin-sim-mpu6000": ("navego-mpu6000", "mpu6000_imu.mat")}
@@ -37,7 +34,6 @@ EVALUATE_DEFAULTS: dict[str, Any] = {
     "methods": ["bgfn", "transformer", "at_lstm", "mlp"],
     "seeds": None,                       # None: train.seeds
     "seed_aggregate": "median",          # 'median' over seeds, or 'first' (the first seed)
-    "outage_windows": [[138906.0, 30.0], [139170.0, 30.0]],   # (start, duration), s
     "pseudo_gps": {"std_m": None, "std_growth_m_per_s": 0.0, "fusion_rate_hz": 1.0},
     "series_rate_hz": 10.0,
     "train_missing": True,

@@ -12,6 +12,11 @@ import pandas as pd
 
 from bgfn.errors import DataError
 from bgfn.evaluate.config import EVALUATE_DEFAULTS, merge_checked
+from bgfn.learning import (ANGULAR_RATE_CHANNELS, ATTITUDE_CHANNELS, CHANNELS, EXTRA_START, IMU_CHANNELS,
+                           SPECIFIC_FORCE_CHANNELS)
+
+#: Position of the yaw in an input sample (the heading frame of a prediction is the last sample's yaw).
+YAW_CHANNEL = CHANNELS.index("yaw")
 
 
 # ----------------------------------------------------------------------------------------------- Eq. pred-gps
@@ -120,7 +125,7 @@ def navigation_context(drive, nav_section: dict | None, starts: Sequence[float])
     full = run_filter(drive.imu, initial, noise, drive.gnss, lever, snapshots=snaps,
                       gate_probability=cfg["innovation_gate"], source=drive.name)
     states = {s: full.states[f"start_{i}"] for i, s in enumerate(starts)}
-    imu = drive.imu[["accel_x", "accel_y", "accel_z", "gyro_x", "gyro_y", "gyro_z"]].to_numpy(float)
+    imu = drive.imu[list(CHANNELS[IMU_CHANNELS])].to_numpy(float)          # [M, 6] in the input layout
     tr = full.trajectory
     ttr = tr["time"].to_numpy(float)
     idx = np.clip(np.searchsorted(ttr, imu_time - 1e-6), 0, len(ttr) - 1)
@@ -203,8 +208,6 @@ class _Run:
             raise DataError(ctx.drive.name, "imu", f"IMU rows inside the outage [{start}, {self.end}]", "none")
         self.time = t_all[sel]
         self.dt = np.diff(np.concatenate([[s.time], self.time]))
-        self.gyro = np.ascontiguousarray(ctx.imu[sel, 3:6])
-        self.accel = np.ascontiguousarray(ctx.imu[sel, 0:3])
         self.times = np.concatenate([[s.time], self.time])          # output rows
         n = len(self.times)
         self.pos, self.v = s.pos.astype(float).copy(), s.v.astype(float).copy()
@@ -227,18 +230,20 @@ class _Run:
                             f"{j0 + 1} before {start}")
         pre = slice(j0 - self.n_window + 1, j0 + 1)
         self.extra = extra
-        cols = ("roll", "pitch", "yaw") + extra
-        n_feat = 9 + len(extra)
         self.t_feat = np.concatenate([t_all[pre], self.time])
-        self.feat = np.empty((self.n_window + len(self.time), n_feat))
-        self.feat[: self.n_window, :3] = np.column_stack([ctx.nav_at_imu[c][pre] for c in cols[:3]])
-        self.feat[: self.n_window, 3:9] = ctx.imu[pre]
+        self.feat = np.empty((self.n_window + len(self.time), EXTRA_START + len(extra)))      # [N + M, C]
+        self.feat[: self.n_window, ATTITUDE_CHANNELS] = np.column_stack(
+            [ctx.nav_at_imu[c][pre] for c in CHANNELS[ATTITUDE_CHANNELS]])
+        self.feat[: self.n_window, IMU_CHANNELS] = ctx.imu[pre]
         for i, c in enumerate(extra):
-            self.feat[: self.n_window, 9 + i] = ctx.nav_at_imu[c][pre]
-        self.feat[self.n_window:, 3:9] = ctx.imu[sel]
-        self.feat[self.n_window:, :3] = np.nan
+            self.feat[: self.n_window, EXTRA_START + i] = ctx.nav_at_imu[c][pre]
+        self.feat[self.n_window:, IMU_CHANNELS] = ctx.imu[sel]
+        self.feat[self.n_window:, ATTITUDE_CHANNELS] = np.nan
         if not np.all(np.isfinite(self.feat[: self.n_window])):
             raise DataError(ctx.drive.name, "attitude", "the GPS-aided solution before the outage start", "NaN")
+        # the strapdown of this run reads the same IMU samples as its network inputs
+        self.gyro = np.ascontiguousarray(self.feat[self.n_window:, ANGULAR_RATE_CHANNELS])
+        self.accel = np.ascontiguousarray(self.feat[self.n_window:, SPECIFIC_FORCE_CHANNELS])
 
     def _fill(self, r0: int, r1: int) -> None:
         """Features of output rows r0..r1 (inclusive, >= 1) from the current solution."""
@@ -249,15 +254,15 @@ class _Run:
             return
         roll, pitch, yaw = transform.euler_from_dcm(self.out_c[r0:r1 + 1])
         k0, k1 = self.n_window + r0 - 1, self.n_window + r1
-        self.feat[k0:k1, 0], self.feat[k0:k1, 1], self.feat[k0:k1, 2] = roll, pitch, yaw
+        self.feat[k0:k1, ATTITUDE_CHANNELS] = np.column_stack([roll, pitch, yaw])
         v = self.out_v[r0:r1 + 1]
         for i, c in enumerate(self.extra):
             if c in ("v_n", "v_e", "v_d"):
-                self.feat[k0:k1, 9 + i] = v[:, ("v_n", "v_e", "v_d").index(c)]
+                self.feat[k0:k1, EXTRA_START + i] = v[:, ("v_n", "v_e", "v_d").index(c)]
             elif c in DERIVED_CHANNELS:                  # (v_along, v_cross), in that order
-                self.feat[k0:k1, 9 + i] = heading_velocity(v[:, 0], v[:, 1], yaw)[DERIVED_CHANNELS.index(c)]
+                self.feat[k0:k1, EXTRA_START + i] = heading_velocity(v[:, 0], v[:, 1], yaw)[DERIVED_CHANNELS.index(c)]
             else:
-                self.feat[k0:k1, 9 + i] = self.out_pos[r0:r1 + 1, ("lat", "lon", "h").index(c)]
+                self.feat[k0:k1, EXTRA_START + i] = self.out_pos[r0:r1 + 1, ("lat", "lon", "h").index(c)]
 
     def propagate_to(self, r: int) -> None:
         """Prediction (strapdown + covariance, Eq. eq3) up to output row ``r``."""
@@ -288,7 +293,7 @@ class _Run:
         if first < 0 or last >= self.n_window + self.row:
             raise DataError("evaluate", "window", f"features up to t = {t_end:.3f} s", "not yet computed")
         x = self.feat[first:last + 1]
-        return x, float(self.t_feat[last]), float(x[-1, 2])
+        return x, float(self.t_feat[last]), float(x[-1, YAW_CHANNEL])
 
     def trajectory(self) -> pd.DataFrame:
         from bgfn.nav.strapdown import trajectory_frame
@@ -332,7 +337,7 @@ def run_outages(ctx: NavContext, windows, predictor=None, method: str = "INS", s
     list of OutageRun
         One per window, same order.
     """
-    from bgfn.learning import CHANNELS, WindowSet, encode_yaw
+    from bgfn.learning import WindowSet, encode_yaw
     from bgfn.nav import metrics
 
     pcfg = merge_checked(EVALUATE_DEFAULTS["pseudo_gps"], pseudo or {}, "evaluate.pseudo_gps")

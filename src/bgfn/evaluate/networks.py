@@ -1,4 +1,5 @@
-"""The trained networks of the evaluation: checkpoint paths, loading, and training the missing ones."""
+"""The trained networks of the evaluation: loading notebook 03's checkpoints (:mod:`bgfn.checkpoints`), and
+training the missing ones."""
 
 from __future__ import annotations
 
@@ -6,18 +7,9 @@ from pathlib import Path
 
 import numpy as np
 
+from bgfn.checkpoints import card_path, checkpoint_path
 from bgfn.errors import DataError
 from bgfn.evaluate.hybrid import NavContext
-
-
-def model_path(profile: str, dataset: str, method: str, seed: int, fold: int | None = None) -> Path:
-    """``results/<profile>/models/<dataset>/[fold<k>/]<method>_seed<seed>.pt``."""
-    from bgfn.train import models_dir
-
-    d = models_dir(profile, dataset)
-    if fold is not None:
-        d = d / f"fold{fold}"
-    return d / f"{method}_seed{seed}.pt"
 
 
 def load_model(path: str | Path):
@@ -28,7 +20,7 @@ def load_model(path: str | Path):
     from bgfn import train
 
     model = train.load_trained(path, device="cpu")
-    card = Path(path).with_suffix(".json")
+    card = card_path(path)
     model.val_rmse_m = float(json.loads(card.read_text()).get("val_rmse_m", np.nan)) if card.exists() else np.nan
     return model
 
@@ -49,7 +41,7 @@ def ensure_models(cfg: dict, profile: str, dataset: str, ctx: NavContext, method
     tc = train.tuned_train_config(cfg, profile, dataset)      # notebook 03's selected learning rates
     for method in methods:
         for seed in seeds:
-            path = model_path(profile, dataset, method, seed)
+            path = checkpoint_path(profile, dataset, method, seed)
             if not path.exists():
                 if not train_missing:
                     raise DataError(path, "checkpoint", "a network trained by notebook 03 "

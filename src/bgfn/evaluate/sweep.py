@@ -8,10 +8,12 @@ import copy
 import numpy as np
 import pandas as pd
 
+from bgfn.checkpoints import checkpoint_path
 from bgfn.errors import DataError
-from bgfn.evaluate.config import METHOD_LABELS, SWEEP_COLUMNS, TABLE_METHODS, evaluate_config
+from bgfn.evaluate.config import SWEEP_COLUMNS, TABLE_METHODS, evaluate_config
 from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
-from bgfn.evaluate.networks import load_model, model_path
+from bgfn.evaluate.networks import load_model
+from bgfn.paper import METHOD_LABELS
 
 
 def sweep_plan(drive, sweep: dict, window_samples: int = 200) -> pd.DataFrame:
@@ -111,7 +113,7 @@ def run_sweep(cfg: dict, profile: str, dataset: str, drive=None, ecfg: dict | No
         fw = [(s, dmax) for s in plan.loc[plan["fold"] == k, "start_s"]]
         if k not in data_cache:
             data_cache = {k: build_learning_data(drive.imu, attitude, drive.gnss, fw, **opts)}
-        path = model_path(profile, dataset, method, seed, fold=int(k))
+        path = checkpoint_path(profile, dataset, method, seed, fold=int(k))
         ta = time.perf_counter()
         card = train.train_model(method, data_cache[k], train.size_config(tc, method), tc, seed=seed,
                                  out_dir=path.parent, progress=False,

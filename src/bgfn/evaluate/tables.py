@@ -10,10 +10,10 @@ import numpy as np
 import pandas as pd
 
 from bgfn.data.gnss import fix_errors
-from bgfn.evaluate.config import (METHOD_LABELS, METRIC_COLUMNS, PAPER_TESTS, TABLE_COLUMNS, TABLE_FILES,
-                                   TABLE_METHODS, evaluate_config)
+from bgfn.evaluate.config import METRIC_COLUMNS, TABLE_COLUMNS, TABLE_FILES, TABLE_METHODS, evaluate_config
 from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
 from bgfn.evaluate.networks import ensure_models
+from bgfn.paper import METHOD_LABELS, test_of
 
 
 @dataclass
@@ -102,7 +102,7 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
         from bgfn.data import load_drive
 
         drive = load_drive(dataset, profile=profile)
-    windows = outages.outage_windows(drive, ecfg)
+    windows = outages.outage_windows(cfg, drive)
     ctx = navigation_context(drive, cfg.get("nav"), [s for s, _ in windows])
     if models is None:
         models = ensure_models(cfg, profile, dataset, ctx, ecfg["methods"], ecfg["seeds"], windows,
@@ -116,7 +116,7 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
              **window_metrics(r.errors, r.start, r.duration)} for r in runs]
     per_seed = pd.DataFrame(rows)
     fixes = fix_errors(drive.gnss, drive.reference, ctx.lever)
-    return TableResult(dataset, PAPER_TESTS.get(dataset, dataset), per_seed,
+    return TableResult(dataset, test_of(dataset) or dataset, per_seed,
                        aggregate_seeds(per_seed, ecfg["seed_aggregate"]), runs, models, fixes,
                        fix_error_table(fixes, windows))
 
@@ -189,41 +189,6 @@ def representative_seeds(per_seed: pd.DataFrame) -> dict:
         g = g.sort_values(["max_h_m", "seed"])
         out[(int(o), m)] = g["seed"].iloc[(len(g) - 1) // 2]
     return out
-
-
-def paper_values(test: str) -> pd.DataFrame:
-    """The paper's published max errors of ``test`` (``data/paper/outage_max_errors.csv``): columns
-    ``outage``, ``method``, ``max_east_m``, ``max_north_m``. For display beside ours only."""
-    from bgfn.config import DATA_DIR
-
-    p = pd.read_csv(DATA_DIR / "paper" / "outage_max_errors.csv")
-    return p[p["test"] == test].drop(columns="test").reset_index(drop=True)
-
-
-def paper_claims() -> dict:
-    """``data/paper/claims.yaml`` (percentages the paper states in its text)."""
-    import yaml
-
-    from bgfn.config import DATA_DIR
-
-    return yaml.safe_load((DATA_DIR / "paper" / "claims.yaml").read_text(encoding="utf-8"))
-
-
-def paper_layout(table: pd.DataFrame, paper: pd.DataFrame | None = None) -> pd.DataFrame:
-    """Max east/north errors in the paper's layout: rows ``Outage k`` (ours, then the paper's), columns
-    (method, East/North), m."""
-    methods = [m for m in TABLE_METHODS if m in set(table["method"])]
-    cols = pd.MultiIndex.from_product([methods, ["East", "North"]])
-    rows, index = [], []
-    for o in sorted(table["outage"].unique()):
-        for src, df in (("ours", table), ("paper", paper)):
-            if df is None:
-                continue
-            sub = df[df["outage"] == o].set_index("method")
-            rows.append([sub.loc[m, c] if m in sub.index else np.nan
-                         for m in methods for c in ("max_east_m", "max_north_m")])
-            index.append((f"Outage {o}", src))
-    return pd.DataFrame(rows, index=pd.MultiIndex.from_tuples(index), columns=cols)
 
 
 def error_reduction(table: pd.DataFrame, reference: str = "INS") -> pd.DataFrame:

@@ -24,13 +24,13 @@ Modules (pyins style, one concept each; SI units, radians, NED, tables as in CON
 - :mod:`~bgfn.nav.filter` -- ``run_filter(imu, initial, noise, gnss, lever_arm, outage_windows,
   pseudo_gps, t_end, snapshots) -> FilterResult`` and ``run_outage(imu, start_state, window, noise,
   lever_arm, pseudo_gps)`` (one outage from a saved state).
-- :mod:`~bgfn.nav.outages` -- ``OutageWindow``, ``check_windows``, ``outage_windows(drive, section)``,
+- :mod:`~bgfn.nav.outages` -- ``OutageWindow``, ``check_windows``, ``outage_windows(profile, drive)`` (the profile's one key),
   the pseudo-GPS hook (``PseudoFix``, ``PseudoGpsContext``, ``IncrementPseudoGps`` = Eq. pred-gps,
   ``TablePseudoGps``).
 - :mod:`~bgfn.nav.metrics` -- ``navigation_errors``, ``outage_metrics`` (max |east|, max |north|,
   horizontal RMSE, end error), ``rms_table``.
 - :mod:`~bgfn.nav.baseline` -- notebook 02: ``nav_config``, ``run_drive(drive, nav_section)``,
-  ``run_baseline``, ``save_baseline``; :mod:`~bgfn.nav.plots` -- its figures.
+  ``run_baseline(drive, cfg, windows)``, ``ins_layout``, ``save_baseline``; :mod:`~bgfn.nav.plots` -- its figures.
 """
 
 __all__ = ["run_drive"]

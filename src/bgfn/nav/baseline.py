@@ -1,10 +1,9 @@
 """Notebook 02 workflow: the KF baseline on a drive (full GPS/INS run, standalone INS in the outages).
 
-The ``nav:`` section of ``params/<profile>.yaml`` configures it (keys and defaults in ``NAV_DEFAULTS``):
+The ``nav:`` section of ``params/<profile>.yaml`` configures it (keys and defaults in ``NAV_DEFAULTS``); the
+outages are the profile's ``outage_windows`` (:func:`bgfn.nav.outages.outage_windows`).
 
 - ``datasets``: drive names for :func:`bgfn.data.load_drive` (the profile's ``data:`` section crops them);
-- ``outage_starts`` (s, time of week) and ``outage_duration_s``: the paper's two 30 s outages
-  (NaveGo's outage starts 138906 s and 139170 s);
 - ``init``: initial std ``position_std_m``, ``height_std_m``, ``velocity_std_mps``, ``level_std_deg``,
   ``azimuth_std_deg`` (P0; the filter starts from the reference's first row);
 - ``bias_model`` (``random_walk`` | ``gauss_markov``), ``noise_scale``: see
@@ -21,17 +20,16 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from .. import paper
 from ..errors import DataError
 from . import metrics
 from .filter import FilterResult, gate_thresholds, run_filter, run_outage
-from .outages import OutageWindow, check_windows, epochs_before
+from .outages import check_windows, epochs_before
 from .state import FilterNoise, FilterState, initial_covariance, initial_state, noise_from_imu_errors
 
 #: Defaults of the ``nav:`` profile section.
 NAV_DEFAULTS: dict = {
     "datasets": ["turin-sim-ekinox", "turin-sim-mpu6000"],
-    "outage_starts": [138906.0, 139170.0],
-    "outage_duration_s": 30.0,
     "init": {"position_std_m": 1.0, "height_std_m": 3.0, "velocity_std_mps": 0.1, "level_std_deg": 0.5,
              "azimuth_std_deg": 2.0},
     "bias_model": "random_walk",
@@ -56,11 +54,6 @@ def nav_config(section: dict | None) -> dict:
             cfg[key] = value
     gate_thresholds(cfg["innovation_gate"], "params nav")      # a bad probability fails here, by name
     return cfg
-
-
-def outage_windows(cfg: dict) -> list:
-    """The configured outage windows as :class:`OutageWindow` objects."""
-    return [OutageWindow(float(s), float(cfg["outage_duration_s"])) for s in cfg["outage_starts"]]
 
 
 def run_drive(drive, section: dict | None = None, snapshots: dict | None = None) -> FilterResult:
@@ -140,7 +133,7 @@ class Baseline:
     noise: FilterNoise
 
 
-def run_baseline(drive, cfg: dict) -> Baseline:
+def run_baseline(drive, cfg: dict, windows) -> Baseline:
     """Full-drive GPS/INS run, then the standalone INS in each outage from the saved state at its start.
 
     Parameters
@@ -148,13 +141,15 @@ def run_baseline(drive, cfg: dict) -> Baseline:
     drive : bgfn.data.Drive
     cfg : dict
         Output of :func:`nav_config`.
+    windows : sequence of (start, duration)
+        The outages, s (:func:`bgfn.nav.outages.outage_windows`).
 
     Returns
     -------
     Baseline
     """
-    windows = check_windows(outage_windows(cfg), float(drive.reference["time"].iloc[0]),
-                            float(drive.imu["time"].iloc[-1]), f"{drive.name} nav.outage_starts")
+    windows = check_windows(windows, float(drive.reference["time"].iloc[0]),
+                            float(drive.imu["time"].iloc[-1]), f"{drive.name}: profile outage_windows")
     initial, noise = filter_setup(drive, cfg)
     lever = drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0])
     names = [f"outage_{i + 1}" for i in range(len(windows))]
@@ -173,22 +168,35 @@ def run_baseline(drive, cfg: dict) -> Baseline:
                     pd.DataFrame(rows), noise)
 
 
-def paper_layout(outage_table: pd.DataFrame) -> pd.DataFrame:
-    """Max-error table in the paper's layout (Tables 1-2): rows ``Outage k``, columns ``INS East/North`` (m).
+def ins_layout(outage_table: pd.DataFrame, dataset: str | None = None) -> pd.DataFrame:
+    """Standalone-INS max errors in the paper's layout (:func:`bgfn.paper.layout`, method ``INS``).
 
     Parameters
     ----------
     outage_table : DataFrame
-        ``Baseline.outage_table`` of one dataset.
+        ``Baseline.outage_table`` of one dataset (one row per outage, in order).
+    dataset : str, optional
+        When it stands for one of the paper's tests (:func:`bgfn.paper.test_of`), the paper's INS row is
+        beside ours.
 
     Returns
     -------
     DataFrame
-        Columns ``outage``, ``INS_east_m``, ``INS_north_m``.
+        Rows ``Outage k``; columns ``(source, "INS", East/North)``, m.
     """
-    return pd.DataFrame({"outage": [f"Outage {i + 1}" for i in range(len(outage_table))],
-                         "INS_east_m": outage_table["max_abs_east"].round(2).to_numpy(),
-                         "INS_north_m": outage_table["max_abs_north"].round(2).to_numpy()})
+    ours = pd.DataFrame({"outage": np.arange(1, len(outage_table) + 1), "method": "INS",
+                         "max_east_m": outage_table["max_abs_east"].to_numpy(float),
+                         "max_north_m": outage_table["max_abs_north"].to_numpy(float)})
+    test = paper.test_of(dataset) if dataset else None
+    return paper.layout(ours, paper.outage_table(test) if test else None, methods=("INS",))
+
+
+def ins_max_error_file(outage_table: pd.DataFrame) -> pd.DataFrame:
+    """:func:`ins_layout` (ours) flattened for ``tables/kf_outage_max_errors_<d>.csv``: ``outage``
+    (``Outage k``), ``INS_east_m``, ``INS_north_m`` (m, 2 decimals)."""
+    ours = ins_layout(outage_table)["ours"]
+    return pd.DataFrame({"outage": list(ours.index),
+                         **{f"INS_{axis.lower()}_m": ours[("INS", axis)].round(2).to_numpy() for _, axis in paper.AXES}})
 
 
 def save_baseline(b: Baseline, out, lat=None) -> dict:
@@ -199,7 +207,7 @@ def save_baseline(b: Baseline, out, lat=None) -> dict:
     - ``nav_states_<d>.npz``: the filter states at the outage starts (:func:`bgfn.nav.state.save_states`,
       names ``outage_1``, ``outage_2``, ...), the start of every outage run of notebook 04;
     - ``tables/kf_rms_<d>.csv``: RMS / max-abs errors of the full GPS/INS run;
-    - ``tables/kf_outage_max_errors_<d>.csv``: :func:`paper_layout`;
+    - ``tables/kf_outage_max_errors_<d>.csv``: :func:`ins_max_error_file`;
     - ``tables/kf_outage_metrics_<d>.csv``: all outage metrics;
     - ``tables/kf_outage_errors_<d>.csv``: standalone-INS error series (``outage``, ``t_rel``, ``east``,
       ``north``, ``down``, ``horizontal``, m).
@@ -218,7 +226,7 @@ def save_baseline(b: Baseline, out, lat=None) -> dict:
     d = b.drive_name
     save_states(out / f"nav_states_{d}.npz", b.states)
     atomic_write_csv(out / "tables" / f"kf_rms_{d}.csv", b.rms.reset_index(), float_format="%.6g")
-    atomic_write_csv(out / "tables" / f"kf_outage_max_errors_{d}.csv", paper_layout(b.outage_table))
+    atomic_write_csv(out / "tables" / f"kf_outage_max_errors_{d}.csv", ins_max_error_file(b.outage_table))
     atomic_write_csv(out / "tables" / f"kf_outage_metrics_{d}.csv", b.outage_table, float_format="%.6g")
     series = pd.concat([e.assign(outage=name)[["outage", "t_rel", "east", "north", "down", "horizontal"]]
                         for name, e in b.outage_errors.items()], ignore_index=True)
@@ -232,7 +240,7 @@ def save_baseline(b: Baseline, out, lat=None) -> dict:
             "states_file": f"nav_states_{d}.npz"}
 
 
-def gate_comparison(drive, cfg: dict, probability: float, baseline: Baseline | None = None) -> pd.DataFrame:
+def gate_comparison(drive, cfg: dict, windows, probability: float, baseline: Baseline | None = None) -> pd.DataFrame:
     """The baseline of ``drive`` without and with an innovation gate on the GNSS fixes (notebook 02).
 
     Parameters
@@ -240,6 +248,8 @@ def gate_comparison(drive, cfg: dict, probability: float, baseline: Baseline | N
     drive : bgfn.data.Drive
     cfg : dict
         Output of :func:`nav_config`; its ``innovation_gate`` is replaced by None and by ``probability``.
+    windows : sequence of (start, duration)
+        The outages, s (as for :func:`run_baseline`).
     probability : float
         Chi-square probability of the gate (:func:`bgfn.nav.filter.gate_thresholds`).
     baseline : Baseline, optional
@@ -256,7 +266,7 @@ def gate_comparison(drive, cfg: dict, probability: float, baseline: Baseline | N
     rows = []
     for gate in (None, probability):
         same = baseline is not None and gate == cfg["innovation_gate"]
-        b = baseline if same else run_baseline(drive, {**cfg, "innovation_gate": gate})
+        b = baseline if same else run_baseline(drive, {**cfg, "innovation_gate": gate}, windows)
         upd = b.full.updates
         row = {"dataset": drive.name, "innovation_gate": "none" if gate is None else f"{gate:g}",
                "gnss_fixes": int(len(upd)), "gnss_rejected": int((~upd["accepted"]).sum()),

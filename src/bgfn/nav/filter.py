@@ -26,13 +26,13 @@ import numpy as np
 import pandas as pd
 
 from ..errors import DataError
+from ..schema import GNSS_FIX_COLUMNS
 from . import error_model as em
 from .error_model import process_noise_nb, system_matrix_nb
 from .outages import OutageWindow, PseudoGpsContext, check_windows
 from .state import FilterNoise, FilterState
 from .strapdown import imu_steps, radii_nb, rotvec_to_dcm_nb, step_inplace, trajectory_frame
 
-GNSS_COLUMNS = ["time", "lat", "lon", "h", "std_n", "std_e", "std_d"]
 #: Pseudo-GPS epochs per second inside an outage (the GNSS rate of the Turin drive).
 PSEUDO_RATE_HZ = 1.0
 
@@ -238,9 +238,9 @@ def gate_thresholds(probability: float | None, source: str = "nav") -> np.ndarra
 
 
 def _check_gnss(gnss, source):
-    missing = [c for c in GNSS_COLUMNS if c not in gnss.columns]
+    missing = [c for c in GNSS_FIX_COLUMNS if c not in gnss.columns]
     if missing:
-        raise DataError(source, ",".join(missing), "gnss columns " + ", ".join(GNSS_COLUMNS), "missing")
+        raise DataError(source, ",".join(missing), "gnss columns " + ", ".join(GNSS_FIX_COLUMNS), "missing")
     t = gnss["time"].to_numpy(dtype=float)
     if t.size > 1 and not np.all(np.diff(t) > 0):
         raise DataError(source, "time", "strictly increasing GNSS times")
@@ -303,7 +303,7 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
     events = []
     if gnss is not None and len(gnss):
         _check_gnss(gnss, source + ":gnss")
-        g = gnss[GNSS_COLUMNS].to_numpy(dtype=float)
+        g = gnss[list(GNSS_FIX_COLUMNS)].to_numpy(dtype=float)
         inside = (g[:, 0] > t0 + 1e-9) & (g[:, 0] <= times[-1] + 1e-9)
         for w in windows:
             inside &= ~w.contains(g[:, 0])
@@ -434,4 +434,4 @@ def run_outage(imu: pd.DataFrame, start_state: FilterState, window, noise: Filte
                       pseudo_gps, t_end=w.end, pseudo_rate_hz=pseudo_rate_hz, source=source)
 
 
-__all__ = ["FilterResult", "run_filter", "run_outage", "gate_thresholds", "GNSS_COLUMNS"]
+__all__ = ["FilterResult", "run_filter", "run_outage", "gate_thresholds"]

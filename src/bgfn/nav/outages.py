@@ -83,11 +83,6 @@ def check_windows(windows, t_first: float, t_last: float, source: str = "outage_
     return out
 
 
-#: NaveGo's outage starts (GPS time of week, s) and the paper's outage length (s).
-NAVEGO_OUTAGE_STARTS = (138906.0, 139170.0)
-OUTAGE_DURATION_S = 30.0
-
-
 def epochs_before(imu_time, starts, source: str = "outage_windows") -> np.ndarray:
     """The last IMU epoch strictly before each outage start, s.
 
@@ -112,30 +107,33 @@ def epochs_before(imu_time, starts, source: str = "outage_windows") -> np.ndarra
     return imu_time[before]
 
 
-def outage_windows(drive=None, section: dict | None = None) -> list:
-    """The evaluation outages ``[(start, duration), ...]`` (s) of a profile section.
+def outage_windows(profile: dict, drive=None) -> list[tuple[float, float]]:
+    """The evaluation outages ``[(start, duration), ...]`` (s): the profile's top-level ``outage_windows``.
+
+    The one reader of this fact: notebook 01 draws the windows, 02 runs the standalone INS in them, 03 keeps
+    them (and a margin) out of training, 04 evaluates every method in them.
 
     Parameters
     ----------
+    profile : dict
+        A profile (:func:`bgfn.config.load_profile`), which checked the list's form.
     drive : bgfn.data.Drive, optional
-        When given, the windows are checked against its time span.
-    section : dict, optional
-        A profile section with ``outage_windows`` (list of (start, duration)) or ``outage_starts`` and
-        ``outage_duration_s``; defaults: NaveGo's starts, 30 s.
+        When given, the windows are checked against its time span (:func:`check_windows`).
 
     Returns
     -------
     list of (float, float)
+        In the profile's order.
     """
-    section = section or {}
-    if section.get("outage_windows") is not None:
-        pairs = [tuple(map(float, w)) for w in section["outage_windows"]]
-    else:
-        d = float(section.get("outage_duration_s", OUTAGE_DURATION_S))
-        pairs = [(float(s), d) for s in section.get("outage_starts", NAVEGO_OUTAGE_STARTS)]
+    windows = profile.get("outage_windows")
+    if not windows:
+        raise DataError(f"profile {profile.get('profile')!r}", "outage_windows",
+                        "the evaluation outages, a list of [start, duration] in s", repr(windows))
+    pairs = [(float(s), float(d)) for s, d in windows]
     if drive is not None:
         t = drive.imu["time"].to_numpy(dtype=float)
-        check_windows(pairs, float(drive.reference["time"].iloc[0]), float(t[-1]), f"{drive.name} outages")
+        check_windows(pairs, float(drive.reference["time"].iloc[0]), float(t[-1]),
+                      f"{drive.name}: profile outage_windows")
     return pairs
 
 

@@ -21,7 +21,8 @@ import pandas as pd
 
 from ..errors import DataError
 from . import earth, transform
-from .strapdown import REFERENCE_COLUMNS, position_step_nb
+from ..schema import REFERENCE_COLUMNS
+from .strapdown import position_step_nb
 
 
 def imu_from_trajectory(reference, source="reference"):

@@ -23,13 +23,10 @@ import numpy as np
 import pandas as pd
 
 from ..errors import DataError
+from ..schema import ACCEL_COLUMNS, GYRO_COLUMNS, IMU_COLUMNS
 from . import transform
 from .earth import A, E2, F, GAMMA_E, K_SOMIGLIANA, M_RATIO, OMEGA_IE
 
-REFERENCE_COLUMNS = ["time", "lat", "lon", "h", "v_n", "v_e", "v_d", "roll", "pitch", "yaw"]
-GYRO_COLUMNS = ["gyro_x", "gyro_y", "gyro_z"]
-ACCEL_COLUMNS = ["accel_x", "accel_y", "accel_z"]
-IMU_COLUMNS = ["time"] + GYRO_COLUMNS + ACCEL_COLUMNS
 #: An IMU step longer than this many nominal (median) steps is a gap, not a sample.
 MAX_GAP_SAMPLES = 5
 
@@ -259,8 +256,8 @@ def imu_steps(imu, t0, source="imu"):
     if dt[0] > (MAX_GAP_SAMPLES + 0.5) * nominal:
         raise DataError(source, "time", f"an IMU row within {MAX_GAP_SAMPLES} samples after t0={t0}",
                         f"first row at {time[0]}")
-    gyro = np.ascontiguousarray(imu.loc[sel, GYRO_COLUMNS].to_numpy(dtype=float))
-    accel = np.ascontiguousarray(imu.loc[sel, ACCEL_COLUMNS].to_numpy(dtype=float))
+    gyro = np.ascontiguousarray(imu.loc[sel, list(GYRO_COLUMNS)].to_numpy(dtype=float))
+    accel = np.ascontiguousarray(imu.loc[sel, list(ACCEL_COLUMNS)].to_numpy(dtype=float))
     if not (np.all(np.isfinite(gyro)) and np.all(np.isfinite(accel))):
         raise DataError(source, "gyro/accel", "finite IMU readings", "NaN or inf")
     return time, gyro, accel, dt

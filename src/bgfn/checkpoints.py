@@ -1,0 +1,88 @@
+"""Where trained networks live, and how their file names are built and read back.
+
+One network = one ``(dataset, method, seed)`` of a profile (a fold ``k`` for the outage sweep's networks)::
+
+    results/<profile>/models/<dataset>/[fold<k>/]<method>_seed<seed>.pt        best checkpoint (bgfn.train)
+                                                 <method>_seed<seed>.json      its card (metrics, config hash)
+                                                 <method>_seed<seed>.last.pt   while training: resumable state
+
+Every module builds these names with :func:`checkpoint_path` (or :func:`checkpoint_name` under a folder it
+was given) and reads them back with :func:`parse_checkpoint`; nothing else spells the pattern.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import NamedTuple
+
+from bgfn.config import results_dir
+
+#: Suffixes of the three files of one network.
+BEST_SUFFIX, CARD_SUFFIX, LAST_SUFFIX = ".pt", ".json", ".last.pt"
+_NAME_RE = re.compile(r"^(?P<method>[A-Za-z0-9_]+?)_seed(?P<seed>\d+)(?P<suffix>\.last\.pt|\.pt|\.json)$")
+_FOLD_RE = re.compile(r"^fold(?P<fold>\d+)$")
+
+
+class Checkpoint(NamedTuple):
+    """What a checkpoint's path says: ``method`` id, training ``seed`` and sweep ``fold`` (None: notebook 03's)."""
+
+    method: str
+    seed: int
+    fold: int | None = None
+
+
+def checkpoint_name(method: str, seed: int, suffix: str = BEST_SUFFIX) -> str:
+    """``<method>_seed<seed><suffix>`` (suffix :data:`BEST_SUFFIX`, :data:`CARD_SUFFIX` or :data:`LAST_SUFFIX`)."""
+    return f"{method}_seed{int(seed)}{suffix}"
+
+
+def models_dir(profile: str, dataset: str, fold: int | None = None, create: bool = True) -> Path:
+    """``results/<profile>/models/<dataset>/`` (``.../fold<k>/`` for a sweep fold), created unless ``create``
+    is False."""
+    d = results_dir(profile, create=create) / "models" / dataset
+    if fold is not None:
+        d = d / f"fold{int(fold)}"
+    if create:
+        d.mkdir(parents=True, exist_ok=True)
+    return d
+
+
+def checkpoint_path(profile: str, dataset: str, method: str, seed: int, fold: int | None = None,
+                    create: bool = True) -> Path:
+    """``results/<profile>/models/<dataset>/[fold<k>/]<method>_seed<seed>.pt``."""
+    return models_dir(profile, dataset, fold, create) / checkpoint_name(method, seed)
+
+
+def card_path(checkpoint: str | Path) -> Path:
+    """The JSON card beside a best checkpoint ``<stem>.pt``."""
+    p = Path(checkpoint)
+    return p.with_name(p.name[: -len(BEST_SUFFIX)] + CARD_SUFFIX)
+
+
+def last_path(checkpoint: str | Path) -> Path:
+    """The resumable state beside a best checkpoint ``<stem>.pt``."""
+    p = Path(checkpoint)
+    return p.with_name(p.name[: -len(BEST_SUFFIX)] + LAST_SUFFIX)
+
+
+def parse_checkpoint(path: str | Path) -> Checkpoint:
+    """Method, seed and fold of a network's file (``.pt``, ``.json`` or ``.last.pt``).
+
+    Raises
+    ------
+    ValueError
+        The name is not ``<method>_seed<k>`` with one of the three suffixes.
+    """
+    p = Path(path)
+    m = _NAME_RE.match(p.name)
+    if m is None:
+        raise ValueError(f"{p}: not a network file <method>_seed<k>{{{BEST_SUFFIX},{CARD_SUFFIX},{LAST_SUFFIX}}}")
+    fold = _FOLD_RE.match(p.parent.name)
+    return Checkpoint(m["method"], int(m["seed"]), int(fold["fold"]) if fold else None)
+
+
+def cards(folder: str | Path) -> list[Path]:
+    """The cards ``<method>_seed<k>.json`` directly in ``folder`` (sorted; fold folders not entered)."""
+    folder = Path(folder)
+    return sorted(p for p in folder.glob(f"*{CARD_SUFFIX}") if _NAME_RE.match(p.name))

@@ -1,0 +1,124 @@
+"""The paper's published values and its vocabulary, in one place.
+
+Everything this artifact knows about what the paper *reports* lives here: its outage tables
+(``data/paper/outage_max_errors.csv``), the numbers it states in its text (``data/paper/claims.yaml``), the
+labels of its methods, which of our datasets stands for which of its tests, and the one function that lays
+a table out as the paper does (rows ``Outage k``, columns method x East/North). The values are shown beside
+ours in a column labelled *paper*; no code reads them to choose a parameter, a seed or a stopping point.
+
+Vocabulary
+----------
+- *test*: ``dataset`` (the paper's Table ``tab-out1-exin``, NaveGo's Turin drive, Ekinox-D IMU) or ``field``
+  (Table ``tab-real``, the paper's own car with an MPU-6000 IMU);
+- *method label*: how a table names a method (``INS``, ``MLP``, ``AT-LSTM``, ``BGFN``, and ours beyond the
+  paper: ``Transformer``, ``GPS``); a *method id* is the key of :mod:`bgfn.models` (``bgfn``, ``mlp``, ...).
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from typing import Sequence
+
+import numpy as np
+import pandas as pd
+
+from bgfn.config import DATA_DIR
+
+#: Folder of the transcribed values (see its README.md).
+PAPER_DIR = DATA_DIR / "paper"
+#: The paper's Tables tab-out1-exin and tab-real: ``test, outage, method, max_east_m, max_north_m``.
+OUTAGE_TABLE_FILE = PAPER_DIR / "outage_max_errors.csv"
+#: Percentages and settings the paper states in its text.
+CLAIMS_FILE = PAPER_DIR / "claims.yaml"
+
+#: Method id (bgfn.models) -> label in the tables (the paper's labels; Transformer is ours: BGFN's ANN twin).
+METHOD_LABELS: dict[str, str] = {"mlp": "MLP", "at_lstm": "AT-LSTM", "bgfn": "BGFN", "transformer": "Transformer"}
+#: The paper's methods, in the order of its tables.
+PAPER_METHODS: tuple[str, ...] = ("INS", "MLP", "AT-LSTM", "BGFN")
+#: Max-error columns of an outage table and their axis labels in the paper's layout.
+AXES: tuple[tuple[str, str], ...] = (("max_east_m", "East"), ("max_north_m", "North"))
+#: Decimals of the paper's tables: values equal at this precision are called equal.
+DECIMALS = 1
+
+#: The paper's two outage tests: its table label, our title, our table file (``results/<profile>/tables/``)
+#: and the paper's caption.
+TESTS: dict[str, dict[str, str]] = {
+    "dataset": {"label": "tab-out1-exin", "title": "dataset test", "file": "outage_dataset.csv",
+                "caption": "The max position error (m) among different algorithms in the dataset test"},
+    "field": {"label": "tab-real", "title": "field test", "file": "outage_field.csv",
+              "caption": "The max position error among different algorithms in the real field test"},
+}
+#: Our dataset -> the paper's test it stands for.
+DATASET_TESTS: dict[str, str] = {"turin-sim-ekinox": "dataset", "navego-ekinox": "dataset",
+                                 "turin-sim-mpu6000": "field", "navego-mpu6000": "field"}
+
+
+def test_of(dataset: str) -> str | None:
+    """The paper's test (``dataset`` | ``field``) that ``dataset`` stands for, or None."""
+    return DATASET_TESTS.get(dataset)
+
+
+def label(method: str) -> str:
+    """Table label of a method id (``bgfn`` -> ``BGFN``); a label or unknown name is returned as given."""
+    return METHOD_LABELS.get(method, method)
+
+
+@lru_cache(maxsize=None)
+def _outage_values() -> pd.DataFrame:
+    return pd.read_csv(OUTAGE_TABLE_FILE)
+
+
+def outage_table(test: str) -> pd.DataFrame:
+    """The paper's max errors of one test: ``outage, method, max_east_m, max_north_m`` (m).
+
+    Raises
+    ------
+    ValueError
+        ``test`` is not one of the paper's tests.
+    """
+    p = _outage_values()
+    if test not in set(p["test"]):
+        raise ValueError(f"no test {test!r} in {OUTAGE_TABLE_FILE.name} (have {sorted(set(p['test']))})")
+    return p[p["test"] == test].drop(columns="test").reset_index(drop=True)
+
+
+def claims() -> dict:
+    """``data/paper/claims.yaml``: the percentages and settings the paper states in its text."""
+    import yaml
+
+    return yaml.safe_load(CLAIMS_FILE.read_text(encoding="utf-8"))
+
+
+def claim_for(claims: dict, test: str, outage: int) -> dict | None:
+    """The paper's stated BGFN reduction against INS (``{'east': %, 'north': %}``) for one outage, if any."""
+    return (claims.get("bgfn_reduction_vs_ins_pct") or {}).get(f"{test}_outage{int(outage)}")
+
+
+def layout(ours: pd.DataFrame | None, paper: pd.DataFrame | None, methods: Sequence[str] = PAPER_METHODS,
+           ours_label: str = "ours", paper_label: str = "paper") -> pd.DataFrame:
+    """Max east/north errors in the paper's layout, ours beside the paper's.
+
+    Parameters
+    ----------
+    ours, paper : DataFrame or None
+        Long tables with ``outage`` (int), ``method`` (label), ``max_east_m``, ``max_north_m`` (m).
+    methods : sequence of str
+        Method labels, in column order.
+
+    Returns
+    -------
+    DataFrame
+        Rows ``Outage k``; columns a MultiIndex ``(source, method, axis)`` with source ``ours_label`` then
+        ``paper_label``, axis ``East``/``North``. A value one side lacks (or a side given as None) is NaN.
+    """
+    frames = [(ours_label, ours), (paper_label, paper)]
+    outages = sorted({int(o) for _, df in frames if df is not None for o in df["outage"]})
+    data = {}
+    for src, df in frames:
+        lookup = {} if df is None else {(int(r.outage), r.method): r for r in df.itertuples(index=False)}
+        for m in methods:
+            for col, axis in AXES:
+                data[(src, m, axis)] = [float(getattr(lookup[(o, m)], col)) if (o, m) in lookup else np.nan
+                                        for o in outages]
+    return pd.DataFrame(data, index=pd.Index([f"Outage {o}" for o in outages], name="Max Position Error (m)"),
+                        columns=pd.MultiIndex.from_tuples(list(data), names=["source", "method", "axis"]))

@@ -205,7 +205,8 @@ def size_config(train_cfg: dict, method: str, size: str | None = None) -> dict:
         raise DataError("train.sizes", f"{method}.{size}", "a size block for this method and size") from None
 
 
-def _even_subset(n: int, k: int | None) -> np.ndarray:
+def even_subset(n: int, k: int | None) -> np.ndarray:
+    """Indices of ``k`` evenly spaced items of ``n`` (all when ``k`` is None or >= n), sorted and unique."""
     if k is None or k >= n:
         return np.arange(n)
     return np.unique(np.linspace(0, n - 1, int(k)).round().astype(int))
@@ -340,8 +341,8 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
     if o["num_threads"]:
         torch.set_num_threads(int(o["num_threads"]))
 
-    tr_idx = _even_subset(len(data.train), o["max_train_windows"])
-    va_idx = _even_subset(len(data.val), o["max_val_windows"])
+    tr_idx = even_subset(len(data.train), o["max_train_windows"])
+    va_idx = even_subset(len(data.val), o["max_val_windows"])
     train_ws, val_ws = data.train.subset(tr_idx), data.val.subset(va_idx)
     if len(train_ws) == 0 or len(val_ws) == 0:
         raise DataError("train", "windows", "at least one training and one validation window",

@@ -16,6 +16,21 @@ SHELL := bash
 MAKEFLAGS += --no-builtin-rules --no-print-directory
 .DEFAULT_GOAL := help
 
+# make splits file names at spaces: a checkout path with one cannot work, so say so before anything is made.
+ifneq ($(words $(CURDIR) $(MAKEFILE_LIST)),2)
+$(error the path "$(CURDIR)" or "$(MAKEFILE_LIST)" contains a space; make cannot handle it -- move or clone the repository to a path without spaces)
+endif
+
+# Every path below is relative to the repository root. `make -f <root>/Makefile` from elsewhere re-runs make
+# there (`make -C <root>` needs nothing: make changes directory first).
+ROOT := $(patsubst %/,%,$(dir $(abspath $(lastword $(MAKEFILE_LIST)))))
+ifneq ($(ROOT),$(CURDIR))
+$(or $(MAKECMDGOALS),help):
+	@$(MAKE) -C "$(ROOT)" -f Makefile $@
+.PHONY: $(or $(MAKECMDGOALS),help)
+else
+
+
 PROFILE ?= quick
 VENV ?= .venv
 # Interpreter that creates the venv (the project pins Python 3.11).
@@ -60,7 +75,12 @@ export MPLBACKEND := Agg
 export PYDEVD_DISABLE_FILE_VALIDATION := 1
 export PYTHONHASHSEED := 0
 
-.PHONY: help reproduce notebooks book test bench clean distclean venv data lock strip
+.PHONY: help reproduce notebooks book test bench clean clean-debris distclean venv data lock strip
+
+# A profile is a plain name (params/<name>.yaml); anything with a path in it would write outside results/.
+ifneq ($(shell printf '%s' '$(PROFILE)' | grep -Ex '[A-Za-z0-9][A-Za-z0-9_-]*'),$(PROFILE))
+$(error PROFILE '$(PROFILE)' is not a profile name: expected letters, digits, '_' or '-' naming params/<name>.yaml)
+endif
 
 ifneq ($(filter reproduce notebooks book,$(MAKECMDGOALS)),)
 ifeq ($(wildcard $(PARAMS)),)
@@ -113,6 +133,7 @@ data: $(STAMP)
 # no executed notebook behind (and Make redoes it next time).
 $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(PARAMS) $(SRC) $(STAMP) | data
 	@mkdir -p $(@D)
+	@$(MAKE) clean-debris
 	@echo "==> [$(PROFILE)] papermill $<"
 	@tmp="$(@D)/.$*.running-$$$$.ipynb"; \
 	if $(VENV_ABS)/bin/papermill "$<" "$$tmp" -p profile $(PROFILE) --cwd "$(CURDIR)" -k python3 \
@@ -144,6 +165,7 @@ define build_book
 	@rm -rf book/notebooks book/_generated && mkdir -p book/notebooks book/_generated
 	@cp $(EXEC) book/notebooks/
 	@for d in tables figures; do if [ -d "$(RES)/$$d" ]; then cp -r "$(RES)/$$d" book/_generated/; fi; done
+	@find book/notebooks book/_generated -name '.*' -type f -delete   # never a temporary or hidden file
 	@if [ -f "$(RES)/findings.md" ]; then cp "$(RES)/findings.md" book/_generated/; else \
 	  echo "No findings yet: notebook 06 of profile \`$(PROFILE)\` has not written them." > book/_generated/findings.md; fi
 	@printf '%s\n' "Built from the executed notebooks of profile \`$(PROFILE)\` (\`params/$(PROFILE).yaml\`)," \
@@ -189,8 +211,16 @@ strip: $(STAMP)
 	  print("stripped:", " ".join(dirty) if dirty else "nothing (all notebooks clean)")'
 
 # ---------------------------------------------------------------- cleaning
+# Debris of an interrupted run of $(PROFILE): papermill's temporary notebooks and half-written outputs
+# (bgfn.io.atomic_path names them .<name>.<random>.tmp<suffix>). Notebooks run one at a time, so none is live.
+clean-debris:
+	@if [ -d "$(RES)" ]; then find "$(RES)" -type f \( -name '.*.running-*.ipynb' -o -name '.*.tmp*' \) \
+	  -print -delete | sed 's/^/    removed debris of an interrupted run: /'; fi
+
 clean:
 	rm -rf results book/_build book/notebooks book/_generated
 
 distclean: clean
 	rm -rf $(VENV) data/processed
+
+endif  # ROOT == CURDIR

@@ -103,6 +103,21 @@ def test_cache_is_written_atomically_and_reused(env, monkeypatch):
         load_drive("turin-sim-ekinox", gnss_rate_hz=1.0, seed=1, **env)  # other parameters: other key
 
 
+def test_a_truncated_cache_entry_is_rebuilt_with_a_line_saying_so(env, caplog):
+    d1 = load_drive("turin-sim-ekinox", gnss_rate_hz=1.0, **env)
+    folder = env["data_dir"] / "processed" / "turin-sim-ekinox"
+    npz = next(folder.glob("*.npz"))
+    npz.write_bytes(npz.read_bytes()[:1000])                     # an interrupted copy: not a zip any more
+    with caplog.at_level("WARNING"):
+        d2 = load_drive("turin-sim-ekinox", gnss_rate_hz=1.0, **env)
+    assert "unreadable" in caplog.text and npz.name in caplog.text
+    pd.testing.assert_frame_equal(d1.imu, d2.imu, check_exact=True)
+    assert npz.stat().st_size > 1000                              # rewritten whole
+    caplog.clear()
+    load_drive("turin-sim-ekinox", gnss_rate_hz=1.0, **env)
+    assert "unreadable" not in caplog.text                        # and read back from now on
+
+
 def test_a_new_entry_removes_the_entries_of_other_code(env):
     folder = env["data_dir"] / "processed" / "turin-sim-mpu6000"
     folder.mkdir(parents=True)

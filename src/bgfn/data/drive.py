@@ -9,6 +9,8 @@ it is incomplete and ignored. Entries written by other code can never be read ag
 from __future__ import annotations
 
 import json
+import logging
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -21,6 +23,7 @@ from bgfn.io import atomic_path, atomic_write_json
 from bgfn.schema import GNSS_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS
 
 _TABLES = ("reference", "imu", "gnss", "imu_bias")
+log = logging.getLogger(__name__)
 
 
 @dataclass
@@ -127,7 +130,11 @@ def save_drive(drive: Drive, stem: str | Path, key: str, code: str | None = None
 
 
 def load_cached(stem: str | Path, key: str) -> Drive | None:
-    """Read a cache entry written by :func:`save_drive`; None when absent, incomplete or stale."""
+    """Read a cache entry written by :func:`save_drive`; None when absent, incomplete, stale or unreadable.
+
+    An entry that exists but cannot be read (a truncated ``.npz``, a corrupt JSON) is reported with one
+    warning line and treated as absent, so the caller rebuilds it and overwrites it atomically.
+    """
     stem = Path(stem)
     jpath, npath = stem.with_suffix(".json"), stem.with_suffix(".npz")
     if not (jpath.is_file() and npath.is_file()):
@@ -138,7 +145,8 @@ def load_cached(stem: str | Path, key: str) -> Drive | None:
             return None
         with np.load(npath, allow_pickle=False) as npz:
             tables = {t: pd.DataFrame(npz[t], columns=info["columns"][t]) for t in info["columns"]}
-    except (OSError, ValueError, KeyError):
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
+        log.warning("cache entry %s is unreadable (%s: %s): rebuilding it", npath, type(exc).__name__, exc)
         return None
     return Drive(info["name"], tables["reference"], tables["imu"], tables["gnss"], info["meta"],
                  tables.get("imu_bias"))

@@ -126,11 +126,6 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None) -> D
     if (std <= 0).any():
         raise DataError(folder / "gnss.csv", "std_n/std_e/std_d", "positive position std, m",
                         f"min {std.min()}")
-    for name in ("gnss.csv", "reference.csv"):
-        lat = tables[name]["lat"].to_numpy(float)
-        if np.abs(lat).max() > np.pi / 2:
-            raise DataError(folder / name, "lat", "latitude in rad within [-pi/2, pi/2] (not degrees)",
-                            f"max |lat| = {np.abs(lat).max()}")
     meta_path = folder / "meta.yaml"
     user = _read_meta(meta_path)
     larm = np.asarray(user.get("lever_arm_m", [0.0, 0.0, 0.0]), dtype=float).ravel()

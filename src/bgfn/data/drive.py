@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 
 from bgfn.data.navego import check_time
+from bgfn.data.physics import check_drive
 from bgfn.errors import DataError
 from bgfn.io import atomic_path, atomic_write_json
 from bgfn.schema import GNSS_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS
@@ -84,13 +85,21 @@ class Drive:
         meta = dict(self.meta, crop=[t_start, t_end])
         return Drive(self.name, ref, sel_imu(self.imu), sel(self.gnss), meta, sel_imu(self.imu_bias))
 
-    def validate(self, source: str | None = None) -> "Drive":
-        """Check columns, strictly increasing times and finite values; return self.
+    def validate(self, source: str | None = None, files: dict | None = None) -> "Drive":
+        """Check columns, strictly increasing times, finite values and physics; return self.
+
+        Parameters
+        ----------
+        source : str, optional
+            Name used in messages (default: the drive's name).
+        files : dict, optional
+            ``{table: file}`` where each table was read from, for the messages of the physics checks.
 
         Raises
         ------
         DataError
-            Naming the table and the column.
+            Naming the table (or file) and the column; for implausible physics (units, axes, spikes, time
+            base) also the likely cause (:func:`bgfn.data.physics.check_drive`).
         """
         src = source or self.name
         for table, cols, nan_ok in (("reference", REFERENCE_COLUMNS, ()), ("imu", IMU_COLUMNS, ()),
@@ -109,6 +118,7 @@ class Drive:
                     k = int(np.argmax(bad))
                     raise DataError(f"{src}/{table}", c, "finite values",
                                     f"{int(bad.sum())} NaN/inf, first at row {k} (time {df['time'].iloc[k]})")
+        check_drive(self, files or {t: f"{src}/{t}" for t in ("reference", "imu", "gnss")})
         return self
 
 

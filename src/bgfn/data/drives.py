@@ -275,7 +275,9 @@ def load_drive(name: str | Path = DEFAULT_DATASET, *, profile: str | None = None
         extra = set(overrides) - {"imu_rate_hz"}  # a profile does not apply to a user's drive
         if extra:
             raise DataError(name, sorted(extra)[0], "only imu_rate_hz for a CSV drive", "unknown parameter")
-        return load_csv_drive(name, **overrides).validate(str(name))
+        folder = Path(name)
+        return load_csv_drive(folder, **overrides).validate(
+            str(folder), files={t: str(folder / f"{t}.csv") for t in ("reference", "imu", "gnss")})
     if name not in DATASETS:
         raise DataError("load_drive", "name", f"one of {', '.join(DATASETS)} or a CSV folder", repr(name))
     if profile is not None:

@@ -141,6 +141,15 @@ $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(PARAMS) $(SRC) $(STAMP) | data
 	  mv -f "$$tmp" "$@"; \
 	else rm -f "$$tmp"; echo "error: $< failed under PROFILE=$(PROFILE); nothing written to $@" >&2; exit 1; fi
 
+# The profile is checked before the first notebook runs: its schema (every notebook's load_profile checks that
+# too) and the facts that need the data (outages inside the drives, window, outage sweep). A bad profile fails
+# here, naming its file and key, before hours of training.
+$(RES)/.profile-checked: $(PARAMS) $(SRC) $(STAMP) | data
+	@echo "==> [$(PROFILE)] check params/$(PROFILE).yaml"
+	@$(PY) -m bgfn.profile_schema $(PROFILE)
+	@mkdir -p $(@D) && touch $@
+$(RES)/notebooks/01_data_prep.ipynb: $(RES)/.profile-checked
+
 # Each notebook reads what the previous one wrote.
 $(RES)/notebooks/02_kf_baseline.ipynb: $(RES)/notebooks/01_data_prep.ipynb
 $(RES)/notebooks/03_bgfn_training.ipynb: $(RES)/notebooks/02_kf_baseline.ipynb

@@ -193,13 +193,34 @@ def load_profile(profile: str) -> dict[str, Any]:
         raise DataError(path, "description", "a string", type(cfg["description"]).__name__)
     if isinstance(cfg["seed"], bool) or not isinstance(cfg["seed"], int) or cfg["seed"] < 0:
         raise DataError(path, "seed", "a non-negative integer", repr(cfg["seed"]))
-    _check_windows_form(path, cfg["outage_windows"])
     for key in SECTION_KEYS:
         if cfg[key] is None:  # a section holding only comments
             cfg[key] = {}
         if not isinstance(cfg[key], dict):
             raise DataError(path, key, "a mapping (section of keys)", type(cfg[key]).__name__)
+    from bgfn.profile_schema import ProfileError, validate
+
+    try:
+        validate(cfg)
+    except ProfileError as exc:
+        raise DataError(_file_setting(chain, exc.path), exc.path, exc.expected, exc.found) from None
     return copy.deepcopy(cfg)
+
+
+def _file_setting(chain: list[tuple[Path, dict]], path: str) -> Path:
+    """The file of a profile chain that sets ``path`` (a dotted key, ``[i]`` list items ignored): the profile's
+    own file when it holds the key, else the nearest base that does; the profile's file when none does."""
+    keys = [k for k in path.split("[")[0].split(".") if k]
+    for depth in range(len(keys), 0, -1):
+        for file, own in chain:
+            node = own
+            for k in keys[:depth]:
+                if not isinstance(node, dict) or k not in node:
+                    break
+                node = node[k]
+            else:
+                return file
+    return chain[0][0]
 
 
 def _check_moved_keys(path: Path, own: dict) -> None:
@@ -209,18 +230,6 @@ def _check_moved_keys(path: Path, own: dict) -> None:
         if isinstance(own.get(section), dict) and key in own[section]:
             raise DataError(path, old, f"the top-level key {new!r} instead (one list of [start, duration] in s "
                             "for every notebook)", f"{old}: {own[section][key]!r}")
-
-
-def _check_windows_form(path: Path, windows: Any) -> None:
-    """``outage_windows`` is a non-empty list of ``[start, duration]`` pairs of numbers, durations > 0."""
-    expected = "a non-empty list of [start, duration] pairs in s (GPS time of week), durations > 0"
-    if not isinstance(windows, list) or not windows:
-        raise DataError(path, "outage_windows", expected, repr(windows))
-    for w in windows:
-        ok = (isinstance(w, list) and len(w) == 2
-              and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in w))
-        if not ok or not w[1] > 0:
-            raise DataError(path, "outage_windows", expected, repr(w))
 
 
 def results_dir(profile: str, create: bool = True) -> Path:

@@ -1,0 +1,351 @@
+"""The schema of a profile (``params/<profile>.yaml``): every key, its type and range, checked before anything runs.
+
+:func:`bgfn.config.load_profile` checks the merged profile (a ``base:`` chain included) against
+:data:`SCHEMA` and the cross-field facts of :func:`cross_check`, so every notebook's parameters handling and
+``make reproduce`` (its ``check-profile`` step, ``python -m bgfn.profile_schema <profile>``) refuse a bad
+profile at once, with one message naming the YAML file that set the key, the key path and the value. Keys
+may be left out (the module that reads a section fills its defaults: ``bgfn.nav.baseline.NAV_DEFAULTS``,
+``bgfn.train`` and ``bgfn.learning`` defaults, ``bgfn.evaluate.EVALUATE_DEFAULTS``); a key that is not in the
+schema is an error with the closest valid key suggested (a typo never silently falls back to a default).
+
+The checks that need the data (outages inside the drive, a window shorter than the GPS-available data, a
+possible outage sweep) run in :func:`check_with_drives`, the ``make`` step, after the data are fetched.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+
+class ProfileError(ValueError):
+    """A profile value that breaks the schema: ``path`` (dotted key), what was ``expected``, what was ``found``."""
+
+    def __init__(self, path: str, expected: str, found: str):
+        super().__init__(f"{path}: expected {expected}, found {found}")
+        self.path, self.expected, self.found = path, expected, found
+
+
+@dataclass(frozen=True)
+class Spec:
+    """What one key holds. ``kind``: ``number``, ``integer``, ``text``, ``flag``, ``list``, ``section``
+    (known keys), ``mapping`` (free keys, each value ``item``) or ``any``."""
+
+    kind: str
+    null: bool = False
+    lo: float | None = None
+    hi: float | None = None
+    lo_open: bool = False
+    hi_open: bool = False
+    choices: tuple = ()
+    item: "Spec | None" = None
+    length: int | None = None
+    min_len: int = 0
+    fields: dict = field(default_factory=dict)
+
+
+def number(lo=None, hi=None, *, lo_open=False, hi_open=False, null=False) -> Spec:
+    return Spec("number", null, lo, hi, lo_open, hi_open)
+
+
+def integer(lo=None, hi=None, *, null=False) -> Spec:
+    return Spec("integer", null, lo, hi)
+
+
+def text(*choices, null=False) -> Spec:
+    return Spec("text", null, choices=tuple(choices))
+
+
+def flag() -> Spec:
+    return Spec("flag")
+
+
+def seq(item: Spec | None = None, *, length=None, min_len=0, null=False) -> Spec:
+    return Spec("list", null, item=item, length=length, min_len=min_len)
+
+
+def section(**fields: Spec) -> Spec:
+    return Spec("section", fields={k.replace("__", "-"): v for k, v in fields.items()})
+
+
+def mapping(item: Spec) -> Spec:
+    return Spec("mapping", item=item)
+
+
+ANY = Spec("any")
+_POS = number(0, lo_open=True)
+_NONNEG = number(0)
+_SEED = integer(0)
+_FRACTION = number(0, 1, lo_open=True, hi_open=True)
+_NAMES = seq(text(), min_len=1)
+
+#: The optimization keys (``train.optimizer``), the same for every method.
+OPTIMIZER = section(
+    epochs=integer(1), batch_size=integer(1), lr=_POS, weight_decay=_NONNEG,
+    schedule=text("plateau", "cosine", "none"), lr_factor=number(0, 1, lo_open=True, hi_open=True),
+    lr_patience=integer(0), min_lr=_NONNEG, patience=integer(1), min_delta=_NONNEG, grad_clip=_NONNEG,
+    max_train_windows=integer(1, null=True), max_val_windows=integer(1, null=True), eval_batch_size=integer(1),
+    num_threads=integer(1, null=True))
+
+#: The ``train:`` section (notebook 03).
+TRAIN = section(
+    datasets=_NAMES, methods=_NAMES, seeds=seq(_SEED, min_len=1),
+    attitude_source=text("kf", "reference"), window=integer(2),
+    alignment=text("ending", "next"), yaw_encoding=text("unwrap", "relative", "raw"),
+    target_frame=text("ned", "heading"), extra_channels=seq(text()), epoch_stride=integer(1),
+    margin_s=_NONNEG, val_fraction=_FRACTION,
+    val_position=Spec("any"),            # 'start' | 'middle' | 'end' | fraction: checked in cross_check
+    target_screen_sigma=number(0, lo_open=True, null=True),
+    optimizer=OPTIMIZER, lr=mapping(_POS),
+    lr_search=section(grid=seq(_POS, null=True), fraction=_FRACTION, seed=_SEED, extend=integer(0)),
+    size=text(), sizes=mapping(mapping(mapping(ANY))))
+
+#: The whole profile.
+SCHEMA = section(
+    profile=text(), description=text(), seed=_SEED, base=text(),
+    outage_windows=seq(seq(number(), length=2), min_len=1),
+    data=section(
+        datasets=_NAMES, seed=_SEED, imu_rate_hz=_POS, smoothing_degree=integer(1, 5),
+        position_sigma_m=_POS, attitude_sigma_rad=_POS, t_start=number(null=True), t_end=number(null=True),
+        imu_plot_start_tow=number(null=True), imu_plot_duration_s=_POS),
+    nav=section(
+        datasets=_NAMES,
+        init=section(position_std_m=_POS, height_std_m=_POS, velocity_std_mps=_POS, level_std_deg=_POS,
+                     azimuth_std_deg=_POS),
+        bias_model=text("random_walk", "gauss_markov"), noise_scale=_POS,
+        innovation_gate=number(0, 1, lo_open=True, hi_open=True, null=True)),
+    train=TRAIN,
+    evaluate=section(
+        datasets=_NAMES, real_imu=flag(), methods=_NAMES, seeds=seq(_SEED, min_len=1, null=True),
+        seed_aggregate=text("median", "first"),
+        pseudo_gps=section(std_m=Spec("any"), std_growth_m_per_s=_NONNEG, fusion_rate_hz=_POS),
+        series_rate_hz=_POS, train_missing=flag(),
+        sweep=section(datasets=seq(text()), n_starts=integer(1), durations_s=seq(_POS, min_len=1),
+                      folds=integer(1), seeds=seq(_SEED, min_len=1), warmup_s=_NONNEG,
+                      train=Spec("section", fields=TRAIN.fields), n_boot=integer(1),
+                      level=_FRACTION, boot_seed=_SEED)),
+    energy=section(
+        e_mac_pj=_POS, e_ac_pj=_POS, dataset=text(null=True), seed=integer(0, null=True),
+        max_windows=integer(1, null=True), batch_size=integer(1), sweep_time_steps=seq(integer(1), min_len=1),
+        sweep_max_rate=number(0, 1, lo_open=True), crosscheck_windows=integer(1),
+        crosscheck_tolerance_pct=_POS))
+
+#: ``data:`` keys that are not in its section are the parameters of one dataset (a mapping; checked by
+#: :func:`bgfn.data.drives.dataset_params`).
+_DATASET_PARAMS = mapping(ANY)
+_SIZES = ("smoke", "quick", "paper")
+
+
+def _fmt(v: Any) -> str:
+    return repr(v) if not isinstance(v, float) else f"{v:g}"
+
+
+def _range(spec: Spec) -> str:
+    lo = "" if spec.lo is None else f"{'>' if spec.lo_open else '>='} {spec.lo:g}"
+    hi = "" if spec.hi is None else f"{'<' if spec.hi_open else '<='} {spec.hi:g}"
+    return " and ".join(p for p in (lo, hi) if p)
+
+
+def _describe(spec: Spec) -> str:
+    what = {"number": "a number", "integer": "an integer", "text": "a string", "flag": "true or false",
+            "list": "a list", "section": "a mapping of keys", "mapping": "a mapping", "any": "a value"}[spec.kind]
+    if spec.choices:
+        what = "one of " + ", ".join(repr(c) for c in spec.choices)
+    rng = _range(spec)
+    if rng:
+        what += f" {rng}"
+    if spec.kind == "list" and spec.length:
+        what += f" of {spec.length} items"
+    elif spec.kind == "list" and spec.min_len:
+        what += f" of at least {spec.min_len} item"
+    return what + (" or null" if spec.null else "")
+
+
+def check(value: Any, spec: Spec, path: str) -> None:
+    """Raise :class:`ProfileError` where ``value`` breaks ``spec`` (``path``: dotted key, for the message)."""
+    if value is None:
+        if spec.null or spec.kind == "any":
+            return
+        raise ProfileError(path, _describe(spec), "null")
+    k = spec.kind
+    if k in ("number", "integer"):
+        ok = isinstance(value, int) if k == "integer" else isinstance(value, (int, float))
+        if isinstance(value, bool) or not ok or (isinstance(value, float) and not math.isfinite(value)):
+            raise ProfileError(path, _describe(spec), _fmt(value))
+        bad_lo = spec.lo is not None and (value <= spec.lo if spec.lo_open else value < spec.lo)
+        bad_hi = spec.hi is not None and (value >= spec.hi if spec.hi_open else value > spec.hi)
+        if bad_lo or bad_hi:
+            raise ProfileError(path, _describe(spec), _fmt(value))
+    elif k == "text":
+        if not isinstance(value, str) or (spec.choices and value not in spec.choices):
+            raise ProfileError(path, _describe(spec), _fmt(value))
+    elif k == "flag":
+        if not isinstance(value, bool):
+            raise ProfileError(path, _describe(spec), _fmt(value))
+    elif k == "list":
+        if not isinstance(value, list) or len(value) < spec.min_len or (spec.length and len(value) != spec.length):
+            raise ProfileError(path, _describe(spec), _fmt(value))
+        if spec.item is not None:
+            for i, v in enumerate(value):
+                check(v, spec.item, f"{path}[{i}]")
+    elif k in ("section", "mapping"):
+        if not isinstance(value, dict):
+            raise ProfileError(path, _describe(spec), type(value).__name__)
+        for key, v in value.items():
+            sub = f"{path}.{key}" if path else str(key)
+            if k == "mapping":
+                check(v, spec.item, sub)
+            elif key in spec.fields:
+                check(v, spec.fields[key], sub)
+            elif path == "data" and isinstance(v, dict):
+                check(v, _DATASET_PARAMS, sub)
+            else:
+                close = difflib.get_close_matches(str(key), list(spec.fields), n=1, cutoff=0.6)
+                hint = f" (did you mean {path + '.' if path else ''}{close[0]}?)" if close else ""
+                raise ProfileError(sub, f"one of the keys {', '.join(sorted(spec.fields))}{hint}", "unknown key")
+
+
+def _windows(cfg: dict) -> list[tuple[float, float]]:
+    return [(float(s), float(d)) for s, d in cfg.get("outage_windows") or []]
+
+
+def cross_check(cfg: dict) -> None:
+    """The facts that tie keys together and need no data; :class:`ProfileError` naming the key."""
+    wins = sorted(_windows(cfg))
+    for i, (s, d) in enumerate(_windows(cfg)):
+        if d <= 0:
+            raise ProfileError(f"outage_windows[{i}]", "a positive duration, s", _fmt([s, d]))
+    for (s0, d0), (s1, d1) in zip(wins[:-1], wins[1:]):
+        if s1 < s0 + d0:
+            raise ProfileError("outage_windows", "windows that do not overlap",
+                               f"[{s0:g}, {s0 + d0:g}] overlaps [{s1:g}, {s1 + d1:g}]")
+    data, tr, ev = cfg.get("data") or {}, cfg.get("train") or {}, cfg.get("evaluate") or {}
+    t0, t1 = data.get("t_start"), data.get("t_end")
+    if t0 is not None and t1 is not None and t1 <= t0:
+        raise ProfileError("data.t_end", f"a time after data.t_start = {t0:g} s", _fmt(t1))
+    for i, (s, d) in enumerate(_windows(cfg)):
+        if (t0 is not None and s < t0) or (t1 is not None and s + d > t1):
+            raise ProfileError(f"outage_windows[{i}]", f"inside the data [{t0}, {t1}] s (data.t_start, data.t_end)",
+                               _fmt([s, d]))
+    rate = data.get("imu_rate_hz")
+    if "window" in tr and rate and t0 is not None and t1 is not None and tr["window"] / rate >= (t1 - t0):
+        raise ProfileError("train.window", f"a window shorter than the data ({t1 - t0:g} s at {rate:g} Hz)",
+                           f"{tr['window']} samples = {tr['window'] / rate:g} s")
+    vp = tr.get("val_position")
+    if vp is not None and not (vp in ("start", "middle", "end") or (isinstance(vp, (int, float))
+                                                                      and not isinstance(vp, bool) and 0 <= vp <= 1)):
+        raise ProfileError("train.val_position", "'start', 'middle', 'end' or a fraction in [0, 1]", _fmt(vp))
+    from bgfn.paper import METHOD_LABELS
+
+    for key, methods in (("train.methods", tr.get("methods")), ("evaluate.methods", ev.get("methods"))):
+        bad = [m for m in methods or [] if m not in METHOD_LABELS]
+        if bad:
+            raise ProfileError(key, f"method ids among {', '.join(METHOD_LABELS)}", _fmt(bad))
+    for key, train in (("train", tr), ("evaluate.sweep.train", {**tr, **((ev.get("sweep") or {}).get("train") or {})})):
+        size = train.get("size")
+        if size is None:
+            continue
+        for m in tr.get("methods") or []:
+            if size not in ((train.get("sizes") or {}).get(m) or {}):
+                raise ProfileError(f"{key}.size", f"a size block that train.sizes.{m} defines "
+                                   f"({', '.join((train.get('sizes') or {}).get(m) or {}) or 'none'})", _fmt(size))
+    sw = ev.get("sweep") or {}
+    if "folds" in sw and "n_starts" in sw and sw["folds"] > sw["n_starts"]:
+        raise ProfileError("evaluate.sweep.folds", f"at most evaluate.sweep.n_starts = {sw['n_starts']}",
+                           _fmt(sw["folds"]))
+    en = cfg.get("energy") or {}
+    if en.get("dataset") is not None and en["dataset"] not in (tr.get("datasets") or []):
+        raise ProfileError("energy.dataset", f"one of train.datasets {tr.get('datasets')} (its networks are "
+                           "measured)", _fmt(en["dataset"]))
+    if en.get("seed") is not None and en["seed"] not in (tr.get("seeds") or []):
+        raise ProfileError("energy.seed", f"one of train.seeds {tr.get('seeds')}", _fmt(en["seed"]))
+
+
+def validate(cfg: dict) -> None:
+    """:func:`check` the whole profile against :data:`SCHEMA`, then :func:`cross_check`."""
+    check(cfg, SCHEMA, "")
+    cross_check(cfg)
+
+
+def check_with_drives(profile: str) -> list[str]:
+    """The checks that need the data, for ``make``'s ``check-profile`` step: each dataset of the profile loads
+    (built and cached when new, as notebook 01 would), the outages lie inside every drive of notebooks 02-04,
+    the input window is shorter than the GPS-available data, and the outage sweep has its starts.
+
+    Returns
+    -------
+    list of str
+        One line per dataset, what was checked.
+
+    Raises
+    ------
+    bgfn.errors.DataError
+        Naming the profile's file and the key.
+    """
+    from bgfn.config import load_profile, profile_chain
+    from bgfn.data import load_drive
+    from bgfn.errors import DataError
+    from bgfn.nav.outages import check_windows
+
+    cfg = load_profile(profile)
+    path = profile_chain(profile)[0]
+    tr, ev = cfg["train"], cfg["evaluate"]
+    names = dict.fromkeys(cfg["nav"].get("datasets", []) + tr.get("datasets", []) + ev.get("datasets", [])
+                          + (ev.get("sweep") or {}).get("datasets", []))
+    lines = []
+    for name in names:
+        drive = load_drive(name, profile=profile)
+        t = drive.imu["time"].to_numpy(float)
+        t0, t1 = float(drive.reference["time"].iloc[0]), float(t[-1])
+        try:
+            check_windows(_windows(cfg), t0, t1, name)
+        except DataError as exc:
+            raise DataError(path, "outage_windows", f"windows inside the drive {name} [{t0:.3f}, {t1:.3f}] s",
+                            exc.found) from None
+        rate = float(drive.meta.get("imu_rate_hz") or 1.0 / float(t[1] - t[0]))
+        window_s = int(tr.get("window", 200)) / rate
+        margin = float(tr.get("margin_s", 30.0))
+        blocked = sum(d + 2 * margin for _, d in _windows(cfg))
+        if window_s >= (t1 - t0) - blocked:
+            raise DataError(path, "train.window", f"a window shorter than the GPS-available data of {name} "
+                            f"({(t1 - t0) - blocked:.1f} s outside the outages and their margins)",
+                            f"{tr.get('window')} samples = {window_s:g} s")
+        lines.append(f"{name}: {t0:.2f}..{t1:.2f} s, outages inside, window {window_s:g} s")
+    from bgfn.evaluate import evaluate_config, sweep_plan
+
+    sw = evaluate_config(ev, tr)["sweep"]
+    for name in sw["datasets"]:
+        drive = load_drive(name, profile=profile)
+        try:
+            plan = sweep_plan(drive, sw, int(tr.get("window", 200)))
+        except DataError as exc:
+            raise DataError(path, "evaluate.sweep.n_starts/durations_s/warmup_s", f"{exc.expected} in {name}",
+                            exc.found) from None
+        lines.append(f"{name}: outage sweep of {len(plan)} starts in {sw.get('folds')} folds")
+    return lines
+
+
+def main(argv=None) -> int:
+    """``python -m bgfn.profile_schema <profile>``: check a profile, with its data, before anything runs."""
+    import argparse
+    import sys
+
+    from bgfn.errors import DataError
+
+    parser = argparse.ArgumentParser(description=main.__doc__)
+    parser.add_argument("profile")
+    args = parser.parse_args(argv)
+    try:
+        lines = check_with_drives(args.profile)
+    except DataError as exc:
+        print(f"error: profile {args.profile!r}: {exc}", file=sys.stderr)
+        return 2
+    for line in lines:
+        print(f"    profile {args.profile}: {line}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,82 @@
+"""A bad profile fails when it is loaded, before anything runs, naming the YAML file, the key and the value."""
+
+from __future__ import annotations
+
+import shutil
+
+import pytest
+
+from bgfn import config
+from bgfn.errors import DataError
+from bgfn.profile_schema import SCHEMA
+
+pytestmark = pytest.mark.usefixtures("repo_untouched")
+
+# variant text over the shipped smoke profile -> (key path named, words of the message)
+BAD = {
+    "top-level typo": ("trian: {window: 50}", "trian", "did you mean train?"),
+    "train key typo": ("train: {windw: 200}", "train.windw", "did you mean train.window?"),
+    "energy key typo": ("energy: {e_mac_p: 3.0}", "energy.e_mac_p", "did you mean energy.e_mac_pj?"),
+    "data key typo": ("data: {t_strat: 138800.0}", "data.t_strat", "did you mean data.t_start?"),
+    "optimizer key typo": ("train: {optimizer: {epoch: 3}}", "train.optimizer.epoch", "did you mean"),
+    "window not a number": ("train: {window: abc}", "train.window", "'abc'"),
+    "window longer than the data": ("train: {window: 1000000}", "train.window", "shorter than the data"),
+    "negative outage": ("outage_windows: [[138906.0, -30.0]]", "outage_windows[0]", "-30"),
+    "overlapping outages": ("outage_windows: [[138906.0, 30.0], [138920.0, 30.0]]", "outage_windows",
+                            "do not overlap"),
+    "outage outside the data": ("outage_windows: [[139250.0, 30.0]]", "outage_windows[0]", "inside the data"),
+    "bad choice": ("nav: {bias_model: randomwalk}", "nav.bias_model", "'random_walk', 'gauss_markov'"),
+    "fraction out of range": ("train: {val_fraction: 1.5}", "train.val_fraction", "1.5"),
+    "more folds than starts": ("evaluate: {sweep: {n_starts: 2, folds: 3}}", "evaluate.sweep.folds", "at most"),
+    "unknown method": ("train: {methods: [bgfn, lstm]}", "train.methods", "'lstm'"),
+    "size block missing": ("train: {size: huge}", "train.size", "'huge'"),
+    "energy dataset not trained": ("energy: {dataset: turin-sim-other}", "energy.dataset", "train.datasets"),
+    "boolean as a number": ("seed: true", "seed", "True"),
+}
+
+
+@pytest.fixture()
+def params(tmp_path, monkeypatch):
+    folder = tmp_path / "params"
+    folder.mkdir()
+    shutil.copy(config.PARAMS_DIR / "smoke.yaml", folder / "smoke.yaml")
+    monkeypatch.setattr(config, "PARAMS_DIR", folder)
+    return folder
+
+
+@pytest.mark.parametrize("case", list(BAD))
+def test_a_bad_variant_names_its_file_the_key_and_the_value(params, case):
+    text, key, words = BAD[case]
+    path = params / "mine.yaml"
+    path.write_text(f"profile: mine\nbase: smoke\ndescription: a variant\n{text}\n")
+    with pytest.raises(DataError) as err:
+        config.load_profile("mine")
+    assert err.value.source == str(path), str(err.value)
+    assert err.value.field == key and words in str(err.value), str(err.value)
+
+
+def test_an_error_in_the_base_names_the_base_file(params):
+    smoke = params / "smoke.yaml"
+    smoke.write_text(smoke.read_text().replace("  margin_s: 30.0", "  margin_s: -1.0"))
+    (params / "mine.yaml").write_text("profile: mine\nbase: smoke\ndescription: v\ntrain: {window: 40}\n")
+    with pytest.raises(DataError) as err:
+        config.load_profile("mine")
+    assert err.value.source == str(smoke) and err.value.field == "train.margin_s"
+
+
+def test_every_shipped_profile_uses_only_schema_keys():
+    # and the schema knows every key the code reads defaults for (no drift between schema and defaults)
+    from bgfn.evaluate import EVALUATE_DEFAULTS
+    from bgfn.learning import LEARNING_DEFAULTS
+    from bgfn.nav.baseline import NAV_DEFAULTS
+    from bgfn.train import LR_SEARCH_DEFAULTS, OPTIMIZER_DEFAULTS
+
+    for name in config.available_profiles():
+        config.load_profile(name)
+    f = SCHEMA.fields
+    assert set(NAV_DEFAULTS) <= set(f["nav"].fields)
+    assert set(EVALUATE_DEFAULTS) <= set(f["evaluate"].fields)
+    assert set(EVALUATE_DEFAULTS["sweep"]) <= set(f["evaluate"].fields["sweep"].fields)
+    assert set(LEARNING_DEFAULTS) <= set(f["train"].fields)
+    assert set(OPTIMIZER_DEFAULTS) == set(f["train"].fields["optimizer"].fields)
+    assert set(LR_SEARCH_DEFAULTS) == set(f["train"].fields["lr_search"].fields)

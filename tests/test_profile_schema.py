@@ -80,3 +80,15 @@ def test_every_shipped_profile_uses_only_schema_keys():
     assert set(LEARNING_DEFAULTS) <= set(f["train"].fields)
     assert set(OPTIMIZER_DEFAULTS) == set(f["train"].fields["optimizer"].fields)
     assert set(LR_SEARCH_DEFAULTS) == set(f["train"].fields["lr_search"].fields)
+
+
+def test_notebook_parameters_are_checked_like_the_profile():
+    cfg = config.load_profile("smoke")
+    out = config.with_overrides(cfg, {"train.methods": ["mlp"], "train.seeds": None, "evaluate.sweep.datasets": []})
+    assert out["train"]["methods"] == ["mlp"] and out["train"]["seeds"] == cfg["train"]["seeds"]
+    assert out["evaluate"]["sweep"]["datasets"] == [] and cfg["train"]["methods"] != ["mlp"]   # a copy
+    with pytest.raises(DataError) as err:
+        config.with_overrides(cfg, {"train.methods": ["lstm"]})
+    assert err.value.source == "notebook parameters" and err.value.field == "train.methods"
+    with pytest.raises(DataError, match="evaluate.real_imu"):
+        config.with_overrides(cfg, {"evaluate.real_imu": "yes"})

@@ -207,6 +207,44 @@ def load_profile(profile: str) -> dict[str, Any]:
     return copy.deepcopy(cfg)
 
 
+def with_overrides(cfg: dict, overrides: dict[str, Any], source: str = "notebook parameters") -> dict:
+    """``cfg`` with the non-None ``overrides`` set, checked against the profile schema like the file itself.
+
+    The notebooks' papermill parameters (``datasets = None`` ... in their ``parameters`` cell) reach the
+    profile through this one function, so a bad parameter fails like a bad profile key.
+
+    Parameters
+    ----------
+    cfg : dict
+        A loaded profile (:func:`load_profile`); not modified.
+    overrides : dict
+        ``{"section.key": value}`` (dotted paths); None values are skipped (None = keep the profile's).
+    source : str
+        Named in the error message instead of a file.
+
+    Raises
+    ------
+    bgfn.errors.DataError
+        ``source``, the key path and the value, as for a profile file.
+    """
+    from bgfn.profile_schema import ProfileError, validate
+
+    out = copy.deepcopy(cfg)
+    for path, value in overrides.items():
+        if value is None:
+            continue
+        *parents, key = path.split(".")
+        node = out
+        for k in parents:
+            node = node.setdefault(k, {})
+        node[key] = copy.deepcopy(value)
+    try:
+        validate(out)
+    except ProfileError as exc:
+        raise DataError(source, exc.path, exc.expected, exc.found) from None
+    return out
+
+
 def _file_setting(chain: list[tuple[Path, dict]], path: str) -> Path:
     """The file of a profile chain that sets ``path`` (a dotted key, ``[i]`` list items ignored): the profile's
     own file when it holds the key, else the nearest base that does; the profile's file when none does."""

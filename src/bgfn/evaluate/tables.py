@@ -1,5 +1,6 @@
-"""The paper's Tables 1-2: every method in the evaluation outages, the seed aggregate, the result files, the
-paper's values beside ours, and plain-language lines computed from the numbers."""
+"""The paper's Tables 1-2 (``tab-out1-exin``, ``tab-real``): every method in the evaluation outages, the seed
+aggregate, the result files, and plain-language lines computed from the numbers. The paper's own values beside
+ours are :mod:`bgfn.evaluate.claims`."""
 
 from __future__ import annotations
 

@@ -446,3 +446,159 @@ def test_plot_gps_row_shows_the_fixes_inside_the_window_beside_gps_and_ins():
     np.testing.assert_allclose(lines["GNSS fixes"].get_ydata(), np.arange(0.0, 11.0))
     np.testing.assert_allclose(lines["INS"].get_ydata(), 0.3 * t_rel)
     np.testing.assert_allclose(fig.axes[1].get_lines()[1].get_ydata(), -0.1 * t_rel)     # north, GPS
+
+
+# ----------------------------------------------------------------------------------------------- notebook 04's calls
+def _table_result(dataset="turin-sim-ekinox", bgfn=(2.0, 4.0)):
+    """Seed aggregate of INS (10/8 m), BGFN and Transformer in two outages (max east/north errors, m)."""
+    rows = []
+    for o in (1, 2):
+        for m, (e, n) in (("INS", (10.0, 8.0)), ("BGFN", bgfn), ("Transformer", (20.0, 4.0))):
+            rows.append({"outage": o, "method": m, "max_east_m": e, "max_north_m": n, "rmse_h_m": 1.0,
+                         "final_h_m": 1.0})
+    return ev.TableResult(dataset, paper.test_of(dataset), pd.DataFrame(), pd.DataFrame(rows), [], {})
+
+
+def test_evaluation_setup_applies_the_notebook_parameters_over_the_profile(monkeypatch):
+    from bgfn.data import acquire
+    from bgfn.nav.outages import outage_windows
+
+    cfg = load_profile("smoke")
+    section = cfg["evaluate"]
+    before = repr(section)
+    setup = ev.evaluation_setup(cfg, seeds=[3, 4], sweep_datasets=[])
+    assert setup.config["seeds"] == [3, 4] and setup.config["sweep"]["datasets"] == []
+    assert setup.config["sweep"]["n_starts"] == section["sweep"]["n_starts"]       # the other sweep keys stay
+    assert setup.config["methods"] == section["methods"] and setup.datasets == section["datasets"]
+    assert setup.windows == outage_windows(cfg) and repr(section) == before         # the profile is not modified
+    lines = setup.describe()
+    assert lines[0].startswith("profile 'smoke': ") and "seeds: [3, 4]" in lines[2]
+    assert lines[3] == f"outages (start, duration) s: {[list(w) for w in outage_windows(cfg)]}"
+    with pytest.raises(DataError):
+        ev.evaluation_setup(cfg, methods=["no_such_network"])
+    # real_imu: one line per note, the tables' and the sweep's, said once
+    monkeypatch.setattr(acquire, "resolve", lambda name, **kw: acquire.Resolved(name, None, "missing", None, "t"))
+    real = ev.evaluation_setup(cfg, real_imu=True, sweep_datasets=["turin-sim-mpu6000"])
+    assert real.datasets == section["datasets"] and len(real.notes) == 2 and real.sweep_notes == real.notes[1:]
+    assert [ln for ln in real.describe() if ln.startswith("real_imu:")] == [f"real_imu: {n}" for n in real.notes]
+
+
+def test_reductions_beside_the_paper_and_its_quoted_claims():
+    res = _table_result()
+    red = ev.reduction_table(res)
+    assert list(red.columns) == list(ev.REDUCTION_COLUMNS)
+    row = red[(red["outage"] == 1) & (red["method"] == "BGFN")].iloc[0]
+    assert row["east_%"] == pytest.approx(80.0) and row["north_%"] == pytest.approx(50.0)   # 100 (10-2)/10, (8-4)/8
+    assert row["paper east_%"] == pytest.approx(100 * (23.1 - 4.7) / 23.1)                   # its Table 1
+    assert red.loc[red["method"] == "Transformer", "paper east_%"].isna().all()             # not in the paper
+    lines = ev.claim_lines({"turin-sim-ekinox": red})
+    c = paper.claims()["bgfn_reduction_vs_ins_pct"]
+    assert lines == [f"BGFN vs INS, dataset test, outage 1: paper quotes {c['dataset_outage1']['east']} % east / "
+                     f"{c['dataset_outage1']['north']} % north; ours 80.0 % east / 50.0 % north",
+                     f"BGFN vs INS, field test, outage 2: paper quotes {c['field_outage2']['east']} % east / "
+                     f"{c['field_outage2']['north']} % north; not evaluated"]
+    # a test's first dataset answers for it
+    other = ev.reduction_table(_table_result("navego-ekinox", bgfn=(5.0, 4.0)))
+    assert ev.claim_lines({"turin-sim-ekinox": red, "navego-ekinox": other})[0].endswith("ours 80.0 % east / 50.0 % north")
+    assert ev.claim_lines({"navego-ekinox": other})[0].endswith("ours 50.0 % east / 50.0 % north")
+    lay = ev.paper_layout(res)
+    assert lay.loc[("Outage 1", "paper"), ("BGFN", "East")] == 4.7
+    assert lay.loc[("Outage 2", "ours"), ("INS", "North")] == 8.0
+    assert np.isnan(lay.loc[("Outage 1", "paper"), ("Transformer", "East")])
+    assert (ev.paper_table_title("dataset"), ev.paper_table_title("field")) == ("Table 1 (dataset test)",
+                                                                              "Table 2 (field test)")
+
+
+def test_pseudo_std_sensitivity_runs_the_first_seeds_networks_with_their_validation_std(drive5, tmp_path):
+    cfg = {"outage_windows": [list(w) for w in WINDOWS], "nav": NAV}
+    ecfg = ev.evaluate_config({"methods": ["bgfn"], "seeds": [1, 0]})
+    models = {}
+    for seed, speed in ((1, 8.0), (0, 6.0)):
+        models[("bgfn", seed)] = Heading(window=20, speed=speed)
+        models[("bgfn", seed)].val_rmse_m = 0.5
+    res = ev.evaluate_dataset(cfg, "none", "turin-sim-ekinox", drive=drive5, ecfg=ecfg, models=models)
+    assert res.drive is drive5
+    sens = ev.pseudo_std_sensitivity(cfg, "none", res, ecfg)
+    assert sens.seed == 1 and list(sens.alternative.models) == [("bgfn", 1)]       # the first seed only
+    t = sens.table.set_index(["outage", "method"])
+    assert list(sens.table.columns) == list(ev.SENSITIVITY_COLUMNS)
+    seed1 = res.per_seed[res.per_seed["seed"] == 1].set_index(["outage", "method"])
+    # the left side is seed 1's own run, not the median over seeds
+    assert t.loc[(1, "BGFN"), "max_east_m"] == seed1.loc[(1, "BGFN"), "max_east_m"]
+    assert t.loc[(1, "BGFN"), "max_east_m"] != res.table.set_index(["outage", "method"]).loc[(1, "BGFN"), "max_east_m"]
+    # INS and GPS fuse no pseudo fix: unchanged; the network's run is not
+    for m in ("INS", "GPS"):
+        assert t.loc[(1, m), "max_east_m"] == t.loc[(1, m), "max_east_m (validation std)"]
+    assert t.loc[(1, "BGFN"), "max_east_m"] != t.loc[(1, "BGFN"), "max_east_m (validation std)"]
+    path = ev.save_sensitivity(tmp_path, sens)
+    assert path.name == "outage_dataset_std_validation.csv"
+    assert list(pd.read_csv(path).columns) == list(ev.TABLE_COLUMNS)
+
+
+def test_run_tables_evaluates_writes_and_times_every_dataset(monkeypatch, tmp_path):
+    from bgfn.evaluate import tables
+
+    seen = []
+
+    def fake_evaluate(cfg, profile, name, ecfg=None, **kw):
+        seen.append(name)
+        res = _table_result(name)
+        res.per_seed = res.table.assign(start_s=100.0 * res.table["outage"], seed=None)
+        res.runs = [ev.OutageRun("INS", None, 100.0, 1.0, pd.DataFrame(),
+                                 errors=pd.DataFrame({"t_rel": [0.0, 1.0], "east": 0.0, "north": 0.0,
+                                                      "horizontal": 0.0}))]
+        return res
+
+    monkeypatch.setattr(tables, "evaluate_dataset", fake_evaluate)
+    lines = []
+    results, timings = ev.run_tables({}, "none", ["turin-sim-ekinox", "turin-sim-mpu6000"],
+                                     {"series_rate_hz": 10.0}, tmp_path, report=lines.append)
+    assert seen == list(results) == ["turin-sim-ekinox", "turin-sim-mpu6000"]
+    assert list(timings) == ["tables_turin-sim-ekinox_s", "tables_turin-sim-mpu6000_s"]
+    assert lines[1].startswith("turin-sim-mpu6000 (field test): 1 runs in ")
+    assert lines[1].endswith("-> tables/outage_field.csv, tables/outage_field_seeds.csv, tables/outage_errors_field.csv")
+    assert (tmp_path / "tables" / "outage_dataset.csv").exists()
+
+
+def test_sweep_tables_and_lines():
+    summary = pd.DataFrame({"dataset": "d", "duration_s": [10.0, 10.0, 30.0, 30.0],
+                            "method": ["BGFN", "INS", "BGFN", "INS"], "n": 4, "n_starts": 4,
+                            "median_m": [1.25, 3.0, 2.0, 9.0], "ci_lo_m": [1.0, 2.0, 1.5, 8.0],
+                            "ci_hi_m": [1.5, 4.0, 2.5, 10.0]})
+    wide = ev.sweep_interval_table(summary)
+    assert list(wide.columns) == ["10 s", "30 s"] and list(wide.index) == [("d", "INS"), ("d", "BGFN")]
+    assert wide.loc[("d", "BGFN"), "30 s"] == "2.0 [1.5, 2.5]" and wide.loc[("d", "INS"), "10 s"] == "3.0 [2.0, 4.0]"
+    sweep = pd.DataFrame({"start_s": [1.0, 1.0, 2.0, 2.0], "duration_s": 10.0, "method": ["INS", "BGFN"] * 2,
+                          "seed": 0})
+    assert ev.describe_sweep_size(sweep) == "4 rows, 2 starts x 1 durations x 2 methods x 1 seeds"
+    # the fold networks are described with the sweep's train overrides over the train: section
+    cfg = load_profile("smoke")
+    ecfg = ev.evaluate_config({"methods": ["mlp"], "sweep": {"train": {"optimizer": {"epochs": 7}}}}, cfg["train"])
+    lines = ev.describe_sweep_setup(cfg["train"], ecfg, ["d"])
+    assert lines[0].startswith("datasets ['d']: ") and lines[0].endswith("x methods ['MLP'] + INS + GPS")
+    assert f"'epochs': 7, 'batch_size': {cfg['train']['optimizer']['batch_size']}" in lines[1]
+    assert lines[2] == f"  {'MLP':>12}: {cfg['train']['sizes']['mlp'][cfg['train']['size']]}"
+    rows, info, timings = ev.run_sweeps(cfg, "smoke", [], ecfg)
+    assert list(rows.columns) == list(ev.SWEEP_COLUMNS) and rows.empty and info == {} and timings == {}
+
+
+def test_evaluation_record_is_what_notebook_06_reads(tmp_path):
+    import json
+
+    from bgfn import report
+
+    cfg = load_profile("smoke")
+    setup = ev.evaluation_setup(cfg, sweep_datasets=[])
+    results = {"turin-sim-ekinox": _table_result("turin-sim-ekinox"),
+               "turin-sim-mpu6000": _table_result("turin-sim-mpu6000")}
+    reductions = {n: ev.reduction_table(r) for n, r in results.items()}
+    path = ev.write_evaluation_record(tmp_path, setup, results, reductions, 0, {}, {"tables_x_s": 1.0})
+    rec = json.loads(path.read_text())
+    assert path.name == ev.RECORD_FILE and rec["meta"]["profile"] == "smoke" and rec["profile"] == "smoke"
+    assert rec["outage_windows"] == [list(w) for w in setup.windows] and rec["evaluate"]["seeds"] == [0]
+    assert set(rec["tables"]) == set(rec["reduction_vs_ins_pct"]) == {"dataset", "field"}
+    bgfn1 = [r for r in rec["reduction_vs_ins_pct"]["dataset"] if r["outage"] == 1 and r["method"] == "BGFN"][0]
+    assert bgfn1["east_%"] == pytest.approx(80.0)
+    assert rec["paper_claims"] == paper.claims()["bgfn_reduction_vs_ins_pct"]
+    assert rec["sweep"] == {"rows": 0, "info": {}} and rec["timings_s"] == {"tables_x_s": 1.0}
+    assert report.outage_datasets(rec) == {"dataset": "turin-sim-ekinox", "field": "turin-sim-mpu6000"}

@@ -45,36 +45,50 @@ Wilcoxon signed-rank test on the (start, seed) pairs.
 
 Modules, in the order of the protocol:
 
-- :mod:`bgfn.evaluate.config` -- method names and labels, table columns, the ``evaluate:`` defaults;
+- :mod:`bgfn.evaluate.config` -- method names and labels, table columns, the ``evaluate:`` defaults, notebook
+  04's parameters over them (:func:`evaluation_setup`);
 - :mod:`bgfn.evaluate.hybrid` -- Eq. pred-gps, the GPS-aided run, the outage runs, their metrics;
 - :mod:`bgfn.evaluate.networks` -- notebook 03's checkpoints (trained here when missing);
 - :mod:`bgfn.evaluate.tables` -- the paper's Tables 1-2 and their files;
+- :mod:`bgfn.evaluate.claims` -- ours beside the paper's: its layout, reductions against INS, its quoted claims;
 - :mod:`bgfn.evaluate.plots` -- the paper's outage figures and the sweep's box plots;
-- :mod:`bgfn.evaluate.sweep` -- the outage sweep and its statistics.
+- :mod:`bgfn.evaluate.sensitivity` -- the tables again with each network's validation std for its pseudo fixes;
+- :mod:`bgfn.evaluate.sweep` -- the outage sweep and its statistics;
+- :mod:`bgfn.evaluate.record` -- ``outage_evaluation.json``, the record notebook 06 reads.
 
 Everything public is re-exported here: ``from bgfn import evaluate as ev; ev.evaluate_dataset(...)``.
 """
 
+from bgfn.evaluate.claims import REDUCTION_COLUMNS, claim_lines, paper_layout, paper_table_title, reduction_table
 from bgfn.evaluate.config import (COLORS, EVALUATE_DEFAULTS, FIGURE_METHODS, METRIC_COLUMNS,
                                   REAL_IMU_DATASETS, SWEEP_COLUMNS, TABLE_COLUMNS, TABLE_FILES,
-                                  TABLE_METHODS, choose_datasets, evaluate_config)
+                                  TABLE_METHODS, EvaluationSetup, choose_datasets, evaluate_config,
+                                  evaluation_setup, override_section)
 from bgfn.evaluate.hybrid import (NavContext, OutageRun, gps_run, navigation_context, pseudo_gps_positions,
                                   run_outages, window_metrics)
 from bgfn.evaluate.networks import ensure_models, load_model
 from bgfn.evaluate.plots import plot_gps_row, plot_outage, plot_sweep_boxes
-from bgfn.evaluate.sweep import (describe_sweep, run_sweep, sweep_comparisons, sweep_plan, sweep_summary,
+from bgfn.evaluate.record import RECORD_FILE, evaluation_record, write_evaluation_record
+from bgfn.evaluate.sensitivity import (SENSITIVITY_COLUMNS, Sensitivity, pseudo_std_sensitivity,
+                                       save_sensitivity, sensitivity_table)
+from bgfn.evaluate.sweep import (describe_sweep, describe_sweep_setup, describe_sweep_size, run_sweep, run_sweeps,
+                                 sweep_comparisons, sweep_interval_table, sweep_plan, sweep_summary,
                                  sweep_train_config)
 from bgfn.evaluate.tables import (TableResult, aggregate_seeds, describe_tables, error_reduction, error_series,
                                   evaluate_dataset, fix_error_table,
-                                  representative_seeds, save_table_result, table_file)
+                                  representative_seeds, run_tables, save_table_result, table_file)
 
 __all__ = [
-    "COLORS", "EVALUATE_DEFAULTS", "FIGURE_METHODS", "METRIC_COLUMNS", "NavContext", "OutageRun",
-    "REAL_IMU_DATASETS", "SWEEP_COLUMNS", "TABLE_COLUMNS", "TABLE_FILES", "TABLE_METHODS",
-    "TableResult", "aggregate_seeds", "choose_datasets", "describe_sweep", "describe_tables", "ensure_models",
-    "error_reduction", "error_series", "evaluate_config", "evaluate_dataset", "fix_error_table", "gps_run",
-    "load_model", "navigation_context", "plot_gps_row", "plot_outage",
-    "plot_sweep_boxes", "pseudo_gps_positions", "representative_seeds", "run_outages", "run_sweep",
-    "save_table_result", "sweep_comparisons", "sweep_plan", "sweep_summary", "sweep_train_config", "table_file",
-    "window_metrics",
+    "COLORS", "EVALUATE_DEFAULTS", "FIGURE_METHODS", "METRIC_COLUMNS", "REAL_IMU_DATASETS", "RECORD_FILE",
+    "REDUCTION_COLUMNS", "SENSITIVITY_COLUMNS", "SWEEP_COLUMNS", "TABLE_COLUMNS", "TABLE_FILES",
+    "TABLE_METHODS", "EvaluationSetup", "NavContext", "OutageRun", "Sensitivity", "TableResult",
+    "aggregate_seeds", "choose_datasets", "claim_lines", "describe_sweep", "describe_sweep_setup",
+    "describe_sweep_size", "describe_tables", "ensure_models", "error_reduction", "error_series",
+    "evaluate_config", "evaluate_dataset", "evaluation_record", "evaluation_setup", "fix_error_table",
+    "gps_run", "load_model", "navigation_context", "override_section", "paper_layout", "paper_table_title",
+    "plot_gps_row", "plot_outage", "plot_sweep_boxes", "pseudo_gps_positions", "pseudo_std_sensitivity",
+    "reduction_table", "representative_seeds", "run_outages", "run_sweep", "run_sweeps", "run_tables",
+    "save_sensitivity", "save_table_result", "sensitivity_table", "sweep_comparisons", "sweep_interval_table",
+    "sweep_plan", "sweep_summary", "sweep_train_config", "table_file", "window_metrics",
+    "write_evaluation_record",
 ]

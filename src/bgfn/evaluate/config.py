@@ -1,8 +1,10 @@
-"""Names, defaults and configuration of the outage evaluation (a profile's ``evaluate:`` section)."""
+"""Names, defaults and configuration of the outage evaluation (a profile's ``evaluate:`` section), and the
+setup of one evaluation run: notebook 04's parameters over that section, the datasets chosen, the outages."""
 
 from __future__ import annotations
 
 import copy
+from dataclasses import dataclass, field
 from typing import Any, Sequence
 
 from bgfn.errors import DataError
@@ -115,3 +117,94 @@ def choose_datasets(datasets: Sequence[str], real_imu: bool) -> tuple[list[str],
             notes.append(f"{fname} absent (the recorded NaveGo IMU is not available here): {d} "
                          f"(simulated IMU) stands in for {real}")
     return names, notes
+
+
+def override_section(section: dict | None, real_imu: bool | None = None, datasets: Sequence[str] | None = None,
+                     methods: Sequence[str] | None = None, seeds: Sequence[int] | None = None,
+                     sweep_datasets: Sequence[str] | None = None) -> dict:
+    """A profile's ``evaluate:`` section with notebook 04's parameters; a parameter left None keeps the
+    section's value.
+
+    ``sweep_datasets`` replaces ``sweep.datasets`` (``[]`` skips the sweep); the other keys of ``sweep`` stay.
+    The section is not checked here: :func:`evaluate_config` does it.
+    """
+    out = dict(section or {})
+    given = {"real_imu": real_imu, "datasets": datasets, "methods": methods, "seeds": seeds}
+    out.update({k: v for k, v in given.items() if v is not None})
+    if sweep_datasets is not None:
+        out["sweep"] = {**(out.get("sweep") or {}), "datasets": list(sweep_datasets)}
+    return out
+
+
+@dataclass
+class EvaluationSetup:
+    """What one run of notebook 04 evaluates (:func:`evaluation_setup`).
+
+    Attributes
+    ----------
+    profile : str
+    description : str
+        The profile's one-line description.
+    config : dict
+        :func:`evaluate_config` of the profile's section with the notebook's parameters.
+    datasets : list of str
+        Datasets of the two tables (``tab-out1-exin``, ``tab-real``), after the real-IMU choice
+        (:func:`choose_datasets`).
+    notes : list of str
+        One line per table dataset on that choice (empty without ``real_imu``).
+    sweep_datasets, sweep_notes : list of str
+        The same for the outage sweep.
+    windows : list of (float, float)
+        The evaluation outages ``(start, duration)``, s (:func:`bgfn.nav.outages.outage_windows`).
+    """
+
+    profile: str
+    description: str
+    config: dict
+    datasets: list[str]
+    notes: list[str]
+    sweep_datasets: list[str]
+    sweep_notes: list[str]
+    windows: list = field(default_factory=list)
+
+    def describe(self) -> list[str]:
+        """Lines saying what is evaluated: profile, IMUs, datasets, methods, seeds, outages, pseudo-GPS."""
+        ecfg = self.config
+        lines = [f"profile {self.profile!r}: {self.description}"]
+        if ecfg["real_imu"]:
+            lines += [f"real_imu: {line}" for line in dict.fromkeys(self.notes + self.sweep_notes)]
+        else:
+            lines.append("real_imu: false -> simulated IMUs (set real_imu=True to use NaveGo's recorded IMU "
+                         "files when present)")
+        lines.append(f"tables: {self.datasets} | methods: {ecfg['methods']} | seeds: {ecfg['seeds']} | "
+                     f"seed aggregate: {ecfg['seed_aggregate']}")
+        lines.append(f"outages (start, duration) s: {[list(w) for w in self.windows]}")
+        lines.append(f"pseudo-GPS: {ecfg['pseudo_gps']}")
+        return lines
+
+
+def evaluation_setup(cfg: dict, real_imu: bool | None = None, datasets: Sequence[str] | None = None,
+                     methods: Sequence[str] | None = None, seeds: Sequence[int] | None = None,
+                     sweep_datasets: Sequence[str] | None = None) -> EvaluationSetup:
+    """Notebook 04's parameters over a profile: the checked configuration, the datasets, the outages.
+
+    Parameters
+    ----------
+    cfg : dict
+        The profile (:func:`bgfn.config.load_profile`).
+    real_imu, datasets, methods, seeds, sweep_datasets
+        The notebook's parameters (:func:`override_section`); None keeps the profile's value.
+
+    Returns
+    -------
+    EvaluationSetup
+    """
+    from bgfn.nav.outages import outage_windows
+
+    section = override_section(cfg.get("evaluate"), real_imu=real_imu, datasets=datasets, methods=methods,
+                               seeds=seeds, sweep_datasets=sweep_datasets)
+    ecfg = evaluate_config(section, cfg.get("train"))
+    names, notes = choose_datasets(ecfg["datasets"], ecfg["real_imu"])
+    sweep_names, sweep_notes = choose_datasets(ecfg["sweep"]["datasets"], ecfg["real_imu"])
+    return EvaluationSetup(cfg.get("profile", ""), cfg.get("description", ""), ecfg, names, notes, sweep_names,
+                           sweep_notes, outage_windows(cfg))

@@ -1,9 +1,10 @@
 """Outage sweep (beyond the paper): many starts and durations, networks trained without the outages they are
-tested on (k-fold), bootstrap intervals and paired tests."""
+tested on (k-fold), bootstrap intervals and paired tests, and the lines and tables notebook 04 shows of it."""
 
 from __future__ import annotations
 
 import copy
+from typing import Callable
 
 import numpy as np
 import pandas as pd
@@ -13,7 +14,7 @@ from bgfn.errors import DataError
 from bgfn.evaluate.config import SWEEP_COLUMNS, TABLE_METHODS, evaluate_config
 from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
 from bgfn.evaluate.networks import load_model
-from bgfn.paper import METHOD_LABELS
+from bgfn.paper import METHOD_LABELS, label
 
 
 def sweep_plan(drive, sweep: dict, window_samples: int = 200) -> pd.DataFrame:
@@ -206,3 +207,71 @@ def describe_sweep(summary: pd.DataFrame, pairs: pd.DataFrame, method: str = "BG
         lines.append(f"{ds}, {du:g} s outages: median max horizontal error (m) [95 % interval]: {med}. "
                      f"{method} {cmp_}.")
     return lines
+
+
+def describe_sweep_setup(train_section: dict, ecfg: dict, datasets) -> list[str]:
+    """Lines saying what the sweep runs: its sizes, and the fold networks' window, size block, optimizer budget
+    and per-method sizes (the ``train:`` section with the ``sweep.train`` overrides, :func:`sweep_train_config`).
+    """
+    sw = ecfg["sweep"]
+    tc = sweep_train_config(train_section, sw)
+    budget = {k: tc["optimizer"][k] for k in ("epochs", "batch_size", "max_train_windows", "patience")
+              if k in tc["optimizer"]}
+    lines = [f"datasets {list(datasets)}: {sw['n_starts']} starts x durations {sw['durations_s']} s x "
+             f"{sw['folds']} folds x seeds {sw['seeds']} x methods {[label(m) for m in ecfg['methods']]} + INS + GPS",
+             f"fold networks: window {tc.get('window')} samples, size block {tc.get('size')!r}, optimizer {budget}"]
+    lines += [f"  {label(m):>12}: {tc['sizes'][m][tc['size']]}" for m in ecfg["methods"]]
+    return lines
+
+
+def run_sweeps(cfg: dict, profile: str, datasets, ecfg: dict, progress: bool = True,
+               report: Callable[[str], None] | None = None) -> tuple[pd.DataFrame, dict, dict]:
+    """:func:`run_sweep` of every dataset, one after the other.
+
+    Parameters
+    ----------
+    report : callable, optional
+        Called with a line or two per dataset as soon as it is done (its rows, wall times, fold starts).
+
+    Returns
+    -------
+    rows : DataFrame
+        ``SWEEP_COLUMNS``, the datasets in turn (empty, with those columns, when ``datasets`` is).
+    info : dict
+        ``{dataset: info of run_sweep}``.
+    timings : dict
+        ``{"sweep_<dataset>_s": wall time, s}``.
+    """
+    import time
+
+    parts, info, timings = [], {}, {}
+    for name in datasets:
+        t0 = time.perf_counter()
+        df, info[name] = run_sweep(cfg, profile, name, ecfg=ecfg, progress=progress)
+        parts.append(df)
+        timings[f"sweep_{name}_s"] = time.perf_counter() - t0
+        if report is not None:
+            report(f"{name}: {len(df)} rows, training {info[name]['train_wall_s']:.0f} s, evaluation "
+                   f"{info[name]['eval_wall_s']:.0f} s\n  fold starts (s): {info[name]['fold_starts']}")
+    rows = pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(columns=list(SWEEP_COLUMNS))
+    return rows, info, timings
+
+
+def describe_sweep_size(sweep: pd.DataFrame) -> str:
+    """``<n> rows, <a> starts x <b> durations x <c> methods x <d> seeds`` of a sweep table."""
+    return (f"{len(sweep)} rows, {sweep['start_s'].nunique()} starts x {sweep['duration_s'].nunique()} durations x "
+            f"{sweep['method'].nunique()} methods x {sweep['seed'].nunique()} seeds")
+
+
+def sweep_interval_table(summary: pd.DataFrame) -> pd.DataFrame:
+    """:func:`sweep_summary` as one text cell per (dataset, method) row and duration column:
+    ``median [lo, hi]`` of the max horizontal error, m, one decimal.
+
+    Rows are ordered by method (``TABLE_METHODS``), then dataset; columns ``<d> s`` by duration.
+    """
+    cell = summary.assign(text=[f"{r.median_m:.1f} [{r.ci_lo_m:.1f}, {r.ci_hi_m:.1f}]"
+                                for r in summary.itertuples(index=False)])
+    wide = cell.pivot_table(index=["dataset", "method"], columns="duration_s", values="text", aggfunc="first")
+    wide = wide.reindex([i for m in TABLE_METHODS for i in wide.index if i[1] == m])
+    wide.columns = [f"{c:g} s" for c in wide.columns]
+    return wide

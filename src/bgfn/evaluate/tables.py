@@ -1,10 +1,12 @@
-"""The paper's Tables 1-2: every method in the evaluation outages, the seed aggregate, the result files, the
-paper's values beside ours, and plain-language lines computed from the numbers."""
+"""The paper's Tables 1-2 (``tab-out1-exin``, ``tab-real``): every method in the evaluation outages, the seed
+aggregate, the result files, and plain-language lines computed from the numbers. The paper's own values beside
+ours are :mod:`bgfn.evaluate.claims`."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any, Callable
 
 import numpy as np
 import pandas as pd
@@ -35,6 +37,8 @@ class TableResult:
         :func:`bgfn.data.gnss.fix_errors` of the drive: each GNSS fix's own error, which the GPS row follows.
     gnss_errors : DataFrame or None
         :func:`fix_error_table` of ``fix_errors``: their largest values in each outage window.
+    drive : bgfn.data.Drive or None
+        The drive evaluated (its reference draws the figures; the sensitivity run reuses it).
     """
 
     dataset: str
@@ -45,6 +49,7 @@ class TableResult:
     models: dict = field(default_factory=dict)
     fix_errors: pd.DataFrame | None = None
     gnss_errors: pd.DataFrame | None = None
+    drive: Any = None
 
 
 def fix_error_table(err: pd.DataFrame, windows) -> pd.DataFrame:
@@ -118,8 +123,45 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
     fixes = fix_errors(drive.gnss, drive.reference, ctx.lever)
     return TableResult(dataset, test_of(dataset) or dataset, per_seed,
                        aggregate_seeds(per_seed, ecfg["seed_aggregate"]), runs, models, fixes,
-                       fix_error_table(fixes, windows))
+                       fix_error_table(fixes, windows), drive)
 
+
+def run_tables(cfg: dict, profile: str, datasets, ecfg: dict, out,
+               report: Callable[[str], None] | None = None) -> tuple[dict, dict]:
+    """:func:`evaluate_dataset` and :func:`save_table_result` of every dataset of the tables, in turn.
+
+    Parameters
+    ----------
+    cfg : dict
+        The profile.
+    profile : str
+    datasets : sequence of str
+    ecfg : dict
+        :func:`evaluate_config`.
+    out : path
+        ``results/<profile>``.
+    report : callable, optional
+        Called with one line per dataset as soon as it is done (runs, wall time, files written).
+
+    Returns
+    -------
+    results : dict
+        ``{dataset: TableResult}``.
+    timings : dict
+        ``{"tables_<dataset>_s": wall time of loading, evaluating and writing, s}``.
+    """
+    import time
+
+    results, timings = {}, {}
+    for name in datasets:
+        t0 = time.perf_counter()
+        res = results[name] = evaluate_dataset(cfg, profile, name, ecfg=ecfg)
+        paths = save_table_result(out, res, ecfg["series_rate_hz"])
+        timings[f"tables_{name}_s"] = time.perf_counter() - t0
+        if report is not None:
+            report(f"{name} ({res.test} test): {len(res.runs)} runs in {timings[f'tables_{name}_s']:.1f} s -> "
+                   + ", ".join(str(Path(q).relative_to(out)) for q in paths.values()))
+    return results, timings
 
 def table_file(test: str) -> str:
     """File name of a test's table under ``tables/``: ``outage_dataset.csv``, ``outage_field.csv``, else

@@ -1,0 +1,91 @@
+"""Our outage tables beside the paper's: its Tables 1-2 (``tab-out1-exin``, ``tab-real``) in its layout, the
+error reductions against INS beside the ones its tables give, and the two reductions its text quotes.
+
+The paper's values are read through :mod:`bgfn.paper` (``data/paper/outage_max_errors.csv`` and
+``claims.yaml``); they are shown beside ours, never used to choose anything.
+"""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+import pandas as pd
+
+from bgfn import paper
+from bgfn.evaluate.config import TABLE_METHODS
+from bgfn.evaluate.tables import TableResult, error_reduction
+
+#: Columns of :func:`reduction_table`: ours, then the paper's (reduction against INS, %).
+REDUCTION_COLUMNS: tuple[str, ...] = ("outage", "method", "east_%", "north_%", "paper east_%", "paper north_%")
+
+
+def paper_table_title(test: str) -> str:
+    """How notebook 04 names the paper's table of a test: ``Table 1 (dataset test)``, ``Table 2 (field test)``
+    (the order of :data:`bgfn.paper.TESTS`)."""
+    return f"Table {list(paper.TESTS).index(test) + 1} ({paper.TESTS[test]['title']})"
+
+
+def paper_layout(result: TableResult) -> pd.DataFrame:
+    """Max east/north errors (m) of one dataset in the paper's layout, ours above its Table 1 or 2.
+
+    :func:`bgfn.paper.layout` over :data:`TABLE_METHODS` with the source moved to the rows, so that each
+    outage reads as two rows of the paper's table (``ours``, then ``paper``) under its columns.
+
+    Returns
+    -------
+    DataFrame
+        Rows ``(Outage k, source)``; columns ``(method, axis)`` with axis ``East``/``North``; NaN where the
+        paper has no such method (Transformer, GPS).
+    """
+    lay = paper.layout(result.table, paper.outage_table(result.test), methods=TABLE_METHODS)
+    return lay.stack("source", future_stack=True)
+
+
+def reduction_table(result: TableResult, reference: str = "INS") -> pd.DataFrame:
+    """Reduction of the max east/north errors against ``reference`` (``100 (ref - method) / ref``, %), ours
+    beside the same arithmetic on the paper's table of the same test.
+
+    Returns
+    -------
+    DataFrame
+        :data:`REDUCTION_COLUMNS`: one row per outage and method of ours; the paper's columns NaN where it
+        has no such row (Transformer, GPS).
+    """
+    ours = error_reduction(result.table, reference).rename(columns={"east_pct": "east_%", "north_pct": "north_%"})
+    theirs = error_reduction(paper.outage_table(result.test), reference).rename(
+        columns={"east_pct": "paper east_%", "north_pct": "paper north_%"})
+    return ours.merge(theirs, on=["outage", "method"], how="left")[list(REDUCTION_COLUMNS)]
+
+
+def claim_lines(reductions: Mapping[str, pd.DataFrame]) -> list[str]:
+    """One line per reduction the paper quotes in its text (``claims.yaml``: BGFN against INS in the dataset
+    test's outage 1, the field test's outage 2) with ours beside it.
+
+    Parameters
+    ----------
+    reductions : mapping
+        ``{dataset: reduction_table(...)}``; a test's first dataset answers for it.
+
+    Returns
+    -------
+    list of str
+        ``BGFN vs INS, <test title>, outage <k>: paper quotes E % east / N % north; ours ...`` (``not
+        evaluated`` when no dataset of that test, or no BGFN row, was run).
+    """
+    claims = paper.claims()
+    by_test: dict[str, pd.DataFrame] = {}
+    for name, red in reductions.items():
+        by_test.setdefault(paper.test_of(name) or name, red)
+    lines = []
+    for test, spec in paper.TESTS.items():
+        for outage in sorted({int(o) for o in paper.outage_table(test)["outage"]}):
+            stated = paper.claim_for(claims, test, outage)
+            if stated is None:
+                continue
+            red = by_test.get(test)
+            row = red[(red["outage"] == outage) & (red["method"] == "BGFN")] if red is not None else None
+            got = (f"ours {row['east_%'].item():.1f} % east / {row['north_%'].item():.1f} % north"
+                   if row is not None and len(row) else "not evaluated")
+            lines.append(f"BGFN vs INS, {spec['title']}, outage {outage}: paper quotes {stated['east']} % east / "
+                         f"{stated['north']} % north; {got}")
+    return lines

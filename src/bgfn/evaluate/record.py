@@ -1,0 +1,69 @@
+"""``results/<profile>/outage_evaluation.json``: the record of one run of notebook 04 (its configuration, the
+outages, the tables, the reductions against INS beside the paper's, the sweep's sizes, wall times and run
+metadata). Notebook 06 reads it (:func:`bgfn.report.outage_datasets`: which dataset stands for which test).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Mapping
+
+import pandas as pd
+
+from bgfn import paper
+from bgfn.evaluate.config import EvaluationSetup
+from bgfn.evaluate.tables import TableResult
+
+#: File name under ``results/<profile>/``.
+RECORD_FILE = "outage_evaluation.json"
+
+
+def evaluation_record(setup: EvaluationSetup, results: Mapping[str, TableResult],
+                      reductions: Mapping[str, pd.DataFrame], sweep_rows: int, sweep_info: dict,
+                      timings: dict) -> dict:
+    """The content of ``outage_evaluation.json`` (without the run metadata).
+
+    Parameters
+    ----------
+    setup : EvaluationSetup
+    results : mapping
+        ``{dataset: TableResult}`` of the two tables.
+    reductions : mapping
+        ``{dataset: reduction_table(...)}`` (:func:`bgfn.evaluate.claims.reduction_table`).
+    sweep_rows : int
+        Rows of ``tables/outage_sweep.csv``.
+    sweep_info : dict
+        ``{dataset: info}`` of :func:`bgfn.evaluate.sweep.run_sweeps`.
+    timings : dict
+        Wall times, s.
+
+    Returns
+    -------
+    dict
+        ``profile``, ``evaluate`` (the configuration), ``outage_windows`` (``[[start, duration], ...]``, s),
+        ``datasets``, ``real_imu_notes``, ``tables`` and ``reduction_vs_ins_pct`` (keyed by the paper's test),
+        ``paper_claims`` (the BGFN reductions the paper quotes, %), ``sweep`` (``rows``, ``info``),
+        ``timings_s``.
+    """
+    return {
+        "profile": setup.profile, "evaluate": setup.config, "outage_windows": [list(w) for w in setup.windows],
+        "datasets": setup.datasets, "real_imu_notes": setup.notes,
+        "tables": {res.test: res.table.to_dict(orient="records") for res in results.values()},
+        "reduction_vs_ins_pct": {results[n].test: r.to_dict(orient="records") for n, r in reductions.items()},
+        "paper_claims": paper.claims()["bgfn_reduction_vs_ins_pct"],
+        "sweep": {"rows": int(sweep_rows), "info": sweep_info},
+        "timings_s": timings,
+    }
+
+
+def write_evaluation_record(out, setup: EvaluationSetup, results: Mapping[str, TableResult],
+                            reductions: Mapping[str, pd.DataFrame], sweep_rows: int, sweep_info: dict,
+                            timings: dict) -> Path:
+    """Write :func:`evaluation_record` plus ``meta`` (:func:`bgfn.config.run_metadata`) to
+    ``<out>/outage_evaluation.json`` atomically; returns the path."""
+    from bgfn.config import run_metadata
+    from bgfn.io import atomic_write_json
+
+    record = {**evaluation_record(setup, results, reductions, sweep_rows, sweep_info, timings),
+              "meta": run_metadata(setup.profile)}
+    return atomic_write_json(Path(out) / RECORD_FILE, record)

@@ -501,7 +501,7 @@ def test_reductions_beside_the_paper_and_its_quoted_claims():
     other = ev.reduction_table(_table_result("navego-ekinox", bgfn=(5.0, 4.0)))
     assert ev.claim_lines({"turin-sim-ekinox": red, "navego-ekinox": other})[0].endswith("ours 80.0 % east / 50.0 % north")
     assert ev.claim_lines({"navego-ekinox": other})[0].endswith("ours 50.0 % east / 50.0 % north")
-    lay = ev.paper_layout(res)
+    lay = ev.ours_above_paper(res)
     assert lay.loc[("Outage 1", "paper"), ("BGFN", "East")] == 4.7
     assert lay.loc[("Outage 2", "ours"), ("INS", "North")] == 8.0
     assert np.isnan(lay.loc[("Outage 1", "paper"), ("Transformer", "East")])

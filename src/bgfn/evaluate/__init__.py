@@ -59,11 +59,11 @@ Modules, in the order of the protocol:
 Everything public is re-exported here: ``from bgfn import evaluate as ev; ev.evaluate_dataset(...)``.
 """
 
-from bgfn.evaluate.claims import REDUCTION_COLUMNS, claim_lines, paper_layout, paper_table_title, reduction_table
+from bgfn.evaluate.claims import REDUCTION_COLUMNS, claim_lines, ours_above_paper, paper_table_title, reduction_table
 from bgfn.evaluate.config import (COLORS, EVALUATE_DEFAULTS, FIGURE_METHODS, METRIC_COLUMNS,
                                   REAL_IMU_DATASETS, SWEEP_COLUMNS, TABLE_COLUMNS, TABLE_FILES,
                                   TABLE_METHODS, EvaluationSetup, choose_datasets, evaluate_config,
-                                  evaluation_setup, override_section)
+                                  evaluation_setup)
 from bgfn.evaluate.hybrid import (NavContext, OutageRun, gps_run, navigation_context, pseudo_gps_positions,
                                   run_outages, window_metrics)
 from bgfn.evaluate.networks import ensure_models, load_model
@@ -85,7 +85,7 @@ __all__ = [
     "aggregate_seeds", "choose_datasets", "claim_lines", "describe_sweep", "describe_sweep_setup",
     "describe_sweep_size", "describe_tables", "ensure_models", "error_reduction", "error_series",
     "evaluate_config", "evaluate_dataset", "evaluation_record", "evaluation_setup", "fix_error_table",
-    "gps_run", "load_model", "navigation_context", "override_section", "paper_layout", "paper_table_title",
+    "gps_run", "load_model", "navigation_context", "ours_above_paper", "paper_table_title",
     "plot_gps_row", "plot_outage", "plot_sweep_boxes", "pseudo_gps_positions", "pseudo_std_sensitivity",
     "reduction_table", "representative_seeds", "run_outages", "run_sweep", "run_sweeps", "run_tables",
     "save_sensitivity", "save_table_result", "sensitivity_table", "sweep_comparisons", "sweep_interval_table",

@@ -25,7 +25,7 @@ def paper_table_title(test: str) -> str:
     return f"Table {list(paper.TESTS).index(test) + 1} ({paper.TESTS[test]['title']})"
 
 
-def paper_layout(result: TableResult) -> pd.DataFrame:
+def ours_above_paper(result: TableResult) -> pd.DataFrame:
     """Max east/north errors (m) of one dataset in the paper's layout, ours above its Table 1 or 2.
 
     :func:`bgfn.paper.layout` over :data:`TABLE_METHODS` with the source moved to the rows, so that each

@@ -119,23 +119,6 @@ def choose_datasets(datasets: Sequence[str], real_imu: bool) -> tuple[list[str],
     return names, notes
 
 
-def override_section(section: dict | None, real_imu: bool | None = None, datasets: Sequence[str] | None = None,
-                     methods: Sequence[str] | None = None, seeds: Sequence[int] | None = None,
-                     sweep_datasets: Sequence[str] | None = None) -> dict:
-    """A profile's ``evaluate:`` section with notebook 04's parameters; a parameter left None keeps the
-    section's value.
-
-    ``sweep_datasets`` replaces ``sweep.datasets`` (``[]`` skips the sweep); the other keys of ``sweep`` stay.
-    The section is not checked here: :func:`evaluate_config` does it.
-    """
-    out = dict(section or {})
-    given = {"real_imu": real_imu, "datasets": datasets, "methods": methods, "seeds": seeds}
-    out.update({k: v for k, v in given.items() if v is not None})
-    if sweep_datasets is not None:
-        out["sweep"] = {**(out.get("sweep") or {}), "datasets": list(sweep_datasets)}
-    return out
-
-
 @dataclass
 class EvaluationSetup:
     """What one run of notebook 04 evaluates (:func:`evaluation_setup`).
@@ -193,17 +176,21 @@ def evaluation_setup(cfg: dict, real_imu: bool | None = None, datasets: Sequence
     cfg : dict
         The profile (:func:`bgfn.config.load_profile`).
     real_imu, datasets, methods, seeds, sweep_datasets
-        The notebook's parameters (:func:`override_section`); None keeps the profile's value.
+        The notebook's parameters, set through :func:`bgfn.config.with_overrides` (checked against the profile
+        schema; ``sweep_datasets`` replaces ``evaluate.sweep.datasets``, ``[]`` skips the sweep); None keeps
+        the profile's value.
 
     Returns
     -------
     EvaluationSetup
     """
+    from bgfn.config import with_overrides
     from bgfn.nav.outages import outage_windows
 
-    section = override_section(cfg.get("evaluate"), real_imu=real_imu, datasets=datasets, methods=methods,
-                               seeds=seeds, sweep_datasets=sweep_datasets)
-    ecfg = evaluate_config(section, cfg.get("train"))
+    cfg = with_overrides(cfg, {"evaluate.real_imu": real_imu, "evaluate.datasets": datasets,
+                               "evaluate.methods": methods, "evaluate.seeds": seeds,
+                               "evaluate.sweep.datasets": sweep_datasets})
+    ecfg = evaluate_config(cfg.get("evaluate"), cfg.get("train"))
     names, notes = choose_datasets(ecfg["datasets"], ecfg["real_imu"])
     sweep_names, sweep_notes = choose_datasets(ecfg["sweep"]["datasets"], ecfg["real_imu"])
     return EvaluationSetup(cfg.get("profile", ""), cfg.get("description", ""), ecfg, names, notes, sweep_names,

@@ -10,6 +10,7 @@ import torch
 
 from bgfn import learning as L
 from bgfn import train as T
+from bgfn.train import loop, lr_search
 from bgfn.errors import DataError
 
 torch.set_num_threads(1)
@@ -91,7 +92,7 @@ def test_resume_after_interruption_gives_the_same_run(data, tmp_path):
     size = {"hidden": 8, "n_recent": 4}
     full = T.train_model("mlp", data, size, _cfg(epochs=4), seed=2, progress=False)
     calls = {"n": 0}
-    orig = T.predict_normalized
+    orig = loop.predict_normalized
 
     def flaky(*args, **kwargs):                       # dies in the validation of the 3rd epoch
         calls["n"] += 1
@@ -99,12 +100,12 @@ def test_resume_after_interruption_gives_the_same_run(data, tmp_path):
             raise _Interrupt
         return orig(*args, **kwargs)
 
-    T.predict_normalized = flaky
+    loop.predict_normalized = flaky                   # the name the training loop calls
     try:
         with pytest.raises(_Interrupt):
             T.train_model("mlp", data, size, _cfg(epochs=4), seed=2, out_dir=tmp_path, progress=False)
     finally:
-        T.predict_normalized = orig
+        loop.predict_normalized = orig
     assert (tmp_path / "mlp_seed2.last.pt").exists() and not (tmp_path / "mlp_seed2.json").exists()
     resumed = T.train_model("mlp", data, size, _cfg(epochs=4), seed=2, out_dir=tmp_path, progress=False)
     assert resumed["epochs_run"] == 4
@@ -267,7 +268,7 @@ def test_learning_rate_search_extends_past_the_grid_edge(data, tmp_path):
 
 
 def test_tuned_config_reads_the_saved_search(tmp_path, monkeypatch):
-    monkeypatch.setattr(T, "results_dir", lambda profile, create=True: tmp_path / profile)
+    monkeypatch.setattr(lr_search, "results_dir", lambda profile, create=True: tmp_path / profile)
     cfg = {"train": {"lr": {"mlp": 1e-3}, "lr_search": {"grid": [1e-3, 1e-2]}}}
     assert T.tuned_train_config(cfg, "p", "d1") is cfg["train"]              # not run yet
     (tmp_path / "p" / "tables").mkdir(parents=True)

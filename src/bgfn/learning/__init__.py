@@ -53,8 +53,8 @@ Modules, one concept each (every public name is re-exported here):
 - :mod:`bgfn.learning.synthetic`: a toy drive for tests and examples.
 """
 
-from bgfn.learning.coverage import (VAL_POSITIONS, motion_in_windows, motion_of_windows, unseen_fraction,
-                                    val_position_coverage)
+from bgfn.learning.coverage import (VAL_POSITIONS, motion_in_windows, motion_of_windows, motion_sets,
+                                    unseen_fraction, val_position_coverage)
 from bgfn.learning.data import (LEARNING_DEFAULTS, LearningData, all_windows, build_learning_data, inner_split,
                                 learning_options, split_summary)
 from bgfn.learning.inputs import (ANGULAR_RATE_CHANNELS, ATTITUDE_CHANNELS, CHANNELS, DERIVED_CHANNELS, EXTRA_START,
@@ -82,7 +82,7 @@ __all__ = [
     "forbidden_intervals", "overlaps", "split_windows", "block_label", "Normalizer",
     # references, coverage
     "rmse", "REFERENCES", "reference_rmse", "reference_columns", "VAL_POSITIONS", "motion_of_windows",
-    "motion_in_windows", "unseen_fraction", "val_position_coverage",
+    "motion_in_windows", "motion_sets", "unseen_fraction", "val_position_coverage",
     # all together
     "LEARNING_DEFAULTS", "LearningData", "learning_options", "all_windows", "build_learning_data", "inner_split",
     "split_summary", "synthetic_tables",

@@ -35,6 +35,14 @@ def motion_in_windows(reference: pd.DataFrame, windows, step_s: float = 1.0) -> 
     return pd.concat(rows, ignore_index=True) if rows else pd.DataFrame(columns=["heading_deg", "speed_mps"])
 
 
+
+def motion_sets(data, reference: pd.DataFrame, outage_windows) -> dict[str, pd.DataFrame]:
+    """Heading and speed of the training and validation windows of ``data`` (a :class:`bgfn.learning.LearningData`)
+    and of the ``reference`` inside the evaluation outages, keyed ``training``, ``validation``, ``evaluation
+    outages`` (:func:`bgfn.train.plot_motion_coverage` draws them)."""
+    return {"training": motion_of_windows(data.train), "validation": motion_of_windows(data.val),
+            "evaluation outages": motion_in_windows(reference, outage_windows)}
+
 def unseen_fraction(train: pd.DataFrame, other: pd.DataFrame, heading_bin_deg: float = 30.0,
                     speed_bin_mps: float = 2.0) -> float:
     """Fraction of the rows of ``other`` whose (heading, speed) cell holds no training row (cells of

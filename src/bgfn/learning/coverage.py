@@ -70,7 +70,7 @@ def val_position_coverage(ws: WindowSet, outage_motion: pd.DataFrame, outage_win
     Parameters
     ----------
     ws : WindowSet
-        Every window of the drive (:func:`make_windows`).
+        Every window of the drive (:func:`bgfn.learning.windows.make_windows`).
     outage_motion : DataFrame
         Heading and speed inside the evaluation outages (:func:`motion_in_windows`).
     outage_windows, margin_s, val_fraction

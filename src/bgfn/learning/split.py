@@ -36,7 +36,7 @@ def split_windows(ws: WindowSet, outage_windows=(), margin_s: float = 30.0, val_
     Parameters
     ----------
     ws : WindowSet
-        From :func:`make_windows` (sorted by time).
+        From :func:`bgfn.learning.windows.make_windows` (sorted by time).
     outage_windows : sequence of (start, duration)
         Evaluation outages, s (GPS time); windows touching ``[start - margin_s, start + duration + margin_s]``
         are excluded from both sets.

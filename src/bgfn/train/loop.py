@@ -90,7 +90,7 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
     data : LearningData
         Training/validation windows and normalization (:func:`bgfn.learning.build_learning_data`).
     size_cfg : dict
-        Model constructor keywords (:func:`size_config`).
+        Model constructor keywords (:func:`bgfn.train.options.size_config`).
     train_cfg : dict
         A profile's ``train:`` section (uses ``optimizer`` and ``lr``).
     seed : int

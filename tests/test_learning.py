@@ -323,3 +323,36 @@ def test_input_layout_places_each_group_of_eq21_where_its_slice_says():
     np.testing.assert_array_equal(feats[:, L.ANGULAR_RATE_CHANNELS], imu[list(schema.GYRO_COLUMNS)].to_numpy())
     np.testing.assert_array_equal(feats[:, L.SPECIFIC_FORCE_CHANNELS], imu[list(schema.ACCEL_COLUMNS)].to_numpy())
     assert channels[L.EXTRA_START] == "v_n" and np.all(feats[:, L.EXTRA_START] == 7.0)
+
+
+def test_split_summary_accounts_for_every_window(tables):
+    imu, att, gnss = tables
+    outage = [(1080.0, 20.0)]
+    data = L.build_learning_data(imu, att, gnss, outage, window=100, margin_s=5.0, val_fraction=0.25,
+                                 val_position="middle")
+    s = L.split_summary(data)
+    assert list(s) == ["windows", "excluded_outages", "purged_near_val", "screened", "train", "val", "val_block_s",
+                       *L.REFERENCES.values()]
+    # every window is in exactly one of: near an outage, validation, purged beside the block, training
+    assert s["windows"] == s["excluded_outages"] + s["val"] + s["purged_near_val"] + s["train"]
+    assert s["excluded_outages"] > 0 and s["purged_near_val"] > 0 and s["screened"] == 0
+    assert (s["train"], s["val"]) == (len(data.train), len(data.val))
+    lo, hi = (float(v) for v in s["val_block_s"].split(".."))
+    assert lo == pytest.approx(data.val.span[0].min(), abs=0.05)
+    assert hi == pytest.approx(data.val.span[1].max(), abs=0.05)
+    assert s["val_rmse_zero_m"] == L.reference_rmse(data.val)["zero"]
+    assert L.block_label([1.04, 2.96]) == "1.0..3.0"
+
+
+def test_motion_sets_hold_training_validation_and_outage_motion(tables):
+    imu, att, gnss = tables
+    data = L.build_learning_data(imu, att, gnss, [(1100.0, 10.0)], window=100, margin_s=5.0)
+    ref = att.assign(v_n=np.interp(att["time"], gnss["time"], gnss["v_n"]),
+                     v_e=np.interp(att["time"], gnss["time"], gnss["v_e"]))
+    sets = L.motion_sets(data, ref, [(1100.0, 10.0)])
+    assert list(sets) == ["training", "validation", "evaluation outages"]
+    assert len(sets["training"]) == len(data.train) and len(sets["validation"]) == len(data.val)
+    assert len(sets["evaluation outages"]) == 10                   # one row per second of the outage
+    # the toy drive's speed is 10 m/s +- 30 %, in the windows as in the outage
+    for df in sets.values():
+        assert df["speed_mps"].between(6.9, 13.1).all()

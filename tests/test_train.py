@@ -1,16 +1,20 @@
-"""The training loop (bgfn.train): artifacts, references, early stopping, determinism and resume."""
+"""The training loop (bgfn.train): artifacts, references, early stopping, determinism and resume; the learning-rate
+search; a profile's training over datasets, methods and seeds, and its tables."""
 
 from __future__ import annotations
 
 import json
+from types import SimpleNamespace
 
 import numpy as np
+import pandas as pd
 import pytest
 import torch
 
 from bgfn import learning as L
 from bgfn import train as T
 from bgfn.errors import DataError
+from bgfn.train import loop, lr_search
 
 torch.set_num_threads(1)
 
@@ -91,7 +95,7 @@ def test_resume_after_interruption_gives_the_same_run(data, tmp_path):
     size = {"hidden": 8, "n_recent": 4}
     full = T.train_model("mlp", data, size, _cfg(epochs=4), seed=2, progress=False)
     calls = {"n": 0}
-    orig = T.predict_normalized
+    orig = loop.predict_normalized
 
     def flaky(*args, **kwargs):                       # dies in the validation of the 3rd epoch
         calls["n"] += 1
@@ -99,12 +103,12 @@ def test_resume_after_interruption_gives_the_same_run(data, tmp_path):
             raise _Interrupt
         return orig(*args, **kwargs)
 
-    T.predict_normalized = flaky
+    loop.predict_normalized = flaky                   # the name the training loop calls
     try:
         with pytest.raises(_Interrupt):
             T.train_model("mlp", data, size, _cfg(epochs=4), seed=2, out_dir=tmp_path, progress=False)
     finally:
-        T.predict_normalized = orig
+        loop.predict_normalized = orig
     assert (tmp_path / "mlp_seed2.last.pt").exists() and not (tmp_path / "mlp_seed2.json").exists()
     resumed = T.train_model("mlp", data, size, _cfg(epochs=4), seed=2, out_dir=tmp_path, progress=False)
     assert resumed["epochs_run"] == 4
@@ -267,7 +271,7 @@ def test_learning_rate_search_extends_past_the_grid_edge(data, tmp_path):
 
 
 def test_tuned_config_reads_the_saved_search(tmp_path, monkeypatch):
-    monkeypatch.setattr(T, "results_dir", lambda profile, create=True: tmp_path / profile)
+    monkeypatch.setattr(lr_search, "results_dir", lambda profile, create=True: tmp_path / profile)
     cfg = {"train": {"lr": {"mlp": 1e-3}, "lr_search": {"grid": [1e-3, 1e-2]}}}
     assert T.tuned_train_config(cfg, "p", "d1") is cfg["train"]              # not run yet
     (tmp_path / "p" / "tables").mkdir(parents=True)
@@ -278,3 +282,125 @@ def test_tuned_config_reads_the_saved_search(tmp_path, monkeypatch):
     assert T.method_lr(T.tuned_train_config(cfg, "p", "d2"), "mlp") == 0.001
     off = {"train": {"lr": {"mlp": 1e-3}, "lr_search": {"grid": None}}}
     assert T.method_lr(T.tuned_train_config(off, "p", "d1"), "mlp") == 0.001   # no search in the profile
+
+
+# ----------------------------------------------------------------------------------------------- a profile's training
+def _toy_plan(datasets=("toy",), methods=("mlp",), seeds=(0,), **train):
+    tc = {"size": "s", "sizes": {"mlp": {"s": {"n_recent": 5, "hidden": 16}}, "at_lstm": {"s": {"hidden": 8}}},
+          **_cfg(epochs=3), **train}
+    return T.TrainingPlan("toyprofile", {"profile": "toyprofile", "description": "toy", "train": tc}, list(datasets),
+                          list(methods), list(seeds), [(1060.0, 20.0)])
+
+
+@pytest.fixture
+def models_in_tmp(tmp_path, monkeypatch):
+    """``results/<profile>/models/<dataset>/`` under ``tmp_path``."""
+    from bgfn import checkpoints
+
+    monkeypatch.setattr(checkpoints, "models_dir", lambda profile, dataset, fold=None, create=True:
+                        tmp_path / profile / dataset)
+    return tmp_path
+
+
+def test_training_plan_takes_the_profile_unless_told():
+    from bgfn.config import load_profile
+    from bgfn.nav.outages import outage_windows
+
+    cfg = load_profile("smoke")
+    plan = T.TrainingPlan.of("smoke")
+    tc = cfg["train"]
+    assert (plan.datasets, plan.methods, plan.seeds) == (tc["datasets"], tc["methods"], tc["seeds"])
+    assert plan.outage_windows == outage_windows(cfg) and plan.train_cfg == tc
+    mine = T.TrainingPlan.of("smoke", datasets=["turin-sim-mpu6000"], methods=["mlp"], seeds=[np.int64(3)],
+                             outage_windows=[(1.0, 2.0)])
+    assert (mine.datasets, mine.methods, mine.seeds, mine.outage_windows) == (["turin-sim-mpu6000"], ["mlp"], [3],
+                                                                             [(1.0, 2.0)])
+    assert type(mine.seeds[0]) is int                      # the card and file name take a plain int
+    text = mine.describe()
+    assert "methods ['mlp'], seeds [3], size 'smoke'" in text and f"+- {tc['margin_s']} s" in text
+
+
+def test_train_dataset_trains_every_method_and_seed_into_the_models_folder(data, models_in_tmp):
+    plan = _toy_plan(methods=("mlp", "at_lstm"), seeds=(0, 1))
+    lines = []
+    cards = T.train_dataset(plan, "toy", data, echo=lines.append)
+    assert [(c["method"], c["seed"]) for c in cards] == [("mlp", 0), ("mlp", 1), ("at_lstm", 0), ("at_lstm", 1)]
+    assert all(c["dataset"] == "toy" and c["profile"] == "toyprofile" and c["size"] == "s" for c in cards)
+    folder = models_in_tmp / "toyprofile" / "toy"
+    assert sorted(p.name for p in folder.glob("*.pt")) == ["at_lstm_seed0.pt", "at_lstm_seed1.pt", "mlp_seed0.pt",
+                                                           "mlp_seed1.pt"]
+    assert lines == [T.card_line(c) for c in cards]
+    assert lines[0].split()[:4] == ["toy", "mlp", "seed", "0:"]
+    assert f"val RMSE {cards[0]['val_rmse_m']:.3f} m" in lines[0]
+    # the figure of the validation block reads the same checkpoints back: the cards' validation error
+    preds = T.checkpoint_predictions(folder, data.val, ["mlp", "at_lstm"], seed=1)
+    assert list(preds) == ["mlp", "at_lstm"]
+    for method, card in zip(("mlp", "at_lstm"), cards[1::2]):
+        assert L.rmse(preds[method], data.val.y) == pytest.approx(card["val_rmse_m"], rel=1e-5)
+
+
+def test_profile_search_selects_per_dataset(data, models_in_tmp):
+    imu, att, gnss = L.synthetic_tables(duration_s=300.0, noise=0.05, seed=2)
+    other = L.build_learning_data(imu, att, gnss, [], window=40, val_fraction=0.25)
+    plan = _toy_plan(datasets=("a", "b"), lr_search={"grid": [0.0, 3e-3], "fraction": 0.25})
+    table = T.search_profile_learning_rates(plan.profile, {"a": data, "b": other}, ["mlp"], plan.train_cfg)
+    assert list(table.columns) == list(T.LR_SEARCH_COLUMNS)
+    assert table["dataset"].tolist() == ["a", "a", "b", "b"]
+    assert (models_in_tmp / "toyprofile" / "b" / "lr_search" / "lr0.003" / "mlp_seed0.json").exists()
+    alone = T.search_learning_rates(data, ["mlp"], plan.train_cfg)
+    np.testing.assert_allclose(table.loc[table["dataset"] == "a", "tuning_loss"], alone["tuning_loss"])
+    assert table.groupby("dataset")["selected"].sum().tolist() == [1, 1]
+    cfgs = T.selected_train_configs(plan.train_cfg, table, ["a", "b"])
+    assert T.chosen_learning_rates(cfgs, ["mlp"]) == {"a": {"mlp": 3e-3}, "b": {"mlp": 3e-3}}   # lr 0 learns nothing
+    # no grid: no search, the profile's rates for every dataset
+    assert T.search_profile_learning_rates(plan.profile, {"a": data}, ["mlp"], _toy_plan().train_cfg) is None
+    plain = T.selected_train_configs(plan.train_cfg, None, ["a", "b"])
+    assert plain == {"a": plan.train_cfg, "b": plan.train_cfg}
+
+
+def test_selected_train_configs_keep_each_datasets_rates():
+    search = pd.DataFrame({"dataset": ["d1", "d1", "d2", "d2"], "method": "mlp", "lr": [1e-3, 1e-2, 1e-3, 1e-2],
+                           "selected": [False, True, True, False]})
+    tc = {"lr": {"mlp": 5e-4, "bgfn": 2e-4}}
+    cfgs = T.selected_train_configs(tc, search, ["d1", "d2"])
+    assert T.chosen_learning_rates(cfgs, ["mlp", "bgfn"]) == {"d1": {"mlp": 1e-2, "bgfn": 2e-4},
+                                                              "d2": {"mlp": 1e-3, "bgfn": 2e-4}}
+    assert tc == {"lr": {"mlp": 5e-4, "bgfn": 2e-4}}       # the profile's section is not changed
+
+
+def _toy_dataset(name, seed, gnss_rate_hz=1.0):
+    imu, att, gnss = L.synthetic_tables(duration_s=200.0, noise=0.05, seed=seed)
+    drive = SimpleNamespace(imu=imu, gnss=gnss, reference=att, meta={"gnss_rate_hz": gnss_rate_hz})
+    data = L.build_learning_data(imu, att, gnss, [(1100.0, 10.0)], window=40, margin_s=2.0, val_fraction=0.25)
+    return T.TrainingDataset(name, drive, att, data)
+
+
+def test_windows_and_val_position_tables_have_one_block_per_dataset():
+    prepared = {"a": _toy_dataset("a", 1), "b": _toy_dataset("b", 2, gnss_rate_hz=5.0)}
+    windows = T.windows_table(prepared)
+    assert list(windows.columns) == ["dataset", "gnss_rate_hz", "windows", "excluded_outages", "purged_near_val",
+                                     "screened", "train", "val", "val_block_s", *L.REFERENCES.values()]
+    assert windows["dataset"].tolist() == ["a", "b"] and windows["gnss_rate_hz"].tolist() == [1.0, 5.0]
+    assert windows.iloc[1].drop(["dataset", "gnss_rate_hz"]).to_dict() == L.split_summary(prepared["b"].data)
+    plan = _toy_plan(datasets=("a", "b"), window=40, margin_s=2.0, val_fraction=0.25)
+    plan.outage_windows = [(1100.0, 10.0)]
+    positions = T.val_position_tables(plan, prepared)
+    assert positions.columns[0] == "dataset"
+    assert positions["dataset"].tolist() == ["a"] * len(L.VAL_POSITIONS) + ["b"] * len(L.VAL_POSITIONS)
+    alone = T.val_position_table(plan.cfg, prepared["b"].drive, attitude=prepared["b"].attitude,
+                                 outage_windows=plan.outage_windows)
+    pd.testing.assert_frame_equal(positions[positions["dataset"] == "b"].drop(columns="dataset")
+                                  .reset_index(drop=True), alone)
+
+
+def test_training_metrics_gather_what_training_json_holds():
+    prepared = {"a": _toy_dataset("a", 1)}
+    cards = [{"dataset": "a", "method": "mlp", "seed": 0, "params": 10, "epochs_run": 3, "best_epoch": 2,
+              "wall_time_s": 1.5, "val_rmse_m": 0.5, "val_rmse_zero_m": 1.0, "val_rmse_last_m": 0.2}]
+    runs, summary = T.cards_table(cards), T.summary_table(cards)
+    plan = T.TrainingPlan.of("smoke", datasets=["a"], outage_windows=[(1100.0, 10.0)])
+    m = T.training_metrics(plan, prepared, runs, summary, T.windows_table(prepared))
+    assert list(m) == ["runs", "summary", "windows", "learning_options", "outage_windows", "meta"]
+    assert m["runs"][0]["wall_time_s"] == 1.5                     # training.json keeps the times
+    assert m["learning_options"] == {"a": prepared["a"].data.options} and m["outage_windows"] == [(1100.0, 10.0)]
+    assert m["windows"][0]["dataset"] == "a" and m["meta"]["profile"] == "smoke"

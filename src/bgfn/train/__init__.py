@@ -1,0 +1,54 @@
+"""Training of BGFN and the baselines (paper Sec. 4.1: BPTT, batch 8, 1000 epochs on a GPU), kept apart from
+the networks (:mod:`bgfn.models`) and the learning problem (:mod:`bgfn.learning`).
+
+Modules, one concept each (every public name is re-exported here):
+
+- :mod:`bgfn.train.options`: the ``train:`` optimizer settings, per-method learning rate, model size blocks;
+- :mod:`bgfn.train.loop`: :func:`train_model`, one ``(method, seed)`` with early stopping, checkpoint, card and
+  resume;
+- :mod:`bgfn.train.trained`: :class:`TrainedModel` and :func:`load_trained`, a checkpoint predicting
+  delta_p_gps (Eq. pred-gps);
+- :mod:`bgfn.train.lr_search`: the learning rate of every method from one grid on a tuning split;
+- :mod:`bgfn.train.profile`: a profile's runs (:class:`TrainingPlan`), its drives and windows, the INS attitude
+  input, the training over datasets x methods x seeds;
+- :mod:`bgfn.train.tables`: the run and summary tables, the windows table, ``training.json``;
+- :mod:`bgfn.train.plots`: the figures of notebook 03;
+- :mod:`bgfn.train.cli`: ``python -m bgfn.train --profile ...``.
+"""
+
+from bgfn.learning import REFERENCES, VAL_POSITIONS
+from bgfn.train.cli import main
+from bgfn.train.loop import set_seed, train_model
+from bgfn.train.lr_search import (LR_SEARCH_COLUMNS, LR_SEARCH_DEFAULTS, LR_SEARCH_FILE, chosen_learning_rates,
+                                  lr_search_options, next_learning_rate, search_learning_rates,
+                                  search_profile_learning_rates, selected_train_configs, tuned_train_config,
+                                  with_selected_lr)
+from bgfn.train.options import (OPTIMIZER_DEFAULTS, even_subset, method_lr, optimizer_options, size_config,
+                                train_subsection)
+from bgfn.train.plots import plot_motion_coverage, plot_training_curves, plot_val_predictions
+from bgfn.train.profile import (TrainingDataset, TrainingPlan, ins_attitude, prepare_datasets, prepare_learning_data,
+                                train_dataset, train_profile, val_position_table, val_position_tables)
+from bgfn.train.tables import (TIMING_COLUMNS, card_line, cards_table, summary_table, timing_table, training_metrics,
+                               windows_table, without_timing)
+from bgfn.train.trained import TrainedModel, checkpoint_predictions, load_trained, pick_device, predict_normalized
+
+__all__ = [
+    # options
+    "OPTIMIZER_DEFAULTS", "train_subsection", "optimizer_options", "method_lr", "size_config", "even_subset",
+    # the loop and a trained network
+    "set_seed", "train_model", "pick_device", "predict_normalized", "TrainedModel", "load_trained",
+    "checkpoint_predictions",
+    # learning-rate search
+    "LR_SEARCH_DEFAULTS", "LR_SEARCH_FILE", "LR_SEARCH_COLUMNS", "lr_search_options", "search_learning_rates",
+    "next_learning_rate", "with_selected_lr", "tuned_train_config", "search_profile_learning_rates",
+    "selected_train_configs", "chosen_learning_rates",
+    # a profile's training
+    "TrainingPlan", "TrainingDataset", "prepare_datasets", "prepare_learning_data", "ins_attitude",
+    "val_position_table", "val_position_tables", "train_dataset", "train_profile",
+    # tables and figures
+    "REFERENCES", "VAL_POSITIONS", "TIMING_COLUMNS", "cards_table", "summary_table", "without_timing",
+    "timing_table", "windows_table", "card_line", "training_metrics", "plot_training_curves",
+    "plot_val_predictions", "plot_motion_coverage",
+    # command line
+    "main",
+]

@@ -1,0 +1,144 @@
+"""The learning rate of every method, chosen the same way: one grid, one budget, one seed, on a tuning split
+inside the training windows (:func:`bgfn.learning.inner_split`); the validation block is never used.
+
+Notebook 03 runs the search per dataset (:func:`search_profile_learning_rates`) and saves it as
+``tables/lr_search.csv``; the networks it trains, and those the outage evaluation trains later
+(:func:`tuned_train_config`), use the selected rates.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from bgfn import checkpoints
+from bgfn.config import results_dir
+from bgfn.errors import DataError
+from bgfn.learning import LearningData, inner_split
+from bgfn.train.loop import train_model
+from bgfn.train.options import method_lr, size_config, train_subsection
+
+#: ``train.lr_search``: learning rates tried for every method on :func:`bgfn.learning.inner_split` (null: none).
+#: ``extend``: when a method's best rate is the grid's smallest or largest, up to this many further rates are
+#: tried beyond it, one grid step (the ratio of the two rates at that end) at a time, so no method's choice
+#: is cut off by the grid's ends.
+LR_SEARCH_DEFAULTS: dict[str, Any] = {"grid": None, "fraction": 0.2, "seed": 0, "extend": 0}
+#: The saved search of notebook 03 (``results/<profile>/tables/``): one row per dataset, method and rate.
+LR_SEARCH_FILE = "lr_search.csv"
+LR_SEARCH_COLUMNS = ("dataset", "method", "lr", "tuning_rmse_m", "tuning_loss", "epochs_run", "selected")
+
+
+def lr_search_options(train_cfg: dict | None) -> dict:
+    """``train.lr_search`` with defaults filled in (unknown keys raise DataError)."""
+    return train_subsection(train_cfg, "lr_search", LR_SEARCH_DEFAULTS)
+
+
+def search_learning_rates(data: LearningData, methods, train_cfg: dict, out_dir: str | Path | None = None,
+                          progress: bool = False) -> pd.DataFrame:
+    """Train every method once per learning rate of ``train.lr_search.grid`` on a tuning split inside the
+    training windows (:func:`bgfn.learning.inner_split`) and mark the rate with the lowest tuning loss.
+
+    Every method gets the same grid, budget (the profile's optimizer) and seed, so none is tuned more than
+    another; the validation block of ``data`` is never used.
+
+    Returns
+    -------
+    DataFrame
+        ``method, lr, tuning_rmse_m, tuning_loss, epochs_run, selected`` (one row per method and rate).
+    """
+    ls = lr_search_options(train_cfg)
+    grid = [float(v) for v in (ls["grid"] or [])]
+    if not grid:
+        raise DataError("train.lr_search", "grid", "a non-empty list of learning rates", repr(ls["grid"]))
+    grid = sorted(set(grid))
+    inner = inner_split(data, float(ls["fraction"]))
+    rows = []
+    for method in methods:
+        def tune(lr: float) -> dict:
+            cfg = {**train_cfg, "lr": {**(train_cfg.get("lr") or {}), method: lr}}
+            sub = Path(out_dir) / f"lr{lr:g}" if out_dir is not None else None
+            card = train_model(method, inner, size_config(train_cfg, method), cfg, seed=int(ls["seed"]),
+                               out_dir=sub, progress=progress)
+            return {"method": method, "lr": lr, "tuning_rmse_m": card["val_rmse_m"],
+                    "tuning_loss": card["best_val_loss"], "epochs_run": card["epochs_run"]}
+
+        tried = [tune(lr) for lr in grid]
+        for _ in range(int(ls["extend"])):
+            nxt = next_learning_rate([r["lr"] for r in tried], min(tried, key=lambda r: r["tuning_loss"])["lr"])
+            if nxt is None:
+                break
+            tried.append(tune(nxt))
+        rows += sorted(tried, key=lambda r: r["lr"])
+    table = pd.DataFrame(rows)
+    best = table.groupby("method", sort=False)["tuning_loss"].idxmin()
+    table["selected"] = table.index.isin(best.to_numpy())
+    return table
+
+
+def next_learning_rate(tried, best: float) -> float | None:
+    """The rate one grid step beyond ``best`` when ``best`` is the smallest or largest of ``tried``
+    (geometric step: the ratio of the two rates at that end); None when ``best`` is inside, or the step is
+    undefined (fewer than two positive rates at that end)."""
+    rates = sorted(set(float(r) for r in tried))
+    if len(rates) < 2:
+        return None
+    if best == rates[-1] and rates[-2] > 0:
+        return rates[-1] * rates[-1] / rates[-2]
+    if best == rates[0] and rates[0] > 0:
+        return rates[0] * rates[0] / rates[1]
+    return None
+
+
+def with_selected_lr(train_cfg: dict, search: pd.DataFrame | None) -> dict:
+    """``train_cfg`` with ``lr`` set to the selected rate of each method in ``search`` (unchanged if None)."""
+    if search is None or len(search) == 0:
+        return train_cfg
+    chosen = search[search["selected"].astype(bool)]
+    return {**train_cfg, "lr": {**(train_cfg.get("lr") or {}),
+                                **{str(m): float(v) for m, v in zip(chosen["method"], chosen["lr"])}}}
+
+
+def tuned_train_config(cfg: dict, profile: str, dataset: str) -> dict:
+    """The profile's ``train:`` section with the learning rates notebook 03 selected for ``dataset``
+    (``tables/lr_search.csv``); unchanged when the profile has no search or it has not run."""
+    tc = cfg["train"]
+    if not lr_search_options(tc)["grid"]:
+        return tc
+    path = results_dir(profile, create=False) / "tables" / LR_SEARCH_FILE
+    if not path.exists():
+        return tc
+    return selected_train_configs(tc, pd.read_csv(path), [dataset])[dataset]
+
+
+def search_profile_learning_rates(profile: str, learning: dict[str, LearningData], methods, train_cfg: dict,
+                                  progress: bool = False) -> pd.DataFrame | None:
+    """:func:`search_learning_rates` for every dataset of ``learning`` (``{dataset: LearningData}``); the runs go
+    to ``results/<profile>/models/<dataset>/lr_search/``.
+
+    Returns
+    -------
+    DataFrame or None
+        :data:`LR_SEARCH_COLUMNS`, datasets in the order of ``learning``; None when ``train.lr_search.grid`` is
+        empty (every method then uses ``train.lr``).
+    """
+    if not lr_search_options(train_cfg)["grid"]:
+        return None
+    tables = [search_learning_rates(data, methods, train_cfg, progress=progress,
+                                    out_dir=checkpoints.models_dir(profile, name) / "lr_search").assign(dataset=name)
+              for name, data in learning.items()]
+    return pd.concat(tables)[list(LR_SEARCH_COLUMNS)]
+
+
+def selected_train_configs(train_cfg: dict, search: pd.DataFrame | None, datasets) -> dict[str, dict]:
+    """``{dataset: train_cfg with the rates search selected for it}`` (:func:`with_selected_lr` of the rows of
+    that dataset); ``train_cfg`` unchanged for every dataset when ``search`` is None."""
+    if search is None:
+        return {name: train_cfg for name in datasets}
+    return {name: with_selected_lr(train_cfg, search[search["dataset"] == name]) for name in datasets}
+
+
+def chosen_learning_rates(train_cfgs: dict[str, dict], methods) -> dict[str, dict[str, float]]:
+    """``{dataset: {method: learning rate}}`` of the per-dataset ``train:`` sections ``train_cfgs``."""
+    return {name: {m: method_lr(tc, m) for m in methods} for name, tc in train_cfgs.items()}

@@ -1,0 +1,227 @@
+"""A profile's training: what notebook 03 and ``python -m bgfn.train`` train, and the data they train it on.
+
+:class:`TrainingPlan` names the ``(dataset, method, seed)`` runs of a profile's ``train:`` section and the
+evaluation outages kept out of training; :func:`prepare_datasets` loads each drive, runs the GPS/INS filter for
+the attitude input of Eq. (eq21) (:func:`ins_attitude`) and builds its windows; :func:`train_dataset` trains
+every method and seed of one dataset into ``results/<profile>/models/<dataset>/``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import pandas as pd
+
+from bgfn import checkpoints
+from bgfn.errors import DataError
+from bgfn.learning import (VAL_POSITIONS, LearningData, all_windows, build_learning_data, learning_options,
+                           motion_in_windows, val_position_coverage)
+from bgfn.nav import outages
+from bgfn.train.loop import train_model
+from bgfn.train.lr_search import tuned_train_config
+from bgfn.train.options import optimizer_options, size_config
+from bgfn.train.tables import card_line
+
+#: Learning options :meth:`TrainingPlan.describe` shows (the rest of :data:`bgfn.learning.LEARNING_DEFAULTS`
+#: is in the profile).
+DESCRIBED_OPTIONS = ("window", "alignment", "yaw_encoding", "target_frame", "extra_channels", "val_position",
+                     "target_screen_sigma")
+
+
+@dataclass
+class TrainingPlan:
+    """The runs of a profile: every ``(dataset, method, seed)``, with the profile and its evaluation outages.
+
+    Attributes
+    ----------
+    profile : str
+        Profile name (``params/<profile>.yaml``).
+    cfg : dict
+        The profile (:func:`bgfn.config.load_profile`); ``cfg['train']`` is :attr:`train_cfg`.
+    datasets, methods : list of str
+    seeds : list of int
+    outage_windows : list of (start, duration)
+        Evaluation outages, s, kept (widened by ``train.margin_s``) out of training and validation.
+    """
+
+    profile: str
+    cfg: dict
+    datasets: list[str]
+    methods: list[str]
+    seeds: list[int]
+    outage_windows: list
+
+    @classmethod
+    def of(cls, profile: str, datasets=None, methods=None, seeds=None, outage_windows=None) -> "TrainingPlan":
+        """The plan of ``profile``; ``datasets``, ``methods``, ``seeds`` and ``outage_windows`` default (None) to
+        the profile's (``train.datasets``, ``train.methods``, ``train.seeds``, top-level ``outage_windows``)."""
+        from bgfn.config import load_profile
+
+        cfg = load_profile(profile)
+        tc = cfg["train"]
+        return cls(profile, cfg, list(datasets or tc["datasets"]), list(methods or tc["methods"]),
+                   [int(s) for s in (seeds if seeds is not None else tc["seeds"])],
+                   outage_windows if outage_windows is not None else outages.outage_windows(cfg))
+
+    @property
+    def train_cfg(self) -> dict:
+        """The profile's ``train:`` section."""
+        return self.cfg["train"]
+
+    def describe(self) -> str:
+        """What is trained, on which data, with which budget (a few lines for the notebook)."""
+        tc = self.train_cfg
+        opts = learning_options(tc)
+        return "\n".join([
+            f"profile {self.cfg['profile']!r}: {self.cfg['description']}",
+            f"datasets {self.datasets}, methods {self.methods}, seeds {self.seeds}, size {tc.get('size')!r}",
+            f"evaluation outages excluded from training (start, duration) s: {self.outage_windows} "
+            f"+- {opts['margin_s']} s",
+            f"optimizer: {optimizer_options(tc)}",
+            f"learning problem: { {k: opts[k] for k in DESCRIBED_OPTIONS} }",
+        ])
+
+
+@dataclass
+class TrainingDataset:
+    """One dataset of a plan: its drive, the INS attitude its windows were built from, and its learning data."""
+
+    name: str
+    drive: Any
+    attitude: pd.DataFrame
+    data: LearningData
+
+
+def prepare_datasets(plan: TrainingPlan) -> dict[str, TrainingDataset]:
+    """``{dataset: TrainingDataset}`` for every dataset of ``plan``, in its order (:func:`prepare_learning_data`
+    with the :func:`ins_attitude` of each drive)."""
+    from bgfn.data import load_drive
+
+    prepared = {}
+    for name in plan.datasets:
+        drive = load_drive(name, profile=plan.profile)
+        attitude = ins_attitude(drive, plan.cfg)
+        data = prepare_learning_data(plan.cfg, name, attitude=attitude, drive=drive,
+                                     outage_windows=plan.outage_windows)
+        prepared[name] = TrainingDataset(name, drive, attitude, data)
+    return prepared
+
+
+def prepare_learning_data(cfg: dict, dataset: str, attitude=None, drive=None, outage_windows=None) -> LearningData:
+    """Windows of drive ``dataset`` for the profile ``cfg`` (:func:`bgfn.config.load_profile`).
+
+    Parameters
+    ----------
+    cfg : dict
+        The profile.
+    dataset : str
+        Name for :func:`bgfn.data.load_drive`.
+    attitude : DataFrame, optional
+        INS/KF attitude (``time, roll, pitch, yaw``) at IMU rate; default :func:`ins_attitude`.
+    drive : Drive, optional
+        Already loaded drive.
+    outage_windows : sequence of (start, duration), optional
+        Evaluation outages; default: the profile's (:func:`bgfn.nav.outages.outage_windows`).
+    """
+    from bgfn.data import load_drive
+
+    if drive is None:
+        drive = load_drive(dataset, profile=cfg["profile"])
+    attitude, outage_windows, opts = _learning_inputs(cfg, drive, attitude, outage_windows)
+    return build_learning_data(drive.imu, attitude, drive.gnss, outage_windows, **opts)
+
+
+def _learning_inputs(cfg: dict, drive, attitude=None, outage_windows=None) -> tuple:
+    """``(attitude, outage_windows, learning options)`` of the profile, defaults filled in."""
+    attitude = attitude if attitude is not None else ins_attitude(drive, cfg)
+    if outage_windows is None:
+        outage_windows = outages.outage_windows(cfg)
+    return attitude, outage_windows, learning_options(cfg.get("train"))
+
+
+def ins_attitude(drive, cfg: dict):
+    """INS/KF solution at IMU rate (reference schema): ``roll, pitch, yaw`` are the attitude input of Eq. (eq21).
+
+    The other columns (``v_n``, ``v_e``, ...) are there for ``train.extra_channels`` (not the paper's input).
+
+    ``train.attitude_source``: ``'kf'`` (default, the paper's online-training mode) runs the 15-state loosely
+    coupled filter with the GNSS fixes and the profile's ``nav:`` section (:func:`bgfn.nav.baseline.run_drive`);
+    ``'reference'`` takes the truth attitude
+    (debugging only: the outage evaluation feeds the INS attitude).
+    """
+    src = (cfg.get("train") or {}).get("attitude_source", "kf")
+    if src == "reference":
+        return drive.reference.copy()
+    if src != "kf":
+        raise DataError("train", "attitude_source", "'kf' or 'reference'", repr(src))
+    from bgfn.nav import run_drive
+
+    traj = run_drive(drive, cfg.get("nav") or {}).trajectory
+    return pd.DataFrame(traj).reset_index(drop=True)
+
+
+def val_position_table(cfg: dict, drive, attitude=None, outage_windows=None, positions=None):
+    """:func:`bgfn.learning.val_position_coverage` of ``drive`` with the profile's learning options: what each
+    place of the validation block would leave to training (notebook 03)."""
+    attitude, outage_windows, opts = _learning_inputs(cfg, drive, attitude, outage_windows)
+    ws = all_windows(drive.imu, attitude, drive.gnss, **opts)
+    return val_position_coverage(ws, motion_in_windows(drive.reference, outage_windows), outage_windows,
+                                 margin_s=float(opts["margin_s"]), val_fraction=float(opts["val_fraction"]),
+                                 positions=positions or VAL_POSITIONS)
+
+
+def val_position_tables(plan: TrainingPlan, prepared: dict[str, TrainingDataset]) -> pd.DataFrame:
+    """:func:`val_position_table` of every prepared dataset in one table, ``dataset`` first."""
+    positions = pd.concat([val_position_table(plan.cfg, d.drive, attitude=d.attitude,
+                                              outage_windows=plan.outage_windows).assign(dataset=name)
+                           for name, d in prepared.items()], ignore_index=True)
+    return positions[["dataset"] + [col for col in positions.columns if col != "dataset"]]
+
+
+def train_dataset(plan: TrainingPlan, dataset: str, data: LearningData, train_cfg: dict | None = None,
+                  device: str | None = None, progress: bool = False,
+                  echo: Callable[[str], Any] | None = None) -> list[dict]:
+    """Train every ``(method, seed)`` of ``plan`` on ``data`` into ``results/<profile>/models/<dataset>/``.
+
+    Parameters
+    ----------
+    train_cfg : dict, optional
+        The ``train:`` section with this dataset's learning rates (:mod:`bgfn.train.lr_search`); default
+        :attr:`TrainingPlan.train_cfg`.
+    echo : callable, optional
+        Called with :func:`bgfn.train.tables.card_line` of each card as it is done (e.g. ``print``).
+
+    Returns
+    -------
+    list of dict
+        The cards (:func:`bgfn.train.loop.train_model`), with ``dataset``, ``profile`` and ``size``.
+    """
+    tc = plan.train_cfg if train_cfg is None else train_cfg
+    out = checkpoints.models_dir(plan.profile, dataset)
+    cards = []
+    for method in plan.methods:
+        for seed in plan.seeds:
+            card = train_model(method, data, size_config(tc, method), tc, seed=seed, out_dir=out, device=device,
+                               progress=progress,
+                               extra_card={"dataset": dataset, "profile": plan.profile, "size": tc.get("size")})
+            cards.append(card)
+            if echo is not None:
+                echo(card_line(card))
+    return cards
+
+
+def train_profile(profile: str, datasets=None, methods=None, seeds=None, device: str | None = None,
+                  progress: bool = True, outage_windows=None, echo: Callable[[str], Any] | None = None) -> list[dict]:
+    """Train every ``(dataset, method, seed)`` of a profile's ``train:`` section; return the cards.
+
+    The learning rates are those notebook 03 selected (:func:`bgfn.train.lr_search.tuned_train_config`) when its
+    search has run.
+    """
+    plan = TrainingPlan.of(profile, datasets, methods, seeds, outage_windows)
+    cards = []
+    for dataset in plan.datasets:
+        tc = tuned_train_config(plan.cfg, profile, dataset)
+        data = prepare_learning_data(plan.cfg, dataset, outage_windows=plan.outage_windows)
+        cards += train_dataset(plan, dataset, data, tc, device=device, progress=progress, echo=echo)
+    return cards

@@ -1,0 +1,90 @@
+"""The training tables of notebook 03: one row per run (:func:`cards_table`), the seed aggregate
+(:func:`summary_table`), the windows of each dataset (:func:`windows_table`) and ``training.json``.
+
+Wall-clock columns vary from run to run: the result tables are saved without them (:func:`without_timing`), so
+the same profile run twice gives byte-identical tables, and the times go to a table of their own.
+"""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from bgfn.learning import REFERENCES, split_summary
+
+
+def cards_table(cards: list[dict]):
+    """One row per run: dataset, method, seed, params, learning rate, epochs, wall time, validation RMSE and
+    references (m)."""
+    cols = ["dataset", "method", "seed", "params", "lr", "epochs_run", "best_epoch", "wall_time_s", "n_train", "n_val",
+            "val_rmse_m", *REFERENCES.values(), "device"]
+    return pd.DataFrame([{c: card.get(c) for c in cols} for card in cards], columns=cols)
+
+
+#: Wall-clock columns of :func:`cards_table` / :func:`summary_table`: they vary from run to run, so the result
+#: tables are saved without them (:func:`without_timing`) and the times go to a table of their own.
+TIMING_COLUMNS = ("wall_time_s", "train_time_s_mean", "train_time_s_total")
+
+
+def without_timing(table):
+    """``table`` without :data:`TIMING_COLUMNS`: the same profile run twice gives byte-identical tables."""
+    return table.drop(columns=[c for c in TIMING_COLUMNS if c in table.columns])
+
+
+def timing_table(table):
+    """The key columns of ``table`` and its :data:`TIMING_COLUMNS` (wall-clock seconds)."""
+    keys = [c for c in ("dataset", "method", "seed") if c in table.columns]
+    return table[keys + [c for c in TIMING_COLUMNS if c in table.columns]]
+
+
+def summary_table(cards: list[dict]):
+    """Per dataset and method: parameters, epochs, training time and validation RMSE over seeds (mean, std)."""
+    runs = cards_table(cards)
+    g = runs.groupby(["dataset", "method"], sort=False)
+    out = g.agg(params=("params", "first"), lr=("lr", "first"), seeds=("seed", "count"),
+                epochs_mean=("epochs_run", "mean"),
+                train_time_s_mean=("wall_time_s", "mean"), train_time_s_total=("wall_time_s", "sum"),
+                val_rmse_m_mean=("val_rmse_m", "mean"), val_rmse_m_std=("val_rmse_m", "std"),
+                **{col: (col, "first") for col in REFERENCES.values()})
+    return out.reset_index()
+
+
+def windows_table(prepared: dict) -> pd.DataFrame:
+    """One row per dataset: its GNSS rate (Hz) and :func:`bgfn.learning.split_summary` of its learning data
+    (``prepared``: ``{dataset: TrainingDataset}`` of :func:`bgfn.train.profile.prepare_datasets`)."""
+    return pd.DataFrame([{"dataset": name, "gnss_rate_hz": d.drive.meta.get("gnss_rate_hz"), **split_summary(d.data)}
+                         for name, d in prepared.items()])
+
+
+def card_line(card: dict) -> str:
+    """One line per run: dataset, method, seed, epochs, wall time, validation RMSE and the references (m)."""
+    return (f"{card.get('dataset', ''):>18} {card['method']:>12} seed {card['seed']}: {card['epochs_run']:4d} epochs, "
+            f"{card['wall_time_s']:7.1f} s, val RMSE {card['val_rmse_m']:.3f} m "
+            f"(zero {card['val_rmse_zero_m']:.3f}, last increment {card['val_rmse_last_m']:.3f}, "
+            f"INS increment {card['val_rmse_ins_m']:.3f})")
+
+
+def training_metrics(plan, prepared: dict, runs: pd.DataFrame, summary: pd.DataFrame,
+                     windows: pd.DataFrame) -> dict:
+    """``training.json`` of notebook 03: the run and summary tables (with their wall-clock columns), the windows
+    table, the learning options per dataset, the evaluation outages kept out of training and the run metadata
+    (:func:`bgfn.config.run_metadata`).
+
+    Parameters
+    ----------
+    plan : TrainingPlan
+        Profile and outages (:class:`bgfn.train.profile.TrainingPlan`).
+    prepared : dict
+        ``{dataset: TrainingDataset}`` (:func:`bgfn.train.profile.prepare_datasets`).
+    runs, summary, windows : DataFrame
+        :func:`cards_table`, :func:`summary_table`, :func:`windows_table`.
+    """
+    from bgfn.config import run_metadata
+
+    return {
+        "runs": runs.to_dict(orient="records"),
+        "summary": summary.to_dict(orient="records"),
+        "windows": windows.to_dict(orient="records"),
+        "learning_options": {name: d.data.options for name, d in prepared.items()},
+        "outage_windows": plan.outage_windows,
+        "meta": run_metadata(plan.profile),
+    }

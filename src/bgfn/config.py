@@ -237,12 +237,23 @@ def with_overrides(cfg: dict, overrides: dict[str, Any], source: str = "notebook
         node = out
         for k in parents:
             node = node.setdefault(k, {})
-        node[key] = copy.deepcopy(value)
+        node[key] = _plain(value)
     try:
         validate(out)
     except ProfileError as exc:
         raise DataError(source, exc.path, exc.expected, exc.found) from None
     return out
+
+
+def _plain(value: Any) -> Any:
+    """``value`` as YAML would give it: tuples as lists, numpy scalars as Python numbers (a copy)."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if hasattr(value, "item") and getattr(value, "ndim", None) == 0:      # numpy scalar
+        return value.item()
+    return copy.deepcopy(value)
 
 
 def _file_setting(chain: list[tuple[Path, dict]], path: str) -> Path:

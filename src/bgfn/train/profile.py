@@ -55,13 +55,15 @@ class TrainingPlan:
     @classmethod
     def of(cls, profile: str, datasets=None, methods=None, seeds=None, outage_windows=None) -> "TrainingPlan":
         """The plan of ``profile``; ``datasets``, ``methods``, ``seeds`` and ``outage_windows`` default (None) to
-        the profile's (``train.datasets``, ``train.methods``, ``train.seeds``, top-level ``outage_windows``)."""
-        from bgfn.config import load_profile
+        the profile's (``train.datasets``, ``train.methods``, ``train.seeds``, top-level ``outage_windows``); the
+        first three (notebook 03's parameters) are checked against the profile schema like the file
+        (:func:`bgfn.config.with_overrides`)."""
+        from bgfn.config import load_profile, with_overrides
 
-        cfg = load_profile(profile)
+        cfg = with_overrides(load_profile(profile), {"train.datasets": datasets, "train.methods": methods,
+                                                     "train.seeds": seeds})
         tc = cfg["train"]
-        return cls(profile, cfg, list(datasets or tc["datasets"]), list(methods or tc["methods"]),
-                   [int(s) for s in (seeds if seeds is not None else tc["seeds"])],
+        return cls(profile, cfg, list(tc["datasets"]), list(tc["methods"]), [int(s) for s in tc["seeds"]],
                    outage_windows if outage_windows is not None else outages.outage_windows(cfg))
 
     @property

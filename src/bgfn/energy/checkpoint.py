@@ -79,6 +79,11 @@ class MeasuredModels:
         return {m: t.model for m, t in self.trained.items()}
 
     @property
+    def size_cfgs(self) -> dict[str, dict]:
+        """Method -> size configuration of the trained network (``dim``, ``depth``, ``time_steps``, ...)."""
+        return {m: t.size_cfg for m, t in self.trained.items()}
+
+    @property
     def time_steps(self) -> int:
         """BGFN's ``T_s`` (SNN steps per IMU sample)."""
         return int(self.trained["bgfn"].size_cfg.get("time_steps", 4))

@@ -1,8 +1,8 @@
 """``results/<profile>/energy.json``: what notebook 05 hands to the results page, and its one-paragraph result.
 
-:mod:`bgfn.report` reads ``energy_uj_per_prediction``, ``macs``, ``sops``, ``reduction_pct``,
+:mod:`bgfn.report` and notebook 06 read ``energy_uj_per_prediction``, ``macs``, ``sops``, ``reduction_pct``,
 ``reduction_pct_without_attention``, ``e_mac_pj``, ``e_ac_pj``, ``time_steps``, ``dataset``, ``seed``,
-``checkpoints`` and ``windows.n_windows``; the rest documents the run.
+``checkpoints``, ``windows.n_windows`` and ``metadata`` (:data:`REPORTED_KEYS`); the rest documents the run.
 """
 
 from __future__ import annotations
@@ -13,6 +13,10 @@ from bgfn.energy.checkpoint import MeasuredModels
 from bgfn.energy.crosscheck import Crosscheck
 from bgfn.energy.tables import EnergyTotals
 from bgfn.energy.windows import EvaluationWindows
+
+#: Top-level keys of ``energy.json`` that the results page reads.
+REPORTED_KEYS = ("energy_uj_per_prediction", "macs", "sops", "reduction_pct", "reduction_pct_without_attention",
+                 "e_mac_pj", "e_ac_pj", "time_steps", "dataset", "seed", "checkpoints", "windows", "metadata")
 
 
 def energy_summary(measured: MeasuredModels, windows: EvaluationWindows, tables: dict[str, pd.DataFrame],

@@ -3,20 +3,31 @@
 The paper gives no counting rule; the one of Spikformer (Zhou et al. 2023) and of the syops counter of SeqSNN
 (Lv et al. 2024, the code BGFN builds on) is used. A Linear/Conv layer is counted by what it reads: real
 values cost one multiply-accumulate per weight use (MAC), spikes one accumulate per input spike and fan-out
-(SOP, ``r * T * FLOPs``). Per prediction (one window), with ``T = T_s`` steps, ``N`` tokens, width ``D``,
-``H`` heads of width ``d_h``, encoder kernel ``k`` and ``r`` the measured input spike rate::
+(SOP, ``r * T * FLOPs``).
 
-    block (module)                          reads                          counted as             rule
-    spike encoder   spike_encoder.conv      real IMU samples               MACs  N C K T_s k      count_linear_or_conv
-    spiking embed.  embedding.layer.linear  encoder spikes                 SOPs  r T FLOPs        count_linear_or_conv
-    SSA Q, K, V     blocks.l.attn.q.linear  residual stream, 1 + 2l trains SOPs  n r T FLOPs      count_linear_or_conv
-    SSA products    blocks.l.attn.qkv_matmul Q, K, V spikes                SOPs  Spikformer       count_spiking_self_attention
-    SSA projection  blocks.l.attn.proj.linear attention-LIF spikes         SOPs  r T FLOPs        count_linear_or_conv
-    spiking MLP     blocks.l.mlp.fc1.linear residual stream, 2 + 2l trains SOPs  n r T FLOPs      count_linear_or_conv
-                    blocks.l.mlp.fc2.linear fc1 spikes                     SOPs  r T FLOPs        count_linear_or_conv
-    readout         head                    mean of the spikes (real)      MACs  2 D              count_linear_or_conv
-    twin layers     conv, embed, qkv, ...   real values                    MACs  FLOPs            count_linear_or_conv
-    twin attention  blocks.l.attention      real Q, K, V                   MACs  2 N^2 D          count_softmax_attention
+Every block kind and its rule, per prediction (one window), with ``T = T_s`` steps, ``N`` tokens, width
+``D``, ``H`` heads of width ``d_h``, ``C`` input channels with ``K`` encoder neurons each, encoder kernel ``k``,
+``r`` the measured input spike rate and FLOPs the multiply-accumulates of one step with every input active
+(module paths of BGFN, then of the twin)::
+
+    spike encoder, Eq. eq:spike_input      spike_encoder.conv          reads real IMU samples
+        -> MACs, N * (C K T_s) * k (grouped convolution)                               count_linear_or_conv
+    spiking embedding, Eq. eq:spiking_embedding   embedding.layer.linear   reads the encoder's spikes
+        -> SOPs, r T FLOPs                                                             count_linear_or_conv
+    SSA: Q, K, V                           blocks.l.attn.{q,k,v}.linear   read the residual stream
+        -> SOPs, n r T FLOPs with n = 1 + 2l merged trains                             count_linear_or_conv
+    SSA: products Q K^T V (no softmax)     blocks.l.attn.qkv_matmul    read the Q, K, V spikes
+        -> SOPs, (min(r_k, r_v) + r_q) T H N d_h^2 (Spikformer; d_h < N)               count_spiking_self_attention
+    SSA: projection                        blocks.l.attn.proj.linear   reads the attention LIF's spikes
+        -> SOPs, r T FLOPs                                                             count_linear_or_conv
+    spiking MLP                            blocks.l.mlp.fc1.linear     reads the residual stream
+        -> SOPs, n r T FLOPs with n = 2 + 2l;  mlp.fc2.linear (fc1's spikes): r T FLOPs  count_linear_or_conv
+    readout                                head                        reads the mean of the spikes (real)
+        -> MACs, 2 D                                                                   count_linear_or_conv
+    twin: every Linear/Conv                conv, embed, qkv, proj, ffn, head    read real values
+        -> MACs, FLOPs                                                                 count_linear_or_conv
+    twin: attention products Q K^T, A V    blocks.l.attention
+        -> MACs, 2 N^2 D                                                               count_softmax_attention
 
 The number of merged trains ``n`` comes from :class:`bgfn.energy.residual.ResidualStream`. Not counted, for
 either model (Spikformer's convention: only synaptic operations / matmuls): biases, BatchNorm (folded into the

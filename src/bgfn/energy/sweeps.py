@@ -53,7 +53,8 @@ def break_even_note(rate: float) -> str:
 
 
 def same_size_builder(size_cfgs: dict[str, dict], in_channels: int, seed: int = 0,
-                      methods: tuple[str, str] = ("bgfn", "transformer")) -> Callable[[int], tuple[nn.Module, nn.Module]]:
+                      methods: tuple[str, str] = ("bgfn", "transformer")
+                      ) -> Callable[[int], tuple[nn.Module, nn.Module]]:
     """``build(T_s) -> (snn, ann)``: untrained models of the trained sizes with ``T_s`` time steps.
 
     Parameters

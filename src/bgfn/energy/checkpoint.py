@@ -1,0 +1,117 @@
+"""Which trained networks the energy estimate measures: BGFN and its Transformer twin of one dataset and seed.
+
+The firing rates, hence the SOPs, are those of a *trained* BGFN; the twin's MACs do not depend on its weights,
+but loading its checkpoint of the same run proves it was trained on the same windows. The dataset and seed
+are the profile's ``energy.dataset`` / ``energy.seed``, by default what notebook 03 trains first.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+from torch import nn
+
+from bgfn.checkpoints import card_path, checkpoint_path, parse_checkpoint
+from bgfn.config import PROJECT_ROOT, load_profile
+from bgfn.train import TrainedModel, load_trained
+
+#: The networks compared: the SNN and its ANN twin (method ids of :data:`bgfn.models.MODELS`).
+MEASURED = ("bgfn", "transformer")
+
+
+def energy_checkpoint(profile: str, method: str, cfg: dict | None = None, dataset: str | None = None,
+                      seed: int | None = None, must_exist: bool = True) -> Path:
+    """The checkpoint of the energy estimate (:func:`bgfn.checkpoints.checkpoint_path`).
+
+    ``dataset``/``seed`` default to the profile's ``energy.dataset``/``energy.seed`` and, when those are
+    null, to the first of ``train.datasets``/``train.seeds`` (what notebook 03 trains first).
+
+    Raises
+    ------
+    FileNotFoundError
+        The checkpoint is missing (``must_exist``); the message names the file and the notebook that writes it.
+    """
+    cfg = cfg if cfg is not None else load_profile(profile)
+    ecfg, tcfg = cfg.get("energy") or {}, cfg.get("train") or {}
+    dataset = dataset or ecfg.get("dataset") or (tcfg.get("datasets") or [None])[0]
+    seed = seed if seed is not None else ecfg.get("seed")
+    seed = seed if seed is not None else (tcfg.get("seeds") or [0])[0]
+    if dataset is None:
+        raise ValueError(f"profile {profile!r}: no dataset (energy.dataset and train.datasets are empty)")
+    path = checkpoint_path(profile, dataset, method, int(seed), create=False)
+    if must_exist and not path.is_file():
+        raise FileNotFoundError(
+            f"trained {method} model not found: {path} -- notebook 03_bgfn_training.ipynb writes it "
+            f"(run `make reproduce PROFILE={profile}`, or `python -m bgfn.train --profile {profile} "
+            f"--dataset {dataset} --method {method} --seed {int(seed)}`)")
+    return path
+
+
+@dataclass
+class MeasuredModels:
+    """The trained networks of the energy estimate (:func:`load_measured`).
+
+    Attributes
+    ----------
+    profile, dataset : str
+    seed : int
+        Training seed, read back from the checkpoint name (:func:`bgfn.checkpoints.parse_checkpoint`).
+    paths : dict
+        Method -> best checkpoint.
+    trained : dict
+        Method -> :class:`bgfn.train.TrainedModel` (eval mode, CPU).
+    cards : dict
+        Method -> its training card (``{}`` when missing).
+    """
+
+    profile: str
+    dataset: str
+    seed: int
+    paths: dict[str, Path]
+    trained: dict[str, TrainedModel]
+    cards: dict[str, dict]
+
+    @property
+    def models(self) -> dict[str, nn.Module]:
+        """Method -> the network (eval mode)."""
+        return {m: t.model for m, t in self.trained.items()}
+
+    @property
+    def size_cfgs(self) -> dict[str, dict]:
+        """Method -> size configuration of the trained network (``dim``, ``depth``, ``time_steps``, ...)."""
+        return {m: t.size_cfg for m, t in self.trained.items()}
+
+    @property
+    def time_steps(self) -> int:
+        """BGFN's ``T_s`` (SNN steps per IMU sample)."""
+        return int(self.trained["bgfn"].size_cfg.get("time_steps", 4))
+
+    def relative_paths(self) -> dict[str, str]:
+        """Method -> checkpoint path relative to the project root (as ``energy.json`` records it)."""
+        return {m: p.relative_to(PROJECT_ROOT).as_posix() if p.is_relative_to(PROJECT_ROOT) else str(p)
+                for m, p in self.paths.items()}
+
+    def lines(self) -> list[str]:
+        """One line per network: checkpoint, size, best epoch, validation RMSE."""
+        rel = self.relative_paths()
+        return [f"{m:>12}: {rel[m]} | size {self.trained[m].size_cfg} | best epoch {c.get('best_epoch')}, "
+                f"val RMSE {c.get('val_rmse_m', float('nan')):.3f} m" for m, c in self.cards.items()]
+
+
+def load_measured(profile: str, cfg: dict | None = None, methods=MEASURED) -> MeasuredModels:
+    """Load the networks of the energy estimate (:func:`energy_checkpoint`) on the CPU.
+
+    Raises
+    ------
+    FileNotFoundError
+        A checkpoint is missing; the message names the file and the notebook that writes it.
+    """
+    paths = {m: energy_checkpoint(profile, m, cfg) for m in methods}
+    trained = {m: load_trained(p, device="cpu") for m, p in paths.items()}
+    for t in trained.values():
+        t.model.eval()
+    cards = {m: json.loads(card_path(p).read_text()) if card_path(p).exists() else {} for m, p in paths.items()}
+    first = paths[methods[0]]
+    return MeasuredModels(profile, first.parent.name, parse_checkpoint(first).seed, paths, trained, cards)

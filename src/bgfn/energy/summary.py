@@ -1,0 +1,88 @@
+"""``results/<profile>/energy.json``: what notebook 05 hands to the results page, and its one-paragraph result.
+
+:mod:`bgfn.report` and notebook 06 read ``energy_uj_per_prediction``, ``macs``, ``sops``, ``reduction_pct``,
+``reduction_pct_without_attention``, ``e_mac_pj``, ``e_ac_pj``, ``time_steps``, ``dataset``, ``seed``,
+``checkpoints``, ``windows.n_windows`` and ``metadata`` (:data:`REPORTED_KEYS`); the rest documents the run.
+"""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from bgfn.energy.checkpoint import MeasuredModels
+from bgfn.energy.crosscheck import Crosscheck
+from bgfn.energy.tables import EnergyTotals
+from bgfn.energy.windows import EvaluationWindows
+
+#: Top-level keys of ``energy.json`` that the results page reads.
+REPORTED_KEYS = ("energy_uj_per_prediction", "macs", "sops", "reduction_pct", "reduction_pct_without_attention",
+                 "e_mac_pj", "e_ac_pj", "time_steps", "dataset", "seed", "checkpoints", "windows", "metadata")
+
+
+def energy_summary(measured: MeasuredModels, windows: EvaluationWindows, tables: dict[str, pd.DataFrame],
+                   totals: EnergyTotals, paper_reduction_pct: float, rates: dict[str, float],
+                   sweep_t: pd.DataFrame, break_even_rate: float, cross: Crosscheck, tolerance_pct: float,
+                   e_mac: float, e_ac: float, metadata: dict) -> dict:
+    """The content of ``energy.json`` (energies in µJ per prediction, operations per prediction).
+
+    Parameters
+    ----------
+    measured, windows
+        The networks and windows measured (:func:`bgfn.energy.checkpoint.load_measured`,
+        :func:`bgfn.energy.windows.evaluation_windows`).
+    tables : dict
+        Method -> per-layer energy table with its ``total`` row.
+    totals : EnergyTotals
+    paper_reduction_pct : float
+        The paper's claim (``bgfn.paper.claims()``).
+    rates : dict
+        LIF layer -> firing rate.
+    sweep_t : DataFrame
+        Reduction vs ``T_s``.
+    break_even_rate : float
+        Mean input rate at which BGFN costs as much as the twin.
+    cross : Crosscheck
+        The SpikingJelly cross-check and its ``tolerance_pct``.
+    e_mac, e_ac : float
+        Energy per MAC and per accumulate, pJ.
+    metadata : dict
+        :func:`bgfn.config.run_metadata` of the profile.
+    """
+    ws = windows.windows
+    return {
+        "profile": measured.profile, "dataset": measured.dataset, "seed": measured.seed,
+        "checkpoints": measured.relative_paths(),
+        "checkpoint_epochs": {m: measured.cards[m].get("best_epoch") for m in measured.cards},
+        "windows": {"source": "validation windows of bgfn.learning (bgfn.train.prepare_learning_data)",
+                    "n_windows": int(len(ws)), "n_validation_windows": int(windows.n_validation),
+                    "window_samples": int(ws.x.shape[1])},
+        "e_mac_pj": e_mac, "e_ac_pj": e_ac, "time_steps": measured.time_steps,
+        "energy_uj_per_prediction": {"bgfn": totals.bgfn_uj, "transformer": totals.twin_uj},
+        "macs": {m: float(tables[m].set_index("layer").loc["total", "macs"]) for m in tables},
+        "sops": {m: float(tables[m].set_index("layer").loc["total", "sops"]) for m in tables},
+        "reduction_pct": totals.reduction_pct, "paper_reduction_pct": paper_reduction_pct,
+        "attention_energy_uj": totals.attention_uj,
+        "reduction_pct_without_attention": totals.reduction_without_attention_pct,
+        "mean_input_firing_rate": totals.mean_rate, "break_even_firing_rate": break_even_rate,
+        "lif_firing_rates": rates,
+        "sweep_time_steps": sweep_t.to_dict(orient="list"),
+        "crosscheck_spikingjelly": {"tolerance_pct": tolerance_pct, "max_abs_difference_pct": cross.worst_pct,
+                                    "table": cross.table.reset_index().to_dict(orient="records"),
+                                    "default_rules_reduction_pct": cross.strict_reduction_pct},
+        "metadata": metadata,
+    }
+
+
+def result_markdown(summary: dict) -> str:
+    """The result of notebook 05 in one paragraph (Markdown), from :func:`energy_summary`'s dict."""
+    s = summary
+    e, attn = s["energy_uj_per_prediction"], s["attention_energy_uj"]
+    return (
+        f"**Result ({s['profile']} profile, {s['dataset']}, seed {s['seed']}):** BGFN {e['bgfn']:.4g} µJ vs "
+        f"Transformer twin {e['transformer']:.4g} µJ per prediction: **{s['reduction_pct']:.1f} % less energy** "
+        f"(paper: {s['paper_reduction_pct']} %), at a mean input firing rate of {s['mean_input_firing_rate']:.3f} "
+        f"(break-even {s['break_even_firing_rate']:.3f}). The twin's softmax attention (2N²D MACs per block) "
+        f"takes {100 * attn['transformer'] / e['transformer']:.0f} % of its energy; without the attention "
+        f"products in both models the reduction is {s['reduction_pct_without_attention']:.1f} %. Under "
+        f"SpikingJelly's stricter default rules (integer residual inputs counted as MACs) it is "
+        f"{s['crosscheck_spikingjelly']['default_rules_reduction_pct']:.1f} %.")

@@ -5,6 +5,8 @@ Adds to ``results/bench.json``:
 - ``train_windows_per_s.<model>.<size>``: training windows per second (forward + BPTT backward + AdamW step),
   batch = the profile's batch size, window N = the profile's window, torch's default CPU threads;
 - ``infer_ms.<model>.<size>``: latency of one window (batch 1, eval mode, 1 CPU thread), ms;
+- ``train_ratio_bgfn_over_twin.<size>``: BGFN's training throughput divided by its ANN twin's (Transformer),
+  both measured in the same run;
 - ``models_bench``: what ran (threads, device, batch, window, parameter counts, repeats).
 
 Sizes come from ``train.sizes`` of ``params/<size>.yaml`` (the same blocks in every profile). Median of a
@@ -71,9 +73,15 @@ def main(sizes=SIZES, methods=METHODS) -> dict:
             info["problem"][size] = prob
             print(f"{m:>12} {size:>6}: {rate:9.1f} train windows/s, {ms:8.2f} ms/window inference, "
                   f"{n_params} parameters", flush=True)
+    # BGFN's training throughput over its ANN twin's, both measured in this run (issue: at least 1/3)
+    ratio = {size: train_rate["bgfn"][size] / train_rate["transformer"][size] for size in sizes
+             if "bgfn" in train_rate and "transformer" in train_rate}
+    for size, r in ratio.items():
+        print(f"BGFN / Transformer training throughput, {size}: {r:.2f}", flush=True)
     update_json(PROJECT_ROOT / "results" / "bench.json",
-                {"train_windows_per_s": train_rate, "infer_ms": infer_ms, "models_bench": info})
-    return {"train_windows_per_s": train_rate, "infer_ms": infer_ms}
+                {"train_windows_per_s": train_rate, "infer_ms": infer_ms, "models_bench": info,
+                 "train_ratio_bgfn_over_twin": ratio})
+    return {"train_windows_per_s": train_rate, "infer_ms": infer_ms, "train_ratio_bgfn_over_twin": ratio}
 
 
 if __name__ == "__main__":

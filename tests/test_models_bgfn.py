@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -60,6 +61,50 @@ def test_surrogate_gradient_is_atan(alpha):
     assert torch.allclose(x.grad, u.grad, atol=1e-6)
     assert torch.allclose(x.grad, atan_surrogate_grad(x.detach() - thr, alpha), atol=1e-6)
     assert x.grad.max() == pytest.approx(alpha / 2, rel=1e-3)       # peak at the threshold
+
+
+@pytest.mark.parametrize("tau,thr,alpha,steps", [(2.0, 1.0, 2.0, 2), (4.0, 0.5, 4.0, 8), (1.25, 0.8, 2.0, 5)])
+def test_fused_lif_equals_eq_lif_and_spikingjelly_forward_and_backward(tau, thr, alpha, steps):
+    g = torch.Generator().manual_seed(steps)
+    current = torch.randn(steps, 6, 17, 5, generator=g) * 1.5                    # [T, B, N, D]
+    upstream = torch.randn(current.shape, generator=g)
+    fused, sj = make_lif(tau, thr, alpha), make_lif(tau, thr, alpha, fused=False)
+    assert type(fused).__name__ == "FusedLIFNode" and isinstance(fused, type(sj))
+    x_f, x_s = current.clone().requires_grad_(True), current.clone().requires_grad_(True)
+    s_f, s_s = fused(x_f), sj(x_s)
+    assert torch.equal(s_f, lif_reference(current, beta_from_tau(tau), thr)[0])  # the paper's Eq. (eq:LIF)
+    assert torch.equal(s_f, s_s) and torch.equal(fused.v, sj.v)                  # and SpikingJelly's state
+    assert 0 < s_f.mean() < 1
+    (s_f * upstream).sum().backward()
+    (s_s * upstream).sum().backward()
+    torch.testing.assert_close(x_f.grad, x_s.grad, rtol=1e-5, atol=1e-6)          # BPTT with the ATan surrogate
+    assert x_f.grad.abs().sum() > 0
+
+
+def test_fused_lif_falls_back_to_spikingjelly_when_the_membrane_is_not_at_rest():
+    fused, sj = make_lif(), make_lif(fused=False)
+    x = torch.rand(3, 4, 5) * 1.5
+    for _ in range(2):                         # the second call starts from the state the first one left
+        assert torch.equal(fused(x), sj(x))
+    assert torch.equal(fused.v, sj.v)
+
+
+def test_bgfn_with_fused_lif_trains_exactly_like_spikingjelly():
+    from spikingjelly.activation_based import neuron
+
+    torch.manual_seed(0)
+    fused = build_model("bgfn", TINY)
+    sj = copy.deepcopy(fused)
+    for m in sj.modules():
+        if type(m).__name__ == "FusedLIFNode":
+            m.__class__ = neuron.LIFNode
+    x, y = torch.randn(4, 20, 9), torch.randn(4, 2)
+    out_f, out_s = fused(x), sj(x)
+    torch.testing.assert_close(out_f, out_s, rtol=0, atol=1e-6)
+    torch.nn.functional.mse_loss(out_f, y).backward()
+    torch.nn.functional.mse_loss(out_s, y).backward()
+    for (name, p_f), p_s in zip(fused.named_parameters(), sj.parameters()):
+        torch.testing.assert_close(p_f.grad, p_s.grad, rtol=1e-4, atol=1e-6, msg=name)
 
 
 def test_ssa_shapes_and_attention_without_softmax():

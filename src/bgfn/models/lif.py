@@ -22,6 +22,15 @@ equation written out literally; the tests check SpikingJelly's node against it.
 The backward pass replaces dS/dU by the derivative of the ATan surrogate (Eq. eq:surrogate_gradient)
 ``g(x) = arctan(pi/2 alpha x)/pi + 1/2`` at ``x = U - U_thr``, i.e. ``g'(x) = alpha / (2 (1 + (pi/2 alpha x)^2))``
 (:func:`atan_surrogate_grad`). Training is BPTT through the ``T_s`` SNN steps (multi-step mode ``'m'``).
+
+Speed: on the CPU, SpikingJelly's multi-step LIF runs the recursion as many small autograd operations per
+step (charge, fire, reset, surrogate), and this overhead, not arithmetic, made BGFN train many times slower
+than its ANN twin. :class:`FusedLIFNode` is a ``LIFNode`` whose multi-step pass on the CPU is one autograd
+node (:class:`FusedLIF`): the forward loop stores U(t) and S(t), the backward pass applies the same chain rule
+in reverse (the surrogate derivative evaluated once over all steps, then one fused multiply-add per step).
+Spikes are bit-identical and gradients equal within float32 rounding (tests compare it with
+:func:`lif_reference` and with SpikingJelly's ``LIFNode``). On a CUDA device, or for any setting it does not
+cover, it falls back to SpikingJelly's own implementation (whose CUDA kernels are fused already).
 """
 
 from __future__ import annotations
@@ -53,8 +62,73 @@ def tau_from_beta(beta: float) -> float:
     return 1.0 / (1.0 - beta)
 
 
+class FusedLIF(torch.autograd.Function):
+    """Eq. (eq:LIF) over all ``T`` steps as one autograd node (hard reset to 0, reset gradient detached).
+
+    Forward, from H(0) = 0: ``U(t) = H(t-1) + I(t)``, ``S(t) = [U(t) >= U_thr]``, ``H(t) = (1 - S(t)) beta U(t)``.
+    Backward (``S`` in the reset term is detached, as SpikingJelly's ``detach_reset=True``)::
+
+        dL/dU(t) = dL/dS(t) g'(U(t) - U_thr) + dL/dU(t+1) (1 - S(t)) beta,     dL/dI(t) = dL/dU(t)
+
+    with ``g'`` the ATan surrogate derivative (Eq. eq:surrogate_gradient).
+    """
+
+    @staticmethod
+    def forward(ctx, current: torch.Tensor, tau: float, u_thr: float, alpha: float):    # current [T, ...]
+        spikes = torch.empty_like(current)                                             # [T, ...]
+        potential = torch.empty_like(current)                                          # U(t), [T, ...]
+        v = None                                                # SpikingJelly's V = (1 - S) U; H = beta V
+        for t in range(current.shape[0]):
+            # charge with SpikingJelly's rounding, V - V/tau + I (= beta V + I), so spikes are bit-identical
+            u = current[t] if v is None else v - v / tau + current[t]
+            potential[t] = u
+            spikes[t] = u >= u_thr                                                     # fire
+            v = u * (1.0 - spikes[t])                                                  # hard reset to 0
+        ctx.save_for_backward(potential, spikes)
+        ctx.beta, ctx.u_thr, ctx.alpha = beta_from_tau(tau), u_thr, alpha
+        ctx.mark_non_differentiable(v)          # the state between calls; every forward pass starts at rest
+        return spikes, v                                        # spikes, SpikingJelly's v after the last step
+
+    @staticmethod
+    def backward(ctx, grad_spikes: torch.Tensor, grad_v: torch.Tensor):
+        potential, spikes = ctx.saved_tensors
+        k = math.pi / 2.0 * ctx.alpha
+        # g'(U - U_thr) for every step at once, then the direct term dL/dS g'
+        grad = (potential - ctx.u_thr).mul_(k).square_().add_(1.0).reciprocal_().mul_(ctx.alpha / 2.0)
+        grad.mul_(grad_spikes)
+        keep = (1.0 - spikes).mul_(ctx.beta)                    # dH(t)/dU(t) with the reset detached
+        for t in range(grad.shape[0] - 2, -1, -1):              # the membrane carries dL/dU(t+1) back
+            grad[t].addcmul_(grad[t + 1], keep[t])
+        return grad, None, None, None
+
+
+class FusedLIFNode(neuron.LIFNode):
+    """SpikingJelly's multi-step ``LIFNode`` whose CPU pass is :class:`FusedLIF` (module docstring).
+
+    It is a ``LIFNode`` (hooks, ``reset_net``, firing-rate and energy counts see it as one); the fused pass
+    runs when the membrane starts from rest (after a reset) and the layer is the paper's (hard reset to 0,
+    ``decay_input=False``, ATan surrogate, detached reset, no stored potential sequence); otherwise, and on
+    CUDA, SpikingJelly's own implementation runs.
+    """
+
+    def _fusable(self, x_seq: torch.Tensor) -> bool:
+        v = self._memories.get("v")
+        return (not x_seq.is_cuda and isinstance(v, float) and v == 0.0 and self.v_reset == 0.0
+                and not self.decay_input and self.detach_reset and not self.store_v_seq
+                and isinstance(self.surrogate_function, surrogate.ATan)
+                and getattr(self, "_neuron_precision", None) is None)
+
+    def multi_step_forward(self, x_seq: torch.Tensor, *args, **kwargs):
+        if args or kwargs or not self._fusable(x_seq):
+            return super().multi_step_forward(x_seq, *args, **kwargs)
+        spikes, v = FusedLIF.apply(x_seq, float(self.tau), float(self.v_threshold),
+                                   float(self.surrogate_function.alpha))
+        self._memories["v"] = v
+        return spikes
+
+
 def make_lif(tau: float = DEFAULT_TAU, v_threshold: float = DEFAULT_THRESHOLD, alpha: float = DEFAULT_ALPHA,
-             detach_reset: bool = True) -> neuron.LIFNode:
+             detach_reset: bool = True, fused: bool = True) -> neuron.LIFNode:
     """A multi-step LIF layer of Eq. (eq:LIF): input ``[T, ...]`` currents, output ``[T, ...]`` spikes in {0, 1}.
 
     Parameters
@@ -67,8 +141,11 @@ def make_lif(tau: float = DEFAULT_TAU, v_threshold: float = DEFAULT_THRESHOLD, a
         Steepness of the ATan surrogate gradient, Eq. (eq:surrogate_gradient).
     detach_reset : bool
         Stop the gradient through the reset term (as in Spikformer/SeqSNN); the forward pass is unchanged.
+    fused : bool
+        :class:`FusedLIFNode` (default; the same dynamics, faster on the CPU) or SpikingJelly's ``LIFNode``.
     """
-    return neuron.LIFNode(tau=float(tau), decay_input=False, v_threshold=float(v_threshold), v_reset=0.0,
+    node = FusedLIFNode if fused else neuron.LIFNode
+    return node(tau=float(tau), decay_input=False, v_threshold=float(v_threshold), v_reset=0.0,
                           surrogate_function=surrogate.ATan(alpha=float(alpha)), detach_reset=detach_reset,
                           step_mode="m")
 

@@ -187,3 +187,29 @@ def test_energy_summary_has_what_the_results_page_reads():
     md = energy.result_markdown(s)
     assert "BGFN 0.00026 µJ vs Transformer twin 0.0011 µJ" in md and "**76.4 % less energy** (paper: 66.3 %)" in md
     assert "takes 73 % of its energy" in md and "the reduction is 20.0 %" in md and md.endswith("it is 50.0 %.")
+
+
+def test_the_energy_network_is_the_median_seed_and_must_be_trained(tmp_path, monkeypatch):
+    import json
+
+    from bgfn import config
+    from bgfn.checkpoints import card_path, checkpoint_path
+    from bgfn.energy.checkpoint import check_trained, energy_checkpoint, median_seed
+    from bgfn.errors import DataError
+
+    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)
+    for seed, rmse in ((0, 3.0), (1, 1.0), (2, 2.0), (3, 9.0)):
+        pt = checkpoint_path("p", "d", "bgfn", seed)
+        pt.write_bytes(b"")
+        card_path(pt).write_text(json.dumps({"val_rmse_m": rmse, "best_epoch": seed}))
+    assert median_seed("p", "d", [0, 1, 2]) == 2                 # 1.0 < 2.0 < 3.0: the median is seed 2
+    assert median_seed("p", "d", [0, 1, 2, 3]) == 2             # even count: the lower median
+    assert median_seed("p", "d", [7]) == 7                      # no card yet: the first seed
+    cfg = {"energy": {"dataset": None, "seed": None}, "train": {"datasets": ["d"], "seeds": [0, 1, 2]}}
+    assert energy_checkpoint("p", "bgfn", cfg).name == "bgfn_seed2.pt"
+    assert energy_checkpoint("p", "bgfn", {**cfg, "energy": {"seed": 0}}).name == "bgfn_seed0.pt"
+    with pytest.raises(DataError, match="best epoch >= 1") as err:
+        check_trained({"best_epoch": 0}, "bgfn_seed0.json")
+    assert err.value.source == "bgfn_seed0.json" and err.value.field == "best_epoch"
+    check_trained({"best_epoch": 0}, "bgfn_seed0.json", allow_untrained=True)
+    check_trained({"best_epoch": 3}, "bgfn_seed0.json")

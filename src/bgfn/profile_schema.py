@@ -127,7 +127,7 @@ SCHEMA = section(
                       train=Spec("section", fields=TRAIN.fields), n_boot=integer(1),
                       level=_FRACTION, boot_seed=_SEED)),
     energy=section(
-        e_mac_pj=_POS, e_ac_pj=_POS, dataset=text(null=True), seed=integer(0, null=True),
+        e_mac_pj=_POS, e_ac_pj=_POS, dataset=text(null=True), seed=integer(0, null=True), allow_untrained=flag(),
         max_windows=integer(1, null=True), batch_size=integer(1), sweep_time_steps=seq(integer(1), min_len=1),
         sweep_max_rate=number(0, 1, lo_open=True), crosscheck_windows=integer(1),
         crosscheck_tolerance_pct=_POS))

@@ -1,8 +1,11 @@
 """Which trained networks the energy estimate measures: BGFN and its Transformer twin of one dataset and seed.
 
 The firing rates, hence the SOPs, are those of a *trained* BGFN; the twin's MACs do not depend on its weights,
-but loading its checkpoint of the same run proves it was trained on the same windows. The dataset and seed
-are the profile's ``energy.dataset`` / ``energy.seed``, by default what notebook 03 trains first.
+but loading its checkpoint of the same run proves it was trained on the same windows. The dataset is the
+profile's ``energy.dataset`` (default: the first of ``train.datasets``); the seed is ``energy.seed`` or, by
+default, the seed whose BGFN has the median validation error over ``train.seeds`` (a representative network,
+not the luckiest or the first). A BGFN whose best epoch is 0 -- the initial, untrained network -- is refused
+unless the profile says ``energy.allow_untrained: true`` (the smoke profile, whose numbers mean nothing).
 """
 
 from __future__ import annotations
@@ -26,7 +29,7 @@ def energy_checkpoint(profile: str, method: str, cfg: dict | None = None, datase
     """The checkpoint of the energy estimate (:func:`bgfn.checkpoints.checkpoint_path`).
 
     ``dataset``/``seed`` default to the profile's ``energy.dataset``/``energy.seed`` and, when those are
-    null, to the first of ``train.datasets``/``train.seeds`` (what notebook 03 trains first).
+    null, to the first of ``train.datasets`` and to :func:`median_seed` over ``train.seeds``.
 
     Raises
     ------
@@ -36,10 +39,10 @@ def energy_checkpoint(profile: str, method: str, cfg: dict | None = None, datase
     cfg = cfg if cfg is not None else load_profile(profile)
     ecfg, tcfg = cfg.get("energy") or {}, cfg.get("train") or {}
     dataset = dataset or ecfg.get("dataset") or (tcfg.get("datasets") or [None])[0]
-    seed = seed if seed is not None else ecfg.get("seed")
-    seed = seed if seed is not None else (tcfg.get("seeds") or [0])[0]
     if dataset is None:
         raise ValueError(f"profile {profile!r}: no dataset (energy.dataset and train.datasets are empty)")
+    seed = seed if seed is not None else ecfg.get("seed")
+    seed = seed if seed is not None else median_seed(profile, dataset, tcfg.get("seeds") or [0])
     path = checkpoint_path(profile, dataset, method, int(seed), create=False)
     if must_exist and not path.is_file():
         raise FileNotFoundError(
@@ -47,6 +50,36 @@ def energy_checkpoint(profile: str, method: str, cfg: dict | None = None, datase
             f"(run `make reproduce PROFILE={profile}`, or `python -m bgfn.train --profile {profile} "
             f"--dataset {dataset} --method {method} --seed {int(seed)}`)")
     return path
+
+
+def median_seed(profile: str, dataset: str, seeds, method: str = "bgfn") -> int:
+    """The seed whose ``method`` network has the median validation RMSE (the lower median; ties: the smaller
+    seed) among the cards of ``seeds``; the first seed when no card is there yet."""
+    scored = []
+    for seed in seeds:
+        card = card_path(checkpoint_path(profile, dataset, method, int(seed), create=False))
+        if card.is_file():
+            scored.append((float(json.loads(card.read_text()).get("val_rmse_m", float("inf"))), int(seed)))
+    if not scored:
+        return int(list(seeds)[0])
+    scored.sort()
+    return scored[(len(scored) - 1) // 2][1]
+
+
+def check_trained(card: dict, card_file: str | Path, allow_untrained: bool = False) -> None:
+    """Refuse a network whose best epoch is 0: its firing rates would be those of the initial weights.
+
+    Raises
+    ------
+    bgfn.errors.DataError
+        Naming the card, unless ``allow_untrained`` (``energy.allow_untrained`` of the profile).
+    """
+    from bgfn.errors import DataError
+
+    if not allow_untrained and int(card.get("best_epoch", 1)) < 1:
+        raise DataError(card_file, "best_epoch", "a network that improved on its initial weights (best epoch >= 1) "
+                        "-- its firing rates decide the energy; train longer (train.optimizer.epochs, patience), "
+                        "set energy.seed to a trained seed, or energy.allow_untrained: true", "0")
 
 
 @dataclass
@@ -107,11 +140,17 @@ def load_measured(profile: str, cfg: dict | None = None, methods=MEASURED) -> Me
     ------
     FileNotFoundError
         A checkpoint is missing; the message names the file and the notebook that writes it.
+    bgfn.errors.DataError
+        A network's best epoch is 0 (:func:`check_trained`).
     """
     paths = {m: energy_checkpoint(profile, m, cfg) for m in methods}
     trained = {m: load_trained(p, device="cpu") for m, p in paths.items()}
     for t in trained.values():
         t.model.eval()
     cards = {m: json.loads(card_path(p).read_text()) if card_path(p).exists() else {} for m, p in paths.items()}
+    cfg = cfg if cfg is not None else load_profile(profile)
+    allow = bool((cfg.get("energy") or {}).get("allow_untrained", False))
+    for m in methods:
+        check_trained(cards[m], card_path(paths[m]), allow)
     first = paths[methods[0]]
     return MeasuredModels(profile, first.parent.name, parse_checkpoint(first).seed, paths, trained, cards)

@@ -22,7 +22,7 @@ import torch
 from bgfn.config import PROJECT_ROOT, load_profile
 from bgfn.io import update_json
 from bgfn.models import METHODS, build_model, count_parameters
-from bgfn.speed import median_time
+from bgfn.speed import median_time, training_throughput
 
 SIZES = ("quick", "paper")
 #: (training steps, inference calls) measured per size, after one warm-up each.
@@ -36,17 +36,8 @@ def bench(model_name: str, size: str) -> tuple[float, float, int, dict]:
     n_train, n_infer = REPEATS[size]
     torch.manual_seed(0)
     model = build_model(model_name, size_cfg)
-    opt = torch.optim.AdamW(model.parameters(), lr=1e-3)
-    x, y = torch.randn(batch, window, 9), torch.randn(batch, 2)
-
-    def step():
-        model.train()
-        opt.zero_grad(set_to_none=True)
-        torch.nn.functional.mse_loss(model(x), y).backward()
-        opt.step()
-
     threads = torch.get_num_threads()
-    train_s = median_time(step, n_train)
+    rate = training_throughput(model, window, batch, repeats=n_train)
     x1 = torch.randn(1, window, 9)
     model.eval()
     torch.set_num_threads(1)
@@ -55,7 +46,7 @@ def bench(model_name: str, size: str) -> tuple[float, float, int, dict]:
             infer_s = median_time(lambda: model(x1), n_infer)
     finally:
         torch.set_num_threads(threads)
-    return batch / train_s, 1e3 * infer_s, count_parameters(model), {"batch": batch, "window": window,
+    return rate, 1e3 * infer_s, count_parameters(model), {"batch": batch, "window": window,
                                                                       "repeats": [n_train, n_infer]}
 
 

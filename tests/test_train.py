@@ -404,3 +404,16 @@ def test_training_metrics_gather_what_training_json_holds():
     assert m["runs"][0]["wall_time_s"] == 1.5                     # training.json keeps the times
     assert m["learning_options"] == {"a": prepared["a"].data.options} and m["outage_windows"] == [(1100.0, 10.0)]
     assert m["windows"][0]["dataset"] == "a" and m["meta"]["profile"] == "smoke"
+
+
+def test_paper_training_estimate_is_epochs_times_windows_over_the_measured_rate():
+    paper = {"train": {"methods": ["bgfn", "mlp"], "seeds": [0, 1, 2], "optimizer": {"epochs": 1000}}}
+    bench = {"train_windows_per_s": {"bgfn": {"paper": 10.0, "quick": 99.0}, "mlp": {"paper": 400.0}}}
+    table = T.paper_training_estimate({"a": 3600, "b": 1800}, paper, bench)
+    t = table.set_index("method")
+    # BGFN: one epoch = 3600/10 + 1800/10 = 540 s; 3 seeds x 1000 epochs = 1.62e6 s = 450 h
+    assert t.loc["bgfn", "epoch_s"] == pytest.approx(540.0) and t.loc["bgfn", "hours"] == pytest.approx(450.0)
+    assert t.loc["mlp", "hours"] == pytest.approx(450.0 * 10 / 400) and t.loc["bgfn", "runs"] == 6
+    assert "at most 461.2 h" in T.estimate_lines(table)[0]
+    assert T.paper_training_estimate({"a": 1}, paper, {"train_windows_per_s": {"bgfn": {"quick": 5.0}}}) is None
+    assert "make bench" in T.estimate_lines(None)[0]

@@ -77,6 +77,23 @@ def throughput(model: nn.Module, window: int, batch: int = 64, in_channels: int 
         return batch / median_time(_infer(model, x), repeats)
 
 
+def training_throughput(model: nn.Module, window: int, batch: int, in_channels: int = 9, repeats: int = 3,
+                        seed: int = 0) -> float:
+    """Training windows per second: forward, BPTT backward and an AdamW step on random inputs (median of
+    ``repeats`` steps after one warm-up), torch's current CPU threads."""
+    g = torch.Generator().manual_seed(seed)
+    x, y = torch.randn(batch, window, in_channels, generator=g), torch.randn(batch, 2, generator=g)
+    opt = torch.optim.AdamW(model.parameters(), lr=1e-3)
+
+    def step():
+        model.train()
+        opt.zero_grad(set_to_none=True)
+        torch.nn.functional.mse_loss(model(x), y).backward()
+        opt.step()
+
+    return batch / median_time(step, repeats)
+
+
 def realtime_flags(latency_ms_value: float, imu_rate_hz: float = IMU_RATE_HZ,
                    gnss_rate_hz: float = GNSS_RATE_HZ) -> dict[str, bool]:
     """Whether a batch-1 latency (ms) keeps up with the IMU and the GNSS rates.

@@ -78,12 +78,19 @@ class FusedLIF(torch.autograd.Function):
         spikes = torch.empty_like(current)                                             # [T, ...]
         potential = torch.empty_like(current)                                          # U(t), [T, ...]
         v = None                                                # SpikingJelly's V = (1 - S) U; H = beta V
+        exact_half = tau == 2.0                                 # V - V/2 == V/2 exactly in floating point
         for t in range(current.shape[0]):
             # charge with SpikingJelly's rounding, V - V/tau + I (= beta V + I), so spikes are bit-identical
-            u = current[t] if v is None else v - v / tau + current[t]
+            if v is None:
+                u = current[t]
+            elif exact_half:
+                u = torch.add(current[t], v, alpha=0.5)
+            else:
+                u = v - v / tau + current[t]
             potential[t] = u
-            spikes[t] = u >= u_thr                                                     # fire
-            v = u * (1.0 - spikes[t])                                                  # hard reset to 0
+            fired = u >= u_thr                                                         # fire
+            spikes[t] = fired
+            v = u.masked_fill(fired, 0.0)                                              # hard reset to 0
         ctx.save_for_backward(potential, spikes)
         ctx.beta, ctx.u_thr, ctx.alpha = beta_from_tau(tau), u_thr, alpha
         ctx.mark_non_differentiable(v)          # the state between calls; every forward pass starts at rest

@@ -1,0 +1,89 @@
+"""How long the paper profile would train on this machine, from a measured training step (``make bench``).
+
+The paper trains for 1000 epochs with batch 8 on an RTX A6000 (Sec. 4.1). Before anyone spends hours on the
+``paper`` profile, notebook 03 prints what it would cost here: ``make bench`` (``benchmarks/bench_models.py``)
+measures the training throughput of every method at the paper size (``train_windows_per_s.<method>.paper``
+in ``results/bench.json``, windows per second, forward + BPTT backward + optimizer step); the estimate
+multiplies one epoch over this profile's training windows by the paper's epochs, seeds and datasets. It is an
+upper bound (early stopping may end a run sooner) without the learning-rate search and the validation passes.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pandas as pd
+
+#: Where ``make bench`` writes its measurements.
+BENCH_FILE = Path("results") / "bench.json"
+
+
+def paper_training_estimate(n_train: dict[str, int], paper_cfg: dict, bench: dict | None) -> pd.DataFrame | None:
+    """Hours the paper profile's training would take on the machine that ran ``make bench``.
+
+    Parameters
+    ----------
+    n_train : dict
+        Dataset -> training windows (all of them, as the paper profile trains on: ``max_train_windows: null``).
+    paper_cfg : dict
+        The ``paper`` profile (:func:`bgfn.config.load_profile`): its methods, seeds and epochs.
+    bench : dict or None
+        ``results/bench.json``; None (not measured yet) gives None.
+
+    Returns
+    -------
+    DataFrame or None
+        One row per method: ``windows_per_s`` (measured), ``epoch_s`` (all datasets), ``runs``
+        (datasets x seeds), ``epochs``, ``hours`` (upper bound); None when no paper-size rate was measured.
+    """
+    rates = ((bench or {}).get("train_windows_per_s") or {})
+    tc = paper_cfg["train"]
+    epochs = int(tc["optimizer"]["epochs"])
+    rows = []
+    for method in tc["methods"]:
+        rate = (rates.get(method) or {}).get("paper")
+        if not rate:
+            return None
+        epoch_s = sum(n / float(rate) for n in n_train.values())          # one epoch of every dataset
+        runs = len(n_train) * len(tc["seeds"])
+        rows.append({"method": method, "windows_per_s": float(rate), "epoch_s": epoch_s,
+                     "runs": runs, "epochs": epochs, "hours": epoch_s * len(tc["seeds"]) * epochs / 3600.0})
+    return pd.DataFrame(rows)
+
+
+def read_bench(root: str | Path) -> dict | None:
+    """``results/bench.json`` under the project ``root``, or None when ``make bench`` has not run."""
+    path = Path(root) / BENCH_FILE
+    return json.loads(path.read_text(encoding="utf-8")) if path.is_file() else None
+
+
+def measure_paper_step(paper_cfg: dict, repeats: int = 2) -> dict:
+    """The paper-size training throughput of every method, measured now (a few seconds per method), in the
+    form of ``results/bench.json`` (``{"train_windows_per_s": {method: {"paper": windows/s}}}``), for when
+    ``make bench`` has not run on this machine."""
+    import torch
+
+    from bgfn.models import build_model
+    from bgfn.speed import training_throughput
+
+    tc = paper_cfg["train"]
+    rates = {}
+    for method in tc["methods"]:
+        torch.manual_seed(0)
+        model = build_model(method, dict(tc["sizes"][method]["paper"]))
+        rates[method] = {"paper": training_throughput(model, int(tc["window"]), int(tc["optimizer"]["batch_size"]),
+                                                       repeats=repeats)}
+    return {"train_windows_per_s": rates, "measured_by": "bgfn.train.estimate.measure_paper_step"}
+
+
+def estimate_lines(table: pd.DataFrame | None) -> list[str]:
+    """Plain lines for notebook 03: the estimate, or how to get one."""
+    if table is None:
+        return ["paper profile: not run here; no paper-size training step measured yet -- run `make bench` "
+                "(benchmarks/bench_models.py), then this notebook prints the estimated training time"]
+    total = float(table["hours"].sum())
+    per = ", ".join(f"{r.method} {r.hours:.1f} h ({r.windows_per_s:.1f} windows/s)" for r in table.itertuples())
+    return [f"paper profile: not run here; its training would take at most {total:.1f} h on this machine, from "
+            f"the measurement ({int(table['epochs'].iloc[0])} epochs x {int(table['runs'].iloc[0])} runs per "
+            f"method, without early stopping): {per}"]

@@ -1,0 +1,60 @@
+"""The documentation describes the layout as it is, and the notebooks stay thin (logic lives in src/bgfn)."""
+
+from __future__ import annotations
+
+import re
+
+import nbformat
+import pytest
+
+from bgfn.config import PROJECT_ROOT
+
+SRC = PROJECT_ROOT / "src" / "bgfn"
+NOTEBOOKS = sorted((PROJECT_ROOT / "notebooks").glob("*.ipynb"))
+#: A notebook is prose, a parameters cell and calls into the package.
+MAX_CODE_LINES = 80
+
+
+def _block(path, heading: str) -> str:
+    """The first fenced code block after ``heading`` in a Markdown file."""
+    text = path.read_text(encoding="utf-8")
+    after = text[text.index(heading):]
+    return re.search(r"```\n(.*?)```", after, re.S).group(1)
+
+
+def _modules():
+    """(package or None, module stem) of every module file of the package."""
+    for p in sorted(SRC.rglob("*.py")):
+        if p.name in ("__init__.py", "__main__.py") or "__pycache__" in p.parts:
+            continue
+        rel = p.relative_to(SRC)
+        yield (rel.parts[0] if len(rel.parts) > 1 else None), p.stem
+
+
+@pytest.mark.parametrize("nb", NOTEBOOKS, ids=lambda p: p.stem)
+def test_notebooks_are_thin(nb):
+    code = [c for c in nbformat.read(nb, as_version=4).cells if c.cell_type == "code"]
+    lines = sum(1 for c in code for line in c.source.splitlines() if line.strip())
+    assert lines <= MAX_CODE_LINES, f"{nb.name}: {lines} code lines; move logic into src/bgfn"
+    assert "parameters" in code[0].metadata.get("tags", [])
+
+
+def test_readme_layout_names_every_package_and_top_level_module():
+    block = _block(PROJECT_ROOT / "README.md", "## Layout")
+    for package, stem in _modules():
+        name = f"{package}/" if package else f"{stem}.py"
+        assert name in block, f"README.md's layout block does not name {name}"
+    words = {5: "five", 6: "six", 7: "seven", 8: "eight"}
+    assert f"built from {words[len(NOTEBOOKS)]} ordered notebooks" in (PROJECT_ROOT / "README.md").read_text()
+
+
+def test_contributing_layout_names_every_module():
+    block = _block(PROJECT_ROOT / "CONTRIBUTING.md", "## Layout")
+    lines = block.splitlines()
+    for package, stem in _modules():
+        if package is None:
+            assert f"{stem}.py" in block, f"CONTRIBUTING.md's layout misses src/bgfn/{stem}.py"
+            continue
+        start = next(i for i, line in enumerate(lines) if line.startswith(f"  {package}/"))
+        end = next((i for i in range(start + 1, len(lines)) if re.match(r"^  \S", lines[i])), len(lines))
+        assert f"{stem}.py" in "\n".join(lines[start:end]), f"CONTRIBUTING.md's layout misses {package}/{stem}.py"

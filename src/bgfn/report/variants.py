@@ -156,8 +156,8 @@ def variants_section(profile: str, variants: Sequence[str], results_root: str | 
     for info in TESTS.values():
         ot = variant_outage_table(profile_tables(shown, info["file"], root))
         if ot is not None:
-            pieces.append(compact(ot.style.format("{:.1f}"),
-                                  f"{info['title'].capitalize()}: mean of max east and max north error (m), per profile"))
+            caption = f"{info['title'].capitalize()}: mean of max east and max north error (m), per profile"
+            pieces.append(compact(ot.style.format("{:.1f}"), caption))
     sweeps = profile_tables(shown, "outage_sweep_summary.csv", root)
     sw = variant_sweep_table(sweeps)
     if sw is not None:

@@ -402,3 +402,105 @@ def test_findings_for_the_first_page_are_the_glance_lines_as_a_list():
     assert body.splitlines() == ["- BGFN beats INS in 0 of 4.", "- energy: 98.6 % less."]
     intro = (BOOK / "intro.md").read_text(encoding="utf-8")
     assert "_generated/findings.md" in intro                    # the first page includes them
+
+
+# ----------------------------------------------------------------------------------------------- page sections
+def results(tmp_path, ours=None, **inputs) -> report.ProfileResults:
+    """A ProfileResults of profile ``p`` under ``tmp_path/p`` with the paper's tables and claims, and ``ours``
+    as the dataset test's table (the field test's missing)."""
+    out = tmp_path / "p"
+    fields = {"profile": "p", "cfg": {"train": {"seeds": [0], "datasets": ["d1"]}}, "out": out, "current": None,
+              "claims": paper.claims(), "kf": None, "training": None, "evaluation": None, "energy": None,
+              "ours": {"dataset": ours, "field": None}, "published": {t: paper.outage_table(t) for t in paper.TESTS},
+              "training_summary": None, "training_times": None, "sweep": None, "sweep_pairs": None}
+    return report.ProfileResults(**{**fields, **inputs})
+
+
+def test_read_results_reads_what_is_there_and_none_for_the_rest(tmp_path):
+    (tmp_path / "tables").mkdir()
+    OURS.to_csv(tmp_path / "tables" / "outage_dataset.csv", index=False)
+    (tmp_path / "energy.json").write_text(json.dumps({"reduction_pct": 75.0}))
+    res = report.read_results("smoke", tmp_path)
+    assert res.out == tmp_path and res.cfg["profile"] == "smoke" and res.current["profile"] == "smoke"
+    pd.testing.assert_frame_equal(res.ours["dataset"], OURS)
+    assert res.ours["field"] is None and res.kf is None and res.sweep is None
+    assert res.energy == {"reduction_pct": 75.0}
+    pd.testing.assert_frame_equal(res.published["field"], paper.outage_table("field"))
+    assert res.claims == paper.claims() and res.table("x.csv") == tmp_path / "tables" / "x.csv"
+
+
+def test_outage_section_serves_both_tests(tmp_path):
+    res = results(tmp_path, OURS)
+    ds = report.outage_section(res, "dataset")
+    # our table there: the paper-layout table with the paper's label and caption, then its provenance line
+    assert len(ds.layout) == 2
+    caption = paper.TESTS["dataset"]["caption"]
+    assert ds.layout[0].caption == f"Table tab-out1-exin: {caption}; ours (p) beside the paper's"
+    assert ds.layout[1].startswith("*Source: `") and "outage_dataset.csv" in ds.layout[1]
+    assert ds.all_rows[0].caption == "All methods and metrics (m), dataset test, profile p"
+    assert ds.reduction[0].caption == "BGFN vs INS, dataset test (%)"
+    assert "outage_max_errors.csv" in ds.reduction[1] and "claims.yaml" in ds.reduction[1]
+    assert ds.reduction[2].startswith("- Outage 1, east: with BGFN the max error of INS is reduced by 75.0 %")
+    assert ds.comparison == ["\n".join(f"- {s}" for s in report.comparison_sentences("dataset", OURS,
+                                                                                      res.published["dataset"]))]
+    # our table missing: a note naming the producer, the paper's values still shown, no table of ours
+    fd = report.outage_section(res, "field")
+    assert "the field test table was not produced" in fd.layout[0] and "notebook 04" in fd.layout[0]
+    assert fd.layout[1].caption.startswith("Table tab-real: ")
+    assert fd.all_rows == [] and fd.comparison == ["- Outage 1: no BGFN row in our table.\n"
+                                                   "- Outage 2: no BGFN row in our table."]
+    assert fd.layout[1].data[("paper", "BGFN", "East")].notna().all()
+
+
+def test_sections_name_the_notebook_of_a_missing_input(tmp_path):
+    res = results(tmp_path)
+    assert "notebook 02" in report.kf_section(res)[0] and "kf_baseline.json" in report.kf_section(res)[0]
+    assert "notebook 03" in report.training_section(res)[0]
+    assert "notebook 04" in report.sweep_section(res)[0]
+    energy = report.energy_section(res)
+    assert "energy.json` is missing" in energy[1] and "notebook 05" in energy[1]
+    assert energy[0].data.loc["energy reduction (%)", "paper"] == paper.claims()["energy_reduction_vs_transformer_pct"]
+    kf = {"meta": None, "nav": {"bias_model": "markov"},
+          "datasets": {"d1": {"gnss_updates": 10, "rms": {"north": 1.0, "yaw": math.pi / 180}}}}
+    table, line = report.kf_section(results(tmp_path, kf=kf))
+    assert table.data.loc["d1", "RMS yaw (deg)"] == pytest.approx(1.0)
+    assert "datasets `d1`" in line and "bias model markov" in line
+
+
+def test_variants_section_puts_a_run_variant_beside_and_names_a_missing_one(tmp_path):
+    for p, bgfn in (("quick", 5.0), ("quick-heading", 1.7)):
+        (tmp_path / p / "tables").mkdir(parents=True)
+        pd.DataFrame({"dataset": ["d"], "method": ["bgfn"], "val_rmse_m_mean": [bgfn], "val_rmse_zero_m": [10.0],
+                      "val_rmse_last_m": [1.4]}).to_csv(tmp_path / p / "tables" / "training_summary.csv", index=False)
+    pieces = report.variants_section("quick", ["quick-heading", "smoke"], tmp_path)
+    assert "`make reproduce PROFILE=smoke`" in pieces[0] and "the variant `smoke`" in pieces[0]
+    assert list(pieces[1].data.columns) == ["val. RMSE quick", "val. RMSE quick-heading", "zero", "last increment"]
+    assert "`quick-heading`, `d`: BGFN 1.70 m" in pieces[2]
+    assert pieces[-1].startswith("*From ") and "profile `quick and quick-heading`" in pieces[-1]
+    # nothing run beside the profile: only the notes
+    assert report.variants_section("quick", ["smoke"], tmp_path / "none") == [
+        report.missing_note(tmp_path / "none" / p / "tables" / "training_summary.csv", f"the variant `{p}`",
+                            f"`make reproduce PROFILE={p}`") for p in ("smoke",)]
+
+
+def test_figure_sections_show_a_file_or_say_it_is_missing(tmp_path):
+    res = results(tmp_path)
+    (res.out / "figures").mkdir(parents=True)
+    (res.out / "figures" / "trajectory_3d.png").write_bytes(b"png")
+    pieces = report.paper_figure_section(res)
+    assert len(pieces) == 2 * len(report.PAPER_FIGURES)           # a heading, then the file or a note
+    i = [e["file"] for e in report.PAPER_FIGURES].index("trajectory_3d.png")
+    assert pieces[2 * i].startswith("**Fig. 3d** (paper).") and "Regenerated by notebook 01" in pieces[2 * i]
+    assert pieces[2 * i + 1] == res.out / "figures" / "trajectory_3d.png"
+    assert "is missing" in pieces[1] and "notebook 06" in pieces[1]          # the first diagram, not drawn here
+    extra = report.extra_figure_section(res)                      # {dataset} figures: per trained dataset
+    assert "**Training curves.** Training and validation loss per epoch (d1)." in "\n".join(
+        p for p in extra if isinstance(p, str))
+
+
+def test_draw_diagrams_writes_the_papers_figures_made_by_notebook_06(tmp_path):
+    from bgfn.config import load_profile
+
+    written = report.draw_diagrams(load_profile("smoke"), None, tmp_path)
+    assert [p.name for p in written] == [e["file"] for e in report.PAPER_FIGURES if e["by"].startswith("notebook 06")]
+    assert all(p.parent == tmp_path and p.stat().st_size > 0 for p in written)

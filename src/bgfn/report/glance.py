@@ -1,0 +1,50 @@
+"""The top of the results page and the book's first page: which runs the page reads (the run header), the
+*At a glance* lines, and ``results/<profile>/findings.md``, those lines as the first page includes them."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Sequence
+
+import pandas as pd
+
+from bgfn.paper import TESTS
+from bgfn.report.provenance import meta_line, run_meta
+from bgfn.report.reading import read_json, rel
+from bgfn.report.sentences import energy_sentences, summary_sentence
+from bgfn.report.variants import reference_sentences
+
+#: The JSON files of notebooks 02-05 (what each holds).
+RUN_FILES: dict[str, str] = {"kf_baseline.json": "notebook 02, Kalman filter baseline",
+                             "training.json": "notebook 03, training",
+                             "outage_evaluation.json": "notebook 04, outage evaluation",
+                             "energy.json": "notebook 05, energy estimate"}
+
+
+def run_header(profile: str, cfg: dict, results: str | Path, current: dict | None = None) -> list[str]:
+    """Markdown lines: the profile of this page and, per JSON file of notebooks 02-05, whether it is there and
+    what produced it."""
+    results = Path(results)
+    lines = [f"Profile **`{profile}`** (`params/{profile}.yaml`): {cfg.get('description', '')}",
+             f"Results read from `{rel(results)}/`; the page itself: {meta_line(current) if current else '-'}.", ""]
+    for name, what in RUN_FILES.items():
+        d = read_json(results / name)
+        state = meta_line(run_meta(d), current) if d else "**missing**"
+        lines.append(f"- `{name}` ({what}): {state}")
+    return lines
+
+
+def glance_lines(profile: str, ours: dict, paper: dict, energy: dict | None, claims: dict,
+                 training_summary: pd.DataFrame | None) -> list[str]:
+    """The results page's *At a glance*: per test how often BGFN beats each method (ours and the paper's), the
+    energy estimate beside the claim, BGFN's validation error against the untrained references."""
+    return ([summary_sentence(t, ours[t], paper[t]) for t in TESTS] + energy_sentences(energy, claims)
+            + reference_sentences(profile, training_summary))
+
+
+def findings_markdown(profile: str, lines: Sequence[str]) -> str:
+    """The *At a glance* lines as a Markdown list for the book's first page (``results/<profile>/findings.md``,
+    included there by the book build)."""
+    head = (f"From profile `{profile}` (`params/{profile}.yaml`); how each number is made, and the paper's beside "
+            "it, is on the {doc}`results page <notebooks/06_results>`.")
+    return head + "\n\n" + "\n".join(f"- {s}" for s in lines) + "\n"

@@ -1,0 +1,134 @@
+"""The sections of the results page (notebook 06), each as the pieces to display, in order.
+
+A *piece* is a Markdown string, a pandas Styler (a table) or a :class:`~pathlib.Path` (a figure file); the
+notebook only displays them, between its prose. An input that is missing gives a note saying which notebook
+produces it, never an error.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from bgfn import paper
+from bgfn.evaluate import describe_sweep
+from bgfn.report.glance import run_header
+from bgfn.report.provenance import cards_line, model_cards, outage_datasets, outage_provenance, provenance, short_source
+from bgfn.report.reading import ProfileResults, missing_note
+from bgfn.report.sentences import bullets, comparison_sentences, energy_sentences, reduction_sentences
+from bgfn.report.tables import (compact, energy_table, fmt_num, kf_table, reduction_comparison, style_layout,
+                                sweep_table, training_table)
+
+#: Format of the outage tables' values: the paper's precision.
+_VALUE = f"{{:.{paper.DECIMALS}f}}"
+
+
+def header_section(res: ProfileResults) -> list:
+    """The run header (:func:`bgfn.report.glance.run_header`) as one Markdown piece."""
+    return ["\n".join(run_header(res.profile, res.cfg, res.out, res.current))]
+
+
+@dataclass
+class OutageSection:
+    """One outage test on the results page (paper Table ``tab-out1-exin`` or ``tab-real``): four parts, each
+    a list of pieces, shown under their own prose.
+
+    Attributes
+    ----------
+    layout : list
+        A missing note when our table is missing; the paper-layout table, ours beside the paper's; its
+        provenance line.
+    all_rows : list
+        Every row and metric of our table and its source line (empty when our table is missing).
+    reduction : list
+        BGFN's reduction against INS, ours beside the paper's table and text; its source line; the sentences.
+    comparison : list
+        One Markdown list: BGFN against each other method, outage by outage.
+    """
+
+    layout: list
+    all_rows: list
+    reduction: list
+    comparison: list
+
+
+def outage_section(res: ProfileResults, test: str) -> OutageSection:
+    """The section of one of the paper's outage tests (a key of :data:`bgfn.paper.TESTS`)."""
+    spec = paper.TESTS[test]
+    title, profile = spec["title"], res.profile
+    ours, published = res.ours[test], res.published[test]
+    file = res.table(spec["file"])
+    dataset = outage_datasets(res.evaluation).get(test)
+
+    layout = [missing_note(file, f"the {title} table", "notebook 04")] if ours is None else []
+    layout += [style_layout(paper.layout(ours, published, ours_label=f"ours ({profile})"),
+                            f"Table {spec['label']}: {spec['caption']}; ours ({profile}) beside the paper's"),
+               outage_provenance(profile, test, res.out, res.evaluation, res.current)]
+
+    all_rows = []
+    if ours is not None:
+        ev = (res.evaluation or {}).get("evaluate", {})
+        all_rows = [compact(ours.set_index(["outage", "method"]).style.format(_VALUE),
+                            f"All methods and metrics (m), {title}, profile {profile}"),
+                    short_source([file], profile, dataset=dataset, seeds=ev.get("seeds"),
+                                 seed_aggregate=ev.get("seed_aggregate"))]
+
+    comp = reduction_comparison(ours, published, res.claims, test)
+    reduction = [compact(comp.style.format(_VALUE, na_rep="-"), f"BGFN vs INS, {title} (%)"),
+                 short_source([file, paper.OUTAGE_TABLE_FILE, paper.CLAIMS_FILE], profile, dataset=dataset),
+                 bullets(reduction_sentences(comp))]
+    return OutageSection(layout, all_rows, reduction, [bullets(comparison_sentences(test, ours, published))])
+
+
+def energy_section(res: ProfileResults) -> list:
+    """Energy per prediction (notebook 05) beside the paper's claim, its source, the sentences."""
+    energy = res.energy
+    pieces: list = [compact(energy_table(energy, res.claims).style.format(fmt_num),
+                            "Energy per prediction and reduction, ours beside the paper's claim")]
+    if energy:
+        pieces.append(provenance(res.out / "energy.json", energy.get("metadata"), res.current,
+                                 dataset=f"`{energy.get('dataset')}`", seed=energy.get("seed"),
+                                 time_steps=energy.get("time_steps"),
+                                 checkpoints=", ".join(f"`{p}`" for p in energy.get("checkpoints", {}).values()),
+                                 validation_windows=energy.get("windows", {}).get("n_windows")))
+    else:
+        pieces.append(missing_note(res.out / "energy.json", "the energy estimate", "notebook 05"))
+    return pieces + [bullets(energy_sentences(energy, res.claims))]
+
+
+def kf_section(res: ProfileResults) -> list:
+    """The full-drive Kalman filter errors (notebook 02) and their source."""
+    kt = kf_table(res.kf)
+    if kt is None:
+        return [missing_note(res.out / "kf_baseline.json", "the Kalman filter baseline", "notebook 02")]
+    return [compact(kt.style.format(fmt_num), f"GPS/INS filter errors against the reference, profile {res.profile}"),
+            provenance(res.out / "kf_baseline.json", res.kf.get("meta"), res.current,
+                       datasets=[f"`{d}`" for d in kt.index], bias_model=res.kf.get("nav", {}).get("bias_model"))]
+
+
+def training_section(res: ProfileResults) -> list:
+    """The training summary (notebook 03), its source, and per dataset the trained networks (model cards)."""
+    file = res.table("training_summary.csv")
+    tt = training_table(res.training_summary, res.training_times)
+    if tt is None:
+        return [missing_note(file, "the training summary", "notebook 03")]
+    return [compact(tt.style.format(fmt_num), f"Training summary, profile {res.profile}"),
+            provenance(file, (res.training or {}).get("meta"), res.current, seeds=res.cfg["train"].get("seeds")),
+            "\n".join(f"- `{d}`: {cards_line(model_cards(res.profile, d, res.out.parent))}"
+                      for d in tt.index.get_level_values("dataset").unique())]
+
+
+def sweep_section(res: ProfileResults) -> list:
+    """The outage sweep (notebook 04) as ``median [interval]`` per duration, its source, the paired
+    comparisons (:func:`bgfn.evaluate.describe_sweep`) when their table is there."""
+    file = res.table("outage_sweep_summary.csv")
+    st = sweep_table(res.sweep)
+    if st is None:
+        return [missing_note(file, "the outage sweep", "notebook 04, `evaluate.sweep`")]
+    sw = (res.evaluation or {}).get("evaluate", {}).get("sweep", {})
+    pieces = [compact(st.style, f"Median max horizontal error (m) [95 % interval], profile {res.profile}"),
+              provenance(file, (res.evaluation or {}).get("meta"), res.current,
+                         datasets=[f"`{d}`" for d in sw.get("datasets", [])], seeds=sw.get("seeds"),
+                         starts=sw.get("n_starts"), folds=sw.get("folds"))]
+    if res.sweep_pairs is not None:
+        pieces.append(bullets(describe_sweep(res.sweep, res.sweep_pairs)))
+    return pieces

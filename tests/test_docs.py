@@ -58,3 +58,23 @@ def test_contributing_layout_names_every_module():
         start = next(i for i, line in enumerate(lines) if line.startswith(f"  {package}/"))
         end = next((i for i in range(start + 1, len(lines)) if re.match(r"^  \S", lines[i])), len(lines))
         assert f"{stem}.py" in "\n".join(lines[start:end]), f"CONTRIBUTING.md's layout misses {package}/{stem}.py"
+
+
+def test_result_files_are_named_once():
+    # the notebooks write and the results page reads results/<profile>/ files through bgfn.config's names;
+    # the Makefile (which cannot import them) copies the findings under the same name
+    from bgfn.config import RUN_RECORDS, SHARED_TABLES
+
+    names = list(RUN_RECORDS.values()) + list(SHARED_TABLES.values())
+    spelled = [f"{p.relative_to(PROJECT_ROOT)}: {name}" for p in sorted(SRC.rglob("*.py")) + NOTEBOOKS
+               if p.name != "config.py"
+               for name in names if re.search(rf"[\"']{re.escape(name)}[\"']", _code(p))]
+    assert not spelled, "spell these result files through bgfn.config.RUN_RECORDS / SHARED_TABLES:\n" + "\n".join(spelled)
+    assert f'$(RES)/{RUN_RECORDS["findings"]}' in (PROJECT_ROOT / "Makefile").read_text()
+
+
+def _code(path) -> str:
+    """The code of a module or notebook (a notebook's code cells only: its prose may name files)."""
+    if path.suffix == ".ipynb":
+        return "\n".join(c.source for c in nbformat.read(path, as_version=4).cells if c.cell_type == "code")
+    return path.read_text(encoding="utf-8")

@@ -59,6 +59,24 @@ SCALAR_KEYS: tuple[str, ...] = ("profile", "description", "seed", "outage_window
 #: One section per notebook: 01 data, 02 nav (KF baseline), 03 train, 04 evaluate, 05 energy.
 SECTION_KEYS: tuple[str, ...] = ("data", "nav", "train", "evaluate", "energy")
 REQUIRED_KEYS: tuple[str, ...] = SCALAR_KEYS + SECTION_KEYS
+#: Files of ``results/<profile>/`` that one notebook writes and a later notebook or the results page reads: the
+#: one place their names are spelled. Run records (``results/<profile>/<name>``):
+RUN_RECORDS: dict[str, str] = {
+    "kf_baseline": "kf_baseline.json",          # notebook 02
+    "training": "training.json",                # notebook 03
+    "evaluation": "outage_evaluation.json",     # notebook 04
+    "energy": "energy.json",                    # notebook 05
+    "findings": "findings.md",                  # notebook 06: the lines the book's first page includes
+}
+#: ... and shared tables (``results/<profile>/tables/<name>``).
+SHARED_TABLES: dict[str, str] = {
+    "training_runs": "training_runs.csv",       # notebook 03
+    "training_summary": "training_summary.csv",
+    "training_times": "training_times.csv",     # wall clock, apart from the deterministic tables
+    "sweep": "outage_sweep.csv",                # notebook 04
+    "sweep_summary": "outage_sweep_summary.csv",
+    "sweep_pairs": "outage_sweep_pairs.csv",
+}
 #: Keys of earlier versions that now live elsewhere: ``section.key`` -> the key to set instead.
 MOVED_KEYS: dict[str, str] = {
     "nav.outage_starts": "outage_windows",

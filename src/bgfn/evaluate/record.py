@@ -11,11 +11,12 @@ from typing import Mapping
 import pandas as pd
 
 from bgfn import paper
+from bgfn.config import RUN_RECORDS
 from bgfn.evaluate.config import EvaluationSetup
 from bgfn.evaluate.tables import TableResult
 
 #: File name under ``results/<profile>/``.
-RECORD_FILE = "outage_evaluation.json"
+RECORD_FILE = RUN_RECORDS["evaluation"]
 
 
 def evaluation_record(setup: EvaluationSetup, results: Mapping[str, TableResult],

@@ -8,6 +8,7 @@ from typing import Sequence
 
 import pandas as pd
 
+from bgfn.config import RUN_RECORDS
 from bgfn.paper import TESTS
 from bgfn.report.provenance import meta_line, run_meta
 from bgfn.report.reading import read_json, rel
@@ -15,10 +16,10 @@ from bgfn.report.sentences import energy_sentences, summary_sentence
 from bgfn.report.variants import reference_sentences
 
 #: The JSON files of notebooks 02-05 (what each holds).
-RUN_FILES: dict[str, str] = {"kf_baseline.json": "notebook 02, Kalman filter baseline",
-                             "training.json": "notebook 03, training",
-                             "outage_evaluation.json": "notebook 04, outage evaluation",
-                             "energy.json": "notebook 05, energy estimate"}
+RUN_FILES: dict[str, str] = {RUN_RECORDS["kf_baseline"]: "notebook 02, Kalman filter baseline",
+                             RUN_RECORDS["training"]: "notebook 03, training",
+                             RUN_RECORDS["evaluation"]: "notebook 04, outage evaluation",
+                             RUN_RECORDS["energy"]: "notebook 05, energy estimate"}
 
 
 def run_header(profile: str, cfg: dict, results: str | Path, current: dict | None = None) -> list[str]:

@@ -13,7 +13,7 @@ from pathlib import Path
 import pandas as pd
 
 from bgfn import paper
-from bgfn.config import PROJECT_ROOT, load_profile, results_dir, run_metadata
+from bgfn.config import PROJECT_ROOT, RUN_RECORDS, SHARED_TABLES, load_profile, results_dir, run_metadata
 
 
 def rel(path: str | Path) -> str:
@@ -106,10 +106,10 @@ def read_results(profile: str, out: str | Path | None = None) -> ProfileResults:
     tables = out / "tables"
     return ProfileResults(
         profile=profile, cfg=cfg, out=out, current=run_metadata(profile), claims=paper.claims(),
-        kf=read_json(out / "kf_baseline.json"), training=read_json(out / "training.json"),
-        evaluation=read_json(out / "outage_evaluation.json"), energy=read_json(out / "energy.json"),
+        kf=read_json(out / RUN_RECORDS["kf_baseline"]), training=read_json(out / RUN_RECORDS["training"]),
+        evaluation=read_json(out / RUN_RECORDS["evaluation"]), energy=read_json(out / RUN_RECORDS["energy"]),
         ours={t: read_csv(tables / spec["file"]) for t, spec in paper.TESTS.items()},
         published={t: paper.outage_table(t) for t in paper.TESTS},
-        training_summary=read_csv(tables / "training_summary.csv"),
-        training_times=read_csv(tables / "training_times.csv"),
-        sweep=read_csv(tables / "outage_sweep_summary.csv"), sweep_pairs=read_csv(tables / "outage_sweep_pairs.csv"))
+        training_summary=read_csv(tables / SHARED_TABLES["training_summary"]),
+        training_times=read_csv(tables / SHARED_TABLES["training_times"]),
+        sweep=read_csv(tables / SHARED_TABLES["sweep_summary"]), sweep_pairs=read_csv(tables / SHARED_TABLES["sweep_pairs"]))

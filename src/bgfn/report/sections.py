@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from bgfn import paper
+from bgfn.config import RUN_RECORDS, SHARED_TABLES
 from bgfn.evaluate import describe_sweep
 from bgfn.report.glance import run_header
 from bgfn.report.provenance import cards_line, model_cards, outage_datasets, outage_provenance, provenance, short_source
@@ -85,13 +86,13 @@ def energy_section(res: ProfileResults) -> list:
     pieces: list = [compact(energy_table(energy, res.claims).style.format(fmt_num),
                             "Energy per prediction and reduction, ours beside the paper's claim")]
     if energy:
-        pieces.append(provenance(res.out / "energy.json", energy.get("metadata"), res.current,
+        pieces.append(provenance(res.out / RUN_RECORDS["energy"], energy.get("metadata"), res.current,
                                  dataset=f"`{energy.get('dataset')}`", seed=energy.get("seed"),
                                  time_steps=energy.get("time_steps"),
                                  checkpoints=", ".join(f"`{p}`" for p in energy.get("checkpoints", {}).values()),
                                  validation_windows=energy.get("windows", {}).get("n_windows")))
     else:
-        pieces.append(missing_note(res.out / "energy.json", "the energy estimate", "notebook 05"))
+        pieces.append(missing_note(res.out / RUN_RECORDS["energy"], "the energy estimate", "notebook 05"))
     return pieces + [bullets(energy_sentences(energy, res.claims))]
 
 
@@ -99,15 +100,15 @@ def kf_section(res: ProfileResults) -> list:
     """The full-drive Kalman filter errors (notebook 02) and their source."""
     kt = kf_table(res.kf)
     if kt is None:
-        return [missing_note(res.out / "kf_baseline.json", "the Kalman filter baseline", "notebook 02")]
+        return [missing_note(res.out / RUN_RECORDS["kf_baseline"], "the Kalman filter baseline", "notebook 02")]
     return [compact(kt.style.format(fmt_num), f"GPS/INS filter errors against the reference, profile {res.profile}"),
-            provenance(res.out / "kf_baseline.json", res.kf.get("meta"), res.current,
+            provenance(res.out / RUN_RECORDS["kf_baseline"], res.kf.get("meta"), res.current,
                        datasets=[f"`{d}`" for d in kt.index], bias_model=res.kf.get("nav", {}).get("bias_model"))]
 
 
 def training_section(res: ProfileResults) -> list:
     """The training summary (notebook 03), its source, and per dataset the trained networks (model cards)."""
-    file = res.table("training_summary.csv")
+    file = res.table(SHARED_TABLES["training_summary"])
     tt = training_table(res.training_summary, res.training_times)
     if tt is None:
         return [missing_note(file, "the training summary", "notebook 03")]
@@ -120,7 +121,7 @@ def training_section(res: ProfileResults) -> list:
 def sweep_section(res: ProfileResults) -> list:
     """The outage sweep (notebook 04) as ``median [interval]`` per duration, its source, the paired
     comparisons (:func:`bgfn.evaluate.describe_sweep`) when their table is there."""
-    file = res.table("outage_sweep_summary.csv")
+    file = res.table(SHARED_TABLES["sweep_summary"])
     st = sweep_table(res.sweep)
     if st is None:
         return [missing_note(file, "the outage sweep", "notebook 04, `evaluate.sweep`")]

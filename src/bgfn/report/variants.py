@@ -13,6 +13,7 @@ from typing import Sequence
 import numpy as np
 import pandas as pd
 
+from bgfn.config import SHARED_TABLES
 from bgfn.evaluate import describe_sweep
 from bgfn.paper import TESTS, label
 from bgfn.report.provenance import short_source
@@ -38,7 +39,7 @@ def compared_profiles(profile: str, variants: Sequence[str],
     base = [p.stem for p in profile_chain(profile)[1:2]]
     names = list(dict.fromkeys([profile, *variants, *base]))
     root = Path(results_root or RESULTS_ROOT)
-    shown = [p for p in names if (root / p / "tables" / "training_summary.csv").exists()]
+    shown = [p for p in names if (root / p / "tables" / SHARED_TABLES["training_summary"]).exists()]
     return shown, [p for p in names[1:] if p not in shown]
 
 
@@ -146,11 +147,11 @@ def variants_section(profile: str, variants: Sequence[str], results_root: str | 
 
     root = Path(results_root or RESULTS_ROOT)
     shown, missing = compared_profiles(profile, variants, root)
-    pieces: list = [missing_note(root / v / "tables" / "training_summary.csv", f"the variant `{v}`",
+    pieces: list = [missing_note(root / v / "tables" / SHARED_TABLES["training_summary"], f"the variant `{v}`",
                                  f"`make reproduce PROFILE={v}`") for v in missing]
     if len(shown) < 2:                     # nothing to put beside this profile
         return pieces
-    vt = variant_training_table(profile_tables(shown, "training_summary.csv", root))
+    vt = variant_training_table(profile_tables(shown, SHARED_TABLES["training_summary"], root))
     pieces += [compact(vt.style.format(fmt_num), "Validation RMSE of one increment (m), per profile"),
                bullets(variant_sentences(vt))]
     for info in TESTS.values():
@@ -158,12 +159,12 @@ def variants_section(profile: str, variants: Sequence[str], results_root: str | 
         if ot is not None:
             caption = f"{info['title'].capitalize()}: mean of max east and max north error (m), per profile"
             pieces.append(compact(ot.style.format("{:.1f}"), caption))
-    sweeps = profile_tables(shown, "outage_sweep_summary.csv", root)
+    sweeps = profile_tables(shown, SHARED_TABLES["sweep_summary"], root)
     sw = variant_sweep_table(sweeps)
     if sw is not None:
         pieces.append(compact(sw.style.format("{:.1f}").format_index("{:g}", axis=0, level=1),
                               "Outage sweep: median max horizontal error (m), per profile"))
-        pairs = profile_tables(shown[1:], "outage_sweep_pairs.csv", root)
+        pairs = profile_tables(shown[1:], SHARED_TABLES["sweep_pairs"], root)
         pieces += ["\n".join(f"- `{p}`: {line}" for line in describe_sweep(sweeps[p], pairs[p]))
                    for p in shown[1:] if sweeps[p] is not None and pairs[p] is not None]
     pieces.append(short_source([root / p / "tables" for p in shown], " and ".join(shown)))

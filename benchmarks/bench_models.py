@@ -19,10 +19,10 @@ import sys
 
 import torch
 
-from bgfn.config import PROJECT_ROOT, load_profile
+from bgfn.config import load_profile
 from bgfn.io import update_json
 from bgfn.models import METHODS, build_model, count_parameters
-from bgfn.speed import median_time, training_throughput
+from bgfn.speed import bench_file, median_time, training_throughput
 
 SIZES = ("quick", "paper")
 #: (training steps, inference calls) measured per size, after one warm-up each.
@@ -69,7 +69,7 @@ def main(sizes=SIZES, methods=METHODS) -> dict:
              if "bgfn" in train_rate and "transformer" in train_rate}
     for size, r in ratio.items():
         print(f"BGFN / Transformer training throughput, {size}: {r:.2f}", flush=True)
-    update_json(PROJECT_ROOT / "results" / "bench.json",
+    update_json(bench_file(),
                 {"train_windows_per_s": train_rate, "infer_ms": infer_ms, "models_bench": info,
                  "train_ratio_bgfn_over_twin": ratio})
     return {"train_windows_per_s": train_rate, "infer_ms": infer_ms, "train_ratio_bgfn_over_twin": ratio}

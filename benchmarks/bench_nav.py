@@ -25,10 +25,10 @@ import time
 import numpy as np
 import pandas as pd
 
-from bgfn.config import PROJECT_ROOT
 from bgfn.io import update_json
 from bgfn.nav.baseline import filter_setup, nav_config
 from bgfn.nav.filter import run_filter
+from bgfn.speed import bench_file
 
 DATASET = "turin-sim-ekinox"
 
@@ -102,7 +102,7 @@ def main() -> int:
     except ImportError:
         info["pyins"] = "not installed"
     res["nav_bench"] = info
-    update_json(PROJECT_ROOT / "results" / "bench.json", res)
+    update_json(bench_file(), res)
     print(f"nav: full drive {info['n_imu']} IMU samples, {info['n_gnss_1hz']} fixes: {t_ours:.2f} s median"
           + (f"; pyins {res['pyins_full_drive_s']:.1f} s; speedup {res['kf_speedup_vs_pyins']}x"
              if "pyins_full_drive_s" in res else ""))

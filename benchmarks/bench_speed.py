@@ -24,17 +24,17 @@ import sys
 
 import torch
 
-from bgfn.config import PROJECT_ROOT, load_profile
+from bgfn.config import load_profile
 from bgfn.io import update_json
 from bgfn.models import METHODS, build_model
-from bgfn.speed import GNSS_RATE_HZ, IMU_RATE_HZ, latency_ms, realtime_flags, throughput
+from bgfn.speed import GNSS_RATE_HZ, IMU_RATE_HZ, bench_file, latency_ms, realtime_flags, throughput
 
 SIZES = ("quick", "paper")
 BATCH = 64
 THREADS = 1
 #: (throughput repeats, fallback latency repeats) per size, after one warm-up each.
 REPEATS = {"quick": (5, 20), "paper": (2, 5)}
-BENCH = PROJECT_ROOT / "results" / "bench.json"
+BENCH = bench_file()
 
 
 def main(sizes=SIZES, methods=METHODS) -> dict:

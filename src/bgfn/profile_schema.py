@@ -289,9 +289,12 @@ def check_with_drives(profile: str) -> list[str]:
     from bgfn.errors import DataError
     from bgfn.nav.outages import check_windows
 
+    from bgfn.learning import learning_options
+
     cfg = load_profile(profile)
     path = profile_chain(profile)[0]
     tr, ev = cfg["train"], cfg["evaluate"]
+    opts = learning_options(tr)                 # the window and margin notebook 03 uses, defaults filled in
     names = dict.fromkeys(cfg["nav"].get("datasets", []) + tr.get("datasets", []) + ev.get("datasets", [])
                           + (ev.get("sweep") or {}).get("datasets", []))
     lines = []
@@ -305,13 +308,13 @@ def check_with_drives(profile: str) -> list[str]:
             raise DataError(path, "outage_windows", f"windows inside the drive {name} [{t0:.3f}, {t1:.3f}] s",
                             exc.found) from None
         rate = float(drive.meta.get("imu_rate_hz") or 1.0 / float(t[1] - t[0]))
-        window_s = int(tr.get("window", 200)) / rate
-        margin = float(tr.get("margin_s", 30.0))
+        window_s = int(opts["window"]) / rate
+        margin = float(opts["margin_s"])
         blocked = sum(d + 2 * margin for _, d in _windows(cfg))
         if window_s >= (t1 - t0) - blocked:
             raise DataError(path, "train.window", f"a window shorter than the GPS-available data of {name} "
                             f"({(t1 - t0) - blocked:.1f} s outside the outages and their margins)",
-                            f"{tr.get('window')} samples = {window_s:g} s")
+                            f"{opts['window']} samples = {window_s:g} s")
         lines.append(f"{name}: {t0:.2f}..{t1:.2f} s, outages inside, window {window_s:g} s")
     from bgfn.evaluate import evaluate_config, sweep_plan
 
@@ -319,7 +322,7 @@ def check_with_drives(profile: str) -> list[str]:
     for name in sw["datasets"]:
         drive = load_drive(name, profile=profile)
         try:
-            plan = sweep_plan(drive, sw, int(tr.get("window", 200)))
+            plan = sweep_plan(drive, sw, int(opts["window"]))
         except DataError as exc:
             raise DataError(path, "evaluate.sweep.n_starts/durations_s/warmup_s", f"{exc.expected} in {name}",
                             exc.found) from None

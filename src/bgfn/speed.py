@@ -13,8 +13,10 @@ never from tests: timings depend on the machine.
 from __future__ import annotations
 
 import contextlib
+import json
 import statistics
 import time
+from pathlib import Path
 from typing import Callable, Iterator
 
 import torch
@@ -24,6 +26,19 @@ from torch import nn
 IMU_RATE_HZ = 100.0
 #: GNSS rate of the low-cost receiver (and of the pseudo-GNSS predictions during an outage), Hz.
 GNSS_RATE_HZ = 1.0
+
+
+def bench_file() -> Path:
+    """``results/bench.json``: what ``make bench`` measured on this machine (every benchmark merges into it)."""
+    from bgfn.config import RESULTS_ROOT
+
+    return RESULTS_ROOT / "bench.json"
+
+
+def read_bench(path: str | Path | None = None) -> dict:
+    """The parsed ``bench.json`` (default :func:`bench_file`); ``{}`` when ``make bench`` has not run."""
+    p = Path(path) if path is not None else bench_file()
+    return json.loads(p.read_text(encoding="utf-8")) if p.is_file() else {}
 
 
 @contextlib.contextmanager

@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 
 from bgfn.errors import DataError
+from bgfn.nav.earth import curvature_radii
 from bgfn.schema import ACCEL_COLUMNS, GYRO_COLUMNS
 
 log = logging.getLogger(__name__)
@@ -41,7 +42,6 @@ SPEED_MAX = 100.0
 PATH_RATIO_RANGE = (0.5, 2.0)
 #: Below this fraction of the IMU span covered by GNSS fixes, the filter runs as pure INS over the rest.
 GNSS_COVERAGE_WARN = 0.9
-_R_EARTH = 6.371e6
 
 
 def check_drive(drive, files: dict | None = None) -> dict:
@@ -129,10 +129,9 @@ def _check_positions(table: pd.DataFrame, src: str) -> None:
 
 
 def _check_jumps(table: pd.DataFrame, src: str) -> None:
-    t, lat, lon = (table[c].to_numpy(float) for c in ("time", "lat", "lon"))
+    t = table["time"].to_numpy(float)
     if len(t) > 1:
-        dn = np.diff(lat) * _R_EARTH
-        de = np.diff(lon) * _R_EARTH * np.cos(lat[1:])
+        dn, de = _steps_ne(table)
         speed = np.hypot(dn, de) / np.diff(t)
         k = int(np.argmax(speed))
         if speed[k] > SPEED_MAX:
@@ -142,14 +141,20 @@ def _check_jumps(table: pd.DataFrame, src: str) -> None:
                             f"(time {t[k + 1]:.3f} s)")
 
 
+def _steps_ne(table: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
+    """North and east steps between successive positions, m (WGS84 radii of curvature)."""
+    lat, lon, h = (table[c].to_numpy(float) for c in ("lat", "lon", "h"))
+    r_m, r_n = curvature_radii(lat[1:])
+    return np.diff(lat) * (r_m + h[1:]), np.diff(lon) * (r_n + h[1:]) * np.cos(lat[1:])
+
+
 def _check_path_against_velocity(ref: pd.DataFrame, src: str) -> None:
     """Positions and velocities of the reference describe the same path (catches lat/lon in degrees whose
     values stay within the radian ranges, e.g. a drive near the prime meridian)."""
     if not {"v_n", "v_e"} <= set(ref.columns) or len(ref) < 2:
         return
-    t, lat, lon = (ref[c].to_numpy(float) for c in ("time", "lat", "lon"))
-    dt = np.diff(t)
-    from_pos = float(np.sum(np.hypot(np.diff(lat) * _R_EARTH, np.diff(lon) * _R_EARTH * np.cos(lat[1:]))))
+    dt = np.diff(ref["time"].to_numpy(float))
+    from_pos = float(np.sum(np.hypot(*_steps_ne(ref))))
     speed = np.hypot(ref["v_n"].to_numpy(float), ref["v_e"].to_numpy(float))
     from_vel = float(np.sum(0.5 * (speed[1:] + speed[:-1]) * dt))
     if from_vel < 50.0:               # hardly moving: the ratio says nothing

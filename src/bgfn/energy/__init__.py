@@ -35,7 +35,7 @@ Modules, one concept each (every public name is also importable from ``bgfn.ener
   figures, speed table and ``energy.json``.
 """
 
-from bgfn.energy.bench import read_bench, speed_notes, speed_table
+from bgfn.energy.bench import speed_notes, speed_table
 from bgfn.energy.checkpoint import MEASURED, MeasuredModels, energy_checkpoint, load_measured
 from bgfn.energy.costs import E_AC_PJ, E_MAC_PJ, energy_uj
 from bgfn.energy.counts import LayerCount, layer_counts, mean_rate, with_rates
@@ -58,7 +58,7 @@ __all__ = [
     "attention_energy_uj", "break_even_note", "compare_with_spikingjelly", "energy_checkpoint", "energy_summary",
     "energy_table", "energy_totals", "energy_uj", "evaluation_windows", "fold_batchnorm", "is_spike_count",
     "layer_counts", "load_measured", "mean_rate", "measure_firing_rates", "model_name", "plot_energy_per_layer",
-    "plot_firing_rates", "plot_sweeps", "rates_table", "read_bench", "reduction_pct", "reduction_vs_rate",
+    "plot_firing_rates", "plot_sweeps", "rates_table", "reduction_pct", "reduction_vs_rate",
     "reduction_vs_time_steps", "result_markdown", "same_size_builder", "softmax_attention_macs", "speed_notes",
     "speed_table", "spikingjelly_counts", "ssa_dense_ops", "ssa_sops", "stack_tables", "table_from_counts",
     "total_energy_uj", "window_indices", "with_input_trains", "with_rates",

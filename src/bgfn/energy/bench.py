@@ -7,9 +7,6 @@ whether each model keeps up with the 100 Hz IMU and the 1 Hz GNSS (:func:`bgfn.s
 
 from __future__ import annotations
 
-import json
-from pathlib import Path
-
 import pandas as pd
 
 #: Keys of ``bench.json`` (method -> size -> value) shown in the table.
@@ -60,8 +57,3 @@ def speed_notes(bench: dict, path: str = "results/bench.json") -> list[str]:
         notes.append(f"missing in {path}: {', '.join(missing)} -- run `make bench`")
     return notes
 
-
-def read_bench(path: str | Path) -> dict:
-    """The parsed ``bench.json`` (``{}`` when it does not exist)."""
-    p = Path(path)
-    return json.loads(p.read_text()) if p.exists() else {}

@@ -13,10 +13,7 @@ import pandas as pd
 from bgfn.errors import DataError
 from bgfn.evaluate.config import EVALUATE_DEFAULTS, merge_checked
 from bgfn.learning import (ANGULAR_RATE_CHANNELS, ATTITUDE_CHANNELS, CHANNELS, EXTRA_START, IMU_CHANNELS,
-                           SPECIFIC_FORCE_CHANNELS)
-
-#: Position of the yaw in an input sample (the heading frame of a prediction is the last sample's yaw).
-YAW_CHANNEL = CHANNELS.index("yaw")
+                           SPECIFIC_FORCE_CHANNELS, YAW_CHANNEL)
 
 
 # ----------------------------------------------------------------------------------------------- Eq. pred-gps

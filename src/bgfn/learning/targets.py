@@ -114,10 +114,7 @@ def to_target_frame(y: np.ndarray, yaw_ref: np.ndarray, target_frame: str) -> np
     if target_frame not in TARGET_FRAMES:
         raise DataError("train", "target_frame", f"one of {TARGET_FRAMES}", repr(target_frame))
     y = np.asarray(y, dtype=float)
-    if target_frame == "ned":
-        return y.copy()
-    c, s = np.cos(yaw_ref), np.sin(yaw_ref)
-    return np.column_stack([c * y[:, 0] + s * y[:, 1], -s * y[:, 0] + c * y[:, 1]])   # along, cross
+    return y.copy() if target_frame == "ned" else _rotate(y, -np.asarray(yaw_ref, dtype=float))   # along, cross
 
 
 def from_target_frame(z: np.ndarray, yaw_ref: np.ndarray, target_frame: str) -> np.ndarray:
@@ -125,7 +122,10 @@ def from_target_frame(z: np.ndarray, yaw_ref: np.ndarray, target_frame: str) -> 
     if target_frame not in TARGET_FRAMES:
         raise DataError("train", "target_frame", f"one of {TARGET_FRAMES}", repr(target_frame))
     z = np.asarray(z, dtype=float)
-    if target_frame == "ned":
-        return z.copy()
-    c, s = np.cos(yaw_ref), np.sin(yaw_ref)
-    return np.column_stack([c * z[:, 0] - s * z[:, 1], s * z[:, 0] + c * z[:, 1]])
+    return z.copy() if target_frame == "ned" else _rotate(z, np.asarray(yaw_ref, dtype=float))
+
+
+def _rotate(v: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """Horizontal vectors [M, 2] (first axis north or along) rotated by ``angle`` (rad, clockwise from north)."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.column_stack([c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1]])

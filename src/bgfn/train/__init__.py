@@ -19,7 +19,7 @@ Modules, one concept each (every public name is re-exported here):
 
 from bgfn.learning import REFERENCES, VAL_POSITIONS
 from bgfn.train.cli import main
-from bgfn.train.estimate import estimate_lines, measure_paper_step, paper_training_estimate, read_bench
+from bgfn.train.estimate import estimate_lines, measure_paper_step, paper_training_estimate
 from bgfn.train.loop import set_seed, train_model
 from bgfn.train.lr_search import (LR_SEARCH_COLUMNS, LR_SEARCH_DEFAULTS, LR_SEARCH_FILE, chosen_learning_rates,
                                   lr_search_options, next_learning_rate, search_learning_rates,
@@ -35,7 +35,7 @@ from bgfn.train.tables import (TIMING_COLUMNS, card_line, cards_table, summary_t
 from bgfn.train.trained import TrainedModel, checkpoint_predictions, load_trained, pick_device, predict_normalized
 
 __all__ = [
-    "estimate_lines", "measure_paper_step", "paper_training_estimate", "read_bench",
+    "estimate_lines", "measure_paper_step", "paper_training_estimate",
     # options
     "OPTIMIZER_DEFAULTS", "train_subsection", "optimizer_options", "method_lr", "size_config", "even_subset",
     # the loop and a trained network

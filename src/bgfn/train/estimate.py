@@ -10,13 +10,7 @@ upper bound (early stopping may end a run sooner) without the learning-rate sear
 
 from __future__ import annotations
 
-import json
-from pathlib import Path
-
 import pandas as pd
-
-#: Where ``make bench`` writes its measurements.
-BENCH_FILE = Path("results") / "bench.json"
 
 
 def paper_training_estimate(n_train: dict[str, int], paper_cfg: dict, bench: dict | None) -> pd.DataFrame | None:
@@ -29,7 +23,7 @@ def paper_training_estimate(n_train: dict[str, int], paper_cfg: dict, bench: dic
     paper_cfg : dict
         The ``paper`` profile (:func:`bgfn.config.load_profile`): its methods, seeds and epochs.
     bench : dict or None
-        ``results/bench.json``; None (not measured yet) gives None.
+        ``results/bench.json`` (:func:`bgfn.speed.read_bench`); without a paper-size rate the result is None.
 
     Returns
     -------
@@ -50,12 +44,6 @@ def paper_training_estimate(n_train: dict[str, int], paper_cfg: dict, bench: dic
         rows.append({"method": method, "windows_per_s": float(rate), "epoch_s": epoch_s,
                      "runs": runs, "epochs": epochs, "hours": epoch_s * len(tc["seeds"]) * epochs / 3600.0})
     return pd.DataFrame(rows)
-
-
-def read_bench(root: str | Path) -> dict | None:
-    """``results/bench.json`` under the project ``root``, or None when ``make bench`` has not run."""
-    path = Path(root) / BENCH_FILE
-    return json.loads(path.read_text(encoding="utf-8")) if path.is_file() else None
 
 
 def measure_paper_step(paper_cfg: dict, repeats: int = 2) -> dict:

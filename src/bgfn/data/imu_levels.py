@@ -1,0 +1,218 @@
+"""IMU error levels measured on a drive: noise at rest, vibration while driving, spectra.
+
+The field-test stand-in (``turin-sim-mpu6000``) simulates a consumer MEMS IMU; how noisy such an IMU is in a
+car is not on its datasheet (engine and road vibration dominate). This module measures the levels on any
+drive's IMU table so that the stand-in's error model can be set from a real car's IMU (the recorded drive
+``rtklib-drive0708``) and checked against it (notebook 01; the book's deviations page).
+
+Motion states come from the reference speed (not from the IMU, so the measurement does not depend on a
+detector tuned on the same signal): *still* below ``still_mps``, *driving* above ``driving_mps``.
+
+- *vibration* = standard deviation of the high-passed signal (2nd-order Butterworth above ``highpass_hz``,
+  zero phase): above a few hertz a car's own motion (turns, pitch and heave of the body) has little power, so
+  what is left is sensor noise plus vibration.
+- *white-noise density* ``N`` (the convention of :mod:`bgfn.data.imu_errors`: white noise of std
+  ``N / sqrt(dt)``, one-sided PSD ``2 N^2``): the high-passed level of white noise is ``N sqrt(B)`` with the
+  filter's noise bandwidth ``B = 2 * integral of |H(f)|^4 df`` over ``[0, f_nyq]`` (:func:`noise_band_hz`;
+  ``|H|^4``: the filter runs forward and backward), about ``f_s - 2 f_hp``.
+- The simulated vibration (:mod:`bgfn.data.imu_errors`) is band-limited noise times a speed envelope; its std
+  that reproduces a measured driving level is ``sqrt(level^2 - N^2 B)`` (:func:`vibration_overrides`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+from scipy import signal
+
+from bgfn.errors import DataError
+
+#: Reference speed below which the vehicle stands still, m/s.
+STILL_MPS = 0.05
+#: Reference speed above which the vehicle is driving, m/s.
+DRIVING_MPS = 3.0
+#: High-pass corner separating vehicle motion from vibration and noise, Hz.
+HIGHPASS_HZ = 5.0
+#: Minimum samples of a motion state for a level to be reported (5 s at 100 Hz).
+MIN_SAMPLES = 500
+#: Channels of the IMU schema, by sensor.
+SENSORS = {"gyro": ("gyro_x", "gyro_y", "gyro_z"), "accel": ("accel_x", "accel_y", "accel_z")}
+#: Units of the levels, by sensor.
+UNITS = {"gyro": "rad/s", "accel": "m/s^2"}
+
+
+def imu_rate_hz(imu: pd.DataFrame) -> float:
+    """IMU rate from the median step of ``imu.time``, Hz."""
+    return float(1.0 / np.median(np.diff(imu["time"].to_numpy(float))))
+
+
+def motion_states(drive, still_mps: float = STILL_MPS, driving_mps: float = DRIVING_MPS) -> pd.Series:
+    """``'still'``, ``'driving'`` or ``''`` at every IMU row, from the reference's horizontal speed.
+
+    The reference speed is interpolated to the IMU times (the reference of a drive is at the IMU rate, but a
+    cropped or user drive need not be).
+    """
+    ref = drive.reference
+    speed = np.hypot(ref["v_n"].to_numpy(float), ref["v_e"].to_numpy(float))
+    t = drive.imu["time"].to_numpy(float)
+    s = np.interp(t, ref["time"].to_numpy(float), speed)
+    out = np.full(t.size, "", dtype=object)
+    out[s < still_mps] = "still"
+    out[s > driving_mps] = "driving"
+    return pd.Series(out, index=drive.imu.index, name="state")
+
+
+def highpass(x: np.ndarray, rate_hz: float, corner_hz: float = HIGHPASS_HZ) -> np.ndarray:
+    """Zero-phase 2nd-order Butterworth high pass of the columns of ``x``."""
+    if not 0.0 < corner_hz < rate_hz / 2:
+        raise DataError("imu_levels", "highpass_hz", f"a corner in (0, {rate_hz / 2}) Hz", str(corner_hz))
+    b, a = signal.butter(2, corner_hz, "highpass", fs=rate_hz)
+    return signal.filtfilt(b, a, x, axis=0)
+
+
+def noise_band_hz(rate_hz: float, corner_hz: float = HIGHPASS_HZ) -> float:
+    """Noise bandwidth ``B`` of :func:`highpass` for white noise of density ``N``: level^2 = ``N^2 B`` (Hz)."""
+    b, a = signal.butter(2, corner_hz, "highpass", fs=rate_hz)
+    f, h = signal.freqz(b, a, worN=8192, fs=rate_hz)
+    return float(2.0 * np.trapezoid(np.abs(h) ** 4, f))
+
+
+def imu_levels(drive, highpass_hz: float = HIGHPASS_HZ, still_mps: float = STILL_MPS,
+               driving_mps: float = DRIVING_MPS) -> pd.DataFrame:
+    """Noise and vibration levels of a drive's IMU, per sensor, axis and motion state.
+
+    The high pass runs over the whole record (edges of a state's spans see their neighbours; at 5 Hz the
+    filter's memory is a fraction of a second).
+
+    Returns
+    -------
+    DataFrame
+        ``dataset, sensor, axis, state, n, mean, level, density, unit``: ``level`` = std of the high-passed
+        signal (unit); ``density`` = the white-noise density that alone gives that level
+        (``level / sqrt(B)``, :func:`noise_band_hz`, unit/sqrt(Hz)); ``mean`` = mean of the raw signal (at rest: the bias
+        plus gravity for the accelerometer). A state with fewer than ``MIN_SAMPLES`` rows is left out.
+    """
+    imu = drive.imu
+    rate = imu_rate_hz(imu)
+    states = motion_states(drive, still_mps, driving_mps).to_numpy()
+    band = noise_band_hz(rate, highpass_hz)
+    rows = []
+    for sensor, cols in SENSORS.items():
+        raw = imu[list(cols)].to_numpy(float)
+        hp = highpass(raw, rate, highpass_hz)
+        for state in ("still", "driving"):
+            sel = states == state
+            if sel.sum() < MIN_SAMPLES:
+                continue
+            for k, col in enumerate(cols):
+                level = float(hp[sel, k].std())
+                rows.append({"dataset": drive.name, "sensor": sensor, "axis": col[-1], "state": state,
+                             "n": int(sel.sum()), "mean": float(raw[sel, k].mean()), "level": level,
+                             "density": level / np.sqrt(band), "unit": UNITS[sensor]})
+    return pd.DataFrame(rows, columns=["dataset", "sensor", "axis", "state", "n", "mean", "level", "density",
+                                       "unit"])
+
+
+def level_summary(levels: pd.DataFrame) -> pd.DataFrame:
+    """One row per (dataset, sensor, state): the level's root-mean-square over the three axes, and the
+    ratio driving / still (how much vibration adds to the noise at rest).
+
+    Returns
+    -------
+    DataFrame
+        ``dataset, sensor, still, driving, ratio, unit`` (NaN where a state is missing).
+    """
+    rms = (levels.assign(sq=levels["level"] ** 2)
+           .groupby(["dataset", "sensor", "state"], sort=False)["sq"].mean() ** 0.5).unstack("state")
+    out = rms.reindex(columns=["still", "driving"]).reset_index()
+    out["ratio"] = out["driving"] / out["still"]
+    out["unit"] = out["sensor"].map(UNITS)
+    return out.rename_axis(columns=None)
+
+
+def vibration_overrides(levels: pd.DataFrame, noise_density: dict, highpass_hz: float = HIGHPASS_HZ,
+                        rate_hz: float = 100.0) -> dict:
+    """Vibration std per axis of :mod:`bgfn.data.imu_errors` that reproduces measured driving levels.
+
+    The simulated vibration's band (``vibration_freq_hz +- bandwidth / 2``) lies above ``highpass_hz``, so
+    nearly all its variance survives the high pass; the white noise contributes ``N^2 B``. The rest of
+    the measured driving variance is vibration; at rest the same split gives the idle fraction of the
+    speed envelope (vibration std at rest / while driving, median over the axes).
+
+    Parameters
+    ----------
+    levels : DataFrame
+        :func:`imu_levels` of ONE drive.
+    noise_density : dict
+        ``{"gyro": [3], "accel": [3]}`` white-noise densities of the simulated IMU (unit/sqrt(Hz)).
+
+    Returns
+    -------
+    dict
+        ``vibration_gyro_std``, ``vibration_accel_std`` (lists of 3), ``vibration_idle_fraction``.
+    """
+    if levels["dataset"].nunique() != 1:
+        raise DataError("imu_levels", "levels", "the levels of one drive", str(sorted(levels["dataset"].unique())))
+    band = noise_band_hz(rate_hz, highpass_hz)
+    out, idle = {}, []
+    for sensor in SENSORS:
+        white = np.asarray(noise_density[sensor], float) ** 2 * band
+        vib = {}
+        for state in ("still", "driving"):
+            lv = levels[(levels["sensor"] == sensor) & (levels["state"] == state)].sort_values("axis")
+            if len(lv) != 3:
+                raise DataError(f"imu_levels {levels['dataset'].iloc[0]}", f"{sensor} {state}",
+                                "three axes measured in that motion state", f"{len(lv)}")
+            vib[state] = np.sqrt(np.clip(lv["level"].to_numpy(float) ** 2 - white, 0.0, None))
+        out[f"vibration_{sensor}_std"] = [float(x) for x in vib["driving"]]
+        ok = vib["driving"] > 0
+        idle.extend(vib["still"][ok] / vib["driving"][ok])
+    out["vibration_idle_fraction"] = float(np.clip(np.median(idle), 0.0, 1.0)) if idle else 0.0
+    return out
+
+
+def imu_psd(drive, state: str = "driving", nperseg: int = 512, still_mps: float = STILL_MPS,
+            driving_mps: float = DRIVING_MPS) -> pd.DataFrame:
+    """Welch power spectral density of every IMU channel over the rows of one motion state.
+
+    The rows of the state are concatenated (the joins add a little broadband power; the spans are long
+    against ``nperseg`` samples).
+
+    Returns
+    -------
+    DataFrame
+        ``freq_hz`` and one column per IMU channel (unit^2/Hz).
+    """
+    imu = drive.imu
+    sel = (motion_states(drive, still_mps, driving_mps) == state).to_numpy()
+    if sel.sum() < nperseg:
+        raise DataError(f"imu_levels {drive.name}", "state", f"at least {nperseg} IMU rows {state}",
+                        f"{int(sel.sum())}")
+    cols = [c for cols in SENSORS.values() for c in cols]
+    f, p = signal.welch(imu.loc[sel, cols].to_numpy(float), fs=imu_rate_hz(imu), nperseg=nperseg, axis=0)
+    out = pd.DataFrame(p, columns=cols)
+    out.insert(0, "freq_hz", f)
+    return out
+
+
+def plot_imu_psd(psds: dict):
+    """Amplitude spectral density of the specific force and the angular rate while driving, one line per drive
+    (root of the sum of the three axes' PSDs).
+
+    Parameters
+    ----------
+    psds : dict
+        ``{label: imu_psd(...)}``.
+    """
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.6), constrained_layout=True)
+    for ax, (sensor, cols) in zip(axes, SENSORS.items()):
+        for name, psd in psds.items():
+            ax.semilogy(psd["freq_hz"], np.sqrt(psd[list(cols)].sum(axis=1)), label=name, lw=1.1)
+        ax.set_xlabel("frequency (Hz)")
+        ax.set_ylabel(f"{sensor} ASD ({UNITS[sensor]}/sqrt(Hz))")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.suptitle("IMU spectra while driving (three axes summed)")
+    return fig

@@ -197,6 +197,12 @@ def test_ins_tuning_table_runs_every_setup_beside_the_papers_row(drive, tmp_path
     assert list(lay.index) == ["Outage 1", "Outage 2"]
     assert lay[("paper", "North")].tolist() == [23.2, 19.6]
     assert lay[("navego-reset", "East")].iloc[0] == rows.loc[("navego-reset", 1), "max_east_m"]
+    # several drives at once, from a profile's nav: section, reusing notebook 02's runs
+    both = ins_setups.ins_tuning_tables([drive], NAV, WINDOWS, baselines={drive.name: shipped})
+    pd.testing.assert_frame_equal(both, table)
+    stacked = ins_setups.layouts(both)
+    assert stacked.index.get_level_values("dataset").unique().tolist() == [drive.name]
+    pd.testing.assert_frame_equal(stacked.loc[drive.name], lay)
     path = ins_setups.save_table(tmp_path, table)
     assert path.name == "kf_ins_tuning.csv"
     back = ins_setups.read_table(tmp_path)

@@ -29,7 +29,7 @@ from .. import paper
 from ..config import SHARED_TABLES
 from ..io import atomic_write_csv
 from . import metrics, navego_setup
-from .baseline import Baseline, filter_imu, run_baseline
+from .baseline import Baseline, filter_imu, nav_config, run_baseline
 from .filter import run_outage
 from .outages import check_windows
 
@@ -91,6 +91,29 @@ def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None
         for r in paper.outage_table(test).query("method == 'INS'").itertuples(index=False):
             rows.append(_row(drive.name, test, r.outage, PAPER, r.max_east_m, r.max_north_m))
     return pd.DataFrame(rows, columns=list(COLUMNS))
+
+
+def ins_tuning_tables(drives, nav_section: dict | None, windows, baselines: dict | None = None) -> pd.DataFrame:
+    """:func:`ins_tuning_table` of several drives, one table (notebooks 02 and 04).
+
+    Parameters
+    ----------
+    drives : iterable of bgfn.data.Drive
+    nav_section : dict or None
+        A profile's ``nav:`` section (:func:`bgfn.nav.baseline.nav_config` fills and checks it).
+    windows : sequence of (start, duration)
+        The outages, s.
+    baselines : dict, optional
+        ``{drive name: Baseline}`` run with ``nav_section`` as it is, reused.
+    """
+    cfg = nav_config(nav_section)
+    return pd.concat([ins_tuning_table(d, cfg, windows, (baselines or {}).get(d.name)) for d in drives],
+                     ignore_index=True)
+
+
+def layouts(table: pd.DataFrame) -> pd.DataFrame:
+    """:func:`layout` of every dataset of ``table``, stacked (outer row level: the dataset)."""
+    return pd.concat({d: layout(table, d) for d in dict.fromkeys(table["dataset"])}, names=["dataset"])
 
 
 def layout(table: pd.DataFrame, dataset: str) -> pd.DataFrame:
@@ -182,5 +205,5 @@ def read_table(out) -> pd.DataFrame | None:
     return pd.read_csv(path) if path.exists() else None
 
 
-__all__ = ["COLUMNS", "PAPER", "RESET", "SETUPS", "gap_explained", "ins_tuning_table", "layout", "read_table",
-           "save_table", "sentences"]
+__all__ = ["COLUMNS", "PAPER", "RESET", "SETUPS", "gap_explained", "ins_tuning_table", "ins_tuning_tables", "layout",
+           "layouts", "read_table", "save_table", "sentences"]

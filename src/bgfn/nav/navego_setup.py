@@ -8,7 +8,8 @@ result as it was, ``navego`` selects this one.
 
 What NaveGo v1.4 does (files of ``rodralez/NaveGo``; ``ins_gnss.m`` Version 012 of 2022-07-19 is the one
 stored at the commit whose ``misc/navego_print_version.m`` prints "NaveGo, release v1.4" and is still the
-newest; the helpers it calls are older and unchanged since. Line numbers of those versions):
+newest stored; the helpers are their newest stored versions, all dated before it. Line numbers of those
+versions):
 
 1. *Static biases removed, as known constants.* Every IMU sample is corrected before the strapdown with the
    profile's static biases ``gb_sta``/``ab_sta`` (``ins-gnss/ins_gnss.m`` lines 251-252,

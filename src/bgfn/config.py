@@ -76,6 +76,7 @@ SHARED_TABLES: dict[str, str] = {
     "sweep": "outage_sweep.csv",                # notebook 04
     "sweep_summary": "outage_sweep_summary.csv",
     "sweep_pairs": "outage_sweep_pairs.csv",
+    "kf_ins_tuning": "kf_ins_tuning.csv",       # notebook 02: the INS row under each filter setup
 }
 #: Keys of earlier versions that now live elsewhere: ``section.key`` -> the key to set instead.
 MOVED_KEYS: dict[str, str] = {

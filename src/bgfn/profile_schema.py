@@ -115,7 +115,8 @@ SCHEMA = section(
         init=section(position_std_m=_POS, height_std_m=_POS, velocity_std_mps=_POS, level_std_deg=_POS,
                      azimuth_std_deg=_POS),
         bias_model=text("random_walk", "gauss_markov"), noise_scale=_POS,
-        innovation_gate=number(0, 1, lo_open=True, hi_open=True, null=True)),
+        innovation_gate=number(0, 1, lo_open=True, hi_open=True, null=True),
+        ins_tuning=text("shipped", "navego")),
     train=TRAIN,
     evaluate=section(
         datasets=_NAMES, real_imu=flag(), methods=_NAMES, seeds=seq(_SEED, min_len=1, null=True),

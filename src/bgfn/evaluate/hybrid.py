@@ -67,6 +67,9 @@ class NavContext:
         Median GNSS epoch interval (length of one ``delta_p_gps``), s.
     gnss_std_m : float
         Median horizontal std of the GNSS fixes, m.
+    imu_static : ndarray [len(CHANNELS)] or None
+        Static biases the strapdown of an outage run removes from ``imu`` (``nav.ins_tuning: navego``,
+        :mod:`bgfn.nav.navego_setup`; zeros outside the IMU channels); None: the network inputs are read as is.
     """
 
     drive: Any
@@ -79,6 +82,7 @@ class NavContext:
     nav_at_imu: dict
     gnss_interval_s: float
     gnss_std_m: float
+    imu_static: np.ndarray | None = None
 
     def attitude_table(self) -> pd.DataFrame:
         """The GPS-aided solution (reference schema; its attitude is the training input of notebook 03)."""
@@ -108,18 +112,19 @@ def navigation_context(drive, nav_section: dict | None, starts: Sequence[float])
         Outage starts, s.
     """
     from bgfn.learning import DERIVED_CHANNELS, with_derived_channels
-    from bgfn.nav import baseline
+    from bgfn.nav import baseline, navego_setup
     from bgfn.nav.filter import run_filter
     from bgfn.nav.outages import epochs_before
 
     cfg = baseline.nav_config(nav_section)
     initial, noise = baseline.filter_setup(drive, cfg)
+    filter_imu = baseline.filter_imu(drive, cfg)     # drive.imu, or without NaveGo's static biases
     lever = np.asarray(drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0]), dtype=float)
     starts = sorted({float(s) for s in starts})
     imu_time = drive.imu["time"].to_numpy(float)
     # The state is taken at the last IMU epoch *before* the start (bgfn.nav.outages.epochs_before).
     snaps = {f"start_{i}": float(t) for i, t in enumerate(epochs_before(imu_time, starts, drive.name))}
-    full = run_filter(drive.imu, initial, noise, drive.gnss, lever, snapshots=snaps,
+    full = run_filter(filter_imu, initial, noise, drive.gnss, lever, snapshots=snaps,
                       gate_probability=cfg["innovation_gate"], source=drive.name)
     states = {s: full.states[f"start_{i}"] for i, s in enumerate(starts)}
     imu = drive.imu[list(CHANNELS[IMU_CHANNELS])].to_numpy(float)          # [M, 6] in the input layout
@@ -136,7 +141,12 @@ def navigation_context(drive, nav_section: dict | None, starts: Sequence[float])
     tg = g["time"].to_numpy(float)
     interval = float(np.median(np.diff(tg))) if len(tg) > 1 else float("nan")
     std = float(np.nanmedian(np.hypot(g["std_n"].to_numpy(float), g["std_e"].to_numpy(float)) / np.sqrt(2.0)))
-    return NavContext(drive, full, noise, lever, states, imu_time, imu, nav_at_imu, interval, std)
+    static = None
+    if filter_imu is not drive.imu:                   # the outage runs remove the same static biases
+        static = np.zeros(len(CHANNELS))
+        static[ANGULAR_RATE_CHANNELS], static[SPECIFIC_FORCE_CHANNELS] = navego_setup.static_biases(
+            drive.meta["imu_errors"], f"{drive.name} meta['imu_errors']")
+    return NavContext(drive, full, noise, lever, states, imu_time, imu, nav_at_imu, interval, std, static)
 
 
 # ----------------------------------------------------------------------------------------------- outage runs
@@ -241,6 +251,9 @@ class _Run:
         # the strapdown of this run reads the same IMU samples as its network inputs
         self.gyro = np.ascontiguousarray(self.feat[self.n_window:, ANGULAR_RATE_CHANNELS])
         self.accel = np.ascontiguousarray(self.feat[self.n_window:, SPECIFIC_FORCE_CHANNELS])
+        if ctx.imu_static is not None:      # nav.ins_tuning: navego reads the IMU without its static biases
+            self.gyro = self.gyro - ctx.imu_static[ANGULAR_RATE_CHANNELS]
+            self.accel = self.accel - ctx.imu_static[SPECIFIC_FORCE_CHANNELS]
 
     def _fill(self, r0: int, r1: int) -> None:
         """Features of output rows r0..r1 (inclusive, >= 1) from the current solution."""

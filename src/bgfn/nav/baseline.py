@@ -8,6 +8,9 @@ outages are the profile's ``outage_windows`` (:func:`bgfn.nav.outages.outage_win
   ``azimuth_std_deg`` (P0; the filter starts from the reference's first row);
 - ``bias_model`` (``random_walk`` | ``gauss_markov``), ``noise_scale``: see
   :func:`bgfn.nav.state.noise_from_imu_errors`;
+- ``ins_tuning``: ``shipped`` (the bias modelling above) or ``navego`` (NaveGo v1.4's: static biases removed
+  from the IMU, Gauss-Markov bias states of the dynamic biases; :mod:`bgfn.nav.navego_setup`, which then
+  ignores ``bias_model``);
 - ``innovation_gate``: null (every GNSS fix fused, the paper's filter) or a probability ``p``: a fix whose NIS
   exceeds the ``p`` quantile of chi-square is not fused (:func:`bgfn.nav.filter.run_filter`).
 """
@@ -22,7 +25,7 @@ import pandas as pd
 
 from .. import paper
 from ..errors import DataError
-from . import metrics
+from . import metrics, navego_setup
 from .filter import FilterResult, gate_thresholds, run_filter, run_outage
 from .outages import check_windows, epochs_before
 from .state import FilterNoise, FilterState, initial_covariance, initial_state, noise_from_imu_errors
@@ -35,6 +38,7 @@ NAV_DEFAULTS: dict = {
     "bias_model": "random_walk",
     "noise_scale": 1.0,
     "innovation_gate": None,
+    "ins_tuning": navego_setup.DEFAULT_TUNING,
 }
 
 
@@ -53,6 +57,7 @@ def nav_config(section: dict | None) -> dict:
         else:
             cfg[key] = value
     gate_thresholds(cfg["innovation_gate"], "params nav")      # a bad probability fails here, by name
+    navego_setup.check_tuning(cfg["ins_tuning"], "params nav")
     return cfg
 
 
@@ -73,12 +78,15 @@ def run_drive(drive, section: dict | None = None, snapshots: dict | None = None)
     """
     cfg = nav_config(section)
     initial, noise = filter_setup(drive, cfg)
-    return run_filter(drive.imu, initial, noise, drive.gnss, drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0]),
+    return run_filter(filter_imu(drive, cfg), initial, noise, drive.gnss, drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0]),
                       snapshots=snapshots, gate_probability=cfg["innovation_gate"], source=drive.name)
 
 
 def filter_setup(drive, cfg: dict) -> tuple[FilterState, FilterNoise]:
     """Initial filter state (at the reference's first row) and noise for a drive.
+
+    With ``ins_tuning: navego`` the noise and the bias priors are NaveGo's (:func:`bgfn.nav.navego_setup.navego_noise`)
+    and the bias estimates start at the dynamic-bias values; the filter must then read :func:`filter_imu`.
 
     Parameters
     ----------
@@ -91,14 +99,30 @@ def filter_setup(drive, cfg: dict) -> tuple[FilterState, FilterNoise]:
     initial : FilterState
     noise : FilterNoise
     """
-    noise = noise_from_imu_errors(drive.meta["imu_errors"], cfg["bias_model"], cfg["noise_scale"],
-                                  source=f"{drive.name} meta['imu_errors']")
+    errors, source = drive.meta["imu_errors"], f"{drive.name} meta['imu_errors']"
+    navego = cfg.get("ins_tuning", navego_setup.DEFAULT_TUNING) == "navego"
+    if navego:
+        noise = navego_setup.navego_noise(errors, cfg["noise_scale"], source=source)
+    else:
+        noise = noise_from_imu_errors(errors, cfg["bias_model"], cfg["noise_scale"], source=source)
     row = drive.reference.iloc[0]
     init = cfg["init"]
     P0 = initial_covariance(row[["lat", "lon", "h"]].to_numpy(float), noise, init["position_std_m"],
                             init["height_std_m"], init["velocity_std_mps"], np.radians(init["level_std_deg"]),
                             np.radians(init["azimuth_std_deg"]))
-    return initial_state(row, P0), noise
+    initial = initial_state(row, P0)
+    if navego:
+        initial.gyro_bias, initial.accel_bias = navego_setup.initial_bias_estimates(errors, source)
+    return initial, noise
+
+
+def filter_imu(drive, cfg: dict) -> pd.DataFrame:
+    """The IMU table the filter reads: ``drive.imu`` itself, or with ``ins_tuning: navego`` a copy without the
+    profile's static biases (:func:`bgfn.nav.navego_setup.remove_static_biases`)."""
+    if cfg.get("ins_tuning", navego_setup.DEFAULT_TUNING) != "navego":
+        return drive.imu
+    return navego_setup.remove_static_biases(
+        drive.imu, *navego_setup.static_biases(drive.meta["imu_errors"], f"{drive.name} meta['imu_errors']"))
 
 
 @dataclass
@@ -151,15 +175,16 @@ def run_baseline(drive, cfg: dict, windows) -> Baseline:
     windows = check_windows(windows, float(drive.reference["time"].iloc[0]),
                             float(drive.imu["time"].iloc[-1]), f"{drive.name}: profile outage_windows")
     initial, noise = filter_setup(drive, cfg)
+    imu = filter_imu(drive, cfg)
     lever = drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0])
     names = [f"outage_{i + 1}" for i in range(len(windows))]
     starts = epochs_before(drive.imu["time"], [w.start for w in windows], drive.name)
-    full = run_filter(drive.imu, initial, noise, drive.gnss, lever, snapshots=dict(zip(names, starts)),
+    full = run_filter(imu, initial, noise, drive.gnss, lever, snapshots=dict(zip(names, starts)),
                       gate_probability=cfg["innovation_gate"], source=drive.name)
     errors = metrics.navigation_errors(full.trajectory, drive.reference)
     rows, outage_errors = [], {}
     for n, w in zip(names, windows):
-        res = run_outage(drive.imu, full.states[n], w, noise, lever, source=drive.name)
+        res = run_outage(imu, full.states[n], w, noise, lever, source=drive.name)
         e = metrics.navigation_errors(res.trajectory, drive.reference)
         e.insert(1, "t_rel", e["time"] - w.start)
         outage_errors[n] = e

@@ -1,0 +1,209 @@
+"""Is the INS row comparable? The standalone INS in the outages under each filter setup, beside the paper's.
+
+Issue 17, question 5: the paper's INS row (its data come from NaveGo) is larger than ours. The INS of an outage
+starts from the GPS-aided filter's state, so its drift depends on how that filter modelled the IMU biases.
+:func:`ins_tuning_table` runs :func:`bgfn.nav.baseline.run_baseline` once per setup of ``nav.ins_tuning``
+(:data:`bgfn.nav.navego_setup.INS_TUNINGS`) and adds one bound:
+
+- ``shipped``: our filter as every other result uses it (random-walk biases, the full constant bias in P0);
+- ``navego``: the filter set up as NaveGo v1.4's ``ins_gnss.m`` (:mod:`bgfn.nav.navego_setup`);
+- ``navego-reset``: the same GPS-aided run, then each outage's INS started with its bias estimates cleared:
+  only the profile's static biases are removed, as by NaveGo v1.4 whose bias estimate is the latest
+  correction alone (:mod:`bgfn.nav.navego_setup`, "Not reproduced"; the latest correction is neglected);
+- ``paper``: the paper's INS row (:func:`bgfn.paper.outage_table`), only for a dataset that stands for one of
+  its tests.
+
+Table columns (:data:`COLUMNS`; ``tables/kf_ins_tuning.csv``, ``bgfn.config.SHARED_TABLES['kf_ins_tuning']``):
+``dataset``, ``test`` (the paper's test or empty), ``outage`` (1, 2, ...), ``setup``, ``max_east_m``,
+``max_north_m`` (max absolute error in the outage, m, :func:`bgfn.nav.metrics.outage_metrics`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .. import paper
+from ..config import SHARED_TABLES
+from ..io import atomic_write_csv
+from . import metrics, navego_setup
+from .baseline import Baseline, filter_imu, nav_config, run_baseline
+from .filter import run_outage
+from .outages import check_windows
+
+#: Setup of the INS row with the bias estimates cleared at the outage start (NaveGo v1.4's bound).
+RESET = "navego-reset"
+#: Label of the paper's row.
+PAPER = "paper"
+#: Row order of the table: our setups, then the paper's.
+SETUPS: tuple[str, ...] = navego_setup.INS_TUNINGS + (RESET, PAPER)
+#: Columns of :func:`ins_tuning_table`.
+COLUMNS: tuple[str, ...] = ("dataset", "test", "outage", "setup", "max_east_m", "max_north_m")
+
+
+def _row(dataset, test, outage, setup, east, north) -> dict:
+    return dict(zip(COLUMNS, (dataset, test or "", int(outage), setup, float(east), float(north))))
+
+
+def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None) -> pd.DataFrame:
+    """The standalone-INS max errors of ``drive`` in each outage under every setup (module docstring).
+
+    Parameters
+    ----------
+    drive : bgfn.data.Drive
+    cfg : dict
+        Output of :func:`bgfn.nav.baseline.nav_config`; its ``ins_tuning`` is replaced by each setup.
+    windows : sequence of (start, duration)
+        The outages, s (:func:`bgfn.nav.outages.outage_windows`).
+    baseline : Baseline, optional
+        The run with ``cfg`` as it is (notebook 02 has it already): reused for the setup it matches.
+
+    Returns
+    -------
+    DataFrame
+        :data:`COLUMNS`, rows in :data:`SETUPS` order, then by outage.
+    """
+    test = paper.test_of(drive.name)
+    checked = check_windows(windows, float(drive.reference["time"].iloc[0]), float(drive.imu["time"].iloc[-1]),
+                            f"{drive.name}: profile outage_windows")
+    lever = drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0])
+    rows = []
+    for tuning in navego_setup.INS_TUNINGS:
+        c = {**cfg, "ins_tuning": tuning}
+        same = baseline is not None and tuning == cfg.get("ins_tuning", navego_setup.DEFAULT_TUNING)
+        b = baseline if same else run_baseline(drive, c, windows)
+        for k, r in enumerate(b.outage_table.itertuples(index=False)):
+            rows.append(_row(drive.name, test, k + 1, tuning, r.max_abs_east, r.max_abs_north))
+        if tuning != "navego":
+            continue
+        imu = filter_imu(drive, c)
+        for k, w in enumerate(checked):
+            s = b.states[f"outage_{k + 1}"].copy()
+            s.gyro_bias[:] = 0.0      # NaveGo v1.4 keeps no accumulated bias estimate (ins_gnss.m l. 366, 412)
+            s.accel_bias[:] = 0.0
+            e = metrics.navigation_errors(run_outage(imu, s, w, b.noise, lever, source=drive.name).trajectory,
+                                          drive.reference)
+            m = metrics.outage_metrics(e, w)
+            rows.append(_row(drive.name, test, k + 1, RESET, m["max_abs_east"], m["max_abs_north"]))
+    if test:
+        for r in paper.outage_table(test).query("method == 'INS'").itertuples(index=False):
+            rows.append(_row(drive.name, test, r.outage, PAPER, r.max_east_m, r.max_north_m))
+    return pd.DataFrame(rows, columns=list(COLUMNS))
+
+
+def ins_tuning_tables(drives, nav_section: dict | None, windows, baselines: dict | None = None) -> pd.DataFrame:
+    """:func:`ins_tuning_table` of several drives, one table (notebooks 02 and 04).
+
+    Parameters
+    ----------
+    drives : iterable of bgfn.data.Drive
+    nav_section : dict or None
+        A profile's ``nav:`` section (:func:`bgfn.nav.baseline.nav_config` fills and checks it).
+    windows : sequence of (start, duration)
+        The outages, s.
+    baselines : dict, optional
+        ``{drive name: Baseline}`` run with ``nav_section`` as it is, reused.
+    """
+    cfg = nav_config(nav_section)
+    return pd.concat([ins_tuning_table(d, cfg, windows, (baselines or {}).get(d.name)) for d in drives],
+                     ignore_index=True)
+
+
+def layouts(table: pd.DataFrame) -> pd.DataFrame:
+    """:func:`layout` of every dataset of ``table``, stacked (outer row level: the dataset)."""
+    return pd.concat({d: layout(table, d) for d in dict.fromkeys(table["dataset"])}, names=["dataset"])
+
+
+def layout(table: pd.DataFrame, dataset: str) -> pd.DataFrame:
+    """One dataset of :func:`ins_tuning_table` in the paper's layout.
+
+    Returns
+    -------
+    DataFrame
+        Rows ``Outage k``; columns ``(setup, East/North)`` in :data:`SETUPS` order, m (NaN where a setup has
+        no value for an outage).
+    """
+    t = table[table["dataset"] == dataset]
+    outages = sorted({int(o) for o in t["outage"]})
+    setups = [s for s in SETUPS if s in set(t["setup"])]
+    data = {}
+    for s in setups:
+        ts = t[t["setup"] == s].set_index("outage")
+        for col, axis in paper.AXES:
+            data[(s, axis)] = [float(ts.loc[o, col]) if o in ts.index else np.nan for o in outages]
+    return pd.DataFrame(data, index=pd.Index([f"Outage {o}" for o in outages], name="Max Position Error (m)"),
+                        columns=pd.MultiIndex.from_tuples(list(data), names=["setup", "axis"]))
+
+
+def gap_explained(table: pd.DataFrame) -> pd.DataFrame:
+    """How much of the gap between our INS row and the paper's each setup closes, per dataset.
+
+    The size of a row is the mean of its max east and north errors over the outages the paper also has (m).
+    ``explained_pct`` of a setup is ``100 (setup - shipped) / (paper - shipped)``: 0 when it changes nothing,
+    100 when it reaches the paper's row, negative when it moves away from it.
+
+    Returns
+    -------
+    DataFrame
+        One row per dataset with a paper test and per setup other than ``shipped``: ``dataset``, ``test``,
+        ``setup``, ``shipped_m``, ``setup_m``, ``paper_m``, ``explained_pct`` (NaN when there is no gap).
+    """
+    rows = []
+    for dataset, t in table.groupby("dataset", sort=False):
+        on = set(t.loc[t["setup"] == PAPER, "outage"])
+        if not on:
+            continue
+        t = t[t["outage"].isin(on)]
+        size = {s: float(g[["max_east_m", "max_north_m"]].to_numpy().mean()) for s, g in t.groupby("setup")}
+        gap = size[PAPER] - size["shipped"]
+        for s in SETUPS:
+            if s in ("shipped", PAPER) or s not in size:
+                continue
+            pct = 100.0 * (size[s] - size["shipped"]) / gap if abs(gap) > 1e-9 else float("nan")
+            rows.append({"dataset": dataset, "test": t["test"].iloc[0], "setup": s, "shipped_m": size["shipped"],
+                         "setup_m": size[s], "paper_m": size[PAPER], "explained_pct": pct})
+    return pd.DataFrame(rows, columns=["dataset", "test", "setup", "shipped_m", "setup_m", "paper_m",
+                                       "explained_pct"])
+
+
+def _share(pct: float) -> str:
+    if not np.isfinite(pct):
+        return "there is no gap to explain"
+    if pct < 0:
+        return f"it moves away from the paper's row ({pct:.0f} % of the gap)"
+    if pct > 100:
+        return f"it overshoots the paper's row ({pct:.0f} % of the gap)"
+    return f"it explains {pct:.0f} % of the gap"
+
+
+def sentences(table: pd.DataFrame) -> list[str]:
+    """Plain sentences from :func:`gap_explained`: per dataset, the mean INS max error under each setup, the
+    paper's, and the share of the gap each setup explains."""
+    gap = gap_explained(table)
+    names = {"navego": "NaveGo v1.4's setup", RESET: "that setup with the bias estimates cleared at the outage start"}
+    out = []
+    for dataset, g in gap.groupby("dataset", sort=False):
+        first = g.iloc[0]
+        parts = [f"{names.get(r.setup, r.setup)}: {r.setup_m:.1f} m, so {_share(r.explained_pct)}"
+                 for r in g.itertuples(index=False)]
+        out.append(f"{dataset} ({paper.TESTS[first.test]['title']}): the INS max error (mean of east and north over "
+                   f"the outages) is {first.shipped_m:.1f} m with the shipped filter against the paper's "
+                   f"{first.paper_m:.1f} m; " + "; ".join(parts) + ".")
+    return out
+
+
+def save_table(out, table: pd.DataFrame) -> Path:
+    """Write :func:`ins_tuning_table` (all datasets) to ``<out>/tables/kf_ins_tuning.csv`` atomically."""
+    return atomic_write_csv(Path(out) / "tables" / SHARED_TABLES["kf_ins_tuning"], table, float_format="%.6g")
+
+
+def read_table(out) -> pd.DataFrame | None:
+    """The table :func:`save_table` wrote under ``out`` (``results/<profile>``), or None when it is missing."""
+    path = Path(out) / "tables" / SHARED_TABLES["kf_ins_tuning"]
+    return pd.read_csv(path) if path.exists() else None
+
+
+__all__ = ["COLUMNS", "PAPER", "RESET", "SETUPS", "gap_explained", "ins_tuning_table", "ins_tuning_tables", "layout",
+           "layouts", "read_table", "save_table", "sentences"]

@@ -45,11 +45,11 @@ from bgfn.data.imu_errors import MPU6000, apply_imu_errors, error_params
 from bgfn.data.navego import read_gnss, read_imu, read_reference, resample_imu
 from bgfn.data.rtklib import LEVER_ARM_M as RTKLIB_LEVER_ARM_M
 from bgfn.data.rtklib import IMU_TIME_OFFSET_S, Q_FIX, quality_spans, read_imu_csv, read_pos, read_tag
+from bgfn.data.trajectory import smooth_reference
+from bgfn.errors import DataError
 from bgfn.nav.earth import curvature_radii
 from bgfn.nav.metrics import REFERENCE_EXCLUDED_KEY
 from bgfn.schema import ATTITUDE_COLUMNS, REFERENCE_COLUMNS
-from bgfn.data.trajectory import smooth_reference
-from bgfn.errors import DataError
 
 log = logging.getLogger(__name__)
 

@@ -26,7 +26,8 @@ def env(tmp_path, mirror):
 
 
 def test_registry_and_defaults():
-    assert list(DATASETS) == ["turin-sim-ekinox", "turin-sim-mpu6000", "navego-ekinox", "navego-mpu6000"]
+    assert list(DATASETS) == ["turin-sim-ekinox", "turin-sim-mpu6000", "navego-ekinox", "navego-mpu6000",
+                              "rtklib-drive0708"]
     assert drives.DEFAULT_DATASET == "turin-sim-ekinox"
     assert DATASETS["turin-sim-mpu6000"]["lever_arm_m"] == [-0.369, 0.0, -0.219]
     with pytest.raises(DataError, match="gnss_rate"):

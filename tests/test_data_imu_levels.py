@@ -38,7 +38,8 @@ def _drive(n=60_000, gyro_nd=1e-3, accel_nd=4e-3, vib_gyro=0.02, vib_accel=0.4, 
 def test_states_from_reference_speed():
     d = _drive(n=3000)
     s = motion_states(d)
-    assert (s.iloc[:900] == "still").all() and (s.iloc[1100:] == "driving").all()
+    assert (s.iloc[60:900] == "still").all() and (s.iloc[:40] == "").all()   # stops trimmed by TRIM_S
+    assert (s.iloc[1100:] == "driving").all()
 
 
 def test_white_noise_density_recovered_at_rest():

@@ -102,6 +102,13 @@ TRAIN = section(
     lr_search=section(grid=seq(_POS, null=True), fraction=_FRACTION, seed=_SEED, extend=integer(0)),
     size=text(), sizes=mapping(mapping(mapping(ANY))))
 
+#: The parameters of the real car drive ``rtklib-drive0708`` (``data.rtklib-drive0708``; the defaults and the
+#: builder's own checks in :data:`bgfn.data.drives.DATASETS`).
+RTKLIB_DRIVE = section(
+    seed=_SEED, imu_rate_hz=_POS, gnss_rate_hz=_POS, gnss_white_std_m=seq(_NONNEG, length=3),
+    gnss_correlated_std_m=seq(_NONNEG, length=3), gnss_correlated_tau_s=_POS, imu_errors=mapping(ANY),
+    imu_time_offset_s=number(-1.0, 1.0), t_start=number(null=True), t_end=number(null=True))
+
 #: The whole profile.
 SCHEMA = section(
     profile=text(), description=text(), seed=_SEED, base=text(),
@@ -109,7 +116,7 @@ SCHEMA = section(
     data=section(
         datasets=_NAMES, seed=_SEED, imu_rate_hz=_POS, smoothing_degree=integer(1, 5),
         position_sigma_m=_POS, attitude_sigma_rad=_POS, t_start=number(null=True), t_end=number(null=True),
-        imu_plot_start_tow=number(null=True), imu_plot_duration_s=_POS),
+        imu_plot_start_tow=number(null=True), imu_plot_duration_s=_POS, rtklib__drive0708=RTKLIB_DRIVE),
     nav=section(
         datasets=_NAMES,
         init=section(position_std_m=_POS, height_std_m=_POS, velocity_std_mps=_POS, level_std_deg=_POS,

@@ -9,6 +9,9 @@ from __future__ import annotations
 
 #: Reference (truth) trajectory: geodetic position (rad, rad, m), NED velocity (m/s), ZYX Euler angles (rad).
 REFERENCE_COLUMNS: tuple[str, ...] = ("time", "lat", "lon", "h", "v_n", "v_e", "v_d", "roll", "pitch", "yaw")
+#: The reference's attitude: all finite, or all NaN for a drive whose reference has no attitude (an RTK-only
+#: reference, e.g. ``rtklib-drive0708``); ``bgfn.data.physics.reference_has_attitude`` tells which.
+ATTITUDE_COLUMNS: tuple[str, ...] = ("roll", "pitch", "yaw")
 #: IMU mean angular rate (rad/s) and specific force (m/s^2) over ``(time[k-1], time[k]]``, body frame.
 GYRO_COLUMNS: tuple[str, ...] = ("gyro_x", "gyro_y", "gyro_z")
 ACCEL_COLUMNS: tuple[str, ...] = ("accel_x", "accel_y", "accel_z")

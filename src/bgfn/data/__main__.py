@@ -1,4 +1,4 @@
-"""Command line: ``python -m bgfn.data fetch`` resolves and verifies the NaveGo files.
+"""Command line: ``python -m bgfn.data fetch`` resolves and verifies the NaveGo files and the RTKLIB drive's.
 
 Prints, per file, where it was resolved from (``raw``, ``mirror``, ``download``) or why it is missing.
 Exit status 0 when the required files (``ref.mat``, ``ekinox_gnss.mat``) are in ``data/raw``, 1 when one
@@ -11,7 +11,7 @@ import argparse
 import logging
 import sys
 
-from bgfn.data.acquire import NAVEGO_FILES, NAVEGO_TAG, fetch_all
+from bgfn.data.acquire import NAVEGO_TAG, fetch_all, raw_files
 from bgfn.errors import DataError
 
 
@@ -19,23 +19,27 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of ``python -m bgfn.data``; returns the exit status."""
     parser = argparse.ArgumentParser(prog="python -m bgfn.data", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
-    fetch = sub.add_parser("fetch", help=f"resolve + verify the NaveGo {NAVEGO_TAG} files into data/raw")
+    fetch = sub.add_parser("fetch", help=f"resolve + verify the NaveGo {NAVEGO_TAG} files and the RTKLIB drive's "
+                           "into data/raw")
     fetch.add_argument("--data-dir", default=None, help="data folder (default: $BGFN_DATA_DIR or <repo>/data)")
     fetch.add_argument("--mirror", default=None, help="mirror folder (default: $BGFN_DATA_MIRROR or "
                        "<repo>/../shared/data/navego)")
+    fetch.add_argument("--rtklib-mirror", default=None, help="mirror folder of the RTKLIB drive (default: "
+                       "$BGFN_RTKLIB_MIRROR or <repo>/../shared/data/rtklib-drive0708)")
     fetch.add_argument("--no-download", action="store_true", help="do not try the pinned URL")
     fetch.add_argument("--timeout", type=float, default=30.0, help="network timeout, s")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
     try:
-        resolved = fetch_all(data_dir=args.data_dir, mirror=args.mirror, download=not args.no_download,
-                             timeout_s=args.timeout)
+        resolved = fetch_all(data_dir=args.data_dir, mirror=args.mirror, rtklib_mirror=args.rtklib_mirror,
+                             download=not args.no_download, timeout_s=args.timeout)
     except DataError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     status = 0
     for res in resolved:
-        required = NAVEGO_FILES[res.name].required
+        spec = raw_files()[res.name]
+        required = spec.required
         if res.path is not None:
             print(f"{res.name:18s} {res.origin:8s} {res.checksum}  <- {res.detail}")
         else:
@@ -43,7 +47,7 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"{res.name:18s} REQUIRED, missing: {res.detail}")
                 status = 1
             else:  # the details are in the warning logged by fetch_all
-                print(f"{res.name:18s} optional, missing: the simulated datasets stand in")
+                print(f"{res.name:18s} optional, missing: {spec.when_missing}")
     return status
 
 

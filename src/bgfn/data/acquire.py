@@ -1,5 +1,9 @@
 """Resolve the four NaveGo v1.4 Turin-drive files: ``data/raw`` -> local mirror -> pinned URL.
 
+The same for the three files of the RTKLIB-logged car drive ``rtklib-drive0708`` (:data:`RTKLIB_FILES`,
+repository ``rtklibexplorer/GNSS_IMU``, pinned commit; read by :mod:`bgfn.data.rtklib`): every file names its
+source, its pinned URL and its mirror folder.
+
 Every file is verified before use (SHA-256 where published, else its git blob id), including a file that
 is already in ``data/raw``. A file from the mirror or from the network is copied into ``data/raw`` only
 after it verifies, atomically (temporary file, then rename), so ``data/raw`` never holds a bad or
@@ -10,7 +14,8 @@ Locations (all configurable, so that tests never touch the repository's ``data/`
 - data folder: argument ``data_dir``, else env ``BGFN_DATA_DIR``, else ``<repo>/data``;
   raw files in ``<data>/raw``, processed datasets in ``<data>/processed``.
 - mirror folder: argument ``mirror``, else env ``BGFN_DATA_MIRROR``, else ``<repo>/../shared/data/navego``
-  when that folder exists.
+  when that folder exists. For the RTKLIB drive: argument ``mirror``, else env ``BGFN_RTKLIB_MIRROR``, else
+  ``<repo>/../shared/data/rtklib-drive0708``.
 """
 
 from __future__ import annotations
@@ -32,6 +37,11 @@ log = logging.getLogger(__name__)
 NAVEGO_TAG = "v1.4"
 #: Pinned download URL pattern of the NaveGo example data.
 NAVEGO_URL = "https://github.com/rodralez/NaveGo/raw/" + NAVEGO_TAG + "/examples/real-data/{file}"
+#: Commit of ``rtklibexplorer/GNSS_IMU`` whose ``data/drive_0708`` files are used.
+RTKLIB_COMMIT = "8235ee6c5f349db529bf43ad556a3769b346b5a1"
+#: Pinned download URL pattern of the RTKLIB drive's files.
+RTKLIB_URL = ("https://raw.githubusercontent.com/rtklibexplorer/GNSS_IMU/" + RTKLIB_COMMIT
+              + "/data/drive_0708/{file}")
 #: Repository root (``src/bgfn/data/acquire.py`` -> three levels up).
 REPO_ROOT = Path(__file__).resolve().parents[3]
 
@@ -50,12 +60,27 @@ class RawFile:
         Git blob id (SHA-1 of ``b"blob <len>\\0" + data``) at tag v1.4.
     required : bool
         Whether the simulated datasets need it (``ref``, ``ekinox_gnss``) or it is optional (real IMUs).
+    url : str
+        Pinned download URL pattern (``{file}``).
+    mirror_folder : str
+        Name of its mirror folder beside the repository (``<repo>/../shared/data/<mirror_folder>``).
+    mirror_env : str
+        Environment variable that may name the mirror folder.
+    source : str
+        Where it comes from, in words (named in the messages).
+    when_missing : str
+        What stands in when an optional file cannot be had.
     """
 
     name: str
     sha256: str | None
     git_blob: str
     required: bool
+    url: str = NAVEGO_URL
+    mirror_folder: str = "navego"
+    mirror_env: str = "BGFN_DATA_MIRROR"
+    source: str = f"NaveGo {NAVEGO_TAG}"
+    when_missing: str = "the simulated datasets turin-sim-ekinox / turin-sim-mpu6000 stand in for the real IMU"
 
 
 #: The four NaveGo files with their checksums (``../shared/data/navego/README.md``).
@@ -71,6 +96,29 @@ NAVEGO_FILES: dict[str, RawFile] = {
         RawFile("mpu6000_imu.mat", None, "830d521b115ca2c5117a0cb0af575a573e4753f4", False),
     )
 }
+
+_RTKLIB = {"url": RTKLIB_URL, "mirror_folder": "rtklib-drive0708", "mirror_env": "BGFN_RTKLIB_MIRROR",
+           "source": f"rtklibexplorer/GNSS_IMU {RTKLIB_COMMIT[:7]} data/drive_0708",
+           "when_missing": "the dataset rtklib-drive0708 cannot be built; the other datasets are unaffected"}
+#: The three files of the RTKLIB-logged car drive (``../shared/data/rtklib-drive0708/README.md``); optional:
+#: only the dataset ``rtklib-drive0708`` needs them.
+RTKLIB_FILES: dict[str, RawFile] = {
+    f.name: f
+    for f in (
+        RawFile("imu_1934.csv", "f1126bf3b36efc4bef2dd2c7d93bb2a0e1b4ce714005cbea00a9218ad0b3b7a9",
+                "f74142a151c63d83f50797deaf40f40929bb369e", False, **_RTKLIB),
+        RawFile("imu_1934.csv.tag", "d30d13d5641df367559472b91b48325601a87c986bf2bb6af368684a36b5ec96",
+                "c79867904df17050fb69470b5da68aac466700c8", False, **_RTKLIB),
+        RawFile("gnss_1934_sf.pos", "618fba5c7193e8eb448faf95c79c0d198233d5f4e5ad8ffec652893911ff7133",
+                "dc0ca25783ebb20d5e1e9f4fac590b72be551951", False, **_RTKLIB),
+    )
+}
+
+
+def raw_files() -> dict[str, RawFile]:
+    """Every pinned raw file by name: ``NAVEGO_FILES`` then ``RTKLIB_FILES`` (read at each call)."""
+    return {**NAVEGO_FILES, **RTKLIB_FILES}
+
 
 _reported_missing: set[str] = set()
 
@@ -97,17 +145,19 @@ def processed_dir(data_dir_: str | Path | None = None) -> Path:
     return data_dir(data_dir_) / "processed"
 
 
-def mirror_dir(mirror: str | Path | None = None) -> Path | None:
-    """Local mirror folder: ``mirror``, else env ``BGFN_DATA_MIRROR``, else ``<repo>/../shared/data/navego``.
+def mirror_dir(mirror: str | Path | None = None, spec: RawFile | None = None) -> Path | None:
+    """Local mirror folder of ``spec`` (default: a NaveGo file): ``mirror``, else its environment variable
+    (``BGFN_DATA_MIRROR`` for NaveGo), else ``<repo>/../shared/data/<its folder>`` (``navego``).
 
     Returns None when no mirror is configured and the default folder does not exist.
     """
+    spec = spec or next(iter(NAVEGO_FILES.values()))
     if mirror is not None:
         return Path(mirror)
-    env = os.environ.get("BGFN_DATA_MIRROR")
+    env = os.environ.get(spec.mirror_env)
     if env:
         return Path(env)
-    default = REPO_ROOT.parent / "shared" / "data" / "navego"
+    default = REPO_ROOT.parent / "shared" / "data" / spec.mirror_folder
     return default if default.is_dir() else None
 
 
@@ -141,12 +191,12 @@ def verify_bytes(data: bytes, spec: RawFile, source: str | Path) -> str:
     if spec.sha256 is not None:
         found = hashlib.sha256(data).hexdigest()
         if found != spec.sha256:
-            raise ChecksumError(source, "sha256", f"{spec.sha256} (NaveGo {NAVEGO_TAG} {spec.name})",
+            raise ChecksumError(source, "sha256", f"{spec.sha256} ({spec.source} {spec.name})",
                                 f"{found} ({len(data)} bytes): corrupted or truncated file, not used")
         return "sha256:" + found
     found = git_blob_id(data)
     if found != spec.git_blob:
-        raise ChecksumError(source, "git blob id", f"{spec.git_blob} (NaveGo {NAVEGO_TAG} {spec.name})",
+        raise ChecksumError(source, "git blob id", f"{spec.git_blob} ({spec.source} {spec.name})",
                             f"{found} ({len(data)} bytes): corrupted or truncated file, not used")
     return "git-blob:" + found
 
@@ -193,20 +243,20 @@ class Resolved:
 
 def resolve(name: str, *, data_dir: str | Path | None = None, mirror: str | Path | None = None,
             download: bool = True, timeout_s: float = 30.0) -> Resolved:
-    """Find, verify and install one NaveGo file into ``<data>/raw``.
+    """Find, verify and install one pinned file into ``<data>/raw``.
 
-    Order: ``<data>/raw`` -> mirror folder -> pinned URL (``NAVEGO_URL``). A file already in ``raw``
-    is verified too; a mismatch anywhere raises (the bad file is never used nor copied).
+    Order: ``<data>/raw`` -> mirror folder -> pinned URL (``NAVEGO_URL``, ``RTKLIB_URL``). A file already in
+    ``raw`` is verified too; a mismatch anywhere raises (the bad file is never used nor copied).
 
     Parameters
     ----------
     name : str
-        One of ``NAVEGO_FILES`` (``"ref.mat"``, ``"ekinox_gnss.mat"``, ``"ekinox_imu.mat"``,
-        ``"mpu6000_imu.mat"``).
+        One of :func:`raw_files`: ``NAVEGO_FILES`` (``"ref.mat"``, ``"ekinox_gnss.mat"``, ``"ekinox_imu.mat"``,
+        ``"mpu6000_imu.mat"``) or ``RTKLIB_FILES``.
     data_dir : str or Path, optional
         Data folder (see :func:`data_dir`).
     mirror : str or Path, optional
-        Mirror folder (see :func:`mirror_dir`).
+        Mirror folder of this file (see :func:`mirror_dir`).
     download : bool
         Whether to try the pinned URL as the last resort.
     timeout_s : float
@@ -222,25 +272,26 @@ def resolve(name: str, *, data_dir: str | Path | None = None, mirror: str | Path
     ChecksumError
         A file was found but does not match its pinned checksum.
     DataError
-        ``name`` is not a NaveGo file.
+        ``name`` is not a pinned file.
     """
-    if name not in NAVEGO_FILES:
-        raise DataError("bgfn.data.acquire", "name", f"one of {sorted(NAVEGO_FILES)}", repr(name))
-    spec = NAVEGO_FILES[name]
+    files = raw_files()
+    if name not in files:
+        raise DataError("bgfn.data.acquire", "name", f"one of {sorted(files)}", repr(name))
+    spec = files[name]
     target = raw_dir(data_dir) / name
     if target.is_file():
         checksum = verify_bytes(target.read_bytes(), spec, target)
         return Resolved(name, target, "raw", checksum, str(target))
     tried = [f"{target} (absent)"]
-    mdir = mirror_dir(mirror)
+    mdir = mirror_dir(mirror, spec)
     if mdir is not None and (mdir / name).is_file():
         data = (mdir / name).read_bytes()
         checksum = verify_bytes(data, spec, mdir / name)
         atomic_write_bytes(target, data)
         return Resolved(name, target, "mirror", checksum, str(mdir / name))
-    tried.append(f"{mdir / name if mdir is not None else 'no mirror (BGFN_DATA_MIRROR unset)'} (absent)")
+    tried.append(f"{mdir / name if mdir is not None else f'no mirror ({spec.mirror_env} unset)'} (absent)")
     if download:
-        url = NAVEGO_URL.format(file=name)
+        url = spec.url.format(file=name)
         try:
             data = _download(url, timeout_s)
         except ConnectionError as exc:
@@ -255,12 +306,12 @@ def resolve(name: str, *, data_dir: str | Path | None = None, mirror: str | Path
 
 
 def require(name: str, **kwargs) -> Path:
-    """Path of a verified NaveGo file in ``<data>/raw``; raise when it cannot be had.
+    """Path of a verified pinned file in ``<data>/raw``; raise when it cannot be had.
 
     Parameters
     ----------
     name : str
-        NaveGo file name.
+        A name of :func:`raw_files`.
     **kwargs
         Passed to :func:`resolve`.
 
@@ -277,31 +328,39 @@ def require(name: str, **kwargs) -> Path:
     """
     res = resolve(name, **kwargs)
     if res.path is None:
-        raise MissingFileError(name, "file", f"NaveGo {NAVEGO_TAG} file {name} in data/raw, the mirror "
-                               f"or {NAVEGO_URL.format(file=name)}", f"nothing: {res.detail}")
+        spec = raw_files()[name]
+        raise MissingFileError(name, "file", f"{spec.source} file {name} in data/raw, the mirror "
+                               f"or {spec.url.format(file=name)}", f"nothing: {res.detail}")
     return res.path
 
 
 def report_missing_once(name: str, detail: str) -> None:
-    """Log (once per process and file) that an optional real-IMU file is absent."""
+    """Log (once per process and file) that an optional file is absent, and what stands in."""
     if name not in _reported_missing:
         _reported_missing.add(name)
-        log.warning("optional NaveGo file %s is not available (%s); the simulated datasets "
-                    "turin-sim-ekinox / turin-sim-mpu6000 stand in for the real IMU", name, detail)
+        spec = raw_files()[name]
+        log.warning("optional %s file %s is not available (%s); %s", spec.source, name, detail, spec.when_missing)
 
 
 def fetch_all(*, data_dir: str | Path | None = None, mirror: str | Path | None = None,
-              download: bool = True, timeout_s: float = 30.0) -> list[Resolved]:
-    """Resolve all four NaveGo files (see :func:`resolve`); an absent optional file is logged once.
+              rtklib_mirror: str | Path | None = None, download: bool = True,
+              timeout_s: float = 30.0) -> list[Resolved]:
+    """Resolve all pinned files (see :func:`resolve`); an absent optional file is logged once.
+
+    Parameters
+    ----------
+    mirror, rtklib_mirror : str or Path, optional
+        Mirror folder of the NaveGo files, of the RTKLIB drive's files (:func:`mirror_dir`).
 
     Returns
     -------
     list of Resolved
-        One entry per file, in ``NAVEGO_FILES`` order. A checksum mismatch raises.
+        One entry per file, in :func:`raw_files` order (NaveGo, then RTKLIB). A checksum mismatch raises.
     """
     out = []
-    for name, spec in NAVEGO_FILES.items():
-        res = resolve(name, data_dir=data_dir, mirror=mirror, download=download, timeout_s=timeout_s)
+    for name, spec in raw_files().items():
+        folder = rtklib_mirror if name in RTKLIB_FILES else mirror
+        res = resolve(name, data_dir=data_dir, mirror=folder, download=download, timeout_s=timeout_s)
         if res.path is None and not spec.required:
             report_missing_once(name, res.detail)
         out.append(res)

@@ -18,10 +18,10 @@ import numpy as np
 import pandas as pd
 
 from bgfn.data.navego import check_time
-from bgfn.data.physics import check_drive
+from bgfn.data.physics import check_drive, reference_has_attitude
 from bgfn.errors import DataError
 from bgfn.io import atomic_path, atomic_write_json
-from bgfn.schema import GNSS_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS
+from bgfn.schema import ATTITUDE_COLUMNS, GNSS_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS
 
 _TABLES = ("reference", "imu", "gnss", "imu_bias")
 log = logging.getLogger(__name__)
@@ -36,7 +36,8 @@ class Drive:
     name : str
         Dataset name (``turin-sim-ekinox``, ...) or the CSV folder's name.
     reference : DataFrame
-        Truth, reference schema (CONTRIBUTING.md), at the IMU rate.
+        Truth, reference schema (CONTRIBUTING.md), at the IMU rate. ``roll, pitch, yaw`` are all NaN when the
+        reference has no attitude (:attr:`has_attitude`).
     imu : DataFrame
         IMU schema; row k = mean rates over ``(time[k-1], time[k]]``.
     gnss : DataFrame
@@ -44,7 +45,9 @@ class Drive:
     meta : dict
         ``imu_rate_hz``, ``gnss_rate_hz``, ``lever_arm_m`` (antenna in the body frame, m),
         ``imu_errors`` (see :mod:`bgfn.data.imu_errors`), ``source``, ``params``, and per dataset
-        diagnostics (``truth_fit``, ``gnss_residual_*``, ``cache_key``).
+        diagnostics (``truth_fit``, ``gnss_residual_*``, ``cache_key``); ``reference_excluded_s``
+        (``[[t0, t1], ...]``, s): spans where the reference is not trusted, left out of every error metric
+        (:func:`bgfn.nav.metrics.reference_rows`).
     imu_bias : DataFrame or None
         True additive IMU bias per epoch (simulated datasets): ``time``, ``gyro_bias_x/y/z`` (rad/s),
         ``accel_bias_x/y/z`` (m/s^2).
@@ -56,6 +59,11 @@ class Drive:
     gnss: pd.DataFrame
     meta: dict = field(default_factory=dict)
     imu_bias: pd.DataFrame | None = None
+
+    @property
+    def has_attitude(self) -> bool:
+        """Whether the reference carries an attitude (False: ``roll, pitch, yaw`` all NaN)."""
+        return not bool(self.reference[list(ATTITUDE_COLUMNS)].isna().to_numpy().all())
 
     def crop(self, t_start: float | None = None, t_end: float | None = None) -> "Drive":
         """A copy restricted to ``t_start <= time <= t_end`` (s, GPS time of week).
@@ -102,7 +110,11 @@ class Drive:
             base) also the likely cause (:func:`bgfn.data.physics.check_drive`).
         """
         src = source or self.name
-        for table, cols, nan_ok in (("reference", REFERENCE_COLUMNS, ()), ("imu", IMU_COLUMNS, ()),
+        ref_nan_ok = ()
+        if all(c in self.reference.columns for c in ATTITUDE_COLUMNS) and \
+                not reference_has_attitude(self.reference, f"{src}/reference"):
+            ref_nan_ok = ATTITUDE_COLUMNS
+        for table, cols, nan_ok in (("reference", REFERENCE_COLUMNS, ref_nan_ok), ("imu", IMU_COLUMNS, ()),
                                     ("gnss", GNSS_COLUMNS, ("v_n", "v_e", "v_d"))):
             df = getattr(self, table)
             missing = [c for c in cols if c not in df.columns]

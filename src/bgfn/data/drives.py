@@ -1,4 +1,5 @@
-"""Datasets of the Turin drive: ``load_drive(name, **overrides)`` with a cache in ``data/processed/``.
+"""Datasets of the Turin drive and of a recorded car drive: ``load_drive(name, **overrides)``, cached in
+``data/processed/``.
 
 =====================  ==========================================================================
 name                   content
@@ -11,6 +12,10 @@ name                   content
                        1 Hz u-blox receiver with lever arm [-0.369, 0, -0.219] m
 ``navego-ekinox``      real Ekinox-D IMU (``ekinox_imu.mat``, 200 Hz -> 100 Hz) + real GNSS + truth
 ``navego-mpu6000``     real MPU-6000 IMU (``mpu6000_imu.mat``, ~250 Hz -> 100 Hz) + real GNSS + truth
+``rtklib-drive0708``   a real car drive (Colorado, 548 s): real 100 Hz MEMS IMU (TDK ICM-45686, jittery
+                       times -> 100 Hz grid); reference = the RTK fixed solution (position, velocity, no
+                       attitude); GNSS = a seeded degraded copy of it like the simulated u-blox receiver
+                       (:func:`_build_rtklib`)
 a folder path          a user's drive in the CSV schema (:mod:`bgfn.data.csv_drive`)
 =====================  ==========================================================================
 
@@ -35,11 +40,16 @@ import pandas as pd
 from bgfn.data import acquire
 from bgfn.data.csv_drive import load_csv_drive
 from bgfn.data.drive import Drive, load_cached, prune_stale, save_drive
-from bgfn.data.gnss import decimate, fix_errors, simulate_fixes
+from bgfn.data.gnss import decimate, degrade_fixes, fix_errors, imu_position, simulate_fixes
 from bgfn.data.imu_errors import MPU6000, apply_imu_errors, error_params
 from bgfn.data.navego import read_gnss, read_imu, read_reference, resample_imu
+from bgfn.data.rtklib import LEVER_ARM_M as RTKLIB_LEVER_ARM_M
+from bgfn.data.rtklib import IMU_TIME_OFFSET_S, Q_FIX, quality_spans, read_imu_csv, read_pos, read_tag
 from bgfn.data.trajectory import smooth_reference
 from bgfn.errors import DataError
+from bgfn.nav.earth import curvature_radii
+from bgfn.nav.metrics import REFERENCE_EXCLUDED_KEY
+from bgfn.schema import ATTITUDE_COLUMNS, REFERENCE_COLUMNS
 
 log = logging.getLogger(__name__)
 
@@ -58,18 +68,25 @@ _COMMON = {
     "t_end": None,
 }
 
+#: The simulated u-blox-like receiver (turin-sim-mpu6000), also the degraded copy of the RTK solution.
+_UBLOX = {"gnss_rate_hz": 1.0, "gnss_white_std_m": [0.3, 0.3, 0.6], "gnss_correlated_std_m": [1.0, 1.0, 2.0],
+          "gnss_correlated_tau_s": 60.0}
+
 #: Parameters of each dataset (defaults). ``imu_errors`` holds overrides of the error profile's keys.
 DATASETS: dict[str, dict] = {
     "turin-sim-ekinox": {**_COMMON, "gnss_rate_hz": 5.0, "imu_errors": {}},
-    "turin-sim-mpu6000": {**_COMMON, "gnss_rate_hz": 1.0, "imu_errors": {},
-                          "lever_arm_m": MPU_LEVER_ARM_M, "gnss_white_std_m": [0.3, 0.3, 0.6],
-                          "gnss_correlated_std_m": [1.0, 1.0, 2.0], "gnss_correlated_tau_s": 60.0},
+    "turin-sim-mpu6000": {**_COMMON, **_UBLOX, "imu_errors": {}, "lever_arm_m": MPU_LEVER_ARM_M},
     "navego-ekinox": {**_COMMON, "gnss_rate_hz": 5.0},
     "navego-mpu6000": {**_COMMON, "gnss_rate_hz": 5.0, "lever_arm_m": MPU_LEVER_ARM_M},
+    "rtklib-drive0708": {"seed": 0, "imu_rate_hz": 100.0, **_UBLOX, "imu_errors": {},
+                         "imu_time_offset_s": IMU_TIME_OFFSET_S, "t_start": None, "t_end": None},
 }
+#: Datasets with a clock of their own: the ``data:`` section's common ``t_start``/``t_end`` (the Turin drive's
+#: GPS time of week) do not crop them; their own section may.
+OWN_CLOCK = ("rtklib-drive0708",)
 _NOT_IN_KEY = ("t_start", "t_end")
 #: Modules whose source is hashed into the cache key.
-_KEY_MODULES = ("acquire", "navego", "trajectory", "imu_errors", "gnss", "drive", "drives")
+_KEY_MODULES = ("acquire", "navego", "rtklib", "trajectory", "imu_errors", "gnss", "drive", "drives")
 
 
 def substream_seed(seed: int, stream: int) -> int:
@@ -98,7 +115,8 @@ def profile_overrides(name: str, profile: str) -> dict:
     common parameters (``imu_rate_hz``, ``smoothing_degree``, ``position_sigma_m``,
     ``attitude_sigma_rad``, ``t_start``, ``t_end``) and one mapping per dataset name with that dataset's
     parameters (e.g. ``turin-sim-ekinox: {gnss_rate_hz: 1.0}``); other keys (``datasets``, plot spans)
-    belong to notebook 01.
+    belong to notebook 01. A common parameter applies to the datasets that have it; the common crop does not
+    apply to the datasets of :data:`OWN_CLOCK`.
 
     Returns
     -------
@@ -110,7 +128,9 @@ def profile_overrides(name: str, profile: str) -> dict:
     cfg = load_profile(profile)
     data = cfg["data"]
     out = {"seed": data.get("seed", cfg["seed"])}
-    out.update({k: data[k] for k in _COMMON if k in data and k != "seed"})
+    own = DATASETS.get(name, {})
+    out.update({k: data[k] for k in _COMMON if k in data and k != "seed" and k in own
+                and not (k in _NOT_IN_KEY and name in OWN_CLOCK)})
     section = data.get(name) or {}
     if not isinstance(section, dict):
         raise DataError(profile_path(profile), f"data.{name}", "a mapping of dataset parameters",
@@ -148,9 +168,10 @@ def _truth(ref: pd.DataFrame, p: dict, t_start=None, t_end=None) -> tuple[pd.Dat
                             t_start=t_start, t_end=t_end)
 
 
-def _gnss_residuals(gnss: pd.DataFrame, truth: pd.DataFrame, lever_arm) -> dict:
-    """Mean and std of (fix - true antenna position), north/east/down, m, over the truth's span."""
-    d = fix_errors(gnss, truth, lever_arm)[["north_m", "east_m", "down_m"]].to_numpy()
+def _gnss_residuals(gnss: pd.DataFrame, truth: pd.DataFrame, lever_arm, excluded_s=()) -> dict:
+    """Mean and std of (fix - true antenna position), north/east/down, m, over the truth's span (outside the
+    spans where the reference is not trusted)."""
+    d = fix_errors(gnss, truth, lever_arm, excluded_s)[["north_m", "east_m", "down_m"]].to_numpy()
     return {"gnss_residual_mean_m": d.mean(axis=0).tolist(), "gnss_residual_std_m": d.std(axis=0).tolist()}
 
 
@@ -226,11 +247,97 @@ def _build_real(name: str, p: dict, paths: dict) -> Drive:
     return Drive(name, truth, imu, gnss, meta)
 
 
+def _rtk_reference(fixed: pd.DataFrame, grid: np.ndarray) -> pd.DataFrame:
+    """The RTK antenna solution at ``grid`` (s): a cubic spline through the fixed positions, its derivative as
+    the velocity (NED, m/s), attitude NaN.
+
+    The solution's own velocity column is not used: in this file it is the backward difference of successive
+    positions (its std is ``sqrt(2)`` times the position std over 0.25 s, and it matches the positions' central
+    difference 0.125 s earlier), i.e. the mean velocity of the past interval, late by half an epoch.
+    """
+    from scipy.interpolate import CubicSpline
+
+    t = fixed["time"].to_numpy(float)
+    splines = {c: CubicSpline(t, fixed[c].to_numpy(float)) for c in ("lat", "lon", "h")}
+    out = {"time": grid, **{c: s(grid) for c, s in splines.items()}}
+    r_m, r_n = curvature_radii(out["lat"])
+    out["v_n"] = splines["lat"](grid, 1) * (r_m + out["h"])
+    out["v_e"] = splines["lon"](grid, 1) * (r_n + out["h"]) * np.cos(out["lat"])
+    out["v_d"] = -splines["h"](grid, 1)
+    for c in ATTITUDE_COLUMNS:
+        out[c] = np.full(grid.size, np.nan)
+    return pd.DataFrame(out, columns=list(REFERENCE_COLUMNS))
+
+
+def _build_rtklib(name: str, p: dict, paths: dict) -> Drive:
+    """The RTKLIB-logged car drive (``bgfn.data.rtklib``; module table).
+
+    - IMU: the real samples, rotated to the body frame, on their tagged times (8-11 ms steps), integrated and
+      resampled onto the regular ``imu_rate_hz`` grid (:func:`bgfn.data.navego.resample_imu`).
+    - Reference: the RTK fixed epochs (Q = 1) on the grid (:func:`_rtk_reference`), moved from the antenna to the
+      IMU with the lever arm (:func:`bgfn.data.gnss.imu_position`: level along the course, since the drive has
+      no attitude; 5 cm arm, millimetres of error). Its velocity is the antenna's (the rotation term
+      ``omega x lever`` is below 3 cm/s). ``roll, pitch, yaw`` are NaN. The spans around the epochs that are
+      not fixed go to ``meta["reference_excluded_s"]``, left out of every metric.
+    - GNSS: every epoch of the solution (all qualities: the copy's own errors are metres), decimated to
+      ``gnss_rate_hz``, with the seeded white + Gauss-Markov errors of the simulated u-blox receiver
+      (:func:`bgfn.data.gnss.degrade_fixes`); velocity = the reference's at the fix times (a consumer
+      receiver's Doppler velocity is of that class, a few cm/s; the filter uses positions only).
+    - IMU errors: no datasheet comes with the data; the filter gets the MPU-6000 consumer-MEMS profile
+      (:data:`bgfn.data.imu_errors.MPU6000`, with ``imu_errors`` overrides), book deviations row 42.
+    """
+    pos, week = read_pos(paths["gnss_1934_sf.pos"])
+    imu_native, imu_info = read_imu_csv(paths["imu_1934.csv"], read_tag(paths["imu_1934.csv.tag"]), week=week,
+                                        time_offset_s=p["imu_time_offset_s"])
+    fixed = pos.loc[pos["q"] == Q_FIX].reset_index(drop=True)
+    if len(fixed) < 2:
+        raise DataError(paths["gnss_1934_sf.pos"], "Q", "RTK fixed epochs (Q = 1)", f"{len(fixed)}")
+    rate = float(p["imu_rate_hz"])
+    t_imu = imu_native["time"].to_numpy(float)
+    lo = max(float(fixed["time"].iloc[0]), 2 * t_imu[0] - t_imu[1])  # row 0 covers one interval before t[0]
+    hi = min(float(fixed["time"].iloc[-1]), float(t_imu[-1]))
+    grid = np.arange(int(np.ceil(lo * rate - 1e-9)), int(np.floor(hi * rate + 1e-9)) + 1) / rate
+    antenna = _rtk_reference(fixed, grid)
+    larm = [float(x) for x in RTKLIB_LEVER_ARM_M]
+    lat, lon, h = imu_position(antenna, larm)
+    ref = antenna.assign(lat=lat, lon=lon, h=h)
+    imu = resample_imu(imu_native, rate, t_start=grid[0], t_end=grid[-1])
+    native_hz = 1.0 / float(np.median(np.diff(pos["time"])))
+    sol = decimate(pos[["time", "lat", "lon", "h"]], round(native_hz), p["gnss_rate_hz"])
+    sol = sol.loc[(sol["time"] >= grid[0]) & (sol["time"] <= grid[-1])].reset_index(drop=True)
+    for c in ("v_n", "v_e", "v_d"):
+        sol[c] = np.interp(sol["time"], grid, antenna[c])
+    gnss, _ = degrade_fixes(sol, substream_seed(p["seed"], 2), rate_hz=p["gnss_rate_hz"],
+                            white_std_m=p["gnss_white_std_m"], correlated_std_m=p["gnss_correlated_std_m"],
+                            correlated_tau_s=p["gnss_correlated_tau_s"])
+    inside = pos.loc[(pos["time"] >= grid[0]) & (pos["time"] <= grid[-1])]
+    excluded = [s for s in quality_spans(pos) if s[1] >= grid[0] and s[0] <= grid[-1]]
+    errors = error_params(MPU6000, p["imu_errors"])
+    errors["realized"] = None  # real sensor: the true errors are unknown
+    errors["note"] = ("no datasheet comes with the data: the MPU-6000 consumer-MEMS profile stands in "
+                      "(the sensor is a TDK ICM-45686)")
+    meta = {"imu_rate_hz": rate, "gnss_rate_hz": float(p["gnss_rate_hz"]),
+            "native_imu_rate_hz": float(1.0 / np.median(np.diff(t_imu))), "lever_arm_m": larm,
+            "imu_errors": errors, "params": p, REFERENCE_EXCLUDED_KEY: excluded,
+            "imu_time": imu_info,
+            "rtk": {"epochs": int(len(inside)), "fixed": int((inside["q"] == Q_FIX).sum()),
+                    "rate_hz": native_hz, "gps_week": int(week)},
+            "gnss_source": "degraded copy of the RTK solution (decimated; white + Gauss-Markov position errors)",
+            "gnss_errors": {"white_std_m": p["gnss_white_std_m"], "correlated_std_m": p["gnss_correlated_std_m"],
+                            "correlated_tau_s": p["gnss_correlated_tau_s"], "seed": substream_seed(p["seed"], 2)},
+            "source": (f"{acquire.RTKLIB_FILES['imu_1934.csv'].source} (BSD 3-Clause, (c) 2025 rtklibexplorer): "
+                       "real TDK ICM-45686 IMU + u-blox X20 RTK solution as reference (no attitude) + "
+                       "degraded copy of it as GNSS")}
+    meta.update(_gnss_residuals(gnss, ref, larm, excluded))
+    return Drive(name, ref, imu, gnss, meta)
+
+
 _BUILDERS: dict[str, tuple[tuple[str, ...], Callable]] = {
     "turin-sim-ekinox": (("ref.mat", "ekinox_gnss.mat"), _build_sim),
     "turin-sim-mpu6000": (("ref.mat",), _build_sim),
     "navego-ekinox": (("ref.mat", "ekinox_gnss.mat", "ekinox_imu.mat"), _build_real),
     "navego-mpu6000": (("ref.mat", "ekinox_gnss.mat", "mpu6000_imu.mat"), _build_real),
+    "rtklib-drive0708": (tuple(acquire.RTKLIB_FILES), _build_rtklib),
 }
 
 
@@ -249,7 +356,9 @@ def load_drive(name: str | Path = DEFAULT_DATASET, *, profile: str | None = None
     data_dir : str or Path, optional
         Data folder (raw files and cache); default ``$BGFN_DATA_DIR`` or ``<repo>/data``.
     mirror : str or Path, optional
-        Mirror folder of the NaveGo files; default ``$BGFN_DATA_MIRROR`` or ``<repo>/../shared/data/navego``.
+        Mirror folder of the dataset's raw files; default ``$BGFN_DATA_MIRROR`` or
+        ``<repo>/../shared/data/navego`` (NaveGo), ``$BGFN_RTKLIB_MIRROR`` or
+        ``<repo>/../shared/data/rtklib-drive0708`` (``rtklib-drive0708``).
     download : bool
         Try the pinned URL when a file is neither in ``raw`` nor in the mirror.
     cache : bool
@@ -288,9 +397,9 @@ def load_drive(name: str | Path = DEFAULT_DATASET, *, profile: str | None = None
     for f in needed:
         res = acquire.resolve(f, data_dir=data_dir, mirror=mirror, download=download)
         if res.path is None:
-            hint = ("; the simulated datasets turin-sim-ekinox / turin-sim-mpu6000 stand in for it"
-                    if not acquire.NAVEGO_FILES[f].required else "")
-            raise acquire.MissingFileError(f, "file", f"NaveGo {acquire.NAVEGO_TAG} {f} (needed by {name}) in "
+            spec = acquire.raw_files()[f]
+            hint = f"; {spec.when_missing}" if not spec.required else ""
+            raise acquire.MissingFileError(f, "file", f"{spec.source} {f} (needed by {name}) in "
                                            f"{acquire.raw_dir(data_dir)}, the mirror or the pinned URL",
                                            f"nothing: {res.detail}{hint}")
         paths[f], checksums[f] = res.path, res.checksum

@@ -6,7 +6,11 @@ drive's IMU table so that the stand-in's error model can be set from a real car'
 ``rtklib-drive0708``) and checked against it (notebook 01; the book's deviations page).
 
 Motion states come from the reference speed (not from the IMU, so the measurement does not depend on a
-detector tuned on the same signal): *still* below ``still_mps``, *driving* above ``driving_mps``.
+detector tuned on the same signal), averaged over ``SMOOTH_S``: *still* below ``STILL_MPS`` for at least
+``MIN_REST_S`` with ``TRIM_S`` cut from both ends of each stop (starting and stopping), *driving* above
+``DRIVING_MPS``. At rest the mean gyro reading of each stop is the gyro bias (the Earth rate, below
+7.3e-5 rad/s, is not removed: a real drive's attitude is unknown) and the mean |f| compares the
+accelerometers with gravity (:func:`rest_biases`).
 
 - *vibration* = standard deviation of the high-passed signal (2nd-order Butterworth above ``highpass_hz``,
   zero phase): above a few hertz a car's own motion (turns, pitch and heave of the body) has little power, so
@@ -27,8 +31,10 @@ from scipy import signal
 
 from bgfn.errors import DataError
 
-#: Reference speed below which the vehicle stands still, m/s.
-STILL_MPS = 0.05
+#: Reference speed below which the vehicle stands still (averaged over SMOOTH_S), m/s ...
+STILL_MPS = 0.1
+#: ... for at least this long, s; TRIM_S cut from both ends of each stop; the averaging span, s.
+MIN_REST_S, TRIM_S, SMOOTH_S = 2.0, 0.5, 1.0
 #: Reference speed above which the vehicle is driving, m/s.
 DRIVING_MPS = 3.0
 #: High-pass corner separating vehicle motion from vibration and noise, Hz.
@@ -46,20 +52,50 @@ def imu_rate_hz(imu: pd.DataFrame) -> float:
     return float(1.0 / np.median(np.diff(imu["time"].to_numpy(float))))
 
 
-def motion_states(drive, still_mps: float = STILL_MPS, driving_mps: float = DRIVING_MPS) -> pd.Series:
-    """``'still'``, ``'driving'`` or ``''`` at every IMU row, from the reference's horizontal speed.
+def _speed_at(imu_time: np.ndarray, reference: pd.DataFrame, smooth_s: float = SMOOTH_S) -> np.ndarray:
+    """Reference horizontal speed, moving-averaged over ``smooth_s``, at the IMU times (m/s)."""
+    t = reference["time"].to_numpy(float)
+    speed = np.hypot(reference["v_n"].to_numpy(float), reference["v_e"].to_numpy(float))
+    n = max(1, int(round(smooth_s / float(np.median(np.diff(t))))))
+    return np.interp(imu_time, t, np.convolve(speed, np.ones(n) / n, mode="same"))
 
-    The reference speed is interpolated to the IMU times (the reference of a drive is at the IMU rate, but a
-    cropped or user drive need not be).
-    """
-    ref = drive.reference
-    speed = np.hypot(ref["v_n"].to_numpy(float), ref["v_e"].to_numpy(float))
+
+def rest_spans(imu: pd.DataFrame, reference: pd.DataFrame, still_mps: float = STILL_MPS,
+               min_rest_s: float = MIN_REST_S, trim_s: float = TRIM_S) -> list[tuple[int, int]]:
+    """IMU row ranges ``[i0, i1)`` where the vehicle stands (module docstring), trimmed at both ends."""
+    t = imu["time"].to_numpy(float)
+    still = _speed_at(t, reference) < still_mps
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], still.astype(np.int8), [0]])))
+    trim = int(round(trim_s / float(np.median(np.diff(t)))))
+    return [(int(i0 + trim), int(i1 - trim)) for i0, i1 in zip(edges[::2], edges[1::2])
+            if t[i1 - 1] - t[i0] >= min_rest_s and i1 - i0 > 2 * trim]
+
+
+def motion_states(drive, still_mps: float = STILL_MPS, driving_mps: float = DRIVING_MPS) -> pd.Series:
+    """``'still'``, ``'driving'`` or ``''`` at every IMU row (module docstring)."""
     t = drive.imu["time"].to_numpy(float)
-    s = np.interp(t, ref["time"].to_numpy(float), speed)
     out = np.full(t.size, "", dtype=object)
-    out[s < still_mps] = "still"
-    out[s > driving_mps] = "driving"
+    for i0, i1 in rest_spans(drive.imu, drive.reference, still_mps):
+        out[i0:i1] = "still"
+    out[_speed_at(t, drive.reference) > driving_mps] = "driving"
     return pd.Series(out, index=drive.imu.index, name="state")
+
+
+def rest_biases(drive, still_mps: float = STILL_MPS) -> pd.DataFrame:
+    """Per stop: its span, the mean gyro reading (the gyro bias, rad/s) and the mean |f| (m/s^2).
+
+    Returns
+    -------
+    DataFrame
+        ``t0, t1, gyro_bias_x, gyro_bias_y, gyro_bias_z, f_norm_mean`` (one row per stop).
+    """
+    imu = drive.imu
+    t = imu["time"].to_numpy(float)
+    gyro = imu[list(SENSORS["gyro"])].to_numpy(float)
+    accel = imu[list(SENSORS["accel"])].to_numpy(float)
+    rows = [[t[a], t[b - 1], *gyro[a:b].mean(axis=0), np.linalg.norm(accel[a:b], axis=1).mean()]
+            for a, b in rest_spans(imu, drive.reference, still_mps)]
+    return pd.DataFrame(rows, columns=["t0", "t1", "gyro_bias_x", "gyro_bias_y", "gyro_bias_z", "f_norm_mean"])
 
 
 def highpass(x: np.ndarray, rate_hz: float, corner_hz: float = HIGHPASS_HZ) -> np.ndarray:

@@ -18,7 +18,7 @@ import pandas as pd
 
 from bgfn.errors import DataError
 from bgfn.nav.earth import curvature_radii
-from bgfn.schema import ACCEL_COLUMNS, GYRO_COLUMNS
+from bgfn.schema import ACCEL_COLUMNS, ATTITUDE_COLUMNS, GYRO_COLUMNS
 
 log = logging.getLogger(__name__)
 
@@ -58,7 +58,8 @@ def check_drive(drive, files: dict | None = None) -> dict:
     -------
     dict
         ``f_median_g``, ``f_z_median_g``, ``rate_p99``, ``gnss_coverage`` (fraction of the IMU span between the
-        first and last fix inside it).
+        first and last fix inside it), ``reference_attitude`` (False: a reference without attitude, its
+        ``roll, pitch, yaw`` all NaN, which is accepted; a partial attitude raises).
     """
     name = {t: (files or {}).get(t, f"{drive.name}/{t}") for t in ("reference", "imu", "gnss")}
     out = _check_imu(drive.imu, name["imu"])
@@ -68,7 +69,29 @@ def check_drive(drive, files: dict | None = None) -> dict:
     for table in ("reference", "gnss"):
         _check_jumps(getattr(drive, table), name[table])
     out["gnss_coverage"] = _check_overlap(drive.imu, drive.gnss, name["imu"], name["gnss"])
+    out["reference_attitude"] = reference_has_attitude(drive.reference, name["reference"])
     return out
+
+
+def reference_has_attitude(reference: pd.DataFrame, src: str = "reference") -> bool:
+    """Whether the reference carries an attitude: True when its ``roll, pitch, yaw`` are all finite, False when
+    all three columns are NaN throughout (a reference without attitude, e.g. an RTK solution).
+
+    Raises
+    ------
+    DataError
+        Anything in between (some NaN, an inf): a partial attitude is a defect, not a missing one.
+    """
+    att = reference[list(ATTITUDE_COLUMNS)].to_numpy(float)   # [n, 3] rad
+    if np.isnan(att).all():
+        return False
+    bad = ~np.isfinite(att)
+    if bad.any():
+        k, c = (int(i) for i in np.argwhere(bad)[0])
+        raise DataError(src, ATTITUDE_COLUMNS[c], "finite roll, pitch and yaw, or all three NaN throughout (a "
+                        "reference without attitude)", f"{int(bad.sum())} NaN/inf, first at row {k} "
+                        f"(time {reference['time'].iloc[k]})")
+    return True
 
 
 def _median_step(time: np.ndarray) -> float:

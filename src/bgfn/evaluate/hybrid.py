@@ -417,7 +417,7 @@ def run_outages(ctx: NavContext, windows, predictor=None, method: str = "INS", s
                         pd.DataFrame(incs[i], columns=["time", "dn", "de"]),
                         pd.DataFrame(fixes[i], columns=["time", "lat", "lon", "h", "cum_dn", "cum_de", "std_m"]))
         if errors:
-            e = metrics.navigation_errors(traj, ctx.drive.reference)
+            e = metrics.navigation_errors(traj, ctx.drive.reference, ctx.drive.meta)
             e.insert(1, "t_rel", e["time"] - r.start)
             run.errors = e
         out.append(run)
@@ -435,7 +435,7 @@ def gps_run(ctx: NavContext, start: float, duration: float, errors: bool = True)
     traj = tr.loc[m].reset_index(drop=True)
     run = OutageRun("GPS", None, float(start), float(duration), traj)
     if errors:
-        e = metrics.navigation_errors(traj, ctx.drive.reference)
+        e = metrics.navigation_errors(traj, ctx.drive.reference, ctx.drive.meta)
         e.insert(1, "t_rel", e["time"] - start)
         run.errors = e
     return run

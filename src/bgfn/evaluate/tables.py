@@ -120,7 +120,7 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
     rows = [{"outage": outage_no[r.start], "start_s": r.start, "method": r.method, "seed": r.seed,
              **window_metrics(r.errors, r.start, r.duration)} for r in runs]
     per_seed = pd.DataFrame(rows)
-    fixes = fix_errors(drive.gnss, drive.reference, ctx.lever)
+    fixes = fix_errors(drive.gnss, drive.reference, ctx.lever, drive.meta)
     return TableResult(dataset, test_of(dataset) or dataset, per_seed,
                        aggregate_seeds(per_seed, ecfg["seed_aggregate"]), runs, models, fixes,
                        fix_error_table(fixes, windows), drive)

@@ -28,7 +28,8 @@ Modules (pyins style, one concept each; SI units, radians, NED, tables as in CON
   the pseudo-GPS hook (``PseudoFix``, ``PseudoGpsContext``, ``IncrementPseudoGps`` = Eq. pred-gps,
   ``TablePseudoGps``).
 - :mod:`~bgfn.nav.metrics` -- ``navigation_errors``, ``outage_metrics`` (max |east|, max |north|,
-  horizontal RMSE, end error), ``rms_table``.
+  horizontal RMSE, end error), ``rms_table``; ``reference_rows`` (a drive's spans where the reference is not
+  trusted, ``meta["reference_excluded_s"]``, left out of every comparison).
 - :mod:`~bgfn.nav.baseline` -- notebook 02: ``nav_config``, ``run_drive(drive, nav_section)``,
   ``run_baseline(drive, cfg, windows)``, ``ins_layout``, ``save_baseline``; :mod:`~bgfn.nav.plots` -- its figures.
 - :mod:`~bgfn.nav.navego_setup` -- the filter set up as NaveGo v1.4's ``ins_gnss.m`` (``nav.ins_tuning: navego``):

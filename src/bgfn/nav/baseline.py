@@ -181,11 +181,11 @@ def run_baseline(drive, cfg: dict, windows) -> Baseline:
     starts = epochs_before(drive.imu["time"], [w.start for w in windows], drive.name)
     full = run_filter(imu, initial, noise, drive.gnss, lever, snapshots=dict(zip(names, starts)),
                       gate_probability=cfg["innovation_gate"], source=drive.name)
-    errors = metrics.navigation_errors(full.trajectory, drive.reference)
+    errors = metrics.navigation_errors(full.trajectory, drive.reference, drive.meta)
     rows, outage_errors = [], {}
     for n, w in zip(names, windows):
         res = run_outage(imu, full.states[n], w, noise, lever, source=drive.name)
-        e = metrics.navigation_errors(res.trajectory, drive.reference)
+        e = metrics.navigation_errors(res.trajectory, drive.reference, drive.meta)
         e.insert(1, "t_rel", e["time"] - w.start)
         outage_errors[n] = e
         rows.append({"dataset": drive.name, "outage": n, **metrics.outage_metrics(e, w)})

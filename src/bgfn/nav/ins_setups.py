@@ -84,7 +84,7 @@ def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None
             s.gyro_bias[:] = 0.0      # NaveGo v1.4 keeps no accumulated bias estimate (ins_gnss.m l. 366, 412)
             s.accel_bias[:] = 0.0
             e = metrics.navigation_errors(run_outage(imu, s, w, b.noise, lever, source=drive.name).trajectory,
-                                          drive.reference)
+                                          drive.reference, drive.meta)
             m = metrics.outage_metrics(e, w)
             rows.append(_row(drive.name, test, k + 1, RESET, m["max_abs_east"], m["max_abs_north"]))
     if test:

@@ -1,7 +1,11 @@
 """Navigation error metrics: error time series against the reference, per-outage numbers (paper Tables 1-2).
 
 Errors are *computed minus reference*, position errors in metres in the local NED frame of the reference
-point (exact, via ECEF), attitude errors wrapped to (-pi, pi].
+point (exact, via ECEF), attitude errors wrapped to (-pi, pi] (NaN where the reference has no attitude).
+
+A drive may name spans where its reference is not trusted (``Drive.meta["reference_excluded_s"]``, e.g. the
+epochs of an RTK reference that are not fixed); every comparison with the reference leaves the rows inside them
+out, through the one helper :func:`reference_rows`.
 """
 
 from __future__ import annotations
@@ -15,6 +19,41 @@ from .outages import OutageWindow
 
 #: Columns of :func:`navigation_errors`.
 ERROR_COLUMNS = ["time", "north", "east", "down", "horizontal", "v_n", "v_e", "v_d", "roll", "pitch", "yaw"]
+#: Key of ``Drive.meta``: ``[[t0, t1], ...]`` (s), spans where the reference is not trusted.
+REFERENCE_EXCLUDED_KEY = "reference_excluded_s"
+
+
+def excluded_spans(meta: dict | None) -> list[tuple[float, float]]:
+    """The spans of ``meta[REFERENCE_EXCLUDED_KEY]`` (none when absent), as ``(t0, t1)`` in s."""
+    spans = (meta or {}).get(REFERENCE_EXCLUDED_KEY) or []
+    out = []
+    for span in spans:
+        if len(span) != 2 or not float(span[0]) <= float(span[1]):
+            raise DataError("meta", REFERENCE_EXCLUDED_KEY, "spans [t0, t1] with t0 <= t1, s", repr(span))
+        out.append((float(span[0]), float(span[1])))
+    return out
+
+
+def reference_rows(time, excluded_s=()) -> np.ndarray:
+    """Which epochs may be compared with the reference: False inside any excluded span ``[t0, t1]``.
+
+    Parameters
+    ----------
+    time : array_like
+        s.
+    excluded_s : sequence of (t0, t1) or dict
+        Spans, s, or a drive's ``meta`` (:func:`excluded_spans`).
+
+    Returns
+    -------
+    ndarray of bool
+    """
+    t = np.asarray(time, dtype=float)
+    spans = excluded_spans(excluded_s) if isinstance(excluded_s, dict) else excluded_s
+    keep = np.ones(t.shape, dtype=bool)
+    for t0, t1 in spans:
+        keep &= ~((t >= float(t0)) & (t <= float(t1)))
+    return keep
 
 
 def align(trajectory: pd.DataFrame, reference: pd.DataFrame, tol: float = 1e-6, source="trajectory"):
@@ -40,19 +79,25 @@ def align(trajectory: pd.DataFrame, reference: pd.DataFrame, tol: float = 1e-6, 
     return reference.iloc[i].reset_index(drop=True)
 
 
-def navigation_errors(trajectory: pd.DataFrame, reference: pd.DataFrame) -> pd.DataFrame:
+def navigation_errors(trajectory: pd.DataFrame, reference: pd.DataFrame, excluded_s=()) -> pd.DataFrame:
     """Position (NED, m), velocity (m/s) and attitude (rad) errors of a trajectory.
 
     Parameters
     ----------
     trajectory, reference : DataFrame
         Reference schema; every trajectory time must have a reference row.
+    excluded_s : sequence of (t0, t1) or dict
+        Spans where the reference is not trusted, or the drive's ``meta`` holding them
+        (:func:`reference_rows`); their rows are left out.
 
     Returns
     -------
     DataFrame
         Columns ``ERROR_COLUMNS``; ``horizontal = hypot(north, east)``.
     """
+    keep = reference_rows(trajectory["time"].to_numpy(float), excluded_s)
+    if not keep.all():
+        trajectory = trajectory.loc[keep].reset_index(drop=True)
     ref = align(trajectory, reference)
     ned = earth.lla_to_ned(trajectory["lat"].to_numpy(), trajectory["lon"].to_numpy(),
                            trajectory["h"].to_numpy(), ref["lat"].to_numpy(), ref["lon"].to_numpy(),

@@ -219,3 +219,31 @@ def test_check_with_drives_applies_the_rule_to_each_drive(tmp_path, monkeypatch)
     with pytest.raises(DataError) as err:
         check_with_drives("mine")
     assert err.value.field == "outage_windows.sim" and "inside the drive sim" in str(err.value), str(err.value)
+
+
+# ----------------------------------------------------------------------------------------------- the callers
+def test_training_and_evaluation_take_each_datasets_outages():
+    from bgfn import evaluate as ev
+    from bgfn import train as T
+    from bgfn.config import load_profile, with_overrides
+
+    smoke = T.TrainingPlan.of("smoke")                     # the shipped mapping: every Turin dataset the default
+    default = outages.default_windows(smoke.cfg)
+    assert smoke.per_dataset and smoke.outage_windows == default == [(138906.0, 30.0), (139170.0, 30.0)]
+    assert smoke.windows_of("turin-sim-mpu6000") == default
+    fixed = T.TrainingPlan.of("smoke", outage_windows=[(1.0, 2.0)])
+    assert not fixed.per_dataset and fixed.windows_of("rtklib-drive0708") == [(1.0, 2.0)]
+    cfg = {"profile": "p", "description": "d", "train": {"margin_s": 30.0},
+           "outage_windows": {"default": [[1100.0, 30.0]], "sim": dict(RULE)}}
+    plan = T.TrainingPlan("p", cfg, ["turin", "sim"], ["mlp"], [0], [(1100.0, 30.0)], per_dataset=True)
+    d = drive()
+    assert plan.windows_of("sim", d) == [(1225.0, 30.0), (1385.0, 30.0)]
+    assert plan.windows_of("turin") == [(1100.0, 30.0)]
+    assert "turin: [(1100.0, 30.0)]; sim: rule cruise_and_manoeuvre (picked from the drive)" in plan.describe()
+    # notebook 04's setup: the default list, and a line for each dataset with its own entry
+    prof = with_overrides(load_profile("smoke"), {"evaluate.datasets": ["turin-sim-ekinox", "sim", "other"]})
+    prof["outage_windows"] = {**prof["outage_windows"], "sim": dict(RULE), "other": [[138800.0, 10.0]]}
+    setup = ev.evaluation_setup(prof, sweep_datasets=[])
+    assert setup.windows == default
+    assert setup.describe()[3] == (f"outages (start, duration) s: {[list(w) for w in default]}; sim: rule "
+                                   "cruise_and_manoeuvre (picked from the drive); other: [[138800.0, 10.0]]")

@@ -9,7 +9,8 @@ may be left out (the module that reads a section fills its defaults: ``bgfn.nav.
 schema is an error with the closest valid key suggested (a typo never silently falls back to a default).
 
 The checks that need the data (outages inside the drive, a rule's outages found in it, a window shorter than
-the GPS-available data, a possible outage sweep) run in :func:`check_with_drives`, the ``make`` step, after the data are fetched.
+the GPS-available data, a possible outage sweep) run in :func:`check_with_drives`, the ``make`` step, after the
+data are fetched.
 """
 
 from __future__ import annotations
@@ -286,13 +287,14 @@ def _check_outage_entries(cfg: dict) -> None:
                 raise ProfileError(f"{path}.rule", "the name of the rule that picks the windows", "missing")
         else:
             _check_window_list(path, entry, t0, t1)
+    from bgfn.nav.outages import DEFAULT_KEY
+
     spec = cfg.get("outage_windows")
-    if isinstance(spec, dict) and "default" not in spec:
-        # the datasets of the notebooks and the sweep (evaluation outages: only the datasets evaluated)
+    if isinstance(spec, dict) and DEFAULT_KEY not in spec:      # every dataset a notebook loads needs its outages
         uncovered = [d for d in _profile_datasets(cfg) if d not in spec]
         if uncovered:
-            raise ProfileError("outage_windows", "an entry for every dataset of the profile, or a 'default' entry",
-                               f"none for {', '.join(uncovered)}")
+            raise ProfileError("outage_windows", f"an entry for every dataset of the profile, or a '{DEFAULT_KEY}' "
+                               "entry", f"none for {', '.join(uncovered)}")
 
 
 def cross_check(cfg: dict) -> None:

@@ -59,7 +59,7 @@ def test_paper_layout_without_our_table_keeps_the_papers_values():
 
 def test_paper_table_read_from_the_transcription():
     raw = pd.read_csv(PROJECT_ROOT / "data" / "paper" / "outage_max_errors.csv")
-    for test in paper.TESTS:
+    for test in [t for t in paper.TESTS if paper.has_own_values(t)]:
         p = paper.outage_table(test)
         lay = paper.layout(None, p)
         for r in raw[raw["test"] == test].itertuples():
@@ -411,7 +411,7 @@ def results(tmp_path, ours=None, **inputs) -> report.ProfileResults:
     out = tmp_path / "p"
     fields = {"profile": "p", "cfg": {"train": {"seeds": [0], "datasets": ["d1"]}}, "out": out, "current": None,
               "claims": paper.claims(), "kf": None, "training": None, "evaluation": None, "energy": None,
-              "ours": {"dataset": ours, "field": None}, "published": {t: paper.outage_table(t) for t in paper.TESTS},
+              "ours": {"dataset": ours, "field": None}, "published": {t: paper.published_values(t) for t in paper.TESTS},
               "training_summary": None, "training_times": None, "sweep": None, "sweep_pairs": None}
     return report.ProfileResults(**{**fields, **inputs})
 
@@ -450,6 +450,43 @@ def test_outage_section_serves_both_tests(tmp_path):
     assert fd.all_rows == [] and fd.comparison == ["- Outage 1: no BGFN row in our table.\n"
                                                    "- Outage 2: no BGFN row in our table."]
     assert fd.layout[1].data[("paper", "BGFN", "East")].notna().all()
+
+
+def test_the_real_drive_stands_beside_the_papers_field_test(tmp_path):
+    from bgfn import evaluate as ev
+    from bgfn.nav import baseline
+
+    assert paper.test_of("rtklib-drive0708") == "real" and not paper.has_own_values("real")
+    pd.testing.assert_frame_equal(paper.published_values("real"), paper.outage_table("field"))
+    assert (paper.paper_label("real"), paper.paper_label("field")) == ("paper (field test)", "paper")
+    assert ev.paper_table_title("field") == "Table 2 (field test)"
+    assert ev.paper_table_title("real") == "real drive (not in the paper; beside it Table 2 (field test))"
+    res = results(tmp_path, OURS)
+    assert report.shown_tests(res) == ["dataset", "field"]          # no real-drive table, none evaluated: hidden
+    glance = report.glance_lines("p", res.ours, res.published, None, res.claims, None)
+    assert not any(line.startswith("Real drive") for line in glance)
+    res.ours["real"] = OURS
+    assert report.shown_tests(res) == ["dataset", "field", "real"]
+    sec = report.outage_section(res, "real")
+    caption = sec.layout[0].caption
+    assert caption.startswith(paper.TESTS["real"]["caption"]) and "field test (Table tab-real)" in caption
+    lay = sec.layout[0].data
+    assert lay.loc["Outage 1", ("paper (field test)", "INS", "East")] == 289.4      # the paper's Table tab-real
+    assert not any(c[0] == "paper" for c in lay.columns)
+    # BGFN's reduction beside the field test's table and text (its outage 2, the manoeuvre: 90.0 % east)
+    assert "paper's field test table" in sec.reduction[2] and "paper's field test text: 90.0 %" in sec.reduction[2]
+    glance = report.glance_lines("p", res.ours, res.published, None, res.claims, None)
+    real = [line for line in glance if line.startswith("Real drive")]
+    assert len(real) == 1 and "(paper's field test: " in real[0]
+    assert "(paper's field test: " in report.comparison_sentences("real", OURS, res.published["real"])[0]
+    # notebook 04's claim lines quote the paper's own tests only; notebook 02's INS row says whose it is
+    reductions = {"rtklib-drive0708": report.reduction_comparison(OURS, res.published["real"], res.claims, "real")}
+    claimed = ev.claim_lines({})
+    assert len(claimed) == 2 and all("real drive" not in line for line in claimed)   # dataset 1, field 2
+    beside = baseline.ins_layout(pd.DataFrame({"max_abs_east": [1.0, 2.0], "max_abs_north": [3.0, 4.0]}),
+                                 "rtklib-drive0708")
+    assert beside.loc["Outage 2", ("paper (field test)", "INS", "East")] == 477.5
+    assert reductions["rtklib-drive0708"].loc["Outage 2", ("paper (text)", "East")] == 90.0
 
 
 def test_sections_name_the_notebook_of_a_missing_input(tmp_path):

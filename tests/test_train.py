@@ -402,7 +402,8 @@ def test_training_metrics_gather_what_training_json_holds():
     m = T.training_metrics(plan, prepared, runs, summary, T.windows_table(prepared))
     assert list(m) == ["runs", "summary", "windows", "learning_options", "outage_windows", "meta"]
     assert m["runs"][0]["wall_time_s"] == 1.5                     # training.json keeps the times
-    assert m["learning_options"] == {"a": prepared["a"].data.options} and m["outage_windows"] == [(1100.0, 10.0)]
+    assert m["learning_options"] == {"a": prepared["a"].data.options}
+    assert m["outage_windows"] == {"a": [[1100.0, 10.0]]}         # per dataset: the windows its data left out
     assert m["windows"][0]["dataset"] == "a" and m["meta"]["profile"] == "smoke"
 
 

@@ -53,8 +53,8 @@ DATA_DIR: Path = PROJECT_ROOT / "data"
 
 #: Profiles shipped with the artifact (users may add their own ``params/<name>.yaml``).
 PROFILES: tuple[str, ...] = ("smoke", "quick", "paper")
-#: Top-level keys every profile file must define (``outage_windows``: the evaluation outages, read by
-#: :func:`bgfn.nav.outages.outage_windows`, shared by notebooks 01-04).
+#: Top-level keys every profile file must define (``outage_windows``: the evaluation outages, one list or per
+#: dataset a list or a rule, read by :func:`bgfn.nav.outages.outage_windows`, shared by notebooks 01-04).
 SCALAR_KEYS: tuple[str, ...] = ("profile", "description", "seed", "outage_windows")
 #: One section per notebook: 01 data, 02 nav (KF baseline), 03 train, 04 evaluate, 05 energy.
 SECTION_KEYS: tuple[str, ...] = ("data", "nav", "train", "evaluate", "energy")
@@ -180,7 +180,8 @@ def load_profile(profile: str) -> dict[str, Any]:
     -------
     dict
         The parsed YAML (merged over its bases): ``profile`` (str, equal to the file name), ``description``
-        (str), ``seed`` (int), ``outage_windows`` (list of [start, duration], s) and one mapping per notebook section (``data``, ``nav``, ``train``,
+        (str), ``seed`` (int), ``outage_windows`` (a list of [start, duration], s, or a mapping dataset -> such a list
+        or a rule, with ``default``) and one mapping per notebook section (``data``, ``nav``, ``train``,
         ``evaluate``, ``energy``; an empty section is returned as ``{}``). A fresh copy on every call.
 
     Raises
@@ -296,8 +297,8 @@ def _check_moved_keys(path: Path, own: dict) -> None:
     for old, new in MOVED_KEYS.items():
         section, key = old.split(".")
         if isinstance(own.get(section), dict) and key in own[section]:
-            raise DataError(path, old, f"the top-level key {new!r} instead (one list of [start, duration] in s "
-                            "for every notebook)", f"{old}: {own[section][key]!r}")
+            raise DataError(path, old, f"the top-level key {new!r} instead (a list of [start, duration] in s, "
+                            "or per dataset a list or a rule; shared by every notebook)", f"{old}: {own[section][key]!r}")
 
 
 def results_dir(profile: str, create: bool = True) -> Path:

@@ -8,8 +8,9 @@ ours in a column labelled *paper*; no code reads them to choose a parameter, a s
 
 Vocabulary
 ----------
-- *test*: ``dataset`` (the paper's Table ``tab-out1-exin``, NaveGo's Turin drive, Ekinox-D IMU) or ``field``
-  (Table ``tab-real``, the paper's own car with an MPU-6000 IMU);
+- *test*: ``dataset`` (the paper's Table ``tab-out1-exin``, NaveGo's Turin drive, Ekinox-D IMU), ``field``
+  (Table ``tab-real``, the paper's own car with an MPU-6000 IMU) or ``real`` (ours: a recorded car drive with a
+  MEMS IMU; the paper has no such table, so the paper's field test is shown beside it, :func:`published_test`);
 - *method label*: how a table names a method (``INS``, ``MLP``, ``AT-LSTM``, ``BGFN``, and ours beyond the
   paper: ``Transformer``, ``GPS``); a *method id* is the key of :mod:`bgfn.models` (``bgfn``, ``mlp``, ...).
 """
@@ -40,22 +41,50 @@ AXES: tuple[tuple[str, str], ...] = (("max_east_m", "East"), ("max_north_m", "No
 #: Decimals of the paper's tables: values equal at this precision are called equal.
 DECIMALS = 1
 
-#: The paper's two outage tests: its table label, our title, our table file (``results/<profile>/tables/``)
-#: and the paper's caption.
-TESTS: dict[str, dict[str, str]] = {
+#: The outage tests: the paper's two and our real drive. Per test: the paper's table label (None: not a table of
+#: the paper), our title, our table file (``results/<profile>/tables/``), the caption, and ``paper``: the
+#: paper's test whose published values stand beside ours (:func:`published_test`).
+TESTS: dict[str, dict] = {
     "dataset": {"label": "tab-out1-exin", "title": "dataset test", "file": "outage_dataset.csv",
-                "caption": "The max position error (m) among different algorithms in the dataset test"},
+                "caption": "The max position error (m) among different algorithms in the dataset test",
+                "paper": "dataset"},
     "field": {"label": "tab-real", "title": "field test", "file": "outage_field.csv",
-              "caption": "The max position error among different algorithms in the real field test"},
+              "caption": "The max position error among different algorithms in the real field test",
+              "paper": "field"},
+    # a recorded car drive (issue 16): no values of its own in the paper; its field test (also a car with a
+    # MEMS IMU, one outage cruising, one manoeuvring) is the closest published comparison
+    "real": {"label": None, "title": "real drive", "file": "outage_real.csv",
+             "caption": "The max position error (m) among different algorithms on a recorded car drive with a "
+                        "MEMS IMU (not in the paper; the paper's field test beside it)",
+             "paper": "field"},
 }
-#: Our dataset -> the paper's test it stands for.
+#: Our dataset -> the test it stands for.
 DATASET_TESTS: dict[str, str] = {"turin-sim-ekinox": "dataset", "navego-ekinox": "dataset",
-                                 "turin-sim-mpu6000": "field", "navego-mpu6000": "field"}
+                                 "turin-sim-mpu6000": "field", "navego-mpu6000": "field",
+                                 "rtklib-drive0708": "real"}
 
 
 def test_of(dataset: str) -> str | None:
-    """The paper's test (``dataset`` | ``field``) that ``dataset`` stands for, or None."""
+    """The test (``dataset`` | ``field`` | ``real``) that ``dataset`` stands for, or None."""
     return DATASET_TESTS.get(dataset)
+
+
+def published_test(test: str) -> str:
+    """The paper's test whose published values stand beside our ``test``: itself for ``dataset`` and
+    ``field``, the field test for ``real``; an unknown name is returned as given."""
+    return (TESTS.get(test) or {}).get("paper", test)
+
+
+def has_own_values(test: str) -> bool:
+    """Whether the paper publishes a table for ``test`` itself (``dataset``, ``field``; not ``real``)."""
+    return test in TESTS and published_test(test) == test
+
+
+def paper_label(test: str) -> str:
+    """The column label of the paper's values beside our ``test``: ``paper``, or ``paper (field test)`` when
+    they are another test's."""
+    shown = published_test(test)
+    return "paper" if shown == test else f"paper ({TESTS[shown]['title']})"
 
 
 def label(method: str) -> str:
@@ -69,17 +98,23 @@ def _outage_values() -> pd.DataFrame:
 
 
 def outage_table(test: str) -> pd.DataFrame:
-    """The paper's max errors of one test: ``outage, method, max_east_m, max_north_m`` (m).
+    """The paper's max errors of one of its tests: ``outage, method, max_east_m, max_north_m`` (m).
 
     Raises
     ------
     ValueError
-        ``test`` is not one of the paper's tests.
+        ``test`` is not one of the paper's tests (``real`` has no table of its own: use
+        :func:`published_values`).
     """
     p = _outage_values()
     if test not in set(p["test"]):
         raise ValueError(f"no test {test!r} in {OUTAGE_TABLE_FILE.name} (have {sorted(set(p['test']))})")
     return p[p["test"] == test].drop(columns="test").reset_index(drop=True)
+
+
+def published_values(test: str) -> pd.DataFrame:
+    """The paper's max errors shown beside our ``test``: :func:`outage_table` of :func:`published_test`."""
+    return outage_table(published_test(test))
 
 
 def claims() -> dict:

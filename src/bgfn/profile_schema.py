@@ -8,8 +8,9 @@ may be left out (the module that reads a section fills its defaults: ``bgfn.nav.
 ``bgfn.train`` and ``bgfn.learning`` defaults, ``bgfn.evaluate.EVALUATE_DEFAULTS``); a key that is not in the
 schema is an error with the closest valid key suggested (a typo never silently falls back to a default).
 
-The checks that need the data (outages inside the drive, a window shorter than the GPS-available data, a
-possible outage sweep) run in :func:`check_with_drives`, the ``make`` step, after the data are fetched.
+The checks that need the data (outages inside the drive, a rule's outages found in it, a window shorter than
+the GPS-available data, a possible outage sweep) run in :func:`check_with_drives`, the ``make`` step, after the
+data are fetched.
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ class ProfileError(ValueError):
 @dataclass(frozen=True)
 class Spec:
     """What one key holds. ``kind``: ``number``, ``integer``, ``text``, ``flag``, ``list``, ``section``
-    (known keys), ``mapping`` (free keys, each value ``item``) or ``any``."""
+    (known keys), ``mapping`` (free keys, each value ``item``), ``either`` (one of ``options``) or ``any``."""
 
     kind: str
     null: bool = False
@@ -44,6 +45,7 @@ class Spec:
     length: int | None = None
     min_len: int = 0
     fields: dict = field(default_factory=dict)
+    options: tuple = ()
 
 
 def number(lo=None, hi=None, *, lo_open=False, hi_open=False, null=False) -> Spec:
@@ -72,6 +74,12 @@ def section(**fields: Spec) -> Spec:
 
 def mapping(item: Spec) -> Spec:
     return Spec("mapping", item=item)
+
+
+def either(*options: Spec) -> Spec:
+    """A value that meets one of ``options`` (a list or a mapping, say); the message is the option of the
+    value's own type."""
+    return Spec("either", options=tuple(options))
 
 
 ANY = Spec("any")
@@ -108,11 +116,19 @@ RTKLIB_DRIVE = section(
     seed=_SEED, imu_rate_hz=_POS, gnss_rate_hz=_POS, gnss_white_std_m=seq(_NONNEG, length=3),
     gnss_correlated_std_m=seq(_NONNEG, length=3), gnss_correlated_tau_s=_POS, imu_errors=mapping(ANY),
     imu_time_offset_s=number(-1.0, 1.0), t_start=number(null=True), t_end=number(null=True))
+#: Evaluation outages typed in: ``[[start, duration], ...]`` (s, GPS time of week).
+OUTAGE_LIST = seq(seq(number(), length=2), min_len=1)
+#: Outages picked from a drive by a rule (:mod:`bgfn.nav.outage_rules`; its defaults fill left-out keys).
+OUTAGE_RULE = section(
+    rule=text("cruise_and_manoeuvre"), duration_s=_POS, step_s=_POS, warmup_s=_NONNEG, min_speed_mps=_NONNEG,
+    cruise_max_yaw_rate_dps=_NONNEG, manoeuvre_min_yaw_rate_dps=_NONNEG, gap_s=_NONNEG, min_training_s=_NONNEG)
+#: ``outage_windows``: one list for every dataset, or per dataset name (and ``default``) a list or a rule.
+OUTAGE_WINDOWS = either(OUTAGE_LIST, mapping(either(OUTAGE_LIST, OUTAGE_RULE)))
 
 #: The whole profile.
 SCHEMA = section(
     profile=text(), description=text(), seed=_SEED, base=text(),
-    outage_windows=seq(seq(number(), length=2), min_len=1),
+    outage_windows=OUTAGE_WINDOWS,
     data=section(
         datasets=_NAMES, seed=_SEED, imu_rate_hz=_POS, smoothing_degree=integer(1, 5),
         position_sigma_m=_POS, attitude_sigma_rad=_POS, t_start=number(null=True), t_end=number(null=True),
@@ -157,6 +173,8 @@ def _range(spec: Spec) -> str:
 
 
 def _describe(spec: Spec) -> str:
+    if spec.kind == "either":
+        return " or ".join(_describe(o) for o in spec.options) + (" or null" if spec.null else "")
     what = {"number": "a number", "integer": "an integer", "text": "a string", "flag": "true or false",
             "list": "a list", "section": "a mapping of keys", "mapping": "a mapping", "any": "a value"}[spec.kind]
     if spec.choices:
@@ -178,6 +196,19 @@ def check(value: Any, spec: Spec, path: str) -> None:
             return
         raise ProfileError(path, _describe(spec), "null")
     k = spec.kind
+    if k == "either":
+        failures = []
+        for option in spec.options:
+            try:
+                check(value, option, path)
+                return
+            except ProfileError as exc:
+                failures.append((option, exc))
+        for option, exc in failures:            # the option of the value's own type says best what is wrong
+            if (option.kind == "list") == isinstance(value, list) and \
+                    (option.kind in ("section", "mapping")) == isinstance(value, dict):
+                raise exc
+        raise ProfileError(path, _describe(spec), _fmt(value))
     if k in ("number", "integer"):
         ok = isinstance(value, int) if k == "integer" else isinstance(value, (int, float))
         if isinstance(value, bool) or not ok or (isinstance(value, float) and not math.isfinite(value)):
@@ -215,28 +246,69 @@ def check(value: Any, spec: Spec, path: str) -> None:
                 raise ProfileError(sub, f"one of the keys {', '.join(sorted(spec.fields))}{hint}", "unknown key")
 
 
-def _windows(cfg: dict) -> list[tuple[float, float]]:
-    return [(float(s), float(d)) for s, d in cfg.get("outage_windows") or []]
+def _window_entries(cfg: dict) -> list[tuple[str, Any]]:
+    """``(key path, entry)`` of every ``outage_windows`` entry: the one list, or each dataset's list or rule."""
+    spec = cfg.get("outage_windows")
+    if isinstance(spec, dict):
+        return [(f"outage_windows.{k}", v) for k, v in spec.items()]
+    return [("outage_windows", spec or [])]
+
+
+def _windows(entry) -> list[tuple[float, float]]:
+    return [(float(s), float(d)) for s, d in entry]
+
+
+def _check_window_list(path: str, entry: list, t0, t1) -> None:
+    """Positive durations, no overlap, inside ``data.t_start``/``data.t_end``."""
+    for i, (s, d) in enumerate(_windows(entry)):
+        if d <= 0:
+            raise ProfileError(f"{path}[{i}]", "a positive duration, s", _fmt([s, d]))
+    wins = sorted(_windows(entry))
+    for (s0, d0), (s1, d1) in zip(wins[:-1], wins[1:]):
+        if s1 < s0 + d0:
+            raise ProfileError(path, "windows that do not overlap",
+                               f"[{s0:g}, {s0 + d0:g}] overlaps [{s1:g}, {s1 + d1:g}]")
+    for i, (s, d) in enumerate(_windows(entry)):
+        if (t0 is not None and s < t0) or (t1 is not None and s + d > t1):
+            raise ProfileError(f"{path}[{i}]", f"inside the data [{t0}, {t1}] s (data.t_start, data.t_end)",
+                               _fmt([s, d]))
+
+
+def _profile_datasets(cfg: dict) -> list[str]:
+    """Every dataset a notebook of the profile loads (data, nav, train, evaluate and its sweep), in order."""
+    ev = cfg.get("evaluate") or {}
+    return list(dict.fromkeys(
+        [d for sec in ("data", "nav", "train", "evaluate") for d in (cfg.get(sec) or {}).get("datasets") or []]
+        + ((ev.get("sweep") or {}).get("datasets") or [])))
+
+
+def _check_outage_entries(cfg: dict) -> None:
+    """Each list entry well formed; each rule names its rule; a mapping answers for every dataset."""
+    data = cfg.get("data") or {}
+    t0, t1 = data.get("t_start"), data.get("t_end")
+    if t0 is not None and t1 is not None and t1 <= t0:
+        raise ProfileError("data.t_end", f"a time after data.t_start = {t0:g} s", _fmt(t1))
+    for path, entry in _window_entries(cfg):
+        if isinstance(entry, dict):
+            if "rule" not in entry:
+                raise ProfileError(f"{path}.rule", "the name of the rule that picks the windows", "missing")
+        else:
+            _check_window_list(path, entry, t0, t1)
+    from bgfn.nav.outages import DEFAULT_KEY
+
+    spec = cfg.get("outage_windows")
+    if isinstance(spec, dict) and DEFAULT_KEY not in spec:      # every dataset a notebook loads needs its outages
+        uncovered = [d for d in _profile_datasets(cfg) if d not in spec]
+        if uncovered:
+            raise ProfileError("outage_windows", f"an entry for every dataset of the profile, or a '{DEFAULT_KEY}' "
+                               "entry", f"none for {', '.join(uncovered)}")
 
 
 def cross_check(cfg: dict) -> None:
     """The facts that tie keys together and need no data; :class:`ProfileError` naming the key."""
-    wins = sorted(_windows(cfg))
-    for i, (s, d) in enumerate(_windows(cfg)):
-        if d <= 0:
-            raise ProfileError(f"outage_windows[{i}]", "a positive duration, s", _fmt([s, d]))
-    for (s0, d0), (s1, d1) in zip(wins[:-1], wins[1:]):
-        if s1 < s0 + d0:
-            raise ProfileError("outage_windows", "windows that do not overlap",
-                               f"[{s0:g}, {s0 + d0:g}] overlaps [{s1:g}, {s1 + d1:g}]")
+    _check_outage_entries(cfg)
     data, tr, ev = cfg.get("data") or {}, cfg.get("train") or {}, cfg.get("evaluate") or {}
     t0, t1 = data.get("t_start"), data.get("t_end")
-    if t0 is not None and t1 is not None and t1 <= t0:
-        raise ProfileError("data.t_end", f"a time after data.t_start = {t0:g} s", _fmt(t1))
-    for i, (s, d) in enumerate(_windows(cfg)):
-        if (t0 is not None and s < t0) or (t1 is not None and s + d > t1):
-            raise ProfileError(f"outage_windows[{i}]", f"inside the data [{t0}, {t1}] s (data.t_start, data.t_end)",
-                               _fmt([s, d]))
     rate = data.get("imu_rate_hz")
     if "window" in tr and rate and t0 is not None and t1 is not None and tr["window"] / rate >= (t1 - t0):
         raise ProfileError("train.window", f"a window shorter than the data ({t1 - t0:g} s at {rate:g} Hz)",
@@ -295,9 +367,8 @@ def check_with_drives(profile: str) -> list[str]:
     from bgfn.config import load_profile, profile_chain
     from bgfn.data import load_drive
     from bgfn.errors import DataError
-    from bgfn.nav.outages import check_windows
-
     from bgfn.learning import learning_options
+    from bgfn.nav.outages import DEFAULT_KEY, check_windows, is_rule, outage_entry, picked_outages
 
     cfg = load_profile(profile)
     path = profile_chain(profile)[0]
@@ -305,25 +376,36 @@ def check_with_drives(profile: str) -> list[str]:
     opts = learning_options(tr)                 # the window and margin notebook 03 uses, defaults filled in
     names = dict.fromkeys(cfg["nav"].get("datasets", []) + tr.get("datasets", []) + ev.get("datasets", [])
                           + (ev.get("sweep") or {}).get("datasets", []))
+    spec = cfg.get("outage_windows")
     lines = []
     for name in names:
         drive = load_drive(name, profile=profile)
         t = drive.imu["time"].to_numpy(float)
         t0, t1 = float(drive.reference["time"].iloc[0]), float(t[-1])
-        try:
-            check_windows(_windows(cfg), t0, t1, name)
+        key = (f"outage_windows.{name if name in spec else DEFAULT_KEY}" if isinstance(spec, dict)
+               else "outage_windows")
+        entry = outage_entry(cfg, name)
+        rule = is_rule(entry)
+        try:                                    # a rule picks the windows from the drive (the notebooks' reader)
+            windows = picked_outages(cfg, drive, name).windows if rule else _windows(entry)
         except DataError as exc:
-            raise DataError(path, "outage_windows", f"windows inside the drive {name} [{t0:.3f}, {t1:.3f}] s",
+            raise DataError(path, f"{key}.{exc.field}", f"{exc.expected} in the drive {name}", exc.found) from None
+        try:
+            check_windows(windows, t0, t1, name)
+        except DataError as exc:
+            raise DataError(path, key, f"windows inside the drive {name} [{t0:.3f}, {t1:.3f}] s",
                             exc.found) from None
         rate = float(drive.meta.get("imu_rate_hz") or 1.0 / float(t[1] - t[0]))
         window_s = int(opts["window"]) / rate
         margin = float(opts["margin_s"])
-        blocked = sum(d + 2 * margin for _, d in _windows(cfg))
+        blocked = sum(d + 2 * margin for _, d in windows)
         if window_s >= (t1 - t0) - blocked:
             raise DataError(path, "train.window", f"a window shorter than the GPS-available data of {name} "
                             f"({(t1 - t0) - blocked:.1f} s outside the outages and their margins)",
                             f"{opts['window']} samples = {window_s:g} s")
-        lines.append(f"{name}: {t0:.2f}..{t1:.2f} s, outages inside, window {window_s:g} s")
+        how = "picked by the rule" if rule else "inside"
+        lines.append(f"{name}: {t0:.2f}..{t1:.2f} s, outages {how} {[list(w) for w in windows]}, "
+                     f"window {window_s:g} s")
     from bgfn.evaluate import evaluate_config, sweep_plan
 
     sw = evaluate_config(ev, tr)["sweep"]

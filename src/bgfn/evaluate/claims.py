@@ -1,5 +1,7 @@
 """Our outage tables beside the paper's: its Tables 1-2 (``tab-out1-exin``, ``tab-real``) in its layout, the
-error reductions against INS beside the ones its tables give, and the two reductions its text quotes.
+error reductions against INS beside the ones its tables give, and the two reductions its text quotes. Our real
+drive (test ``real``) has no table in the paper: its field test stands beside it
+(:func:`bgfn.paper.published_values`), labelled as such.
 
 The paper's values are read through :mod:`bgfn.paper` (``data/paper/outage_max_errors.csv`` and
 ``claims.yaml``); they are shown beside ours, never used to choose anything.
@@ -20,9 +22,13 @@ REDUCTION_COLUMNS: tuple[str, ...] = ("outage", "method", "east_%", "north_%", "
 
 
 def paper_table_title(test: str) -> str:
-    """How notebook 04 names the paper's table of a test: ``Table 1 (dataset test)``, ``Table 2 (field test)``
-    (the order of :data:`bgfn.paper.TESTS`)."""
-    return f"Table {list(paper.TESTS).index(test) + 1} ({paper.TESTS[test]['title']})"
+    """How notebook 04 names the paper's table beside a test: ``Table 1 (dataset test)``, ``Table 2 (field
+    test)`` (the order of the paper's tests in :data:`bgfn.paper.TESTS`); for a test the paper has no table of,
+    ``real drive (not in the paper; beside it Table 2 (field test))``."""
+    own = [t for t in paper.TESTS if paper.has_own_values(t)]
+    shown = paper.published_test(test)
+    title = f"Table {own.index(shown) + 1} ({paper.TESTS[shown]['title']})"
+    return title if shown == test else f"{paper.TESTS[test]['title']} (not in the paper; beside it {title})"
 
 
 def ours_above_paper(result: TableResult) -> pd.DataFrame:
@@ -35,15 +41,17 @@ def ours_above_paper(result: TableResult) -> pd.DataFrame:
     -------
     DataFrame
         Rows ``(Outage k, source)``; columns ``(method, axis)`` with axis ``East``/``North``; NaN where the
-        paper has no such method (Transformer, GPS).
+        paper has no such method (Transformer, GPS). The paper's rows are labelled ``paper``, or ``paper (field
+        test)`` beside the real drive (:func:`bgfn.paper.paper_label`).
     """
-    lay = paper.layout(result.table, paper.outage_table(result.test), methods=TABLE_METHODS)
+    lay = paper.layout(result.table, paper.published_values(result.test), methods=TABLE_METHODS,
+                       paper_label=paper.paper_label(result.test))
     return lay.stack("source", future_stack=True)
 
 
 def reduction_table(result: TableResult, reference: str = "INS") -> pd.DataFrame:
     """Reduction of the max east/north errors against ``reference`` (``100 (ref - method) / ref``, %), ours
-    beside the same arithmetic on the paper's table of the same test.
+    beside the same arithmetic on the paper's table of the same test (of its field test for the real drive).
 
     Returns
     -------
@@ -52,7 +60,7 @@ def reduction_table(result: TableResult, reference: str = "INS") -> pd.DataFrame
         has no such row (Transformer, GPS).
     """
     ours = error_reduction(result.table, reference).rename(columns={"east_pct": "east_%", "north_pct": "north_%"})
-    theirs = error_reduction(paper.outage_table(result.test), reference).rename(
+    theirs = error_reduction(paper.published_values(result.test), reference).rename(
         columns={"east_pct": "paper east_%", "north_pct": "paper north_%"})
     return ours.merge(theirs, on=["outage", "method"], how="left")[list(REDUCTION_COLUMNS)]
 
@@ -70,7 +78,8 @@ def claim_lines(reductions: Mapping[str, pd.DataFrame]) -> list[str]:
     -------
     list of str
         ``BGFN vs INS, <test title>, outage <k>: paper quotes E % east / N % north; ours ...`` (``not
-        evaluated`` when no dataset of that test, or no BGFN row, was run).
+        evaluated`` when no dataset of that test, or no BGFN row, was run); the quotes are of the paper's own
+        tests, so a test it has no table of (the real drive) gets no line.
     """
     claims = paper.claims()
     by_test: dict[str, pd.DataFrame] = {}
@@ -78,6 +87,8 @@ def claim_lines(reductions: Mapping[str, pd.DataFrame]) -> list[str]:
         by_test.setdefault(paper.test_of(name) or name, red)
     lines = []
     for test, spec in paper.TESTS.items():
+        if not paper.has_own_values(test):
+            continue
         for outage in sorted({int(o) for o in paper.outage_table(test)["outage"]}):
             stated = paper.claim_for(claims, test, outage)
             if stated is None:

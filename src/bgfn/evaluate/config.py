@@ -138,7 +138,11 @@ class EvaluationSetup:
     sweep_datasets, sweep_notes : list of str
         The same for the outage sweep.
     windows : list of (float, float)
-        The evaluation outages ``(start, duration)``, s (:func:`bgfn.nav.outages.outage_windows`).
+        The evaluation outages ``(start, duration)``, s, of the profile's one list or ``default`` entry
+        (:func:`bgfn.nav.outages.default_windows`; empty when that is a rule); each dataset's own are in its
+        :class:`~bgfn.evaluate.tables.TableResult` (``windows``).
+    outage_lines : list of str
+        Per dataset of the tables whose entry differs from ``windows``: its list, or the rule that picks them.
     """
 
     profile: str
@@ -149,6 +153,7 @@ class EvaluationSetup:
     sweep_datasets: list[str]
     sweep_notes: list[str]
     windows: list = field(default_factory=list)
+    outage_lines: list = field(default_factory=list)
 
     def describe(self) -> list[str]:
         """Lines saying what is evaluated: profile, IMUs, datasets, methods, seeds, outages, pseudo-GPS."""
@@ -161,7 +166,8 @@ class EvaluationSetup:
                          "files when present)")
         lines.append(f"tables: {self.datasets} | methods: {ecfg['methods']} | seeds: {ecfg['seeds']} | "
                      f"seed aggregate: {ecfg['seed_aggregate']}")
-        lines.append(f"outages (start, duration) s: {[list(w) for w in self.windows]}")
+        lines.append(f"outages (start, duration) s: {[list(w) for w in self.windows]}"
+                     + "".join(f"; {line}" for line in self.outage_lines))
         lines.append(f"pseudo-GPS: {ecfg['pseudo_gps']}")
         return lines
 
@@ -185,7 +191,7 @@ def evaluation_setup(cfg: dict, real_imu: bool | None = None, datasets: Sequence
     EvaluationSetup
     """
     from bgfn.config import with_overrides
-    from bgfn.nav.outages import outage_windows
+    from bgfn.nav import outages
 
     cfg = with_overrides(cfg, {"evaluate.real_imu": real_imu, "evaluate.datasets": datasets,
                                "evaluate.methods": methods, "evaluate.seeds": seeds,
@@ -193,5 +199,13 @@ def evaluation_setup(cfg: dict, real_imu: bool | None = None, datasets: Sequence
     ecfg = evaluate_config(cfg.get("evaluate"), cfg.get("train"))
     names, notes = choose_datasets(ecfg["datasets"], ecfg["real_imu"])
     sweep_names, sweep_notes = choose_datasets(ecfg["sweep"]["datasets"], ecfg["real_imu"])
+    default = outages.default_windows(cfg) or []
+    lines = []
+    for name in names:                     # datasets whose outages are not the default list
+        entry = outages.outage_entry(cfg, name)
+        if outages.is_rule(entry):
+            lines.append(f"{name}: rule {entry['rule']} (picked from the drive)")
+        elif outages.outage_windows(cfg, dataset=name) != default:
+            lines.append(f"{name}: {[list(w) for w in outages.outage_windows(cfg, dataset=name)]}")
     return EvaluationSetup(cfg.get("profile", ""), cfg.get("description", ""), ecfg, names, notes, sweep_names,
-                           sweep_notes, outage_windows(cfg))
+                           sweep_notes, default, lines)

@@ -41,13 +41,18 @@ def evaluation_record(setup: EvaluationSetup, results: Mapping[str, TableResult]
     Returns
     -------
     dict
-        ``profile``, ``evaluate`` (the configuration), ``outage_windows`` (``[[start, duration], ...]``, s),
+        ``profile``, ``evaluate`` (the configuration), ``outage_windows`` (``[[start, duration], ...]``, s: the
+        profile's default list), ``outage_windows_by_dataset`` (``{dataset: [[start, duration], ...]}``: the
+        windows each table was evaluated in),
         ``datasets``, ``real_imu_notes``, ``tables`` and ``reduction_vs_ins_pct`` (keyed by the paper's test),
         ``paper_claims`` (the BGFN reductions the paper quotes, %), ``sweep`` (``rows``, ``info``),
         ``timings_s``.
     """
     return {
         "profile": setup.profile, "evaluate": setup.config, "outage_windows": [list(w) for w in setup.windows],
+        "outage_windows_by_dataset": {name: [list(w) for w in (res.windows if res.windows is not None
+                                                               else setup.windows)]
+                                      for name, res in results.items()},
         "datasets": setup.datasets, "real_imu_notes": setup.notes,
         "tables": {res.test: res.table.to_dict(orient="records") for res in results.values()},
         "reduction_vs_ins_pct": {results[n].test: r.to_dict(orient="records") for n, r in reductions.items()},

@@ -39,6 +39,8 @@ class TableResult:
         :func:`fix_error_table` of ``fix_errors``: their largest values in each outage window.
     drive : bgfn.data.Drive or None
         The drive evaluated (its reference draws the figures; the sensitivity run reuses it).
+    windows : list of (float, float) or None
+        The outages evaluated, ``(start, duration)``, s; ``Outage k`` is ``windows[k - 1]``.
     """
 
     dataset: str
@@ -50,6 +52,7 @@ class TableResult:
     fix_errors: pd.DataFrame | None = None
     gnss_errors: pd.DataFrame | None = None
     drive: Any = None
+    windows: list | None = None
 
 
 def fix_error_table(err: pd.DataFrame, windows) -> pd.DataFrame:
@@ -107,7 +110,7 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
         from bgfn.data import load_drive
 
         drive = load_drive(dataset, profile=profile)
-    windows = outages.outage_windows(cfg, drive)
+    windows = outages.outage_windows(cfg, drive, dataset)
     ctx = navigation_context(drive, cfg.get("nav"), [s for s, _ in windows])
     if models is None:
         models = ensure_models(cfg, profile, dataset, ctx, ecfg["methods"], ecfg["seeds"], windows,
@@ -123,7 +126,7 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
     fixes = fix_errors(drive.gnss, drive.reference, ctx.lever, drive.meta)
     return TableResult(dataset, test_of(dataset) or dataset, per_seed,
                        aggregate_seeds(per_seed, ecfg["seed_aggregate"]), runs, models, fixes,
-                       fix_error_table(fixes, windows), drive)
+                       fix_error_table(fixes, windows), drive, list(windows))
 
 
 def run_tables(cfg: dict, profile: str, datasets, ecfg: dict, out,

@@ -24,9 +24,11 @@ Modules (pyins style, one concept each; SI units, radians, NED, tables as in CON
 - :mod:`~bgfn.nav.filter` -- ``run_filter(imu, initial, noise, gnss, lever_arm, outage_windows,
   pseudo_gps, t_end, snapshots) -> FilterResult`` and ``run_outage(imu, start_state, window, noise,
   lever_arm, pseudo_gps)`` (one outage from a saved state).
-- :mod:`~bgfn.nav.outages` -- ``OutageWindow``, ``check_windows``, ``outage_windows(profile, drive)`` (the profile's one key),
-  the pseudo-GPS hook (``PseudoFix``, ``PseudoGpsContext``, ``IncrementPseudoGps`` = Eq. pred-gps,
-  ``TablePseudoGps``).
+- :mod:`~bgfn.nav.outages` -- ``OutageWindow``, ``check_windows``, ``outage_windows(profile, drive, dataset)``
+  (the profile's one key: one list, or per dataset a list or a rule), the pseudo-GPS hook (``PseudoFix``,
+  ``PseudoGpsContext``, ``IncrementPseudoGps`` = Eq. pred-gps, ``TablePseudoGps``).
+- :mod:`~bgfn.nav.outage_rules` -- ``pick_windows(rule, reference, margin_s)``: a drive's outages picked by a
+  rule (``cruise_and_manoeuvre``: one cruising, one manoeuvring, as the paper's field test).
 - :mod:`~bgfn.nav.metrics` -- ``navigation_errors``, ``outage_metrics`` (max |east|, max |north|,
   horizontal RMSE, end error), ``rms_table``; ``reference_rows`` (a drive's spans where the reference is not
   trusted, ``meta["reference_excluded_s"]``, left out of every comparison).

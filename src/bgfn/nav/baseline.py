@@ -172,8 +172,8 @@ def run_baseline(drive, cfg: dict, windows) -> Baseline:
     -------
     Baseline
     """
-    windows = check_windows(windows, float(drive.reference["time"].iloc[0]),
-                            float(drive.imu["time"].iloc[-1]), f"{drive.name}: profile outage_windows")
+    windows = check_windows(windows, float(drive.reference["time"].iloc[0]),   # the given order: Outage k as in 04
+                            float(drive.imu["time"].iloc[-1]), f"{drive.name}: profile outage_windows", sort=False)
     initial, noise = filter_setup(drive, cfg)
     imu = filter_imu(drive, cfg)
     lever = drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0])
@@ -201,8 +201,8 @@ def ins_layout(outage_table: pd.DataFrame, dataset: str | None = None) -> pd.Dat
     outage_table : DataFrame
         ``Baseline.outage_table`` of one dataset (one row per outage, in order).
     dataset : str, optional
-        When it stands for one of the paper's tests (:func:`bgfn.paper.test_of`), the paper's INS row is
-        beside ours.
+        When it stands for one of the tests (:func:`bgfn.paper.test_of`), the paper's INS row of that test is
+        beside ours (of its field test, labelled ``paper (field test)``, for the real drive).
 
     Returns
     -------
@@ -213,7 +213,8 @@ def ins_layout(outage_table: pd.DataFrame, dataset: str | None = None) -> pd.Dat
                          "max_east_m": outage_table["max_abs_east"].to_numpy(float),
                          "max_north_m": outage_table["max_abs_north"].to_numpy(float)})
     test = paper.test_of(dataset) if dataset else None
-    return paper.layout(ours, paper.outage_table(test) if test else None, methods=("INS",))
+    return paper.layout(ours, paper.published_values(test) if test else None, methods=("INS",),
+                        paper_label=paper.paper_label(test) if test else "paper")
 
 
 def ins_max_error_file(outage_table: pd.DataFrame) -> pd.DataFrame:

@@ -6,6 +6,9 @@ pseudo-GPS source is given: a callable ``source(ctx: PseudoGpsContext) -> Pseudo
 pseudo-GPS epochs ``start + k / rate`` (k = 1, 2, ...) inside the window. Its position is fused like a
 GNSS fix (antenna position, NED standard deviations; a NaN std leaves that axis out). This is how
 notebook 04 feeds MLP / AT-LSTM / BGFN predictions of ``delta_p_gps`` into the filter.
+
+Which windows a drive gets is the profile's ``outage_windows`` (:func:`outage_windows`): one list for every
+drive, or per dataset a list or a rule that picks them from the drive (:mod:`bgfn.nav.outage_rules`).
 """
 
 from __future__ import annotations
@@ -41,7 +44,7 @@ class OutageWindow:
         return (t >= self.start - TIME_TOL) & (t < self.end - TIME_TOL)
 
 
-def check_windows(windows, t_first: float, t_last: float, source: str = "outage_windows") -> list:
+def check_windows(windows, t_first: float, t_last: float, source: str = "outage_windows", sort: bool = True) -> list:
     """Validate outage windows against the data span.
 
     Parameters
@@ -51,11 +54,13 @@ def check_windows(windows, t_first: float, t_last: float, source: str = "outage_
         First and last time of the data, s.
     source : str
         Name used in error messages.
+    sort : bool
+        Return the windows sorted by start (default) or in the given order (``Outage k`` is the k-th).
 
     Returns
     -------
     list of OutageWindow
-        Sorted by start.
+        Sorted by start, or in the given order.
 
     Raises
     ------
@@ -75,12 +80,12 @@ def check_windows(windows, t_first: float, t_last: float, source: str = "outage_
             raise DataError(source, "window", f"inside the data [{t_first}, {t_last}] s",
                             f"[{start}, {start + duration}] s")
         out.append(OutageWindow(start, duration))
-    out.sort(key=lambda w: w.start)
-    for a, b in zip(out[:-1], out[1:]):
+    ordered = sorted(out, key=lambda w: w.start)
+    for a, b in zip(ordered[:-1], ordered[1:]):
         if b.start < a.end - TIME_TOL:
             raise DataError(source, "window", "non-overlapping windows",
                             f"[{a.start}, {a.end}] overlaps [{b.start}, {b.end}]")
-    return out
+    return ordered if sort else out
 
 
 def epochs_before(imu_time, starts, source: str = "outage_windows") -> np.ndarray:
@@ -107,34 +112,119 @@ def epochs_before(imu_time, starts, source: str = "outage_windows") -> np.ndarra
     return imu_time[before]
 
 
-def outage_windows(profile: dict, drive=None) -> list[tuple[float, float]]:
-    """The evaluation outages ``[(start, duration), ...]`` (s): the profile's top-level ``outage_windows``.
+#: Key of a per-dataset ``outage_windows`` mapping that answers for every dataset it does not name.
+DEFAULT_KEY = "default"
+
+
+def outage_entry(profile: dict, dataset: str | None = None):
+    """The profile's ``outage_windows`` entry for ``dataset``: a list of ``[start, duration]`` or a rule mapping.
+
+    ``outage_windows`` is either one list (every dataset) or a mapping from dataset name to a list or a rule
+    (:mod:`bgfn.nav.outage_rules`), where ``default`` answers for the datasets it does not name (and for
+    ``dataset=None``).
+
+    Raises
+    ------
+    DataError
+        The key is missing or empty, or the mapping has neither ``dataset`` nor ``default``.
+    """
+    where = f"profile {profile.get('profile')!r}"
+    spec = profile.get("outage_windows")
+    if isinstance(spec, dict):
+        key = dataset if dataset in spec else DEFAULT_KEY
+        if key not in spec:
+            raise DataError(where, f"outage_windows.{dataset if dataset is not None else DEFAULT_KEY}",
+                            f"an entry for this dataset or a '{DEFAULT_KEY}' entry", f"keys {sorted(spec)}")
+        spec = spec[key]
+    if not spec:
+        raise DataError(where, "outage_windows", "the evaluation outages: a list of [start, duration] in s, or a "
+                        "mapping dataset -> list or rule with a 'default' entry", repr(spec))
+    return spec
+
+
+def default_windows(profile: dict) -> list[tuple[float, float]] | None:
+    """The windows of the profile's one list or ``default`` list; None when ``default`` is a rule or missing
+    (then every dataset has its own entry). What a reader without a drive, e.g. a run description, shows."""
+    spec = profile.get("outage_windows")
+    entry = spec.get(DEFAULT_KEY) if isinstance(spec, dict) else spec
+    if not entry or is_rule(entry):
+        return None
+    return [(float(s), float(d)) for s, d in entry]
+
+
+def is_rule(entry) -> bool:
+    """Whether an ``outage_windows`` entry is a rule (a mapping with ``rule:``) rather than a list of windows."""
+    return isinstance(entry, dict)
+
+
+def outage_windows(profile: dict, drive=None, dataset: str | None = None) -> list[tuple[float, float]]:
+    """The evaluation outages ``[(start, duration), ...]`` (s) of one drive: the profile's ``outage_windows``.
 
     The one reader of this fact: notebook 01 draws the windows, 02 runs the standalone INS in them, 03 keeps
-    them (and a margin) out of training, 04 evaluates every method in them.
+    them (and a margin) out of training, 04 evaluates every method in them, and ``make``'s profile check
+    (:func:`bgfn.profile_schema.check_with_drives`) checks them against each drive.
 
     Parameters
     ----------
     profile : dict
-        A profile (:func:`bgfn.config.load_profile`), which checked the list's form.
+        A profile (:func:`bgfn.config.load_profile`), which checked the key's form.
     drive : bgfn.data.Drive, optional
-        When given, the windows are checked against its time span (:func:`check_windows`).
+        When given, the windows are checked against its time span (:func:`check_windows`); a rule entry needs
+        it (the rule picks the windows from the drive's reference).
+    dataset : str, optional
+        The dataset's name in the profile (its key in a per-dataset mapping); default ``drive.name``; neither:
+        the ``default`` entry.
 
     Returns
     -------
     list of (float, float)
-        In the profile's order.
+        In the profile's order, a rule's in its own (``Outage k`` is the k-th everywhere).
+
+    Raises
+    ------
+    DataError
+        No entry (:func:`outage_entry`), a rule without a drive, a rule that finds no windows, or windows
+        outside the drive.
     """
-    windows = profile.get("outage_windows")
-    if not windows:
-        raise DataError(f"profile {profile.get('profile')!r}", "outage_windows",
-                        "the evaluation outages, a list of [start, duration] in s", repr(windows))
-    pairs = [(float(s), float(d)) for s, d in windows]
+    name = dataset if dataset is not None else getattr(drive, "name", None)
+    entry = outage_entry(profile, name)
+    source = f"{name}: profile outage_windows" if name is not None else "profile outage_windows"
+    if is_rule(entry):
+        if drive is None:
+            raise DataError(f"profile {profile.get('profile')!r}", f"outage_windows.{name}",
+                            "the drive as well: a rule picks the windows from its reference", f"rule {entry}")
+        pairs = picked_outages(profile, drive, name).windows
+    else:
+        pairs = [(float(s), float(d)) for s, d in entry]
     if drive is not None:
         t = drive.imu["time"].to_numpy(dtype=float)
-        check_windows(pairs, float(drive.reference["time"].iloc[0]), float(t[-1]),
-                      f"{drive.name}: profile outage_windows")
+        check_windows(pairs, float(drive.reference["time"].iloc[0]), float(t[-1]), source)
     return pairs
+
+
+def picked_outages(profile: dict, drive, dataset: str | None = None):
+    """What the profile's rule for ``dataset`` picks on ``drive`` (:class:`bgfn.nav.outage_rules.PickedOutages`),
+    or None when its entry is a list. The training margin of the rule's check is ``train.margin_s``."""
+    from bgfn.learning import learning_options
+    from bgfn.nav import outage_rules
+
+    name = dataset if dataset is not None else getattr(drive, "name", None)
+    entry = outage_entry(profile, name)
+    if not is_rule(entry):
+        return None
+    margin = float(learning_options(profile.get("train"))["margin_s"])
+    return outage_rules.pick_windows(entry, drive.reference, margin, f"{name}: profile outage_windows")
+
+
+def describe_windows(profile: dict, drive, dataset: str | None = None) -> list[str]:
+    """Lines for a notebook: the outages of one drive and, for a rule, what it picked and why."""
+    name = dataset if dataset is not None else drive.name
+    windows = outage_windows(profile, drive, name)
+    picked = picked_outages(profile, drive, name)
+    head = f"{name}: outages (start, duration) s {[list(w) for w in windows]}"
+    if picked is None:
+        return [head + " (listed in the profile)"]
+    return [head + f" (rule {picked.rule['rule']})"] + [f"  {line}" for line in picked.lines()]
 
 
 class PseudoFix(NamedTuple):

@@ -34,9 +34,9 @@ from bgfn.report.provenance import (cards_line, meta_line, model_cards, outage_d
                                     provenance, run_meta, short_source)
 from bgfn.report.reading import ProfileResults, missing_note, read_csv, read_json, read_results, rel
 from bgfn.report.sections import (OutageSection, energy_section, header_section, kf_section, outage_section,
-                                  sweep_section, training_section)
+                                  shown_tests, sweep_section, training_section)
 from bgfn.report.sentences import (BASELINES, EXTRA_METHODS, EXTRA_TAGS, bullets, comparison_sentences,
-                                   energy_sentences, reduction_sentences, summary_sentence, win_counts)
+                                   energy_sentences, paper_name, reduction_sentences, summary_sentence, win_counts)
 from bgfn.report.tables import (REFERENCE_LABELS, TABLE_STYLES, TRAINING_COLUMNS, best_mask, compact, energy_table,
                                 fmt_num, kf_table, reduction_comparison, reductions, style_layout, sweep_table,
                                 training_table)
@@ -59,4 +59,6 @@ __all__ = [
     "ProfileResults", "read_results", "OutageSection", "header_section", "outage_section", "energy_section",
     "kf_section", "training_section", "sweep_section", "variants_section", "paper_figure_section",
     "extra_figure_section", "draw_diagrams", "bullets", "run_meta",
+    # a test the paper has no table of (the real drive): which tests the page shows, how it names the paper's
+    "shown_tests", "paper_name",
 ]

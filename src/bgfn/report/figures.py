@@ -46,7 +46,8 @@ PAPER_FIGURES: tuple[dict[str, str], ...] = (
      "caption": "The position errors among different algorithms during the second outage in the field test."},
 )
 
-#: Figures beyond the paper shown on the results page (``{dataset}`` expands to every dataset).
+#: Figures beyond the paper shown on the results page (``{dataset}`` expands to every dataset; an entry with a
+#: ``test`` is shown only when that test's table exists: the real drive, which not every profile evaluates).
 EXTRA_FIGURES: tuple[dict[str, str], ...] = (
     {"label": "energy per layer", "file": "energy_per_layer.png", "by": "notebook 05",
      "caption": "Theoretical energy per layer, BGFN and its Transformer twin (the paper gives no figure for "
@@ -59,6 +60,11 @@ EXTRA_FIGURES: tuple[dict[str, str], ...] = (
        "by": "notebook 04",
        "caption": "East and north error of the GPS row beside the errors of the real GNSS fixes it follows (dots) "
                   "and the standalone INS from the same state."} for k in (1, 2)),
+    *({"label": f"outage {k} of the real drive", "file": f"outage_real_{k}.png", "by": "notebook 04",
+       "test": "real",
+       "caption": f"The position errors among different algorithms during outage {k} of the recorded car drive "
+                  "(not in the paper; the rule cruise_and_manoeuvre makes outage 1 the cruise and outage 2 the "
+                  "manoeuvre, as in the paper's field test)."} for k in (1, 2)),
     {"label": "outage sweep", "file": "outage_sweep_{dataset}.png", "by": "notebook 04", "datasets": "sweep",
      "caption": "Max horizontal error over many outage starts and durations ({dataset})."},
     {"label": "training curves", "file": "training_curves_{dataset}.png", "by": "notebook 03",
@@ -137,6 +143,7 @@ def _datasets(res: ProfileResults) -> dict[str, list[str]]:
 
 def _figure_pieces(res: ProfileResults, entries: Sequence[dict], heading) -> list:
     pieces: list = []
+    entries = [e for e in entries if "test" not in e or res.ours.get(e["test"]) is not None]
     for f in figure_list(res.out / "figures", entries, _datasets(res)):
         pieces.append(heading(f))
         pieces.append(f["path"] if f["exists"] else missing_note(f["path"], "this figure", f["by"]))

@@ -121,8 +121,9 @@ def outage_provenance(profile: str, test: str, results: str | Path, evaluation: 
     ev = (evaluation or {}).get("evaluate", {})
     seeds = ev.get("seeds")
     agg = ev.get("seed_aggregate")
-    windows = ", ".join(f"{d:g} s from {s:g} s (GPS time of week)"
-                        for s, d in (evaluation or {}).get("outage_windows", []))
+    by_dataset = (evaluation or {}).get("outage_windows_by_dataset") or {}   # per dataset (a rule's differ)
+    recorded = by_dataset.get(dataset) if dataset in by_dataset else (evaluation or {}).get("outage_windows", [])
+    windows = ", ".join(f"{d:g} s from {s:g} s (GPS time of week)" for s, d in recorded or [])
     return provenance(results / "tables" / TESTS[test]["file"], run_meta(evaluation), current,
                       dataset=f"`{dataset}`" if dataset else None,
                       seeds=(f"{', '.join(map(str, seeds))} ({agg} over seeds)" if seeds else None),

@@ -65,7 +65,8 @@ class ProfileResults:
     kf, training, evaluation, energy : dict or None
         ``kf_baseline.json`` (02), ``training.json`` (03), ``outage_evaluation.json`` (04), ``energy.json`` (05).
     ours, published : dict
-        ``{test: table}`` of :data:`bgfn.paper.TESTS`: our outage table (notebook 04) and the paper's.
+        ``{test: table}`` of :data:`bgfn.paper.TESTS`: our outage table (notebook 04) and the paper's beside it
+        (:func:`bgfn.paper.published_values`: for the real drive, the paper's field test).
     training_summary, training_times, sweep, sweep_pairs : DataFrame or None
         ``tables/training_summary.csv``, ``tables/training_times.csv`` (03), ``tables/outage_sweep_summary.csv``
         and ``tables/outage_sweep_pairs.csv`` (04).
@@ -109,7 +110,7 @@ def read_results(profile: str, out: str | Path | None = None) -> ProfileResults:
         kf=read_json(out / RUN_RECORDS["kf_baseline"]), training=read_json(out / RUN_RECORDS["training"]),
         evaluation=read_json(out / RUN_RECORDS["evaluation"]), energy=read_json(out / RUN_RECORDS["energy"]),
         ours={t: read_csv(tables / spec["file"]) for t, spec in paper.TESTS.items()},
-        published={t: paper.outage_table(t) for t in paper.TESTS},
+        published={t: paper.published_values(t) for t in paper.TESTS},   # the real drive: the field test's
         training_summary=read_csv(tables / SHARED_TABLES["training_summary"]),
         training_times=read_csv(tables / SHARED_TABLES["training_times"]),
         sweep=read_csv(tables / SHARED_TABLES["sweep_summary"]), sweep_pairs=read_csv(tables / SHARED_TABLES["sweep_pairs"]))

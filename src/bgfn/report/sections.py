@@ -52,8 +52,18 @@ class OutageSection:
     comparison: list
 
 
+def shown_tests(res: ProfileResults) -> list[str]:
+    """The outage tests the results page shows: the paper's own (always: a missing table gets a note) and a test
+    it has no table of (the real drive) when notebook 04 wrote its table or the profile evaluates a dataset of
+    it."""
+    evaluated = {paper.test_of(d) for d in (res.cfg.get("evaluate") or {}).get("datasets") or []}
+    return [t for t in paper.TESTS
+            if paper.has_own_values(t) or res.ours.get(t) is not None or t in evaluated]
+
+
 def outage_section(res: ProfileResults, test: str) -> OutageSection:
-    """The section of one of the paper's outage tests (a key of :data:`bgfn.paper.TESTS`)."""
+    """The section of one outage test (a key of :data:`bgfn.paper.TESTS`): the paper's dataset or field test, or
+    our real drive beside the paper's field test."""
     spec = paper.TESTS[test]
     title, profile = spec["title"], res.profile
     ours, published = res.ours[test], res.published[test]
@@ -61,8 +71,13 @@ def outage_section(res: ProfileResults, test: str) -> OutageSection:
     dataset = outage_datasets(res.evaluation).get(test)
 
     layout = [missing_note(file, f"the {title} table", "notebook 04")] if ours is None else []
-    layout += [style_layout(paper.layout(ours, published, ours_label=f"ours ({profile})"),
-                            f"Table {spec['label']}: {spec['caption']}; ours ({profile}) beside the paper's"),
+    if spec["label"]:
+        caption = f"Table {spec['label']}: {spec['caption']}; ours ({profile}) beside the paper's"
+    else:                                   # not a table of the paper: its test whose values stand beside ours
+        shown = paper.TESTS[paper.published_test(test)]
+        caption = f"{spec['caption']}; ours ({profile}) beside the paper's {shown['title']} (Table {shown['label']})"
+    layout += [style_layout(paper.layout(ours, published, ours_label=f"ours ({profile})",
+                                         paper_label=paper.paper_label(test)), caption),
                outage_provenance(profile, test, res.out, res.evaluation, res.current)]
 
     all_rows = []
@@ -76,7 +91,7 @@ def outage_section(res: ProfileResults, test: str) -> OutageSection:
     comp = reduction_comparison(ours, published, res.claims, test)
     reduction = [compact(comp.style.format(_VALUE, na_rep="-"), f"BGFN vs INS, {title} (%)"),
                  short_source([file, paper.OUTAGE_TABLE_FILE, paper.CLAIMS_FILE], profile, dataset=dataset),
-                 bullets(reduction_sentences(comp))]
+                 bullets(reduction_sentences(comp, test=test))]
     return OutageSection(layout, all_rows, reduction, [bullets(comparison_sentences(test, ours, published))])
 
 

@@ -10,7 +10,7 @@ from typing import Sequence
 import numpy as np
 import pandas as pd
 
-from bgfn.paper import DECIMALS, TESTS
+from bgfn.paper import DECIMALS, TESTS, published_test
 
 #: Everything BGFN is compared with on this page (Transformer: ANN twin; GPS: the lower bound).
 BASELINES: tuple[str, ...] = ("INS", "MLP", "AT-LSTM", "Transformer", "GPS")
@@ -18,6 +18,13 @@ BASELINES: tuple[str, ...] = ("INS", "MLP", "AT-LSTM", "Transformer", "GPS")
 EXTRA_METHODS: dict[str, str] = {"Transformer": "the ANN twin of BGFN, not in the paper",
                                  "GPS": "the GPS-aided solution over the same window: the lower bound"}
 EXTRA_TAGS: dict[str, str] = {"Transformer": "ANN twin", "GPS": "lower bound"}
+
+
+def paper_name(test: str) -> str:
+    """How a sentence names the paper's values beside ``test``: ``paper``, or ``paper's field test`` beside the
+    real drive (the paper has no table of its own for it)."""
+    shown = published_test(test)
+    return "paper" if shown == test else f"paper's {TESTS[shown]['title']}"
 
 
 def bullets(lines: Sequence[str]) -> str:
@@ -75,7 +82,7 @@ def summary_sentence(test: str, ours: pd.DataFrame | None, paper: pd.DataFrame |
     for b, (w, n) in mine.items():
         p = theirs.get(b)
         tag = f" ({EXTRA_TAGS[b]})" if b in EXTRA_TAGS else ""
-        parts.append(f"against {b}{tag} in {w} of {n}" + (f" (paper: {p[0]} of {p[1]})" if p else ""))
+        parts.append(f"against {b}{tag} in {w} of {n}" + (f" ({paper_name(test)}: {p[0]} of {p[1]})" if p else ""))
     return (f"{t.capitalize()}: {method} has the smaller max error (cases: outage x axis) " + "; ".join(parts)
             + ".")
 
@@ -100,7 +107,7 @@ def comparison_sentences(test: str, ours: pd.DataFrame | None, paper: pd.DataFra
             if (o, method) in plook and (o, b) in plook:
                 pbe, pbn = plook[(o, method)]
                 pe, pn = plook[(o, b)]
-                txt += (f" (paper: {_m(pbe)} vs {_m(pe)} east, {_m(pbn)} vs {_m(pn)} north, "
+                txt += (f" ({paper_name(test)}: {_m(pbe)} vs {_m(pe)} east, {_m(pbn)} vs {_m(pn)} north, "
                         f"{_verdict(_cmp(pbe, pe), _cmp(pbn, pn))})")
             elif b in EXTRA_METHODS:
                 txt += f" ({b}: {EXTRA_METHODS[b]})"
@@ -114,9 +121,11 @@ def _pct_phrase(pct: float) -> str:
     return f"reduced by {pct:.1f} %" if pct >= 0 else f"increased by {-pct:.1f} %"
 
 
-def reduction_sentences(comp: pd.DataFrame, method: str = "BGFN") -> list[str]:
+def reduction_sentences(comp: pd.DataFrame, method: str = "BGFN", test: str | None = None) -> list[str]:
     """Sentences from :func:`bgfn.report.tables.reduction_comparison`: our reduction against INS beside the
-    paper's."""
+    paper's (of ``test``; beside the real drive, the paper's field test's)."""
+    theirs = paper_name(test) if test else "paper"
+    theirs = "paper's" if theirs == "paper" else theirs
     lines = []
     for row in comp.index:
         for axis in ("East", "North"):
@@ -127,9 +136,9 @@ def reduction_sentences(comp: pd.DataFrame, method: str = "BGFN") -> list[str]:
             ptab, ptxt = comp.loc[row, ("paper (table)", axis)], comp.loc[row, ("paper (text)", axis)]
             ref = []
             if np.isfinite(ptab):
-                ref.append(f"paper's table: {_pct_phrase(ptab)}")
+                ref.append(f"{theirs} table: {_pct_phrase(ptab)}")
             if np.isfinite(ptxt):
-                ref.append(f"paper's text: {ptxt:.1f} %")
+                ref.append(f"{theirs} text: {ptxt:.1f} %")
             lines.append(txt + (f" ({'; '.join(ref)})" if ref else "") + ".")
     return lines
 

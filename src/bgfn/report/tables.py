@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from bgfn.evaluate import error_reduction
-from bgfn.paper import DECIMALS, PAPER_METHODS, claim_for, label
+from bgfn.paper import DECIMALS, PAPER_METHODS, claim_for, label, published_test
 
 
 # ----------------------------------------------------------------------------------------------- styling
@@ -96,7 +96,8 @@ def reduction_comparison(ours: pd.DataFrame | None, paper: pd.DataFrame, claims:
     """BGFN's reduction against INS per outage: ours, the paper's table (recomputed), the paper's text claim.
 
     Columns: a MultiIndex ``(source, axis)`` with sources ``ours``, ``paper (table)``, ``paper (text)``;
-    rows ``Outage k``.
+    rows ``Outage k``. ``paper`` is the table beside ours (:func:`bgfn.paper.published_values`), and the text's
+    claims are those of the same test (beside the real drive: the field test's).
     """
     parts = {"ours": ours, "paper (table)": paper}
     red = {k: (reductions(v, reference, [method]).set_index("outage") if v is not None else None)
@@ -108,7 +109,7 @@ def reduction_comparison(ours: pd.DataFrame | None, paper: pd.DataFrame, claims:
             vals = []
             for o in outages:
                 if src == "paper (text)":
-                    c = claim_for(claims, test, o)
+                    c = claim_for(claims, published_test(test), o)
                     vals.append(float(c[axis]) if c and axis in c else np.nan)
                 else:
                     r = red[src]

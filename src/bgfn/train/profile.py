@@ -41,8 +41,13 @@ class TrainingPlan:
         The profile (:func:`bgfn.config.load_profile`); ``cfg['train']`` is :attr:`train_cfg`.
     datasets, methods : list of str
     seeds : list of int
-    outage_windows : list of (start, duration)
-        Evaluation outages, s, kept (widened by ``train.margin_s``) out of training and validation.
+    outage_windows : list of (start, duration) or None
+        Evaluation outages, s, kept (widened by ``train.margin_s``) out of training and validation: with
+        ``per_dataset`` False the windows of every dataset; with ``per_dataset`` True the profile's ``default``
+        list (None when the profile has no such list), and each dataset's own are :meth:`windows_of`.
+    per_dataset : bool
+        Whether each dataset takes its own entry of the profile's ``outage_windows`` (:meth:`of` without
+        windows) rather than ``outage_windows``.
     """
 
     profile: str
@@ -50,21 +55,34 @@ class TrainingPlan:
     datasets: list[str]
     methods: list[str]
     seeds: list[int]
-    outage_windows: list
+    outage_windows: list | None
+    per_dataset: bool = False
 
     @classmethod
     def of(cls, profile: str, datasets=None, methods=None, seeds=None, outage_windows=None) -> "TrainingPlan":
-        """The plan of ``profile``; ``datasets``, ``methods``, ``seeds`` and ``outage_windows`` default (None) to
-        the profile's (``train.datasets``, ``train.methods``, ``train.seeds``, top-level ``outage_windows``); the
-        first three (notebook 03's parameters) are checked against the profile schema like the file
-        (:func:`bgfn.config.with_overrides`)."""
+        """The plan of ``profile``; ``datasets``, ``methods`` and ``seeds`` default (None) to the profile's
+        (``train.datasets``, ``train.methods``, ``train.seeds``) and are checked against the profile schema like
+        the file (:func:`bgfn.config.with_overrides`); ``outage_windows`` given: the outages of every dataset,
+        else each dataset's own from the top-level ``outage_windows`` (:meth:`windows_of`)."""
         from bgfn.config import load_profile, with_overrides
 
         cfg = with_overrides(load_profile(profile), {"train.datasets": datasets, "train.methods": methods,
                                                      "train.seeds": seeds})
         tc = cfg["train"]
+        if outage_windows is not None:
+            windows, per_dataset = [(float(s), float(d)) for s, d in outage_windows], False
+        else:
+            windows, per_dataset = outages.default_windows(cfg), True
         return cls(profile, cfg, list(tc["datasets"]), list(tc["methods"]), [int(s) for s in tc["seeds"]],
-                   outage_windows if outage_windows is not None else outages.outage_windows(cfg))
+                   windows, per_dataset)
+
+    def windows_of(self, dataset: str, drive=None) -> list:
+        """The evaluation outages of ``dataset`` kept out of its training, s: :attr:`outage_windows`, or with
+        :attr:`per_dataset` its entry in the profile (:func:`bgfn.nav.outages.outage_windows`; a rule needs the
+        ``drive``)."""
+        if not self.per_dataset:
+            return list(self.outage_windows)
+        return outages.outage_windows(self.cfg, drive, dataset)
 
     @property
     def train_cfg(self) -> dict:
@@ -78,21 +96,35 @@ class TrainingPlan:
         return "\n".join([
             f"profile {self.cfg['profile']!r}: {self.cfg['description']}",
             f"datasets {self.datasets}, methods {self.methods}, seeds {self.seeds}, size {tc.get('size')!r}",
-            f"evaluation outages excluded from training (start, duration) s: {self.outage_windows} "
+            f"evaluation outages excluded from training (start, duration) s: {self._windows_text()} "
             f"+- {opts['margin_s']} s",
             f"optimizer: {optimizer_options(tc)}",
             f"learning problem: { {k: opts[k] for k in DESCRIBED_OPTIONS} }",
         ])
 
 
+    def _windows_text(self) -> str:
+        """The outages per dataset where the profile gives them per dataset, else the one list."""
+        if not self.per_dataset:
+            return str(self.outage_windows)
+        parts = []
+        for name in self.datasets:
+            entry = outages.outage_entry(self.cfg, name)
+            parts.append(f"{name}: " + (f"rule {entry['rule']} (picked from the drive)" if outages.is_rule(entry)
+                                        else str(outages.outage_windows(self.cfg, dataset=name))))
+        return "; ".join(parts)
+
+
 @dataclass
 class TrainingDataset:
-    """One dataset of a plan: its drive, the INS attitude its windows were built from, and its learning data."""
+    """One dataset of a plan: its drive, the INS attitude its windows were built from, its learning data, and
+    the evaluation outages kept out of them (``windows``, s; None: the plan's, :meth:`TrainingPlan.windows_of`)."""
 
     name: str
     drive: Any
     attitude: pd.DataFrame
     data: LearningData
+    windows: list | None = None
 
 
 def prepare_datasets(plan: TrainingPlan) -> dict[str, TrainingDataset]:
@@ -104,9 +136,9 @@ def prepare_datasets(plan: TrainingPlan) -> dict[str, TrainingDataset]:
     for name in plan.datasets:
         drive = load_drive(name, profile=plan.profile)
         attitude = ins_attitude(drive, plan.cfg)
-        data = prepare_learning_data(plan.cfg, name, attitude=attitude, drive=drive,
-                                     outage_windows=plan.outage_windows)
-        prepared[name] = TrainingDataset(name, drive, attitude, data)
+        windows = plan.windows_of(name, drive)
+        data = prepare_learning_data(plan.cfg, name, attitude=attitude, drive=drive, outage_windows=windows)
+        prepared[name] = TrainingDataset(name, drive, attitude, data, windows)
     return prepared
 
 
@@ -124,21 +156,22 @@ def prepare_learning_data(cfg: dict, dataset: str, attitude=None, drive=None, ou
     drive : Drive, optional
         Already loaded drive.
     outage_windows : sequence of (start, duration), optional
-        Evaluation outages; default: the profile's (:func:`bgfn.nav.outages.outage_windows`).
+        Evaluation outages; default: the profile's for ``dataset`` (:func:`bgfn.nav.outages.outage_windows`).
     """
     from bgfn.data import load_drive
 
     if drive is None:
         drive = load_drive(dataset, profile=cfg["profile"])
-    attitude, outage_windows, opts = _learning_inputs(cfg, drive, attitude, outage_windows)
+    attitude, outage_windows, opts = _learning_inputs(cfg, drive, attitude, outage_windows, dataset)
     return build_learning_data(drive.imu, attitude, drive.gnss, outage_windows, **opts)
 
 
-def _learning_inputs(cfg: dict, drive, attitude=None, outage_windows=None) -> tuple:
-    """``(attitude, outage_windows, learning options)`` of the profile, defaults filled in."""
+def _learning_inputs(cfg: dict, drive, attitude=None, outage_windows=None, dataset: str | None = None) -> tuple:
+    """``(attitude, outage_windows, learning options)`` of the profile, defaults filled in (the outages of
+    ``dataset``, default ``drive.name``)."""
     attitude = attitude if attitude is not None else ins_attitude(drive, cfg)
     if outage_windows is None:
-        outage_windows = outages.outage_windows(cfg)
+        outage_windows = outages.outage_windows(cfg, drive, dataset)
     return attitude, outage_windows, learning_options(cfg.get("train"))
 
 
@@ -163,10 +196,11 @@ def ins_attitude(drive, cfg: dict):
     return pd.DataFrame(traj).reset_index(drop=True)
 
 
-def val_position_table(cfg: dict, drive, attitude=None, outage_windows=None, positions=None):
+def val_position_table(cfg: dict, drive, attitude=None, outage_windows=None, positions=None,
+                       dataset: str | None = None):
     """:func:`bgfn.learning.val_position_coverage` of ``drive`` with the profile's learning options: what each
     place of the validation block would leave to training (notebook 03)."""
-    attitude, outage_windows, opts = _learning_inputs(cfg, drive, attitude, outage_windows)
+    attitude, outage_windows, opts = _learning_inputs(cfg, drive, attitude, outage_windows, dataset)
     ws = all_windows(drive.imu, attitude, drive.gnss, **opts)
     return val_position_coverage(ws, motion_in_windows(drive.reference, outage_windows), outage_windows,
                                  margin_s=float(opts["margin_s"]), val_fraction=float(opts["val_fraction"]),
@@ -176,9 +210,15 @@ def val_position_table(cfg: dict, drive, attitude=None, outage_windows=None, pos
 def val_position_tables(plan: TrainingPlan, prepared: dict[str, TrainingDataset]) -> pd.DataFrame:
     """:func:`val_position_table` of every prepared dataset in one table, ``dataset`` first."""
     positions = pd.concat([val_position_table(plan.cfg, d.drive, attitude=d.attitude,
-                                              outage_windows=plan.outage_windows).assign(dataset=name)
+                                              outage_windows=dataset_windows(plan, name, d),
+                                              dataset=name).assign(dataset=name)
                            for name, d in prepared.items()], ignore_index=True)
     return positions[["dataset"] + [col for col in positions.columns if col != "dataset"]]
+
+
+def dataset_windows(plan: TrainingPlan, name: str, prepared: TrainingDataset) -> list:
+    """The evaluation outages kept out of a prepared dataset: its own (``prepared.windows``), else the plan's."""
+    return prepared.windows if prepared.windows is not None else plan.windows_of(name, prepared.drive)
 
 
 def train_dataset(plan: TrainingPlan, dataset: str, data: LearningData, train_cfg: dict | None = None,
@@ -224,6 +264,7 @@ def train_profile(profile: str, datasets=None, methods=None, seeds=None, device:
     cards = []
     for dataset in plan.datasets:
         tc = tuned_train_config(plan.cfg, profile, dataset)
-        data = prepare_learning_data(plan.cfg, dataset, outage_windows=plan.outage_windows)
+        data = prepare_learning_data(plan.cfg, dataset,   # None: the dataset's own outages, from its drive
+                                     outage_windows=None if plan.per_dataset else plan.outage_windows)
         cards += train_dataset(plan, dataset, data, tc, device=device, progress=progress, echo=echo)
     return cards

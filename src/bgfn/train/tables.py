@@ -66,8 +66,8 @@ def card_line(card: dict) -> str:
 def training_metrics(plan, prepared: dict, runs: pd.DataFrame, summary: pd.DataFrame,
                      windows: pd.DataFrame) -> dict:
     """``training.json`` of notebook 03: the run and summary tables (with their wall-clock columns), the windows
-    table, the learning options per dataset, the evaluation outages kept out of training and the run metadata
-    (:func:`bgfn.config.run_metadata`).
+    table, the learning options per dataset, the evaluation outages kept out of training per dataset and the run
+    metadata (:func:`bgfn.config.run_metadata`).
 
     Parameters
     ----------
@@ -79,12 +79,15 @@ def training_metrics(plan, prepared: dict, runs: pd.DataFrame, summary: pd.DataF
         :func:`cards_table`, :func:`summary_table`, :func:`windows_table`.
     """
     from bgfn.config import run_metadata
+    from bgfn.train.profile import dataset_windows
 
     return {
         "runs": runs.to_dict(orient="records"),
         "summary": summary.to_dict(orient="records"),
         "windows": windows.to_dict(orient="records"),
         "learning_options": {name: d.data.options for name, d in prepared.items()},
-        "outage_windows": plan.outage_windows,
+        # per dataset, the outages its learning data were built without (a rule's differ from drive to drive)
+        "outage_windows": {name: d.data.info.get("outage_windows", dataset_windows(plan, name, d))
+                           for name, d in prepared.items()},
         "meta": run_metadata(plan.profile),
     }

@@ -82,3 +82,24 @@ def test_overrides_need_one_drive_with_both_states():
     two = pd.concat([lv, lv.assign(dataset="other")])
     with pytest.raises(DataError, match="one drive"):
         vibration_overrides(two, {"gyro": [0.0] * 3, "accel": [0.0] * 3})
+
+
+def test_stand_in_vibration_is_the_real_drives():
+    """The profiles' field-test stand-in vibrates as the recorded car's IMU does (deviations row 61)."""
+    from bgfn.config import load_profile
+    from bgfn.data import load_drive
+    from bgfn.data.acquire import MissingFileError
+    from bgfn.data.imu_errors import MPU6000
+
+    try:
+        real = load_drive("rtklib-drive0708")
+    except (MissingFileError, DataError) as exc:
+        pytest.skip(f"real drive not available: {exc}")
+    implied = vibration_overrides(imu_levels(real), {"gyro": MPU6000["gyro_noise_density"],
+                                                     "accel": MPU6000["accel_noise_density"]})
+    for profile in ("smoke", "quick", "paper"):
+        set_ = load_profile(profile)["data"]["turin-sim-mpu6000"]["imu_errors"]
+        for key in ("vibration_gyro_std", "vibration_accel_std"):
+            assert np.allclose(set_[key], implied[key], rtol=0.03), (profile, key)
+        assert set_["vibration_idle_fraction"] == pytest.approx(implied["vibration_idle_fraction"], abs=0.01)
+        assert set_["vibration_speed_ref_mps"] == implied["vibration_speed_ref_mps"]

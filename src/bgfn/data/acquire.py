@@ -106,11 +106,11 @@ RTKLIB_FILES: dict[str, RawFile] = {
     f.name: f
     for f in (
         RawFile("imu_1934.csv", "f1126bf3b36efc4bef2dd2c7d93bb2a0e1b4ce714005cbea00a9218ad0b3b7a9",
-                "f74142a151c63d83f50797deaf40f40929bb369e", False, **_RTKLIB),
+                "f74142a151c63d83f50797deaf40f40929bb369e", True, **_RTKLIB),
         RawFile("imu_1934.csv.tag", "d30d13d5641df367559472b91b48325601a87c986bf2bb6af368684a36b5ec96",
-                "c79867904df17050fb69470b5da68aac466700c8", False, **_RTKLIB),
+                "c79867904df17050fb69470b5da68aac466700c8", True, **_RTKLIB),
         RawFile("gnss_1934_sf.pos", "618fba5c7193e8eb448faf95c79c0d198233d5f4e5ad8ffec652893911ff7133",
-                "dc0ca25783ebb20d5e1e9f4fac590b72be551951", False, **_RTKLIB),
+                "dc0ca25783ebb20d5e1e9f4fac590b72be551951", True, **_RTKLIB),
     )
 }
 

@@ -185,7 +185,8 @@ def vibration_overrides(levels: pd.DataFrame, noise_density: dict, highpass_hz: 
     Returns
     -------
     dict
-        ``vibration_gyro_std``, ``vibration_accel_std`` (lists of 3), ``vibration_idle_fraction``.
+        ``vibration_gyro_std``, ``vibration_accel_std`` (lists of 3), ``vibration_idle_fraction``, and
+        ``vibration_speed_ref_mps`` = ``DRIVING_MPS`` (the envelope at full level wherever the level was measured).
     """
     if levels["dataset"].nunique() != 1:
         raise DataError("imu_levels", "levels", "the levels of one drive", str(sorted(levels["dataset"].unique())))
@@ -204,7 +205,38 @@ def vibration_overrides(levels: pd.DataFrame, noise_density: dict, highpass_hz: 
         ok = vib["driving"] > 0
         idle.extend(vib["still"][ok] / vib["driving"][ok])
     out["vibration_idle_fraction"] = float(np.clip(np.median(idle), 0.0, 1.0)) if idle else 0.0
+    out["vibration_speed_ref_mps"] = DRIVING_MPS
     return out
+
+
+def stand_in_table(measured, stand_in) -> pd.DataFrame:
+    """The stand-in's vibration settings beside what a measured drive implies, and what the same measurement
+    finds on the stand-in itself (the method checked on data whose truth is known).
+
+    Parameters
+    ----------
+    measured, stand_in : bgfn.data.Drive
+        A recorded drive, and a simulated one whose ``meta["imu_errors"]`` holds its error model.
+
+    Returns
+    -------
+    DataFrame
+        ``parameter`` (``vibration_gyro_std_x``, ...), ``unit``, ``<measured name>`` (implied by the recorded
+        drive), ``<stand-in name> setting``, ``<stand-in name> measured``.
+    """
+    errs = stand_in.meta["imu_errors"]
+    nd = {s: errs[f"{s}_noise_density"] for s in SENSORS}
+    implied = vibration_overrides(imu_levels(measured), nd, rate_hz=imu_rate_hz(measured.imu))
+    found = vibration_overrides(imu_levels(stand_in), nd, rate_hz=imu_rate_hz(stand_in.imu))
+    rows = []
+    for key in ("vibration_gyro_std", "vibration_accel_std"):
+        unit = UNITS[key.split("_")[1]]
+        for k, a in enumerate("xyz"):
+            rows.append((f"{key}_{a}", unit, implied[key][k], errs[key][k], found[key][k]))
+    rows.append(("vibration_idle_fraction", "-", implied["vibration_idle_fraction"],
+                 errs["vibration_idle_fraction"], found["vibration_idle_fraction"]))
+    return pd.DataFrame(rows, columns=["parameter", "unit", measured.name, f"{stand_in.name} setting",
+                                       f"{stand_in.name} measured"])
 
 
 def imu_psd(drive, state: str = "driving", nperseg: int = 512, still_mps: float = STILL_MPS,

@@ -104,7 +104,7 @@ TRAIN = section(
 
 #: The whole profile.
 SCHEMA = section(
-    profile=text(), description=text(), seed=_SEED, base=text(),
+    profile=text(), description=text(), seed=_SEED, base=text(), datasets=_NAMES,
     outage_windows=seq(seq(number(), length=2), min_len=1),
     data=section(
         datasets=_NAMES, seed=_SEED, imu_rate_hz=_POS, smoothing_degree=integer(1, 5),

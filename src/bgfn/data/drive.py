@@ -85,6 +85,12 @@ class Drive:
         meta = dict(self.meta, crop=[t_start, t_end])
         return Drive(self.name, ref, sel_imu(self.imu), sel(self.gnss), meta, sel_imu(self.imu_bias))
 
+    @property
+    def has_attitude(self) -> bool:
+        """True when the reference's ``roll``, ``pitch`` and ``yaw`` are all finite (a drive without a reference
+        attitude, e.g. a user's log, holds them all NaN)."""
+        return bool(np.isfinite(self.reference[["roll", "pitch", "yaw"]].to_numpy(float)).all())
+
     def validate(self, source: str | None = None, files: dict | None = None) -> "Drive":
         """Check columns, strictly increasing times, finite values and physics; return self.
 
@@ -99,10 +105,15 @@ class Drive:
         ------
         DataError
             Naming the table (or file) and the column; for implausible physics (units, axes, spikes, time
-            base) also the likely cause (:func:`bgfn.data.physics.check_drive`).
+            base) also the likely cause (:func:`bgfn.data.physics.check_drive`). A reference whose roll, pitch
+            and yaw are all NaN (no attitude) passes; one with some of them NaN does not.
         """
         src = source or self.name
-        for table, cols, nan_ok in (("reference", REFERENCE_COLUMNS, ()), ("imu", IMU_COLUMNS, ()),
+        attitude = ("roll", "pitch", "yaw")
+        no_attitude = all(c in self.reference.columns for c in attitude) and bool(
+            np.isnan(self.reference[list(attitude)].to_numpy(float)).all())
+        for table, cols, nan_ok in (("reference", REFERENCE_COLUMNS, attitude if no_attitude else ()),
+                                    ("imu", IMU_COLUMNS, ()),
                                     ("gnss", GNSS_COLUMNS, ("v_n", "v_e", "v_d"))):
             df = getattr(self, table)
             missing = [c for c in cols if c not in df.columns]

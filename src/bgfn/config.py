@@ -241,9 +241,9 @@ def load_profile(profile: str) -> dict[str, Any]:
 
 
 def _spread_datasets(datasets) -> dict:
-    """A top-level ``datasets:`` as the sections' keys of :data:`DATASET_KEYS` (``{}`` when not a list: the
-    schema check names a bad value)."""
-    if not isinstance(datasets, list):
+    """A top-level ``datasets:`` as the sections' keys of :data:`DATASET_KEYS` (``{}`` when not a non-empty list:
+    the schema check then names the bad value)."""
+    if not isinstance(datasets, list) or not datasets:
         return {}
     out: dict = {}
     for path in DATASET_KEYS:

@@ -45,8 +45,10 @@ IMU_ERROR_KEYS: tuple[str, ...] = VECTOR_KEYS + OPTIONAL_VECTOR_KEYS + SCALAR_KE
 
 
 def _unknown_key(path: Path, key, valid, prefix: str = "") -> DataError:
-    close = difflib.get_close_matches(str(key), list(valid), n=1, cutoff=0.6)
-    hint = f" (did you mean {prefix}{close[0]}?)" if close else ""
+    close = [prefix + k for k in difflib.get_close_matches(str(key), list(valid), n=1, cutoff=0.6)]
+    if not close and not prefix:       # an error parameter written at the top level belongs under imu_errors:
+        close = ["imu_errors." + k for k in difflib.get_close_matches(str(key), IMU_ERROR_KEYS, n=1, cutoff=0.6)]
+    hint = f" (did you mean {close[0]}?)" if close else ""
     return DataError(path, f"{prefix}{key}", f"one of the keys {', '.join(valid)}{hint}", "unknown key")
 
 

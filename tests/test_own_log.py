@@ -143,6 +143,13 @@ def test_a_csv_log_named_by_its_path_runs_notebooks_01_to_04(tmp_path, monkeypat
     assert set(table["method"]) == {"INS", "GPS", "BGFN", "MLP"}
     assert np.isfinite(table[list(ev.METRIC_COLUMNS)].to_numpy(float)).all()
     assert res[name].test == did
+    # notebook 04's displays beside the paper: a drive that stands for none of its tests has no paper values
+    lay = ev.ours_above_paper(res[name])
+    assert lay.xs("paper", level="source").isna().all().all() and lay.xs("ours", level="source").notna().any().any()
+    red = ev.reduction_table(res[name])
+    assert red["paper east_%"].isna().all() and red["paper east_%"].dtype == float
+    assert set(red["method"]) == {"GPS", "BGFN", "MLP"}                 # each against INS
+    assert ev.paper_table_title(did) == f"no table of the paper ({did})"
 
     written = [p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*") if p.is_file()]
     outside = [p for p in written if not p.startswith(("results/mine/", "logs/", "params/"))]
@@ -298,6 +305,20 @@ def test_dataset_ids_are_safe_and_keep_the_shipped_names(tmp_path, monkeypatch):
     with pytest.raises(DataError, match="both have the id 'rainy'"):
         unique_ids([str(a), str(b)])
     assert unique_ids(["turin-sim-ekinox", str(a)]) == {"turin-sim-ekinox": "turin-sim-ekinox", str(a): "rainy"}
+
+
+def test_attitude_all_three_or_none(tmp_path, truth):
+    log = _write_log(tmp_path / "d", truth)
+    pd.read_csv(log / "reference.csv").drop(columns=["yaw"]).to_csv(log / "reference.csv", index=False)
+    with pytest.raises(DataError) as err:
+        load_drive(log)
+    assert err.value.source == str(log / "reference.csv") and err.value.field == "yaw"
+    drive = load_drive(_write_log(tmp_path / "e", truth, attitude=False))
+    assert not drive.has_attitude and drive.validate() is drive        # all NaN: a drive without attitude
+    drive.reference.loc[3, ["roll", "pitch", "yaw"]] = 0.0               # some NaN: a broken reference
+    with pytest.raises(DataError) as err:
+        drive.validate()
+    assert err.value.field == "roll"
 
 
 def test_a_missing_folder_is_named(tmp_path):

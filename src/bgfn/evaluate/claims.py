@@ -19,9 +19,16 @@ from bgfn.evaluate.tables import TableResult, error_reduction
 REDUCTION_COLUMNS: tuple[str, ...] = ("outage", "method", "east_%", "north_%", "paper east_%", "paper north_%")
 
 
+def _paper_values(test: str) -> pd.DataFrame | None:
+    """The paper's table of ``test``; None for a dataset that stands for none of its tests (a user's drive)."""
+    return paper.outage_table(test) if test in paper.TESTS else None
+
+
 def paper_table_title(test: str) -> str:
     """How notebook 04 names the paper's table of a test: ``Table 1 (dataset test)``, ``Table 2 (field test)``
-    (the order of :data:`bgfn.paper.TESTS`)."""
+    (the order of :data:`bgfn.paper.TESTS`); ``no table of the paper (<test>)`` for any other drive."""
+    if test not in paper.TESTS:
+        return f"no table of the paper ({test})"
     return f"Table {list(paper.TESTS).index(test) + 1} ({paper.TESTS[test]['title']})"
 
 
@@ -35,9 +42,9 @@ def ours_above_paper(result: TableResult) -> pd.DataFrame:
     -------
     DataFrame
         Rows ``(Outage k, source)``; columns ``(method, axis)`` with axis ``East``/``North``; NaN where the
-        paper has no such method (Transformer, GPS).
+        paper has no such method (Transformer, GPS), or no such test (a user's drive: its rows all NaN).
     """
-    lay = paper.layout(result.table, paper.outage_table(result.test), methods=TABLE_METHODS)
+    lay = paper.layout(result.table, _paper_values(result.test), methods=TABLE_METHODS)
     return lay.stack("source", future_stack=True)
 
 
@@ -49,10 +56,13 @@ def reduction_table(result: TableResult, reference: str = "INS") -> pd.DataFrame
     -------
     DataFrame
         :data:`REDUCTION_COLUMNS`: one row per outage and method of ours; the paper's columns NaN where it
-        has no such row (Transformer, GPS).
+        has no such row (Transformer, GPS) or no such test (a user's drive).
     """
     ours = error_reduction(result.table, reference).rename(columns={"east_pct": "east_%", "north_pct": "north_%"})
-    theirs = error_reduction(paper.outage_table(result.test), reference).rename(
+    values = _paper_values(result.test)
+    theirs = (error_reduction(values, reference) if values is not None
+              else pd.DataFrame({"outage": pd.Series(dtype=ours["outage"].dtype), "method": pd.Series(dtype=object),
+                                 "east_pct": pd.Series(dtype=float), "north_pct": pd.Series(dtype=float)})).rename(
         columns={"east_pct": "paper east_%", "north_pct": "paper north_%"})
     return ours.merge(theirs, on=["outage", "method"], how="left")[list(REDUCTION_COLUMNS)]
 

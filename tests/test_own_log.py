@@ -307,18 +307,33 @@ def test_dataset_ids_are_safe_and_keep_the_shipped_names(tmp_path, monkeypatch):
     assert unique_ids(["turin-sim-ekinox", str(a)]) == {"turin-sim-ekinox": "turin-sim-ekinox", str(a): "rainy"}
 
 
-def test_attitude_all_three_or_none(tmp_path, truth):
+def test_attitude_all_three_or_none(tmp_path, monkeypatch, truth):
     log = _write_log(tmp_path / "d", truth)
     pd.read_csv(log / "reference.csv").drop(columns=["yaw"]).to_csv(log / "reference.csv", index=False)
     with pytest.raises(DataError) as err:
         load_drive(log)
     assert err.value.source == str(log / "reference.csv") and err.value.field == "yaw"
-    drive = load_drive(_write_log(tmp_path / "e", truth, attitude=False))
+    _write_log(tmp_path / "e", truth, attitude=False)
+    monkeypatch.chdir(tmp_path)
+    drive = load_drive("e")                                              # a relative folder path
     assert not drive.has_attitude and drive.validate() is drive        # all NaN: a drive without attitude
     drive.reference.loc[3, ["roll", "pitch", "yaw"]] = 0.0               # some NaN: a broken reference
     with pytest.raises(DataError) as err:
         drive.validate()
     assert err.value.field == "roll"
+
+
+def test_the_imu_plot_shows_a_drive_on_another_clock(tmp_path, truth):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from bgfn.data.plots import plot_imu_channels
+
+    drive = load_drive(_write_log(tmp_path / "d", truth))
+    fig = plot_imu_channels({"d": drive}, 138840.0, 20.0)      # quick's plot span lies on the Turin clock
+    x = fig.axes[0].lines[0].get_xdata()
+    assert len(x) == 2001 and x[0] == pytest.approx(0.0) and x[-1] == pytest.approx(20.0)   # its first 20 s
+    matplotlib.pyplot.close(fig)
 
 
 def test_a_missing_folder_is_named(tmp_path):

@@ -165,6 +165,7 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_st
     t_imu, t_ref = raw["imu"]["time"].to_numpy(float), raw["reference"]["time"].to_numpy(float)
     native = median_rate_hz(t_imu)
     rate = float(imu_rate_hz) if imu_rate_hz is not None else native
+    # the common span; IMU row 0 covers one step before its own time (schema, CONTRIBUTING.md)
     lo = max(t_ref[0], 2 * t_imu[0] - t_imu[1], -np.inf if t_start is None else float(t_start))
     hi = min(t_ref[-1], t_imu[-1], np.inf if t_end is None else float(t_end))
     if hi - lo < 2.0 / rate:

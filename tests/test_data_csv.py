@@ -50,7 +50,9 @@ def test_optional_velocity_and_meta(tmp_path, drive):
     (folder / "meta.yaml").unlink()
     back = load_csv_drive(folder)
     assert back.gnss[["v_n", "v_e", "v_d"]].isna().all().all()
-    assert back.meta["lever_arm_m"] == [0.0, 0.0, 0.0] and back.meta["imu_errors"] is None
+    # no meta.yaml: the documented defaults, the consumer-MEMS profile for the filter
+    assert back.meta["lever_arm_m"] == [0.0, 0.0, 0.0] and back.meta["imu_errors"] == error_params("mpu6000")
+    assert "default" in back.meta["imu_errors_source"]
     assert back.name == "d"
 
 

@@ -2,12 +2,14 @@
 
 One network = one ``(dataset, method, seed)`` of a profile (a fold ``k`` for the outage sweep's networks)::
 
-    results/<profile>/models/<dataset>/[fold<k>/]<method>_seed<seed>.pt        best checkpoint (bgfn.train)
+    results/<profile>/models/<dataset id>/[fold<k>/]<method>_seed<seed>.pt     best checkpoint (bgfn.train)
                                                  <method>_seed<seed>.json      its card (metrics, config hash)
                                                  <method>_seed<seed>.last.pt   while training: resumable state
 
 Every module builds these names with :func:`checkpoint_path` (or :func:`checkpoint_name` under a folder it
-was given) and reads them back with :func:`parse_checkpoint`; nothing else spells the pattern.
+was given) and reads them back with :func:`parse_checkpoint`; nothing else spells the pattern. The folder is the
+dataset's id (:func:`bgfn.data.names.dataset_id`: a shipped dataset's name, a CSV drive's ``meta.yaml`` name or
+folder name), so a drive named by a folder path never writes outside ``results/<profile>/``.
 """
 
 from __future__ import annotations
@@ -38,9 +40,11 @@ def checkpoint_name(method: str, seed: int, suffix: str = BEST_SUFFIX) -> str:
 
 
 def models_dir(profile: str, dataset: str, fold: int | None = None, create: bool = True) -> Path:
-    """``results/<profile>/models/<dataset>/`` (``.../fold<k>/`` for a sweep fold), created unless ``create``
-    is False."""
-    d = results_dir(profile, create=create) / "models" / dataset
+    """``results/<profile>/models/<dataset id>/`` (``.../fold<k>/`` for a sweep fold), created unless ``create``
+    is False; ``dataset`` may be a registered name, a CSV folder path or an id (:func:`bgfn.data.names.dataset_id`)."""
+    from bgfn.data.names import dataset_id
+
+    d = results_dir(profile, create=create) / "models" / dataset_id(dataset)
     if fold is not None:
         d = d / f"fold{int(fold)}"
     if create:
@@ -50,7 +54,7 @@ def models_dir(profile: str, dataset: str, fold: int | None = None, create: bool
 
 def checkpoint_path(profile: str, dataset: str, method: str, seed: int, fold: int | None = None,
                     create: bool = True) -> Path:
-    """``results/<profile>/models/<dataset>/[fold<k>/]<method>_seed<seed>.pt``."""
+    """``results/<profile>/models/<dataset id>/[fold<k>/]<method>_seed<seed>.pt``."""
     return models_dir(profile, dataset, fold, create) / checkpoint_name(method, seed)
 
 

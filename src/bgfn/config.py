@@ -78,6 +78,10 @@ SHARED_TABLES: dict[str, str] = {
     "sweep_pairs": "outage_sweep_pairs.csv",
     "kf_ins_tuning": "kf_ins_tuning.csv",       # notebook 02: the INS row under each filter setup
 }
+#: Where a top-level ``datasets:`` puts its list (the datasets of every notebook), unless the same file or a later
+#: one in the ``base:`` chain sets that section's own ``datasets``.
+DATASET_KEYS: tuple[str, ...] = ("data.datasets", "nav.datasets", "train.datasets", "evaluate.datasets",
+                                 "evaluate.sweep.datasets")
 #: Keys of earlier versions that now live elsewhere: ``section.key`` -> the key to set instead.
 MOVED_KEYS: dict[str, str] = {
     "nav.outage_starts": "outage_windows",
@@ -169,7 +173,15 @@ def load_profile(profile: str) -> dict[str, Any]:
 
     A profile may name another one as ``base:``; it then holds only what differs: its sections are laid
     over the base's key by key (:func:`merge_sections`), so ``params/quick-heading.yaml`` lists only the
-    settings it changes in ``params/quick.yaml``. ``profile`` and ``description`` are always the file's own.
+    settings it changes in ``params/quick.yaml``. ``profile`` and ``description`` are always the file's own
+    (``profile`` may be left out: it is the file's name). A top-level ``datasets:`` list sets the datasets of
+    every notebook (:data:`DATASET_KEYS`) over the base's; a section's own ``datasets`` in the same file wins.
+    So a user's drive needs four lines (README, "Your own log")::
+
+        base: quick
+        description: "my car, 2024-05-01"
+        datasets: [/home/me/logs/drive-0501]      # a CSV folder (data/README.md)
+        outage_windows: [[243100.0, 30.0], [243400.0, 30.0]]
 
     Parameters
     ----------
@@ -196,11 +208,14 @@ def load_profile(profile: str) -> dict[str, Any]:
     for file, own in chain:
         _check_moved_keys(file, own)
     cfg: dict = {}
-    for _, own in reversed(chain):                  # the furthest base first, the profile's own file last
+    for i, (_, own) in enumerate(reversed(chain)):   # the furthest base first, the profile's own file last
         own = {k: v for k, v in own.items() if k != "base"}
+        if i == len(chain) - 1:
+            own.setdefault("profile", profile)     # the file's name unless it says otherwise
         if cfg:   # the base's name and description are not inherited; a comments-only section changes nothing
             cfg = {k: v for k, v in cfg.items() if k not in ("profile", "description")}
             own = {k: v for k, v in own.items() if not (k in SECTION_KEYS and v is None)}
+        cfg = merge_sections(cfg, _spread_datasets(own.get("datasets")))
         cfg = merge_sections(cfg, own)
 
     missing = [key for key in REQUIRED_KEYS if key not in cfg]
@@ -225,6 +240,21 @@ def load_profile(profile: str) -> dict[str, Any]:
     except ProfileError as exc:
         raise DataError(_file_setting(chain, exc.path), exc.path, exc.expected, exc.found) from None
     return copy.deepcopy(cfg)
+
+
+def _spread_datasets(datasets) -> dict:
+    """A top-level ``datasets:`` as the sections' keys of :data:`DATASET_KEYS` (``{}`` when not a non-empty list:
+    the schema check then names the bad value)."""
+    if not isinstance(datasets, list) or not datasets:
+        return {}
+    out: dict = {}
+    for path in DATASET_KEYS:
+        *parents, key = path.split(".")
+        node = out
+        for k in parents:
+            node = node.setdefault(k, {})
+        node[key] = list(datasets)
+    return out
 
 
 def with_overrides(cfg: dict, overrides: dict[str, Any], source: str = "notebook parameters") -> dict:

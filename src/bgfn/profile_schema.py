@@ -127,7 +127,7 @@ OUTAGE_WINDOWS = either(OUTAGE_LIST, mapping(either(OUTAGE_LIST, OUTAGE_RULE)))
 
 #: The whole profile.
 SCHEMA = section(
-    profile=text(), description=text(), seed=_SEED, base=text(),
+    profile=text(), description=text(), seed=_SEED, base=text(), datasets=_NAMES,
     outage_windows=OUTAGE_WINDOWS,
     data=section(
         datasets=_NAMES, seed=_SEED, imu_rate_hz=_POS, smoothing_degree=integer(1, 5),
@@ -351,7 +351,8 @@ def validate(cfg: dict) -> None:
 
 def check_with_drives(profile: str) -> list[str]:
     """The checks that need the data, for ``make``'s ``check-profile`` step: each dataset of the profile loads
-    (built and cached when new, as notebook 01 would), the outages lie inside every drive of notebooks 02-04,
+    (built and cached when new, as notebook 01 would), no two share a dataset id (the name of their result files,
+    :func:`bgfn.data.names.dataset_id`), the outages lie inside every drive of notebooks 02-04,
     the input window is shorter than the GPS-available data, and the outage sweep has its starts.
 
     Returns
@@ -376,6 +377,9 @@ def check_with_drives(profile: str) -> list[str]:
     opts = learning_options(tr)                 # the window and margin notebook 03 uses, defaults filled in
     names = dict.fromkeys(cfg["nav"].get("datasets", []) + tr.get("datasets", []) + ev.get("datasets", [])
                           + (ev.get("sweep") or {}).get("datasets", []))
+    from bgfn.data.names import unique_ids
+
+    unique_ids(list(cfg["data"].get("datasets", [])) + list(names), path)   # result files must not overwrite
     spec = cfg.get("outage_windows")
     lines = []
     for name in names:

@@ -4,6 +4,7 @@ Public API:
 
 - :func:`load_drive` ``(name="turin-sim-ekinox", **overrides) -> Drive`` and the registry
   :data:`DATASETS` (name -> default parameters); a CSV folder path loads a user's drive.
+- :func:`dataset_id`: the safe id that names a dataset's result files (a folder path never becomes a file name).
 - :class:`Drive`: ``name``, ``reference``, ``imu``, ``gnss`` tables, ``meta``, ``imu_bias``.
 - :func:`fetch_all` / :func:`resolve`: the NaveGo files, ``data/raw`` -> mirror -> pinned URL
   (``python -m bgfn.data fetch``).
@@ -22,10 +23,11 @@ from bgfn.data.drive import Drive
 from bgfn.data.drives import DATASETS, DEFAULT_DATASET, dataset_params, load_drive
 from bgfn.data.gnss import simulate_fixes
 from bgfn.data.imu_errors import EKINOX_D, MPU6000, apply_imu_errors, error_params
+from bgfn.data.names import dataset_id
 from bgfn.data.trajectory import smooth_reference
 
 __all__ = [
     "DATASETS", "DEFAULT_DATASET", "Drive", "EKINOX_D", "MPU6000", "MissingFileError", "NAVEGO_FILES",
-    "apply_imu_errors", "dataset_params", "error_params", "fetch_all", "load_csv_drive", "load_drive",
+    "apply_imu_errors", "dataset_id", "dataset_params", "error_params", "fetch_all", "load_csv_drive", "load_drive",
     "resolve", "simulate_fixes", "smooth_reference", "write_csv_drive",
 ]

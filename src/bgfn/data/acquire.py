@@ -100,8 +100,8 @@ NAVEGO_FILES: dict[str, RawFile] = {
 _RTKLIB = {"url": RTKLIB_URL, "mirror_folder": "rtklib-drive0708", "mirror_env": "BGFN_RTKLIB_MIRROR",
            "source": f"rtklibexplorer/GNSS_IMU {RTKLIB_COMMIT[:7]} data/drive_0708",
            "when_missing": "the dataset rtklib-drive0708 cannot be built; the other datasets are unaffected"}
-#: The three files of the RTKLIB-logged car drive (``../shared/data/rtklib-drive0708/README.md``); optional:
-#: only the dataset ``rtklib-drive0708`` needs them.
+#: The three files of the RTKLIB-logged car drive (``../shared/data/rtklib-drive0708/README.md``); required:
+#: the shipped profiles use the dataset ``rtklib-drive0708``.
 RTKLIB_FILES: dict[str, RawFile] = {
     f.name: f
     for f in (

@@ -4,15 +4,21 @@ Schema (``data/README.md``; CONTRIBUTING.md tables; SI units, rad, GPS time of w
 base in s, body frame x forward / y right / z down, NED):
 
 - ``imu.csv``: ``time, gyro_x, gyro_y, gyro_z`` (rad/s), ``accel_x, accel_y, accel_z`` (m/s^2); row k =
-  mean rates over ``(time[k-1], time[k]]``.
+  mean rates over ``(time[k-1], time[k]]``. The times may jitter; a gap of more than a few samples is an error.
 - ``gnss.csv``: ``time, lat, lon`` (rad), ``h`` (m), ``std_n, std_e, std_d`` (m); optional
   ``v_n, v_e, v_d`` (m/s; empty/NaN when not given).
-- ``reference.csv``: ``time, lat, lon, h, v_n, v_e, v_d, roll, pitch, yaw``.
-- ``meta.yaml`` (optional): ``name``, ``lever_arm_m`` ([x, y, z] antenna in the body frame, m,
-  default [0, 0, 0]), ``imu_errors`` (keys of :mod:`bgfn.data.imu_errors`, e.g. noise densities, for the
-  KF), ``source`` (free text).
+- ``reference.csv``: ``time, lat, lon, h, v_n, v_e, v_d`` at its own rate; optional ``roll, pitch, yaw``
+  (all three or none; absent: NaN columns, a drive without reference attitude, ``Drive.has_attitude``).
+- ``meta.yaml`` (optional; :mod:`bgfn.data.csv_meta`): ``name``, ``lever_arm_m``, ``source``, ``imu_errors``
+  (default: the consumer-MEMS profile :data:`bgfn.data.imu_errors.MPU6000`).
 
-Extra columns are ignored; any defect raises :class:`bgfn.errors.DataError` naming the file and column.
+Loading (:func:`load_csv_drive`): the raw tables first pass the plausibility checks of
+:mod:`bgfn.data.physics` (accelerations in g, rates in deg/s, unrotated axes, lat/lon in degrees, times in ms:
+each a DataError naming the CSV file and column), then go onto one regular grid (:mod:`bgfn.data.regrid`): the
+IMU resampled by integrating its increments when its steps jitter, the reference interpolated at the IMU epochs
+(position by cubic Hermite segments with the reference's velocities as slopes, velocities and attitude linearly,
+yaw unwrapped). Extra columns are ignored; any defect raises :class:`bgfn.errors.DataError` naming the file and
+column.
 """
 
 from __future__ import annotations
@@ -22,19 +28,25 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from bgfn.data.csv_meta import META_FILE, read_meta
 from bgfn.data.drive import Drive
-from bgfn.data.imu_errors import error_params
-from bgfn.data.navego import check_time, resample_imu
+from bgfn.data.navego import check_time
+from bgfn.data.physics import check_drive
+from bgfn.data.regrid import check_gaps, imu_on_grid, interpolate_reference, median_rate_hz
 from bgfn.errors import DataError
 from bgfn.schema import GNSS_COLUMNS, GNSS_FIX_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS
 
+#: Reference attitude columns: all three or none.
+ATTITUDE_COLUMNS: tuple[str, ...] = ("roll", "pitch", "yaw")
 #: Files of a CSV drive and their required columns.
 CSV_FILES = {
     "imu.csv": IMU_COLUMNS,
     "gnss.csv": GNSS_FIX_COLUMNS,
-    "reference.csv": REFERENCE_COLUMNS,
+    "reference.csv": tuple(c for c in REFERENCE_COLUMNS if c not in ATTITUDE_COLUMNS),
 }
-_OPTIONAL = {"gnss.csv": ("v_n", "v_e", "v_d")}
+_OPTIONAL = {"gnss.csv": ("v_n", "v_e", "v_d"), "reference.csv": ATTITUDE_COLUMNS}
+#: Table of the drive each file holds.
+TABLE_OF = {"imu.csv": "imu", "gnss.csv": "gnss", "reference.csv": "reference"}
 
 
 def read_table(path: Path, required: tuple[str, ...], optional: tuple[str, ...] = ()) -> pd.DataFrame:
@@ -86,21 +98,27 @@ def read_table(path: Path, required: tuple[str, ...], optional: tuple[str, ...] 
     return pd.DataFrame({c: out[c] for c in order})
 
 
-def _read_meta(path: Path) -> dict:
-    if not path.is_file():
-        return {}
-    import yaml
+def _check_attitude(path: Path, header: list[str], ref: pd.DataFrame) -> None:
+    """All three attitude columns or none; present ones finite."""
+    given = [c for c in ATTITUDE_COLUMNS if c in header]
+    if given and len(given) < len(ATTITUDE_COLUMNS):
+        absent = [c for c in ATTITUDE_COLUMNS if c not in given]
+        raise DataError(path, absent[0], "all of roll, pitch, yaw (rad) or none of them (a drive without "
+                        "reference attitude)", f"{', '.join(given)} without {', '.join(absent)}")
+    for c in given:
+        bad = ~np.isfinite(ref[c].to_numpy(float))
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise DataError(path, c, "finite numbers", f"{int(bad.sum())} empty/non-numeric/NaN values, first in "
+                            f"data row {k + 1}")
 
-    try:
-        meta = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
-    except yaml.YAMLError as exc:
-        raise DataError(path, "<yaml>", "valid YAML", str(exc).replace("\n", " ")) from None
-    if not isinstance(meta, dict):
-        raise DataError(path, "<top level>", "a mapping", type(meta).__name__)
-    return meta
+
+def _header(path: Path) -> list[str]:
+    return [str(c).strip() for c in pd.read_csv(path, comment="#", skipinitialspace=True, nrows=0).columns]
 
 
-def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None) -> Drive:
+def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_start: float | None = None,
+                   t_end: float | None = None) -> Drive:
     """Load a drive from a folder in the CSV schema of the module docstring.
 
     Parameters
@@ -108,50 +126,71 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None) -> D
     folder : str or Path
         Folder holding ``imu.csv``, ``gnss.csv``, ``reference.csv`` (and optionally ``meta.yaml``).
     imu_rate_hz : float, optional
-        Resample the IMU to this rate by integrating its increments
-        (:func:`bgfn.data.navego.resample_imu`); default: keep the file's rate.
+        Rate of the IMU grid, Hz (resampled by integrating the increments,
+        :func:`bgfn.data.navego.resample_imu`); default: the log's median rate (a regular log is kept as is).
+    t_start, t_end : float, optional
+        Keep only this span, s (on the files' time base).
 
     Returns
     -------
     Drive
-        ``meta``: ``imu_rate_hz``, ``gnss_rate_hz`` (from the median intervals), ``lever_arm_m``,
-        ``imu_errors`` (validated, or None), ``source``, ``params``.
+        Named by ``meta.yaml``'s ``name``, else by the folder (:func:`bgfn.data.names.dataset_id`); the
+        reference at the IMU epochs; ``meta``: ``imu_rate_hz``, ``native_imu_rate_hz``, ``imu_resampled``,
+        ``reference_rate_hz``, ``reference_interpolated``, ``gnss_rate_hz`` (from the median intervals),
+        ``lever_arm_m``, ``imu_errors``, ``imu_errors_source``, ``source``, ``params``.
+
+    Raises
+    ------
+    DataError
+        Naming the file and the column (or ``meta.yaml`` and the key).
     """
+    from bgfn.data.names import safe_id
+
     folder = Path(folder)
     if not folder.is_dir():
         raise DataError(folder, "folder", "a folder with imu.csv, gnss.csv, reference.csv", "no such folder")
-    tables = {name: read_table(folder / name, cols, _OPTIONAL.get(name, ())) for name, cols in CSV_FILES.items()}
-    gnss = tables["gnss.csv"]
+    files = {TABLE_OF[name]: folder / name for name in CSV_FILES}
+    raw = {TABLE_OF[name]: read_table(folder / name, cols, _OPTIONAL.get(name, ())) for name, cols in CSV_FILES.items()}
+    _check_attitude(files["reference"], _header(files["reference"]), raw["reference"])
+    gnss = raw["gnss"]
     std = gnss[["std_n", "std_e", "std_d"]].to_numpy(float)
     if (std <= 0).any():
-        raise DataError(folder / "gnss.csv", "std_n/std_e/std_d", "positive position std, m",
-                        f"min {std.min()}")
-    meta_path = folder / "meta.yaml"
-    user = _read_meta(meta_path)
-    larm = np.asarray(user.get("lever_arm_m", [0.0, 0.0, 0.0]), dtype=float).ravel()
-    if larm.size != 3 or not np.isfinite(larm).all():
-        raise DataError(meta_path, "lever_arm_m", "3 finite numbers [x, y, z], m", str(user.get("lever_arm_m")))
-    imu_errors = None
-    if "imu_errors" in user:
-        if not isinstance(user["imu_errors"], dict):
-            raise DataError(meta_path, "imu_errors", "a mapping of error parameters", type(user["imu_errors"]).__name__)
-        try:
-            imu_errors = error_params(dict(user["imu_errors"], model=user["imu_errors"].get("model", "user")))
-        except DataError as exc:
-            raise DataError(meta_path, f"imu_errors.{exc.field}", exc.expected, exc.found) from None
-    imu = tables["imu.csv"]
-    if imu_rate_hz is not None:
-        imu = resample_imu(imu, imu_rate_hz)
-    rate = float(imu_rate_hz) if imu_rate_hz is not None else float(1.0 / np.median(np.diff(imu["time"])))
+        raise DataError(files["gnss"], "std_n/std_e/std_d", "positive position std, m", f"min {std.min()}")
+    meta_path = folder / META_FILE
+    user = read_meta(meta_path)
+    # units and axes on the files' own rows, so that each message names the CSV file, column and data row
+    check_drive(Drive(str(folder), raw["reference"], raw["imu"], gnss), {t: str(p) for t, p in files.items()})
+    for table in ("imu", "reference"):
+        check_gaps(raw[table]["time"].to_numpy(float), files[table])
+    t_imu, t_ref = raw["imu"]["time"].to_numpy(float), raw["reference"]["time"].to_numpy(float)
+    native = median_rate_hz(t_imu)
+    rate = float(imu_rate_hz) if imu_rate_hz is not None else native
+    # the common span; IMU row 0 covers one step before its own time (schema, CONTRIBUTING.md)
+    lo = max(t_ref[0], 2 * t_imu[0] - t_imu[1], -np.inf if t_start is None else float(t_start))
+    hi = min(t_ref[-1], t_imu[-1], np.inf if t_end is None else float(t_end))
+    if hi - lo < 2.0 / rate:
+        raise DataError(files["reference"], "time", f"a reference overlapping the IMU span [{t_imu[0]:.3f}, "
+                        f"{t_imu[-1]:.3f}] s of {files['imu']} (within t_start {t_start}, t_end {t_end}) by "
+                        "at least two IMU intervals: the same time base", f"[{t_ref[0]:.3f}, {t_ref[-1]:.3f}] s")
+    imu, t_first, resampled = imu_on_grid(raw["imu"], rate, lo, hi)
+    epochs = np.concatenate([[t_first], imu["time"].to_numpy(float)])
+    reference = interpolate_reference(raw["reference"], epochs, files["reference"])
+    tg = gnss["time"].to_numpy(float)
+    gnss = gnss.loc[(tg >= epochs[0]) & (tg <= epochs[-1])].reset_index(drop=True)
     meta = {
         "imu_rate_hz": rate,
-        "gnss_rate_hz": float(1.0 / np.median(np.diff(gnss["time"]))),
-        "lever_arm_m": larm.tolist(),
-        "imu_errors": imu_errors,
-        "source": str(user.get("source", f"CSV drive {folder}")),
-        "params": {"folder": str(folder), "imu_rate_hz": imu_rate_hz},
+        "native_imu_rate_hz": native,
+        "imu_resampled": resampled,
+        "reference_rate_hz": median_rate_hz(t_ref),
+        "reference_interpolated": not np.isin(epochs, t_ref).all(),
+        "gnss_rate_hz": median_rate_hz(tg) if len(tg) > 1 else None,
+        "lever_arm_m": user["lever_arm_m"],
+        "imu_errors": user["imu_errors"],
+        "imu_errors_source": user["imu_errors_source"],
+        "source": user["source"] or f"CSV drive {folder}",
+        "params": {"folder": str(folder), "imu_rate_hz": imu_rate_hz, "t_start": t_start, "t_end": t_end},
     }
-    return Drive(str(user.get("name", folder.name)), tables["reference.csv"], imu, gnss, meta)
+    return Drive(user["name"] or safe_id(folder.name), reference, imu, gnss, meta)
 
 
 def write_csv_drive(drive: Drive, folder: str | Path) -> Path:
@@ -167,15 +206,18 @@ def write_csv_drive(drive: Drive, folder: str | Path) -> Path:
     from bgfn.io import atomic_write_csv, atomic_write_text
 
     folder = Path(folder)
+    ref_cols = [c for c in REFERENCE_COLUMNS if drive.has_attitude or c not in ATTITUDE_COLUMNS]
     atomic_write_csv(folder / "imu.csv", drive.imu[list(IMU_COLUMNS)], float_format="%.17g")
     atomic_write_csv(folder / "gnss.csv", drive.gnss[list(GNSS_COLUMNS)], float_format="%.17g")
-    atomic_write_csv(folder / "reference.csv", drive.reference[list(REFERENCE_COLUMNS)], float_format="%.17g")
-    meta = {"name": drive.name, "lever_arm_m": [float(x) for x in drive.meta.get("lever_arm_m", [0, 0, 0])],
+    atomic_write_csv(folder / "reference.csv", drive.reference[ref_cols], float_format="%.17g")
+    from bgfn.data.names import safe_id
+
+    meta = {"name": safe_id(drive.name), "lever_arm_m": [float(x) for x in drive.meta.get("lever_arm_m", [0, 0, 0])],
             "source": str(drive.meta.get("source", ""))}
     errs = drive.meta.get("imu_errors")
     if errs:
         from bgfn.data.imu_errors import OPTIONAL_VECTOR_KEYS, SCALAR_KEYS, VECTOR_KEYS
 
         meta["imu_errors"] = {k: errs[k] for k in VECTOR_KEYS + OPTIONAL_VECTOR_KEYS + SCALAR_KEYS + ("model",) if k in errs}
-    atomic_write_text(folder / "meta.yaml", yaml.safe_dump(meta, sort_keys=True))
+    atomic_write_text(folder / META_FILE, yaml.safe_dump(meta, sort_keys=True))
     return folder

@@ -93,6 +93,12 @@ class Drive:
         meta = dict(self.meta, crop=[t_start, t_end])
         return Drive(self.name, ref, sel_imu(self.imu), sel(self.gnss), meta, sel_imu(self.imu_bias))
 
+    @property
+    def has_attitude(self) -> bool:
+        """True when the reference's ``roll``, ``pitch`` and ``yaw`` are all finite (a drive without a reference
+        attitude, e.g. a user's log, holds them all NaN)."""
+        return bool(np.isfinite(self.reference[["roll", "pitch", "yaw"]].to_numpy(float)).all())
+
     def validate(self, source: str | None = None, files: dict | None = None) -> "Drive":
         """Check columns, strictly increasing times, finite values and physics; return self.
 
@@ -107,7 +113,8 @@ class Drive:
         ------
         DataError
             Naming the table (or file) and the column; for implausible physics (units, axes, spikes, time
-            base) also the likely cause (:func:`bgfn.data.physics.check_drive`).
+            base) also the likely cause (:func:`bgfn.data.physics.check_drive`). A reference whose roll, pitch
+            and yaw are all NaN (no attitude) passes; one with some of them NaN does not.
         """
         src = source or self.name
         ref_nan_ok = ()

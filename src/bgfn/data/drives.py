@@ -38,10 +38,11 @@ import numpy as np
 import pandas as pd
 
 from bgfn.data import acquire
-from bgfn.data.csv_drive import load_csv_drive
+from bgfn.data.csv_drive import CSV_FILES, TABLE_OF, load_csv_drive
 from bgfn.data.drive import Drive, load_cached, prune_stale, save_drive
 from bgfn.data.gnss import decimate, degrade_fixes, fix_errors, imu_position, simulate_fixes
 from bgfn.data.imu_errors import MPU6000, apply_imu_errors, error_params
+from bgfn.data.names import dataset_folder
 from bgfn.data.navego import read_gnss, read_imu, read_reference, resample_imu
 from bgfn.data.rtklib import LEVER_ARM_M as RTKLIB_LEVER_ARM_M
 from bgfn.data.rtklib import IMU_TIME_OFFSET_S, Q_FIX, quality_spans, read_imu_csv, read_pos, read_tag
@@ -341,6 +342,27 @@ _BUILDERS: dict[str, tuple[tuple[str, ...], Callable]] = {
 }
 
 
+#: Parameters a CSV drive takes (from the profile's ``data:`` section or as overrides).
+CSV_PARAMS: tuple[str, ...] = ("imu_rate_hz", "t_start", "t_end")
+
+
+def _load_folder(folder: Path, profile: str | None, overrides: dict) -> Drive:
+    """A user's CSV drive (:func:`bgfn.data.csv_drive.load_csv_drive`) with the profile's ``data:`` grid rate and
+    crop (``imu_rate_hz``, ``t_start``, ``t_end``), checked (:meth:`Drive.validate`) with messages naming the files."""
+    extra = sorted(set(overrides) - set(CSV_PARAMS))
+    if extra:
+        raise DataError(folder, extra[0], f"a parameter of a CSV drive: {', '.join(CSV_PARAMS)}", "unknown parameter")
+    params = {}
+    if profile is not None:
+        from bgfn.config import load_profile
+
+        data = load_profile(profile)["data"]
+        params = {k: data[k] for k in CSV_PARAMS if data.get(k) is not None}
+    params.update({k: v for k, v in overrides.items() if v is not None})
+    files = {TABLE_OF[f]: str(folder / f) for f in CSV_FILES}
+    return load_csv_drive(folder, **params).validate(str(folder), files=files)
+
+
 def load_drive(name: str | Path = DEFAULT_DATASET, *, profile: str | None = None,
                data_dir: str | Path | None = None, mirror: str | Path | None = None, download: bool = True,
                cache: bool = True, **overrides) -> Drive:
@@ -349,7 +371,8 @@ def load_drive(name: str | Path = DEFAULT_DATASET, *, profile: str | None = None
     Parameters
     ----------
     name : str or Path
-        A key of ``DATASETS`` (default ``"turin-sim-ekinox"``) or a folder in the CSV schema.
+        A key of ``DATASETS`` (default ``"turin-sim-ekinox"``) or a folder in the CSV schema, absolute or
+        relative to the repository root, else to the current directory (:func:`bgfn.data.names.dataset_folder`).
     profile : str, optional
         Take the parameters from the ``data:`` section of ``params/<profile>.yaml``
         (:func:`profile_overrides`); explicit ``overrides`` win.
@@ -367,7 +390,8 @@ def load_drive(name: str | Path = DEFAULT_DATASET, *, profile: str | None = None
         Dataset parameters (see ``DATASETS``): ``seed``, ``imu_rate_hz``, ``gnss_rate_hz``,
         ``smoothing_degree``, ``position_sigma_m``, ``attitude_sigma_rad``, ``imu_errors`` (dict of
         error-profile keys), ``lever_arm_m``, ``gnss_*_std_m``, ``gnss_correlated_tau_s``, ``t_start``,
-        ``t_end``. For a CSV folder only ``imu_rate_hz``.
+        ``t_end``. For a CSV folder only ``imu_rate_hz``, ``t_start``, ``t_end`` (:data:`CSV_PARAMS`; also taken
+        from the profile's ``data:`` section).
 
     Returns
     -------
@@ -380,15 +404,17 @@ def load_drive(name: str | Path = DEFAULT_DATASET, *, profile: str | None = None
         file cannot be had (for the real IMU files: says that the simulated datasets stand in);
         :class:`bgfn.errors.ChecksumError` on a checksum mismatch.
     """
-    if isinstance(name, Path) or (isinstance(name, str) and name not in DATASETS and Path(name).is_dir()):
-        extra = set(overrides) - {"imu_rate_hz"}  # a profile does not apply to a user's drive
-        if extra:
-            raise DataError(name, sorted(extra)[0], "only imu_rate_hz for a CSV drive", "unknown parameter")
-        folder = Path(name)
-        return load_csv_drive(folder, **overrides).validate(
-            str(folder), files={t: str(folder / f"{t}.csv") for t in ("reference", "imu", "gnss")})
+    folder = dataset_folder(name)
+    if folder is not None:
+        return _load_folder(folder, profile, overrides)
     if name not in DATASETS:
-        raise DataError("load_drive", "name", f"one of {', '.join(DATASETS)} or a CSV folder", repr(name))
+        from bgfn.config import PROJECT_ROOT
+
+        if isinstance(name, Path) or "/" in str(name) or "\\" in str(name):
+            raise DataError(name, "folder", f"a folder with {', '.join(CSV_FILES)} (a relative path is taken from "
+                            f"{PROJECT_ROOT}, else from the current directory)", "no such folder")
+        raise DataError("load_drive", "name", f"one of {', '.join(DATASETS)} or a CSV folder (absolute, or "
+                        f"relative to {PROJECT_ROOT} or the current directory)", repr(str(name)))
     if profile is not None:
         overrides = {**profile_overrides(name, profile), **overrides}
     params = dataset_params(name, overrides)

@@ -107,7 +107,7 @@ def plot_imu_channels(drives: dict, t_start: float, duration: float):
     drives : dict of str to Drive
         Drives to overlay (e.g. the Ekinox-D and the MPU-6000 grade).
     t_start, duration : float
-        Segment, s.
+        Segment, s; when no drive has samples there, the first drive's first ``duration`` seconds.
 
     Returns
     -------
@@ -115,6 +115,9 @@ def plot_imu_channels(drives: dict, t_start: float, duration: float):
         3 x 2 panels: gyro x/y/z (deg/s) left, accel x/y/z (m/s^2) right.
     """
     fig, axes = plt.subplots(3, 2, figsize=(11, 7), sharex=True)
+    if drives and not any(((d.imu["time"] >= t_start) & (d.imu["time"] <= t_start + duration)).any()
+                          for d in drives.values()):
+        t_start = float(next(iter(drives.values())).imu["time"].iloc[0])   # e.g. a user's drive on another clock
     for name, drive in drives.items():
         imu = drive.imu
         seg = imu.loc[(imu["time"] >= t_start) & (imu["time"] <= t_start + duration)]

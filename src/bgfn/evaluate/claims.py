@@ -21,10 +21,19 @@ from bgfn.evaluate.tables import TableResult, error_reduction
 REDUCTION_COLUMNS: tuple[str, ...] = ("outage", "method", "east_%", "north_%", "paper east_%", "paper north_%")
 
 
+def _paper_values(test: str) -> pd.DataFrame | None:
+    """The paper's values shown beside ``test`` (:func:`bgfn.paper.published_values`); None for a dataset that
+    stands for none of its tests (a user's drive)."""
+    return paper.published_values(test) if test in paper.TESTS else None
+
+
 def paper_table_title(test: str) -> str:
     """How notebook 04 names the paper's table beside a test: ``Table 1 (dataset test)``, ``Table 2 (field
     test)`` (the order of the paper's tests in :data:`bgfn.paper.TESTS`); for a test the paper has no table of,
-    ``real drive (not in the paper; beside it Table 2 (field test))``."""
+    ``real drive (not in the paper; beside it Table 2 (field test))``; ``no table of the paper (<test>)`` for any
+    other drive (a user's)."""
+    if test not in paper.TESTS:
+        return f"no table of the paper ({test})"
     own = [t for t in paper.TESTS if paper.has_own_values(t)]
     shown = paper.published_test(test)
     title = f"Table {own.index(shown) + 1} ({paper.TESTS[shown]['title']})"
@@ -41,11 +50,12 @@ def ours_above_paper(result: TableResult) -> pd.DataFrame:
     -------
     DataFrame
         Rows ``(Outage k, source)``; columns ``(method, axis)`` with axis ``East``/``North``; NaN where the
-        paper has no such method (Transformer, GPS). The paper's rows are labelled ``paper``, or ``paper (field
-        test)`` beside the real drive (:func:`bgfn.paper.paper_label`).
+        paper has no such method (Transformer, GPS), or no such test (a user's drive: its rows all NaN). The
+        paper's rows are labelled ``paper``, or ``paper (field test)`` beside the real drive
+        (:func:`bgfn.paper.paper_label`).
     """
-    lay = paper.layout(result.table, paper.published_values(result.test), methods=TABLE_METHODS,
-                       paper_label=paper.paper_label(result.test))
+    label = paper.paper_label(result.test) if result.test in paper.TESTS else "paper"
+    lay = paper.layout(result.table, _paper_values(result.test), methods=TABLE_METHODS, paper_label=label)
     return lay.stack("source", future_stack=True)
 
 
@@ -57,10 +67,13 @@ def reduction_table(result: TableResult, reference: str = "INS") -> pd.DataFrame
     -------
     DataFrame
         :data:`REDUCTION_COLUMNS`: one row per outage and method of ours; the paper's columns NaN where it
-        has no such row (Transformer, GPS).
+        has no such row (Transformer, GPS) or no such test (a user's drive).
     """
     ours = error_reduction(result.table, reference).rename(columns={"east_pct": "east_%", "north_pct": "north_%"})
-    theirs = error_reduction(paper.published_values(result.test), reference).rename(
+    values = _paper_values(result.test)
+    theirs = (error_reduction(values, reference) if values is not None
+              else pd.DataFrame({"outage": pd.Series(dtype=ours["outage"].dtype), "method": pd.Series(dtype=object),
+                                 "east_pct": pd.Series(dtype=float), "north_pct": pd.Series(dtype=float)})).rename(
         columns={"east_pct": "paper east_%", "north_pct": "paper north_%"})
     return ours.merge(theirs, on=["outage", "method"], how="left")[list(REDUCTION_COLUMNS)]
 

@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from bgfn.data.gnss import fix_errors
+from bgfn.data.names import dataset_id
 from bgfn.evaluate.config import METRIC_COLUMNS, TABLE_COLUMNS, TABLE_FILES, TABLE_METHODS, evaluate_config
 from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
 from bgfn.evaluate.networks import ensure_models
@@ -124,7 +125,8 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
              **window_metrics(r.errors, r.start, r.duration)} for r in runs]
     per_seed = pd.DataFrame(rows)
     fixes = fix_errors(drive.gnss, drive.reference, ctx.lever, drive.meta)
-    return TableResult(dataset, test_of(dataset) or dataset, per_seed,
+    # a dataset that stands for none of the paper's tests names its table files by its id (never a folder path)
+    return TableResult(dataset, test_of(dataset) or dataset_id(dataset), per_seed,
                        aggregate_seeds(per_seed, ecfg["seed_aggregate"]), runs, models, fixes,
                        fix_error_table(fixes, windows), drive, list(windows))
 

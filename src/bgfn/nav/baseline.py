@@ -228,7 +228,7 @@ def ins_max_error_file(outage_table: pd.DataFrame) -> pd.DataFrame:
 def save_baseline(b: Baseline, out, lat=None) -> dict:
     """Write one drive's baseline under ``out`` (``results/<profile>``) atomically.
 
-    Files (``<d>`` = dataset name):
+    Files (``<d>`` = the dataset's id, :func:`bgfn.data.names.dataset_id`, never a folder path):
 
     - ``nav_states_<d>.npz``: the filter states at the outage starts (:func:`bgfn.nav.state.save_states`,
       names ``outage_1``, ``outage_2``, ...), the start of every outage run of notebook 04;
@@ -245,11 +245,12 @@ def save_baseline(b: Baseline, out, lat=None) -> dict:
     """
     from pathlib import Path
 
+    from ..data.names import dataset_id
     from ..io import atomic_write_csv
     from .state import save_states
 
     out = Path(out)
-    d = b.drive_name
+    d = dataset_id(b.drive_name)
     save_states(out / f"nav_states_{d}.npz", b.states)
     atomic_write_csv(out / "tables" / f"kf_rms_{d}.csv", b.rms.reset_index(), float_format="%.6g")
     atomic_write_csv(out / "tables" / f"kf_outage_max_errors_{d}.csv", ins_max_error_file(b.outage_table))

@@ -13,6 +13,7 @@ from typing import Sequence
 import matplotlib.pyplot as plt
 
 from bgfn import figures as drawings
+from bgfn.data.names import dataset_id
 from bgfn.io import save_figure
 from bgfn.learning import CHANNELS
 from bgfn.models import build_model
@@ -89,6 +90,7 @@ def figure_list(figures_dir: str | Path, entries: Sequence[dict],
         else:
             dsets = [None]
         for d in dsets:
+            d = dataset_id(d) if d is not None else None          # the id names the file, never a folder path
             name = e["file"].format(dataset=d)
             p = Path(figures_dir) / name
             out.append({**e, "file": name, "caption": e["caption"].format(dataset=d), "path": p,

@@ -13,10 +13,11 @@ from bgfn.report.reading import rel
 
 
 def model_cards(profile: str, dataset: str, results_root: str | Path | None = None) -> list[dict]:
-    """The model cards ``results/<profile>/models/<dataset>/<method>_seed<k>.json`` (fold models excluded)."""
+    """The model cards ``results/<profile>/models/<dataset id>/<method>_seed<k>.json`` (fold models excluded)."""
     from bgfn.config import RESULTS_ROOT
+    from bgfn.data.names import dataset_id
 
-    d = Path(results_root or RESULTS_ROOT) / profile / "models" / dataset
+    d = Path(results_root or RESULTS_ROOT) / profile / "models" / dataset_id(dataset)
     cards = []
     for p in checkpoints.cards(d):
         try:

@@ -1,0 +1,114 @@
+"""Dataset names and dataset ids: what a profile writes, and the safe id every result file is named by.
+
+A profile names a drive either by a registered dataset (``turin-sim-ekinox``, ... :data:`bgfn.data.DATASETS`)
+or by a folder in the CSV schema (:mod:`bgfn.data.csv_drive`), given as an absolute path or relative to the
+repository root (the folder ``make`` runs the notebooks in), else to the current directory. Result files
+(checkpoints, tables, figures, filter states) are named by :func:`dataset_id`, never by the path: outputs stay
+under ``results/<profile>/`` and no file name holds a folder path.
+
+=======================  ===============================================================================
+name in the profile      dataset id
+=======================  ===============================================================================
+a registered dataset     the name itself (the shipped datasets keep their file names)
+a CSV folder             ``name`` of its ``meta.yaml`` when given, else the folder's own name made safe
+                         (characters other than letters, digits, ``_``, ``-``, ``.`` become ``-``)
+anything else            the last path component, made safe (a missing folder fails later, in
+                         :func:`bgfn.data.load_drive`, with a message naming it)
+=======================  ===============================================================================
+
+Every function that builds a file name from a dataset calls :func:`dataset_id`; it is idempotent on ids, so a
+name read back from a result file (a model card, a table's ``dataset`` column) gives the same file.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from bgfn.errors import DataError
+
+#: A dataset id: letters, digits, ``_``, ``-`` and ``.``, starting with a letter or digit.
+ID_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+_UNSAFE = re.compile(r"[^A-Za-z0-9_.-]+")
+#: The id of a folder whose name has no safe character at all.
+FALLBACK_ID = "drive"
+
+
+def registered(name) -> bool:
+    """True when ``name`` is a dataset of :data:`bgfn.data.drives.DATASETS`."""
+    from bgfn.data.drives import DATASETS
+
+    return isinstance(name, str) and name in DATASETS
+
+
+def dataset_folder(name: str | Path) -> Path | None:
+    """The CSV folder a dataset name denotes, or None (a registered dataset, or no such folder).
+
+    An absolute path is taken as is; a relative one relative to the repository root
+    (:data:`bgfn.config.PROJECT_ROOT`, where ``make`` runs the notebooks), else to the current directory.
+    """
+    if registered(name) or not str(name).strip():
+        return None
+    path = Path(str(name)).expanduser()
+    if path.is_absolute():
+        return path if path.is_dir() else None
+    from bgfn.config import PROJECT_ROOT
+
+    for base in (PROJECT_ROOT, Path.cwd()):
+        if (base / path).is_dir():
+            return (base / path).resolve()
+    return None
+
+
+def safe_id(text: str) -> str:
+    """``text`` with every run of characters outside ``[A-Za-z0-9_.-]`` replaced by ``-`` (and no leading
+    ``.``, ``-`` or ``_``); :data:`FALLBACK_ID` when nothing is left."""
+    out = _UNSAFE.sub("-", str(text)).lstrip("._-")
+    return out or FALLBACK_ID
+
+
+def dataset_id(name: str | Path) -> str:
+    """The safe id that names a dataset's result files (module docstring).
+
+    Parameters
+    ----------
+    name : str or Path
+        A registered dataset, a CSV folder (absolute or relative path), or an id.
+
+    Returns
+    -------
+    str
+        Matches :data:`ID_PATTERN`; a registered name is returned unchanged.
+
+    Raises
+    ------
+    DataError
+        The folder's ``meta.yaml`` is unreadable or its ``name`` is not a safe id (naming the file).
+    """
+    if registered(name):
+        return str(name)
+    folder = dataset_folder(name)
+    if folder is not None:
+        from bgfn.data.csv_meta import META_FILE, read_meta_name
+
+        meta_name = read_meta_name(folder / META_FILE)
+        return meta_name if meta_name is not None else safe_id(folder.name)
+    text = str(name)
+    if ID_PATTERN.match(text):
+        return text
+    return safe_id(Path(text.rstrip("/\\")).name)
+
+
+def unique_ids(names, source: str | Path = "profile") -> dict[str, str]:
+    """``{name: dataset_id(name)}``; a DataError naming ``source`` when two names share one id (their result
+    files would overwrite each other)."""
+    ids: dict[str, str] = {}
+    seen: dict[str, str] = {}
+    for name in dict.fromkeys(str(n) for n in names):
+        i = dataset_id(name)
+        if i in seen and seen[i] != name:
+            raise DataError(source, "datasets", "datasets with distinct ids (a CSV folder's id is its meta.yaml "
+                            "'name', else its folder name)", f"{seen[i]!r} and {name!r} both have the id {i!r}")
+        seen[i] = name
+        ids[name] = i
+    return ids

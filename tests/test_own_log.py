@@ -1,0 +1,363 @@
+"""A user's own log, end to end (issue 16, outcome 5): a CSV folder named by path in a four-line profile runs
+through notebooks 01-04's library path; outputs only under results/<profile>/, the data folder untouched.
+
+The drive is written by the test as a logger would: IMU times that jitter (7.5-12.5 ms steps around 10 ms), a
+reference at 5 Hz (not at the IMU epochs), a 1 Hz GNSS with a lever arm, times in GPS time of week.
+"""
+
+from __future__ import annotations
+
+import shutil
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from bgfn import config
+from bgfn.data import Drive, load_drive, write_csv_drive
+from bgfn.data import imu_errors as ie
+from bgfn.data.csv_meta import DEFAULT_IMU_PROFILE, META_KEYS, read_meta
+from bgfn.data.names import dataset_folder, dataset_id, unique_ids
+from bgfn.data.regrid import GAP_SAMPLES, interpolate_reference
+from bgfn.errors import DataError
+from bgfn.nav import earth, sim
+
+pytestmark = pytest.mark.usefixtures("repo_untouched")
+
+T0 = 243000.0                   # GPS time of week of the first epoch, s
+FINE_HZ = 400.0                 # truth rate the jittery IMU intervals are cut from
+DURATION_S = 240.0
+LEVER = [-0.4, 0.0, -1.0]       # antenna in the body frame, m
+OUTAGE = [T0 + 150.0, 30.0]     # one 30 s outage: 120 s of GPS time before it, 60 s after
+REF_EVERY = 80                  # a reference row every 80 fine steps: 5 Hz
+
+
+def _jittery_imu(truth: pd.DataFrame, seed: int) -> pd.DataFrame:
+    """IMU rows over intervals of 3, 4 or 5 fine steps (7.5, 10, 12.5 ms): mean rates = summed increments over
+    the interval (exact), plus Ekinox-grade errors."""
+    fine = sim.imu_from_trajectory(truth)                     # rows for truth.time[1:], 2.5 ms each
+    rng = np.random.default_rng(seed)
+    steps = rng.choice([3, 4, 5], size=len(fine) // 3 + 1, p=[0.25, 0.5, 0.25])
+    ends = np.cumsum(steps)
+    ends = ends[ends <= len(fine)]
+    cols = [c for c in fine.columns if c != "time"]
+    cum = np.vstack([np.zeros(len(cols)), np.cumsum(fine[cols].to_numpy(float), axis=0)])
+    sums = np.diff(cum[np.concatenate([[0], ends])], axis=0)       # equal fine steps: mean = sum / count
+    imu = pd.DataFrame(sums / np.diff(np.concatenate([[0], ends]))[:, None], columns=cols)
+    imu.insert(0, "time", truth["time"].to_numpy(float)[ends])
+    noise = rng.standard_normal((len(imu), 6)) * ([2e-4] * 3 + [2e-3] * 3)       # white noise, rad/s and m/s^2
+    imu[cols] = imu[cols].to_numpy() + noise + [1e-4, -1e-4, 5e-5, 0.01, -0.01, 0.005]
+    return imu
+
+
+@pytest.fixture(scope="module")
+def truth():
+    ref = sim.demo_trajectory(DURATION_S, FINE_HZ)
+    ref["time"] = ref["time"] + T0
+    return ref
+
+
+def _write_log(folder, truth, attitude=True, meta=True):
+    """The drive as a logger writes it: jittery IMU, 5 Hz reference, 1 Hz GNSS; returns the folder."""
+    imu = _jittery_imu(truth, seed=7)
+    gnss = sim.gnss_from_trajectory(truth, 1.0, 0.5, 1.0, LEVER, seed=8)
+    ref = truth.iloc[::REF_EVERY].reset_index(drop=True)
+    # the filter's error model: the white noise above as densities (std x sqrt(0.01 s)), the biases as turn-on
+    errors = ie.error_params("ekinox-d", {"gyro_noise_density": 2e-5, "accel_noise_density": 2e-4,
+                                          "gyro_turn_on_bias_std": 2e-4, "accel_turn_on_bias_std": 0.02})
+    drive = Drive("my-car", ref, imu, gnss, {"lever_arm_m": LEVER, "imu_errors": errors, "source": "test"})
+    write_csv_drive(drive, folder)
+    if not attitude:
+        pd.read_csv(folder / "reference.csv").drop(columns=["roll", "pitch", "yaw"]).to_csv(
+            folder / "reference.csv", index=False)
+    if not meta:
+        (folder / "meta.yaml").unlink()
+    return folder
+
+
+def _tree(folder):
+    return {p.relative_to(folder).as_posix(): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+# ------------------------------------------------------------------------------------------- the whole path
+def test_a_csv_log_named_by_its_path_runs_notebooks_01_to_04(tmp_path, monkeypatch, truth):
+    from bgfn import evaluate as ev
+    from bgfn import train
+    from bgfn.data.summary import summary_table
+    from bgfn.io import atomic_write_csv
+    from bgfn.nav import baseline
+    from bgfn.nav.outages import outage_windows
+
+    log = _write_log(tmp_path / "logs" / "2024-05-01 run 3", truth)
+    before = _tree(log)
+    params = tmp_path / "params"
+    params.mkdir()
+    shutil.copy(config.PARAMS_DIR / "quick.yaml", params / "quick.yaml")
+    # the README's four lines, then what keeps this test under a minute (tiny networks, one epoch, no sweep)
+    (params / "mine.yaml").write_text(
+        f"base: quick\ndescription: my car\ndatasets: [{log}]\noutage_windows: [{OUTAGE}]\n"
+        "train: {methods: [bgfn, mlp], seeds: [0], size: smoke, lr_search: {grid: null},\n"
+        "        optimizer: {epochs: 1, max_train_windows: 64, max_val_windows: 32}}\n"
+        "evaluate: {methods: [bgfn, mlp], sweep: {datasets: []}}\n")
+    monkeypatch.setattr(config, "PARAMS_DIR", params)
+    results = tmp_path / "results"
+    monkeypatch.setattr(config, "RESULTS_ROOT", results)
+    monkeypatch.chdir(tmp_path)
+
+    cfg = config.load_profile("mine")
+    assert cfg["profile"] == "mine"                               # the file's name
+    from bgfn.profile_schema import check_with_drives
+
+    assert check_with_drives("mine")[0].startswith(f"{log}: {T0:.2f}..")    # make's check step, with the data
+    name = str(log)
+    assert [cfg[s]["datasets"] for s in ("data", "nav", "train", "evaluate")] == [[name]] * 4
+    assert cfg["evaluate"]["sweep"]["datasets"] == []             # the file's own section wins
+    did = dataset_id(name)
+    assert did == "my-car"                                        # meta.yaml's name
+    out = config.results_dir("mine")
+
+    # notebook 01
+    drive = load_drive(name, profile="mine")
+    assert drive.name == did and drive.has_attitude
+    assert drive.meta["imu_resampled"] and drive.meta["reference_interpolated"]
+    assert drive.meta["imu_rate_hz"] == 100.0 and drive.meta["reference_rate_hz"] == 5.0
+    t = drive.imu["time"].to_numpy()
+    np.testing.assert_allclose(np.diff(t), 0.01, atol=1e-9)      # the regular grid the outages and windows need
+    atomic_write_csv(out / "tables" / f"dataset_{dataset_id(name)}.csv", summary_table(drive))
+    # notebook 02
+    windows = outage_windows(cfg)
+    b = baseline.run_baseline(drive, baseline.nav_config(cfg["nav"]), windows)
+    rec = baseline.save_baseline(b, out)
+    assert rec["states_file"] == f"nav_states_{did}.npz"
+    assert b.rms.loc["horizontal", "rms"] < 2.0                   # GPS-aided: near the 0.5 m fixes
+    # notebook 03
+    plan = train.TrainingPlan.of("mine")
+    prepared = train.prepare_datasets(plan)
+    cards = [c for n, d in prepared.items() for c in train.train_dataset(plan, n, d.data)]
+    assert {c["method"] for c in cards} == {"bgfn", "mlp"}
+    # notebook 04
+    setup = ev.evaluation_setup(cfg)
+    res, _ = ev.run_tables(cfg, "mine", setup.datasets, setup.config, out)
+    table = res[name].table
+    assert set(table["method"]) == {"INS", "GPS", "BGFN", "MLP"}
+    assert np.isfinite(table[list(ev.METRIC_COLUMNS)].to_numpy(float)).all()
+    assert res[name].test == did
+    # notebook 04's displays beside the paper: a drive that stands for none of its tests has no paper values
+    lay = ev.ours_above_paper(res[name])
+    assert lay.xs("paper", level="source").isna().all().all() and lay.xs("ours", level="source").notna().any().any()
+    red = ev.reduction_table(res[name])
+    assert red["paper east_%"].isna().all() and red["paper east_%"].dtype == float
+    assert set(red["method"]) == {"GPS", "BGFN", "MLP"}                 # each against INS
+    assert ev.paper_table_title(did) == f"no table of the paper ({did})"
+
+    written = [p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*") if p.is_file()]
+    outside = [p for p in written if not p.startswith(("results/mine/", "logs/", "params/"))]
+    assert outside == []
+    assert _tree(log) == before                                   # the data folder untouched
+    files = [p.name for p in results.rglob("*")]
+    assert f"kf_rms_{did}.csv" in files and "outage_my-car.csv" in files and "bgfn_seed0.pt" in files
+    assert (out / "models" / did / "mlp_seed0.pt").is_file()
+    assert not any("logs" in p or " " in p for p in written if p.startswith("results/"))
+
+
+# ------------------------------------------------------------------------------------ regrid and reference
+def test_jittery_imu_keeps_its_increments_and_the_reference_follows_the_truth(tmp_path, truth):
+    log = _write_log(tmp_path / "d", truth, attitude=False, meta=False)
+    drive = load_drive(log)
+    assert not drive.has_attitude and drive.reference[["roll", "pitch", "yaw"]].isna().all().all()
+    assert drive.name == "d" and drive.meta["imu_errors"] == ie.error_params(DEFAULT_IMU_PROFILE)
+    raw = pd.read_csv(log / "imu.csv")
+    # the integral of the rates over the common span is the same (resample_imu preserves increments)
+    t_raw, t = raw["time"].to_numpy(), drive.imu["time"].to_numpy()
+    inside = (t_raw > t[0] - 0.01 + 1e-9) & (t_raw <= t[-1])
+    for c in ("gyro_z", "accel_x"):
+        grid_sum = float(np.sum(drive.imu[c].to_numpy() * 0.01))
+        raw_dt = np.diff(np.concatenate([[t_raw[0] - 0.01], t_raw]))
+        raw_sum = float(np.sum((raw[c].to_numpy() * raw_dt)[inside]))
+        assert grid_sum == pytest.approx(raw_sum, abs=0.02 * 0.01 * 10)   # up to the ends' partial intervals
+    # the 5 Hz reference at the 100 Hz epochs: Hermite with the velocities as slopes, centimetres from the truth
+    truth_at = truth.set_index(np.round(truth["time"].to_numpy() * 400).astype(int))
+    idx = np.round(drive.reference["time"].to_numpy() * 400).astype(int)
+    tr = truth_at.loc[idx]
+    ned = earth.lla_to_ned(drive.reference["lat"].to_numpy(), drive.reference["lon"].to_numpy(),
+                           drive.reference["h"].to_numpy(), tr["lat"].to_numpy(), tr["lon"].to_numpy(),
+                           tr["h"].to_numpy())
+    assert np.abs(ned).max() < 0.02
+    assert np.abs(drive.reference["v_n"].to_numpy() - tr["v_n"].to_numpy()).max() < 0.05
+
+
+def test_interpolated_yaw_crosses_pi_without_a_full_turn():
+    ref = pd.DataFrame({"time": [0.0, 1.0], "lat": 0.8, "lon": 0.1, "h": 200.0, "v_n": 0.0, "v_e": 0.0,
+                        "v_d": 0.0, "roll": 0.0, "pitch": 0.0, "yaw": [np.pi - 0.1, -np.pi + 0.1]})
+    out = interpolate_reference(ref, np.array([0.0, 0.25, 0.5, 1.0]))
+    np.testing.assert_allclose(np.abs(out["yaw"].to_numpy()[:3]), [np.pi - 0.1, np.pi - 0.05, np.pi], atol=1e-12)
+    assert out["lat"].tolist() == pytest.approx([0.8] * 4) and out["time"].tolist() == [0.0, 0.25, 0.5, 1.0]
+
+
+def test_a_gap_in_the_imu_log_names_the_file_and_the_time(tmp_path, truth):
+    log = _write_log(tmp_path / "d", truth)
+    imu = pd.read_csv(log / "imu.csv")
+    imu = imu.drop(index=range(1000, 1000 + int(GAP_SAMPLES) + 2)).reset_index(drop=True)
+    imu.to_csv(log / "imu.csv", index=False)
+    with pytest.raises(DataError, match="gap") as err:
+        load_drive(log)
+    assert err.value.source == str(log / "imu.csv") and err.value.field == "time"
+    assert f"{imu['time'].iloc[999]:.3f}" in str(err.value)
+
+
+# -------------------------------------------------------------------------------- units and axes, by file
+@pytest.mark.parametrize("case,file,field,words", [
+    ("accel_in_g", "imu.csv", "accel_x/accel_y/accel_z", "in g"),
+    ("rates_in_deg", "imu.csv", "gyro_x/gyro_y/gyro_z", "deg/s"),
+    ("z_up", "imu.csv", "accel_z", "points up"),
+    ("axes_unrotated", "imu.csv", "accel_z", "not rotated"),
+    ("lat_in_degrees", "reference.csv", "lat", "degrees"),
+    ("lon_in_degrees_gnss", "gnss.csv", "lon", "degrees"),
+    ("time_in_ms", "imu.csv", "time", "milliseconds"),
+])
+def test_implausible_units_and_axes_name_the_csv_file_and_column(tmp_path, truth, case, file, field, words):
+    log = _write_log(tmp_path / "d", truth)
+    df = pd.read_csv(log / file)
+    if case == "accel_in_g":
+        df[["accel_x", "accel_y", "accel_z"]] /= 9.80665
+    elif case == "rates_in_deg":
+        df[["gyro_x", "gyro_y", "gyro_z"]] = np.degrees(df[["gyro_x", "gyro_y", "gyro_z"]])
+    elif case == "z_up":
+        df[["accel_z", "gyro_z"]] *= -1
+    elif case == "axes_unrotated":                              # sensor x down: gravity along x
+        df["accel_x"], df["accel_z"] = df["accel_z"].copy(), df["accel_x"].copy()
+    elif case == "lat_in_degrees":
+        df["lat"] = np.degrees(df["lat"])
+    elif case == "lon_in_degrees_gnss":
+        df["lon"] = np.degrees(df["lon"])
+    elif case == "time_in_ms":
+        df["time"] *= 1000.0
+    df.to_csv(log / file, index=False)
+    with pytest.raises(DataError) as err:
+        load_drive(log)
+    assert err.value.source == str(log / file) and err.value.field == field
+    assert words in str(err.value)
+
+
+# ---------------------------------------------------------------------------------------------- meta.yaml
+@pytest.mark.parametrize("text,field,words", [
+    ("gyro_noise_densty: 1e-4\n", "gyro_noise_densty", "did you mean imu_errors.gyro_noise_density?"),
+    ("nmae: x\n", "nmae", "did you mean name?"),
+    ("imu_errors:\n  gyro_noise_densty: 1e-4\n", "imu_errors.gyro_noise_densty",
+     "did you mean imu_errors.gyro_noise_density?"),
+    ("imu_errors:\n  accel_bias_instabilty: 1e-3\n", "imu_errors.accel_bias_instabilty",
+     "imu_errors.accel_bias_instability"),
+    ("imu_errors:\n  gyro_noise_density: -1\n", "imu_errors.gyro_noise_density", "non-negative"),
+    ("imu_errors:\n  gyro_noise_density: [1, 2]\n", "imu_errors.gyro_noise_density", "3 finite values"),
+    ("imu_errors:\n  gyro_noise_density: fast\n", "imu_errors", "numbers"),
+    ("imu_errors:\n  base: bosch\n", "imu_errors.base", "mpu6000"),
+    ("imu_errors: [1, 2]\n", "imu_errors", "a mapping"),
+    ("lever_arm_m: [1.0, 2.0]\n", "lever_arm_m", "3 finite numbers"),
+    ("name: my drive/2\n", "name", "dataset id"),
+    ("- a\n- b\n", "<top level>", "a mapping"),
+    ("name: [unclosed\n", "<yaml>", "valid YAML"),
+])
+def test_a_bad_meta_yaml_gives_one_clear_error(tmp_path, text, field, words):
+    path = tmp_path / "meta.yaml"
+    path.write_text(text)
+    with pytest.raises(DataError) as err:
+        read_meta(path)
+    assert err.value.source == str(path) and err.value.field == field
+    assert words in str(err.value)
+
+
+@pytest.mark.parametrize("text,expect", [
+    (None, {"gyro_noise_density": ie.MPU6000["gyro_noise_density"]}),                  # no file
+    ("", {"gyro_noise_density": ie.MPU6000["gyro_noise_density"]}),                    # empty file
+    ("name: car\nimu_errors:\n", {"gyro_noise_density": ie.MPU6000["gyro_noise_density"]}),
+    ("imu_errors: {gyro_noise_density: 1.0e-3}\n",
+     {"gyro_noise_density": [1e-3] * 3, "accel_noise_density": ie.MPU6000["accel_noise_density"]}),
+    ("imu_errors: {base: ekinox-d, accel_noise_density: [1, 2, 3]}\n",
+     {"accel_noise_density": [1.0, 2.0, 3.0], "gyro_noise_density": ie.EKINOX_D["gyro_noise_density"]}),
+])
+def test_meta_defaults_and_overrides(tmp_path, text, expect):
+    path = tmp_path / "meta.yaml"
+    if text is not None:
+        path.write_text(text)
+    meta = read_meta(path)
+    for key, value in expect.items():
+        assert meta["imu_errors"][key] == pytest.approx(value)
+    assert meta["lever_arm_m"] == [0.0, 0.0, 0.0] and meta["source"] is None
+    assert set(yaml.safe_load(path.read_text()) or {}) <= set(META_KEYS) if text is not None else True
+
+
+# --------------------------------------------------------------------------------------------- dataset ids
+def test_dataset_ids_are_safe_and_keep_the_shipped_names(tmp_path, monkeypatch):
+    assert dataset_id("turin-sim-ekinox") == "turin-sim-ekinox" and dataset_id("my-car") == "my-car"
+    a = tmp_path / "Drive 1 (rain)"
+    a.mkdir()
+    assert dataset_id(a) == "Drive-1-rain-" and dataset_id(str(a) + "/") == "Drive-1-rain-"
+    assert dataset_id(dataset_id(a)) == dataset_id(a)             # idempotent on ids
+    (a / "meta.yaml").write_text("name: rainy\n")
+    assert dataset_id(a) == "rainy"
+    monkeypatch.chdir(tmp_path)
+    assert dataset_folder("Drive 1 (rain)") == a.resolve() and dataset_id("Drive 1 (rain)") == "rainy"
+    assert dataset_id("/no/such/folder/x y") == "x-y"
+    b = tmp_path / "other"
+    b.mkdir()
+    (b / "meta.yaml").write_text("name: rainy\n")
+    with pytest.raises(DataError, match="both have the id 'rainy'"):
+        unique_ids([str(a), str(b)])
+    assert unique_ids(["turin-sim-ekinox", str(a)]) == {"turin-sim-ekinox": "turin-sim-ekinox", str(a): "rainy"}
+
+
+def test_attitude_all_three_or_none(tmp_path, monkeypatch, truth):
+    log = _write_log(tmp_path / "d", truth)
+    pd.read_csv(log / "reference.csv").drop(columns=["yaw"]).to_csv(log / "reference.csv", index=False)
+    with pytest.raises(DataError) as err:
+        load_drive(log)
+    assert err.value.source == str(log / "reference.csv") and err.value.field == "yaw"
+    _write_log(tmp_path / "e", truth, attitude=False)
+    monkeypatch.chdir(tmp_path)
+    drive = load_drive("e")                                              # a relative folder path
+    assert not drive.has_attitude and drive.validate() is drive        # all NaN: a drive without attitude
+    drive.reference.loc[3, ["roll", "pitch", "yaw"]] = 0.0               # some NaN: a broken reference
+    with pytest.raises(DataError) as err:
+        drive.validate()
+    assert err.value.field == "roll"
+
+
+def test_the_imu_plot_shows_a_drive_on_another_clock(tmp_path, truth):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from bgfn.data.plots import plot_imu_channels
+
+    drive = load_drive(_write_log(tmp_path / "d", truth))
+    fig = plot_imu_channels({"d": drive}, 138840.0, 20.0)      # quick's plot span lies on the Turin clock
+    x = fig.axes[0].lines[0].get_xdata()
+    assert len(x) == 2001 and x[0] == pytest.approx(0.0) and x[-1] == pytest.approx(20.0)   # its first 20 s
+    matplotlib.pyplot.close(fig)
+
+
+def test_a_missing_folder_is_named(tmp_path):
+    with pytest.raises(DataError) as err:
+        load_drive(str(tmp_path / "absent"))
+    assert err.value.field == "folder" and str(tmp_path / "absent") in str(err.value)
+
+
+def test_top_level_datasets_reach_every_notebook_and_a_section_still_wins(tmp_path, monkeypatch):
+    params = tmp_path / "params"
+    params.mkdir()
+    shutil.copy(config.PARAMS_DIR / "quick.yaml", params / "quick.yaml")
+    monkeypatch.setattr(config, "PARAMS_DIR", params)
+    (params / "mine.yaml").write_text("base: quick\ndescription: d\ndatasets: [a/b]\n")
+    (params / "again.yaml").write_text("base: mine\ndescription: e\nnav: {datasets: [c]}\n")
+    (params / "bad.yaml").write_text("base: quick\ndescription: d\ndatasets: []\n")
+    mine, again = config.load_profile("mine"), config.load_profile("again")
+    quick = config.load_profile("quick")
+    for section in ("data", "nav", "train", "evaluate"):
+        assert mine[section]["datasets"] == ["a/b"]
+    assert mine["evaluate"]["sweep"]["datasets"] == ["a/b"] and mine["profile"] == "mine"
+    assert again["nav"]["datasets"] == ["c"] and again["train"]["datasets"] == ["a/b"]
+    assert {k: v for k, v in mine["train"].items() if k != "datasets"} == {
+        k: v for k, v in quick["train"].items() if k != "datasets"}
+    with pytest.raises(DataError) as err:
+        config.load_profile("bad")
+    assert err.value.field == "datasets" and err.value.source == str(params / "bad.yaml")

@@ -114,7 +114,13 @@ SCHEMA = section(
         datasets=_NAMES,
         init=section(position_std_m=_POS, height_std_m=_POS, velocity_std_mps=_POS, level_std_deg=_POS,
                      azimuth_std_deg=_POS),
-        bias_model=text("random_walk", "gauss_markov"), noise_scale=_POS,
+        alignment=section(
+            mode=text("reference", "gnss", "auto"), speed_threshold_mps=_POS, heading_time_s=_POS,
+            level_time_s=_POS, still_window_s=_POS, still_min_s=_NONNEG, still_accel_std_mps2=_POS,
+            still_gyro_std_dps=_POS, level_std_deg=_POS, azimuth_std_deg=_POS, velocity_std_mps=_POS),
+        bias_model=text("random_walk", "gauss_markov"),
+        noise_scale=Spec("any"),             # a positive number or 'auto': checked in cross_check
+        noise_search=section(range=seq(_POS, length=2), max_runs=integer(1), tolerance=_POS, bias_walk=flag()),
         innovation_gate=number(0, 1, lo_open=True, hi_open=True, null=True)),
     train=TRAIN,
     evaluate=section(
@@ -222,6 +228,14 @@ def cross_check(cfg: dict) -> None:
             raise ProfileError("outage_windows", "windows that do not overlap",
                                f"[{s0:g}, {s0 + d0:g}] overlaps [{s1:g}, {s1 + d1:g}]")
     data, tr, ev = cfg.get("data") or {}, cfg.get("train") or {}, cfg.get("evaluate") or {}
+    nav = cfg.get("nav") or {}
+    ns = nav.get("noise_scale")
+    if "noise_scale" in nav and ns != "auto" and (isinstance(ns, bool) or not isinstance(ns, (int, float))
+                                                  or not math.isfinite(ns) or ns <= 0):
+        raise ProfileError("nav.noise_scale", "a positive number or 'auto'", _fmt(ns))
+    band = (nav.get("noise_search") or {}).get("range")
+    if band and not band[0] < band[1]:
+        raise ProfileError("nav.noise_search.range", "[low, high] with low < high", _fmt(band))
     t0, t1 = data.get("t_start"), data.get("t_end")
     if t0 is not None and t1 is not None and t1 <= t0:
         raise ProfileError("data.t_end", f"a time after data.t_start = {t0:g} s", _fmt(t1))
@@ -287,6 +301,7 @@ def check_with_drives(profile: str) -> list[str]:
     from bgfn.config import load_profile, profile_chain
     from bgfn.data import load_drive
     from bgfn.errors import DataError
+    from bgfn.nav.baseline import filter_start
     from bgfn.nav.outages import check_windows
 
     from bgfn.learning import learning_options
@@ -301,12 +316,12 @@ def check_with_drives(profile: str) -> list[str]:
     for name in names:
         drive = load_drive(name, profile=profile)
         t = drive.imu["time"].to_numpy(float)
-        t0, t1 = float(drive.reference["time"].iloc[0]), float(t[-1])
+        t0, t1 = filter_start(drive, cfg["nav"]), float(t[-1])     # a self-aligned filter starts late
         try:
             check_windows(_windows(cfg), t0, t1, name)
         except DataError as exc:
-            raise DataError(path, "outage_windows", f"windows inside the drive {name} [{t0:.3f}, {t1:.3f}] s",
-                            exc.found) from None
+            raise DataError(path, "outage_windows", f"windows inside the drive {name} after the filter's start "
+                            f"[{t0:.3f}, {t1:.3f}] s", exc.found) from None
         rate = float(drive.meta.get("imu_rate_hz") or 1.0 / float(t[1] - t[0]))
         window_s = int(opts["window"]) / rate
         margin = float(opts["margin_s"])
@@ -322,7 +337,7 @@ def check_with_drives(profile: str) -> list[str]:
     for name in sw["datasets"]:
         drive = load_drive(name, profile=profile)
         try:
-            plan = sweep_plan(drive, sw, int(opts["window"]))
+            plan = sweep_plan(drive, sw, int(opts["window"]), t_first=filter_start(drive, cfg["nav"]))
         except DataError as exc:
             raise DataError(path, "evaluate.sweep.n_starts/durations_s/warmup_s", f"{exc.expected} in {name}",
                             exc.found) from None

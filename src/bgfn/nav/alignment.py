@@ -73,8 +73,10 @@ ALIGNMENT_DEFAULTS: dict = {
 BASELINE_S = 1.0
 #: A GNSS interval longer than this many nominal intervals is a gap: the moving run restarts after it.
 MAX_GAP_INTERVALS = 2.5
-#: Level iterations of the velocity matching (each divides the error by about g / |dv/dt|).
-LEVEL_ITERATIONS = 6
+#: Most level iterations of the velocity matching (each divides the error by about g / |dv/dt|), and the change
+#: that ends them, rad.
+LEVEL_ITERATIONS = 50
+LEVEL_CONVERGED_RAD = 1e-12
 
 
 @dataclass(frozen=True)
@@ -166,7 +168,11 @@ def level_by_velocity_matching(f_mean_b, accel_n, yaw: float) -> tuple[float, fl
     roll = pitch = 0.0
     for _ in range(LEVEL_ITERATIONS):
         c = transform.dcm_from_euler(roll, pitch, yaw)
-        roll, pitch = level_from_specific_force(f - c.T @ a)
+        new = level_from_specific_force(f - c.T @ a)
+        done = max(abs(new[0] - roll), abs(new[1] - pitch)) < LEVEL_CONVERGED_RAD
+        roll, pitch = new
+        if done:
+            break
     return roll, pitch
 
 

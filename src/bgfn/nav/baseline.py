@@ -28,7 +28,7 @@ from .. import paper
 from ..errors import DataError
 from . import metrics
 from .alignment import ALIGNMENT_DEFAULTS, MODES, Alignment, align
-from .consistency import nis_summary
+from .consistency import nis_line, nis_summary
 from .filter import FilterResult, gate_thresholds, run_filter, run_outage
 from .outages import check_windows, epochs_before
 from .state import FilterNoise, FilterState, initial_covariance, initial_state, noise_from_imu_errors
@@ -260,6 +260,12 @@ class Baseline:
     noise: FilterNoise
     setup: FilterSetup | None = None
 
+    def lines(self) -> list[str]:
+        """Notebook 02's sentences of this run: the self-alignment and the noise search (when they ran) and the
+        NIS verdict of the GPS-aided run (:func:`bgfn.nav.consistency.nis_line`)."""
+        setup = self.setup.lines(self.drive_name) if self.setup is not None else []
+        return setup + [nis_line(self.drive_name, nis_summary(self.full.updates))]
+
 
 def run_baseline(drive, cfg: dict, windows) -> Baseline:
     """Full-drive GPS/INS run, then the standalone INS in each outage from the saved state at its start.
@@ -368,6 +374,7 @@ def save_baseline(b: Baseline, out, lat=None) -> dict:
             "gnss_updates": int(len(upd)), "gnss_rejected": int((~upd["accepted"]).sum()) if len(upd) else 0,
             "mean_nis": float(upd["nis"].mean()) if len(upd) else None,
             "mean_nis_dof": float(upd["dof"].mean()) if len(upd) else None,
+            "nis_verdict": nis_summary(upd)["verdict"],
             "states_file": f"nav_states_{d}.npz", **(b.setup.record() if b.setup is not None else {})}
 
 

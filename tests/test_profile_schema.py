@@ -32,6 +32,11 @@ BAD = {
     "size block missing": ("train: {size: huge}", "train.size", "'huge'"),
     "energy dataset not trained": ("energy: {dataset: turin-sim-other}", "energy.dataset", "train.datasets"),
     "boolean as a number": ("seed: true", "seed", "True"),
+    "noise scale word": ("nav: {noise_scale: fast}", "nav.noise_scale", "'auto'"),
+    "noise scale zero": ("nav: {noise_scale: 0}", "nav.noise_scale", "positive number"),
+    "alignment mode": ("nav: {alignment: {mode: compass}}", "nav.alignment.mode", "'reference', 'gnss', 'auto'"),
+    "alignment key typo": ("nav: {alignment: {heading_s: 5.0}}", "nav.alignment.heading_s", "heading_time_s"),
+    "noise search range": ("nav: {noise_search: {range: [10.0, 1.0]}}", "nav.noise_search.range", "low < high"),
 }
 
 
@@ -53,6 +58,15 @@ def test_a_bad_variant_names_its_file_the_key_and_the_value(params, case):
         config.load_profile("mine")
     assert err.value.source == str(path), str(err.value)
     assert err.value.field == key and words in str(err.value), str(err.value)
+
+
+def test_noise_scale_auto_and_alignment_options_are_accepted(params):
+    (params / "mine.yaml").write_text("profile: mine\nbase: smoke\ndescription: v\n"
+                                      "nav: {noise_scale: auto, alignment: {mode: gnss, heading_time_s: 5.0}}\n")
+    nav = config.load_profile("mine")["nav"]
+    assert nav["noise_scale"] == "auto" and nav["alignment"]["mode"] == "gnss"
+    assert nav["alignment"]["speed_threshold_mps"] == config.load_profile("smoke")["nav"]["alignment"][
+        "speed_threshold_mps"]                                   # sections merge key by key
 
 
 def test_an_error_in_the_base_names_the_base_file(params):

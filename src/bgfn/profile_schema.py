@@ -137,7 +137,13 @@ SCHEMA = section(
         datasets=_NAMES,
         init=section(position_std_m=_POS, height_std_m=_POS, velocity_std_mps=_POS, level_std_deg=_POS,
                      azimuth_std_deg=_POS),
-        bias_model=text("random_walk", "gauss_markov"), noise_scale=_POS,
+        alignment=section(
+            mode=text("reference", "gnss", "auto"), speed_threshold_mps=_POS, heading_time_s=_POS,
+            level_time_s=_POS, still_window_s=_POS, still_min_s=_NONNEG, still_accel_std_mps2=_POS,
+            still_gyro_std_dps=_POS, level_std_deg=_POS, azimuth_std_deg=_POS, velocity_std_mps=_POS),
+        bias_model=text("random_walk", "gauss_markov"),
+        noise_scale=Spec("any"),             # a positive number or 'auto': checked in cross_check
+        noise_search=section(range=seq(_POS, length=2), max_runs=integer(1), tolerance=_POS, bias_walk=flag()),
         innovation_gate=number(0, 1, lo_open=True, hi_open=True, null=True),
         ins_tuning=text("shipped", "navego")),
     train=TRAIN,
@@ -308,6 +314,14 @@ def cross_check(cfg: dict) -> None:
     """The facts that tie keys together and need no data; :class:`ProfileError` naming the key."""
     _check_outage_entries(cfg)
     data, tr, ev = cfg.get("data") or {}, cfg.get("train") or {}, cfg.get("evaluate") or {}
+    nav = cfg.get("nav") or {}
+    ns = nav.get("noise_scale")
+    if "noise_scale" in nav and ns != "auto" and (isinstance(ns, bool) or not isinstance(ns, (int, float))
+                                                  or not math.isfinite(ns) or ns <= 0):
+        raise ProfileError("nav.noise_scale", "a positive number or 'auto'", _fmt(ns))
+    band = (nav.get("noise_search") or {}).get("range")
+    if band and not band[0] < band[1]:
+        raise ProfileError("nav.noise_search.range", "[low, high] with low < high", _fmt(band))
     t0, t1 = data.get("t_start"), data.get("t_end")
     rate = data.get("imu_rate_hz")
     if "window" in tr and rate and t0 is not None and t1 is not None and tr["window"] / rate >= (t1 - t0):
@@ -367,8 +381,10 @@ def check_with_drives(profile: str) -> list[str]:
     """
     from bgfn.config import load_profile, profile_chain
     from bgfn.data import load_drive
+    from bgfn.data.names import unique_ids
     from bgfn.errors import DataError
     from bgfn.learning import learning_options
+    from bgfn.nav.baseline import filter_start
     from bgfn.nav.outages import DEFAULT_KEY, check_windows, is_rule, outage_entry, picked_outages
 
     cfg = load_profile(profile)
@@ -377,15 +393,13 @@ def check_with_drives(profile: str) -> list[str]:
     opts = learning_options(tr)                 # the window and margin notebook 03 uses, defaults filled in
     names = dict.fromkeys(cfg["nav"].get("datasets", []) + tr.get("datasets", []) + ev.get("datasets", [])
                           + (ev.get("sweep") or {}).get("datasets", []))
-    from bgfn.data.names import unique_ids
-
     unique_ids(list(cfg["data"].get("datasets", [])) + list(names), path)   # result files must not overwrite
     spec = cfg.get("outage_windows")
     lines = []
     for name in names:
         drive = load_drive(name, profile=profile)
         t = drive.imu["time"].to_numpy(float)
-        t0, t1 = float(drive.reference["time"].iloc[0]), float(t[-1])
+        t0, t1 = filter_start(drive, cfg["nav"]), float(t[-1])     # a self-aligned filter starts late
         key = (f"outage_windows.{name if name in spec else DEFAULT_KEY}" if isinstance(spec, dict)
                else "outage_windows")
         entry = outage_entry(cfg, name)
@@ -397,8 +411,8 @@ def check_with_drives(profile: str) -> list[str]:
         try:
             check_windows(windows, t0, t1, name)
         except DataError as exc:
-            raise DataError(path, key, f"windows inside the drive {name} [{t0:.3f}, {t1:.3f}] s",
-                            exc.found) from None
+            raise DataError(path, key, f"windows inside the drive {name} after the filter's start "
+                            f"[{t0:.3f}, {t1:.3f}] s", exc.found) from None
         rate = float(drive.meta.get("imu_rate_hz") or 1.0 / float(t[1] - t[0]))
         window_s = int(opts["window"]) / rate
         margin = float(opts["margin_s"])
@@ -416,7 +430,7 @@ def check_with_drives(profile: str) -> list[str]:
     for name in sw["datasets"]:
         drive = load_drive(name, profile=profile)
         try:
-            plan = sweep_plan(drive, sw, int(opts["window"]))
+            plan = sweep_plan(drive, sw, int(opts["window"]), t_first=filter_start(drive, cfg["nav"]))
         except DataError as exc:
             raise DataError(path, "evaluate.sweep.n_starts/durations_s/warmup_s", f"{exc.expected} in {name}",
                             exc.found) from None

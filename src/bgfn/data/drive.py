@@ -62,8 +62,11 @@ class Drive:
 
     @property
     def has_attitude(self) -> bool:
-        """Whether the reference carries an attitude (False: ``roll, pitch, yaw`` all NaN)."""
-        return not bool(self.reference[list(ATTITUDE_COLUMNS)].isna().to_numpy().all())
+        """Whether the reference carries an attitude (``roll``, ``pitch``, ``yaw`` all finite): the filter can start
+        from its first row; otherwise it aligns itself (:mod:`bgfn.nav.alignment`)."""
+        cols = list(ATTITUDE_COLUMNS)
+        return set(cols) <= set(self.reference.columns) and bool(
+            np.isfinite(self.reference[cols].to_numpy(float)).all())
 
     def crop(self, t_start: float | None = None, t_end: float | None = None) -> "Drive":
         """A copy restricted to ``t_start <= time <= t_end`` (s, GPS time of week).

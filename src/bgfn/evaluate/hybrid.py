@@ -121,6 +121,9 @@ def navigation_context(drive, nav_section: dict | None, starts: Sequence[float])
     filter_imu = baseline.filter_imu(drive, cfg)     # drive.imu, or without NaveGo's static biases
     lever = np.asarray(drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0]), dtype=float)
     starts = sorted({float(s) for s in starts})
+    if starts and starts[0] <= initial.time:                     # a self-aligned filter starts late
+        raise DataError(drive.name, "outage start", f"starts after the filter's start at {initial.time:.2f} s "
+                        "(nav.alignment)", f"{starts[0]:.2f} s")
     imu_time = drive.imu["time"].to_numpy(float)
     # The state is taken at the last IMU epoch *before* the start (bgfn.nav.outages.epochs_before).
     snaps = {f"start_{i}": float(t) for i, t in enumerate(epochs_before(imu_time, starts, drive.name))}

@@ -14,14 +14,16 @@ from bgfn.errors import DataError
 from bgfn.evaluate.config import SWEEP_COLUMNS, TABLE_METHODS, evaluate_config
 from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
 from bgfn.evaluate.networks import load_model
+from bgfn.nav.baseline import filter_start
 from bgfn.paper import METHOD_LABELS, label
 
 
-def sweep_plan(drive, sweep: dict, window_samples: int = 200) -> pd.DataFrame:
+def sweep_plan(drive, sweep: dict, window_samples: int = 200, t_first: float | None = None) -> pd.DataFrame:
     """Outage starts spread evenly over the drive and their folds (contiguous blocks of starts).
 
     The first start leaves ``warmup_s`` after the first epoch (filter convergence; at least the input window),
-    the last one room for the longest duration.
+    the last one room for the longest duration. ``t_first``: the filter's start when it is later than the
+    reference's first row (a self-aligned filter, :func:`bgfn.nav.baseline.filter_start`), s.
 
     Returns
     -------
@@ -30,7 +32,8 @@ def sweep_plan(drive, sweep: dict, window_samples: int = 200) -> pd.DataFrame:
     """
     t = drive.imu["time"].to_numpy(float)
     rate = 1.0 / float(np.median(np.diff(t)))
-    t0 = float(drive.reference["time"].iloc[0])
+    t0 = float(drive.reference["time"].iloc[0]) if t_first is None else max(float(t_first),
+                                                                           float(drive.reference["time"].iloc[0]))
     lo = t0 + max(float(sweep["warmup_s"]), (window_samples + 1) / rate)
     hi = float(t[-1]) - max(sweep["durations_s"]) - 1.0 / rate
     n = int(sweep["n_starts"])
@@ -82,7 +85,7 @@ def run_sweep(cfg: dict, profile: str, dataset: str, drive=None, ecfg: dict | No
     # the sweep's budget, with the learning rates notebook 03 selected for this dataset (same for every fold)
     tc = sweep_train_config(train.tuned_train_config(cfg, profile, dataset), sw)
     opts = learning_options(tc)
-    plan = sweep_plan(drive, sw, int(opts["window"]))
+    plan = sweep_plan(drive, sw, int(opts["window"]), t_first=filter_start(drive, cfg.get("nav")))
     durations = sorted(float(d) for d in sw["durations_s"])
     dmax = durations[-1]
     seeds = [int(s) for s in sw["seeds"]]

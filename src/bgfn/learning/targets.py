@@ -76,14 +76,16 @@ def gnss_increments(gnss: pd.DataFrame, max_gap_factor: float = 1.5) -> pd.DataF
 def ins_increments(attitude: pd.DataFrame, t_from, t_to) -> np.ndarray:
     """North/east distance the INS/KF solution travels over each interval ``[t_from, t_to]``: its velocity
     ``v_n, v_e`` integrated (trapezoid), m, [M, 2]. The position columns are not used because the filter's
-    position jumps at each GNSS update, by the very GNSS error being checked."""
+    position jumps at each GNSS update, by the very GNSS error being checked. NaN for an interval outside the
+    solution's span (a filter that starts late, after its self-alignment: :mod:`bgfn.nav.alignment`)."""
     check_table(attitude, "attitude", ("time", "v_n", "v_e"))
     t = attitude["time"].to_numpy(float)
     out = np.empty((len(np.atleast_1d(t_from)), 2))
     for k, col in enumerate(("v_n", "v_e")):
         v = attitude[col].to_numpy(float)
         dist = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
-        out[:, k] = np.interp(t_to, t, dist) - np.interp(t_from, t, dist)
+        out[:, k] = (np.interp(t_to, t, dist, left=np.nan, right=np.nan)
+                     - np.interp(t_from, t, dist, left=np.nan, right=np.nan))
     return out
 
 

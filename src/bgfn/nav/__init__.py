@@ -32,7 +32,13 @@ Modules (pyins style, one concept each; SI units, radians, NED, tables as in CON
 - :mod:`~bgfn.nav.metrics` -- ``navigation_errors``, ``outage_metrics`` (max |east|, max |north|,
   horizontal RMSE, end error), ``rms_table``; ``reference_rows`` (a drive's spans where the reference is not
   trusted, ``meta["reference_excluded_s"]``, left out of every comparison).
+- :mod:`~bgfn.nav.alignment` -- ``align(imu, gnss, lever_arm, noise, options) -> Alignment`` (its ``state``: the
+  filter's start without a reference attitude), ``rest_end``, ``level_from_specific_force``,
+  ``level_by_velocity_matching``.
+- :mod:`~bgfn.nav.tuning` -- ``search_noise_scale(mean_nis, options) -> NoiseTuning`` (``nav.noise_scale: auto``).
+- :mod:`~bgfn.nav.consistency` -- ``nis_summary(updates)``, ``verdict``, ``nis_line``, ``nis_table``.
 - :mod:`~bgfn.nav.baseline` -- notebook 02: ``nav_config``, ``run_drive(drive, nav_section)``,
+  ``setup_filter(drive, cfg) -> FilterSetup`` (start and noise), ``filter_start``,
   ``run_baseline(drive, cfg, windows)``, ``ins_layout``, ``save_baseline``; :mod:`~bgfn.nav.plots` -- its figures.
 - :mod:`~bgfn.nav.navego_setup` -- the filter set up as NaveGo v1.4's ``ins_gnss.m`` (``nav.ins_tuning: navego``):
   ``navego_noise``, ``static_biases``, ``initial_bias_estimates``, ``remove_static_biases``.

@@ -5,9 +5,13 @@ outages are the profile's ``outage_windows`` (:func:`bgfn.nav.outages.outage_win
 
 - ``datasets``: drive names for :func:`bgfn.data.load_drive` (the profile's ``data:`` section crops them);
 - ``init``: initial std ``position_std_m``, ``height_std_m``, ``velocity_std_mps``, ``level_std_deg``,
-  ``azimuth_std_deg`` (P0; the filter starts from the reference's first row);
-- ``bias_model`` (``random_walk`` | ``gauss_markov``), ``noise_scale``: see
-  :func:`bgfn.nav.state.noise_from_imu_errors`;
+  ``azimuth_std_deg`` (P0 when the filter starts from the reference's first row);
+- ``alignment``: where the filter starts (:mod:`bgfn.nav.alignment`): ``mode`` ``reference`` (the reference's first
+  row; the drive must carry an attitude), ``gnss`` (self-alignment from the IMU and GNSS; the filter waits for it)
+  or ``auto`` (reference when the drive has an attitude, else gnss), and the self-alignment's thresholds and stds;
+- ``bias_model`` (``random_walk`` | ``gauss_markov``): see :func:`bgfn.nav.state.noise_from_imu_errors`;
+- ``noise_scale``: factor on the IMU white-noise densities, a number or ``auto`` (the factor that makes the GNSS
+  innovations consistent, :mod:`bgfn.nav.tuning`, with the ``noise_search`` options);
 - ``ins_tuning``: ``shipped`` (the bias modelling above) or ``navego`` (NaveGo v1.4's: static biases removed
   from the IMU, Gauss-Markov bias states of the dynamic biases; :mod:`bgfn.nav.navego_setup`, which then
   ignores ``bias_model``);
@@ -26,20 +30,27 @@ import pandas as pd
 from .. import paper
 from ..errors import DataError
 from . import metrics, navego_setup
+from .alignment import ALIGNMENT_DEFAULTS, MODES, Alignment, align
+from .consistency import nis_line, nis_summary
 from .filter import FilterResult, gate_thresholds, run_filter, run_outage
 from .outages import check_windows, epochs_before
 from .state import FilterNoise, FilterState, initial_covariance, initial_state, noise_from_imu_errors
+from .tuning import NOISE_SEARCH_DEFAULTS, NoiseTuning, search_noise_scale
 
 #: Defaults of the ``nav:`` profile section.
 NAV_DEFAULTS: dict = {
     "datasets": ["turin-sim-ekinox", "turin-sim-mpu6000"],
     "init": {"position_std_m": 1.0, "height_std_m": 3.0, "velocity_std_mps": 0.1, "level_std_deg": 0.5,
              "azimuth_std_deg": 2.0},
+    "alignment": dict(ALIGNMENT_DEFAULTS),
     "bias_model": "random_walk",
     "noise_scale": 1.0,
+    "noise_search": dict(NOISE_SEARCH_DEFAULTS),
     "innovation_gate": None,
     "ins_tuning": navego_setup.DEFAULT_TUNING,
 }
+#: ``nav.noise_scale`` that asks for the factor from the data.
+AUTO = "auto"
 
 
 def nav_config(section: dict | None) -> dict:
@@ -48,16 +59,21 @@ def nav_config(section: dict | None) -> dict:
     for key, value in (section or {}).items():
         if key not in cfg:
             raise DataError("params nav", key, f"one of {sorted(cfg)}", "unknown key")
-        if key == "init":
-            unknown = set(value) - set(cfg["init"])
+        if isinstance(cfg[key], dict):                           # init, alignment, noise_search: key by key
+            unknown = set(value or {}) - set(cfg[key])
             if unknown:
-                raise DataError("params nav.init", sorted(unknown)[0], f"one of {sorted(cfg['init'])}",
+                raise DataError(f"params nav.{key}", sorted(unknown)[0], f"one of {sorted(cfg[key])}",
                                 "unknown key")
-            cfg["init"].update(value)
+            cfg[key].update(value or {})
         else:
             cfg[key] = value
     gate_thresholds(cfg["innovation_gate"], "params nav")      # a bad probability fails here, by name
     navego_setup.check_tuning(cfg["ins_tuning"], "params nav")
+    if cfg["alignment"]["mode"] not in MODES:
+        raise DataError("params nav.alignment", "mode", f"one of {MODES}", repr(cfg["alignment"]["mode"]))
+    scale = cfg["noise_scale"]
+    if scale != AUTO and (isinstance(scale, bool) or not isinstance(scale, (int, float)) or not scale > 0):
+        raise DataError("params nav", "noise_scale", f"a positive number or {AUTO!r}", repr(scale))
     return cfg
 
 
@@ -78,12 +94,133 @@ def run_drive(drive, section: dict | None = None, snapshots: dict | None = None)
     """
     cfg = nav_config(section)
     initial, noise = filter_setup(drive, cfg)
-    return run_filter(filter_imu(drive, cfg), initial, noise, drive.gnss, drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0]),
-                      snapshots=snapshots, gate_probability=cfg["innovation_gate"], source=drive.name)
+    return run_filter(filter_imu(drive, cfg), initial, noise, drive.gnss, _lever(drive), snapshots=snapshots,
+                      gate_probability=cfg["innovation_gate"], source=drive.name)
+
+
+@dataclass
+class FilterSetup:
+    """Where and how the filter of a drive starts (:func:`setup_filter`).
+
+    Attributes
+    ----------
+    initial : FilterState
+        State at the start: the reference's first row, or the self-alignment's epoch (later).
+    noise : FilterNoise
+    noise_scale : float
+        The factor on the white-noise densities in ``noise`` (the profile's number, or the one found).
+    alignment : Alignment or None
+        The self-alignment (:mod:`bgfn.nav.alignment`); None when the filter starts from the reference.
+    tuning : NoiseTuning or None
+        The noise search (:mod:`bgfn.nav.tuning`); None when ``noise_scale`` is a number.
+    """
+
+    initial: FilterState
+    noise: FilterNoise
+    noise_scale: float
+    alignment: Alignment | None = None
+    tuning: NoiseTuning | None = None
+
+    def lines(self, name: str) -> list[str]:
+        """Plain sentences for notebook 02: the alignment and the noise search, when there were any."""
+        out = [self.alignment.line(name)] if self.alignment is not None else []
+        return out + ([self.tuning.line(name)] if self.tuning is not None else [])
+
+    def record(self) -> dict:
+        """JSON-ready record (``kf_baseline.json``)."""
+        a = self.alignment
+        return {"start_time": float(self.initial.time), "noise_scale": float(self.noise_scale),
+                "noise_tuning": self.tuning.record() if self.tuning is not None else None,
+                "alignment": None if a is None else {
+                    "time": float(a.state.time), "gnss_time": a.gnss_time, "roll_deg": float(np.degrees(a.roll)),
+                    "pitch_deg": float(np.degrees(a.pitch)), "yaw_deg": float(np.degrees(a.yaw)),
+                    "level_source": a.level_source, "course_source": a.course_source, "rest_end": a.rest_end,
+                    "moving_from": a.moving_from, "level_std_deg": float(np.degrees(a.level_std)),
+                    "azimuth_std_deg": float(np.degrees(a.azimuth_std))}}
+
+
+def _lever(drive) -> list:
+    return drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0])
+
+
+def _has_attitude(drive) -> bool:
+    return bool(getattr(drive, "has_attitude", True))
+
+
+def _navego(cfg: dict) -> bool:
+    return cfg.get("ins_tuning", navego_setup.DEFAULT_TUNING) == "navego"
+
+
+def _noise(drive, cfg: dict, scale: float) -> FilterNoise:
+    """Process noise with the factor ``scale`` on the white-noise densities (``nav.ins_tuning`` picks the model)."""
+    errors, source = drive.meta["imu_errors"], f"{drive.name} meta['imu_errors']"
+    if _navego(cfg):
+        return navego_setup.navego_noise(errors, scale, source=source)
+    walk = scale if cfg["noise_search"]["bias_walk"] else 1.0     # the factor on the bias walk too, when asked
+    return noise_from_imu_errors(errors, cfg["bias_model"], scale, source=source, bias_walk_scale=walk)
+
+
+def _initial(drive, cfg: dict, noise: FilterNoise) -> tuple[FilterState, Alignment | None]:
+    """The state the filter starts from (``nav.alignment.mode``) and the self-alignment when it ran."""
+    mode = cfg["alignment"]["mode"]
+    if mode == "reference" and not _has_attitude(drive):
+        raise DataError(drive.name, "nav.alignment.mode", "'gnss' or 'auto' for a drive without a reference "
+                        "attitude (roll, pitch, yaw all finite)", "'reference'")
+    if mode == "gnss" or (mode == "auto" and not _has_attitude(drive)):
+        options = {k: v for k, v in cfg["alignment"].items() if k != "mode"}
+        a = align(filter_imu(drive, cfg), drive.gnss, _lever(drive), noise, options, source=drive.name)
+        initial, alignment = a.state, a
+    else:
+        row = drive.reference.iloc[0]
+        init = cfg["init"]
+        P0 = initial_covariance(row[["lat", "lon", "h"]].to_numpy(float), noise, init["position_std_m"],
+                                init["height_std_m"], init["velocity_std_mps"], np.radians(init["level_std_deg"]),
+                                np.radians(init["azimuth_std_deg"]))
+        initial, alignment = initial_state(row, P0), None
+    if _navego(cfg):      # NaveGo starts its bias estimates at the dynamic-bias values (navego_setup)
+        errors = drive.meta["imu_errors"]
+        initial.gyro_bias, initial.accel_bias = navego_setup.initial_bias_estimates(
+            errors, f"{drive.name} meta['imu_errors']")
+    return initial, alignment
+
+
+def setup_filter(drive, cfg: dict) -> FilterSetup:
+    """Initial state and noise of a drive's filter (``nav.alignment``, ``nav.noise_scale``).
+
+    With ``noise_scale: auto`` the factor comes from :func:`bgfn.nav.tuning.search_noise_scale` over GPS-aided runs
+    of the whole drive from the same initial state (the initial state does not depend on the factor: P0 holds
+    only the bias priors of the noise).
+
+    Parameters
+    ----------
+    drive : bgfn.data.Drive
+    cfg : dict
+        Output of :func:`nav_config`.
+
+    Returns
+    -------
+    FilterSetup
+    """
+    auto = cfg["noise_scale"] == AUTO
+    noise = _noise(drive, cfg, 1.0 if auto else cfg["noise_scale"])
+    initial, alignment = _initial(drive, cfg, noise)
+    if not auto:
+        return FilterSetup(initial, noise, float(cfg["noise_scale"]), alignment)
+
+    def mean_nis(scale: float) -> tuple[float, float]:
+        run = run_filter(filter_imu(drive, cfg), initial, _noise(drive, cfg, scale), drive.gnss, _lever(drive),
+                         gate_probability=cfg["innovation_gate"], source=drive.name)
+        s = nis_summary(run.updates)
+        if not s["fixes"]:
+            raise DataError(drive.name, "gnss", "GNSS fixes to set nav.noise_scale: auto from", "none fused")
+        return s["mean_nis"], s["dof"]
+
+    tuning = search_noise_scale(mean_nis, cfg["noise_search"])
+    return FilterSetup(initial, _noise(drive, cfg, tuning.scale), tuning.scale, alignment, tuning)
 
 
 def filter_setup(drive, cfg: dict) -> tuple[FilterState, FilterNoise]:
-    """Initial filter state (at the reference's first row) and noise for a drive.
+    """Initial filter state and noise for a drive (:func:`setup_filter` without its record).
 
     With ``ins_tuning: navego`` the noise and the bias priors are NaveGo's (:func:`bgfn.nav.navego_setup.navego_noise`)
     and the bias estimates start at the dynamic-bias values; the filter must then read :func:`filter_imu`.
@@ -97,32 +234,31 @@ def filter_setup(drive, cfg: dict) -> tuple[FilterState, FilterNoise]:
     Returns
     -------
     initial : FilterState
+        At the reference's first row, or at the self-alignment's epoch (``nav.alignment``).
     noise : FilterNoise
     """
-    errors, source = drive.meta["imu_errors"], f"{drive.name} meta['imu_errors']"
-    navego = cfg.get("ins_tuning", navego_setup.DEFAULT_TUNING) == "navego"
-    if navego:
-        noise = navego_setup.navego_noise(errors, cfg["noise_scale"], source=source)
-    else:
-        noise = noise_from_imu_errors(errors, cfg["bias_model"], cfg["noise_scale"], source=source)
-    row = drive.reference.iloc[0]
-    init = cfg["init"]
-    P0 = initial_covariance(row[["lat", "lon", "h"]].to_numpy(float), noise, init["position_std_m"],
-                            init["height_std_m"], init["velocity_std_mps"], np.radians(init["level_std_deg"]),
-                            np.radians(init["azimuth_std_deg"]))
-    initial = initial_state(row, P0)
-    if navego:
-        initial.gyro_bias, initial.accel_bias = navego_setup.initial_bias_estimates(errors, source)
-    return initial, noise
+    s = setup_filter(drive, cfg)
+    return s.initial, s.noise
 
 
 def filter_imu(drive, cfg: dict) -> pd.DataFrame:
     """The IMU table the filter reads: ``drive.imu`` itself, or with ``ins_tuning: navego`` a copy without the
     profile's static biases (:func:`bgfn.nav.navego_setup.remove_static_biases`)."""
-    if cfg.get("ins_tuning", navego_setup.DEFAULT_TUNING) != "navego":
+    if not _navego(cfg):
         return drive.imu
     return navego_setup.remove_static_biases(
         drive.imu, *navego_setup.static_biases(drive.meta["imu_errors"], f"{drive.name} meta['imu_errors']"))
+
+
+def filter_start(drive, section: dict | None) -> float:
+    """Time the filter of ``drive`` starts at with a profile's ``nav:`` section, s: the reference's first row, or
+    the self-alignment's epoch. Cheap (no filter run): for the checks of outage windows and sweep starts."""
+    cfg = nav_config(section)
+    mode = cfg["alignment"]["mode"]
+    if mode == "reference" or (mode == "auto" and _has_attitude(drive)):
+        return float(drive.reference["time"].iloc[0])
+    initial, _ = _initial(drive, cfg, _noise(drive, {**cfg, "noise_scale": 1.0}, 1.0))
+    return float(initial.time)
 
 
 @dataclass
@@ -155,6 +291,13 @@ class Baseline:
     outage_errors: dict
     outage_table: pd.DataFrame
     noise: FilterNoise
+    setup: FilterSetup | None = None
+
+    def lines(self) -> list[str]:
+        """Notebook 02's sentences of this run: the self-alignment and the noise search (when they ran) and the
+        NIS verdict of the GPS-aided run (:func:`bgfn.nav.consistency.nis_line`)."""
+        setup = self.setup.lines(self.drive_name) if self.setup is not None else []
+        return setup + [nis_line(self.drive_name, nis_summary(self.full.updates))]
 
 
 def run_baseline(drive, cfg: dict, windows) -> Baseline:
@@ -172,11 +315,14 @@ def run_baseline(drive, cfg: dict, windows) -> Baseline:
     -------
     Baseline
     """
-    windows = check_windows(windows, float(drive.reference["time"].iloc[0]),   # the given order: Outage k as in 04
-                            float(drive.imu["time"].iloc[-1]), f"{drive.name}: profile outage_windows", sort=False)
-    initial, noise = filter_setup(drive, cfg)
+    setup = setup_filter(drive, cfg)
+    initial, noise = setup.initial, setup.noise
+    # the filter may start after the reference's first row (self-alignment): outages must come after its start;
+    # the given order is kept (Outage k as in notebook 04)
+    windows = check_windows(windows, float(initial.time), float(drive.imu["time"].iloc[-1]),
+                            f"{drive.name}: profile outage_windows (filter start {initial.time:.2f} s)", sort=False)
     imu = filter_imu(drive, cfg)
-    lever = drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0])
+    lever = _lever(drive)
     names = [f"outage_{i + 1}" for i in range(len(windows))]
     starts = epochs_before(drive.imu["time"], [w.start for w in windows], drive.name)
     full = run_filter(imu, initial, noise, drive.gnss, lever, snapshots=dict(zip(names, starts)),
@@ -190,7 +336,7 @@ def run_baseline(drive, cfg: dict, windows) -> Baseline:
         outage_errors[n] = e
         rows.append({"dataset": drive.name, "outage": n, **metrics.outage_metrics(e, w)})
     return Baseline(drive.name, full, errors, metrics.rms_table(errors), full.states, outage_errors,
-                    pd.DataFrame(rows), noise)
+                    pd.DataFrame(rows), noise, setup)
 
 
 def ins_layout(outage_table: pd.DataFrame, dataset: str | None = None) -> pd.DataFrame:
@@ -241,7 +387,8 @@ def save_baseline(b: Baseline, out, lat=None) -> dict:
     Returns
     -------
     dict
-        JSON-ready summary (RMS, outage metrics, mean NIS) for ``kf_baseline.json``.
+        JSON-ready summary (RMS, outage metrics, mean NIS, the filter's start and noise factor:
+        :meth:`FilterSetup.record`) for ``kf_baseline.json``.
     """
     from pathlib import Path
 
@@ -264,7 +411,8 @@ def save_baseline(b: Baseline, out, lat=None) -> dict:
             "gnss_updates": int(len(upd)), "gnss_rejected": int((~upd["accepted"]).sum()) if len(upd) else 0,
             "mean_nis": float(upd["nis"].mean()) if len(upd) else None,
             "mean_nis_dof": float(upd["dof"].mean()) if len(upd) else None,
-            "states_file": f"nav_states_{d}.npz"}
+            "nis_verdict": nis_summary(upd)["verdict"],
+            "states_file": f"nav_states_{d}.npz", **(b.setup.record() if b.setup is not None else {})}
 
 
 def gate_comparison(drive, cfg: dict, windows, probability: float, baseline: Baseline | None = None) -> pd.DataFrame:
@@ -291,6 +439,8 @@ def gate_comparison(drive, cfg: dict, windows, probability: float, baseline: Bas
         start from the filter's state.
     """
     rows = []
+    if baseline is not None and baseline.setup is not None:       # a factor found once serves both settings
+        cfg = {**cfg, "noise_scale": baseline.setup.noise_scale}
     for gate in (None, probability):
         same = baseline is not None and gate == cfg["innovation_gate"]
         b = baseline if same else run_baseline(drive, {**cfg, "innovation_gate": gate}, windows)

@@ -113,7 +113,7 @@ def positions_from_velocity(time, v_ned, lat0, lon0, h0):
 
 
 def demo_trajectory(duration_s=600.0, rate_hz=100.0, lat0=np.radians(45.06), lon0=np.radians(7.66),
-                    h0=250.0):
+                    h0=250.0, rest_s=0.0, start_s=10.0):
     """A smooth, deterministic, curvy 3D car-like trajectory (for tests and examples).
 
     Speed 8 +- 3 m/s, heading wandering over several turns, gentle climbs, roll and pitch following
@@ -130,6 +130,10 @@ def demo_trajectory(duration_s=600.0, rate_hz=100.0, lat0=np.radians(45.06), lon
         Start position, rad.
     h0 : float
         Start height, m.
+    rest_s : float
+        Time the vehicle stands still at the start, s (0: it moves from the first row).
+    start_s : float
+        After a rest, the time over which the motion comes up to its full pace (smoothstep), s.
 
     Returns
     -------
@@ -137,13 +141,22 @@ def demo_trajectory(duration_s=600.0, rate_hz=100.0, lat0=np.radians(45.06), lon
         Reference table starting at time 0.
     """
     t = np.arange(int(round(duration_s * rate_hz)) + 1) / rate_hz
-    speed = 8.0 + 3.0 * np.sin(0.05 * t)
-    yaw = 0.6 + 0.02 * t + 1.2 * np.sin(0.03 * t) + 0.3 * np.sin(0.11 * t)
-    yaw_rate = 0.02 + 0.036 * np.cos(0.03 * t) + 0.033 * np.cos(0.11 * t)
-    climb = 0.4 * np.sin(0.04 * t) + 0.1 * np.sin(0.17 * t)  # up, m/s
+    if rest_s > 0:
+        # the motion's own clock tau stands still, then runs up to real time: a car that waits, then drives off
+        x = np.clip((t - rest_s) / start_s, 0.0, 1.0)
+        pace = x * x * (3.0 - 2.0 * x)                                 # d tau / dt
+        tau = np.concatenate([[0.0], np.cumsum(0.5 * (pace[1:] + pace[:-1]) * np.diff(t))])
+    else:
+        pace, tau = 1.0, t
+    speed_f = 8.0 + 3.0 * np.sin(0.05 * tau)
+    speed = pace * speed_f
+    yaw = 0.6 + 0.02 * tau + 1.2 * np.sin(0.03 * tau) + 0.3 * np.sin(0.11 * tau)
+    yaw_rate = pace * (0.02 + 0.036 * np.cos(0.03 * tau) + 0.033 * np.cos(0.11 * tau))
+    climb_f = 0.4 * np.sin(0.04 * tau) + 0.1 * np.sin(0.17 * tau)  # up, m/s
+    climb = pace * climb_f
     v = np.stack([speed * np.cos(yaw), speed * np.sin(yaw), -climb], axis=-1)
-    pitch = np.arctan2(climb, speed) + 0.01 * np.sin(0.3 * t)
-    roll = 0.04 * speed * yaw_rate + 0.02 * np.sin(0.23 * t)
+    pitch = np.arctan2(climb_f, speed_f) + 0.01 * np.sin(0.3 * tau)  # the road's grade, also at rest
+    roll = 0.04 * speed * yaw_rate + 0.02 * np.sin(0.23 * tau)
     pos = positions_from_velocity(t, v, lat0, lon0, h0)
     return pd.DataFrame({"time": t, "lat": pos[:, 0], "lon": pos[:, 1], "h": pos[:, 2],
                          "v_n": v[:, 0], "v_e": v[:, 1], "v_d": v[:, 2],

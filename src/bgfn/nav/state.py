@@ -117,7 +117,7 @@ def _vec3(d, key, source):
 
 
 def noise_from_imu_errors(imu_errors: dict, bias_model: str = "random_walk", noise_scale: float = 1.0,
-                          source: str = "meta['imu_errors']") -> FilterNoise:
+                          source: str = "meta['imu_errors']", bias_walk_scale: float = 1.0) -> FilterNoise:
     """Filter noise from a drive's IMU error parameters (``Drive.meta['imu_errors']``).
 
     Keys read (see :mod:`bgfn.data.imu_errors`): ``gyro_noise_density``, ``accel_noise_density``,
@@ -137,6 +137,8 @@ def noise_from_imu_errors(imu_errors: dict, bias_model: str = "random_walk", noi
         Factor on the white-noise densities (tuning; 1 = as simulated).
     source : str
         Name used in error messages.
+    bias_walk_scale : float
+        Factor on the bias driving-noise densities (1 = as given; :mod:`bgfn.nav.tuning` may scale both).
 
     Returns
     -------
@@ -151,7 +153,7 @@ def noise_from_imu_errors(imu_errors: dict, bias_model: str = "random_walk", noi
         if np.any(tau <= 0):
             raise DataError(source, f"{s}_bias_corr_time", "positive correlation times, s", str(tau.tolist()))
         out[f"{s}_noise"] = noise_scale * _vec3(imu_errors, f"{s}_noise_density", source)
-        out[f"{s}_bias_walk"] = np.sqrt(2.0 * sigma ** 2 / tau)
+        out[f"{s}_bias_walk"] = bias_walk_scale * np.sqrt(2.0 * sigma ** 2 / tau)
         out[f"{s}_bias_tau"] = np.full(3, np.inf) if bias_model == "random_walk" else tau
         if f"p0_{s}_bias_std" in imu_errors:
             out[f"{s}_bias_std"] = _vec3(imu_errors, f"p0_{s}_bias_std", source)

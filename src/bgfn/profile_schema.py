@@ -142,7 +142,7 @@ SCHEMA = section(
             level_time_s=_POS, still_window_s=_POS, still_min_s=_NONNEG, still_accel_std_mps2=_POS,
             still_gyro_std_dps=_POS, level_std_deg=_POS, azimuth_std_deg=_POS, velocity_std_mps=_POS),
         bias_model=text("random_walk", "gauss_markov"),
-        noise_scale=Spec("any"),             # a positive number or 'auto': checked in cross_check
+        noise_scale=Spec("any"),             # a positive number or 'auto', or per dataset: checked in cross_check
         noise_search=section(range=seq(_POS, length=2), max_runs=integer(1), tolerance=_POS, bias_walk=flag()),
         innovation_gate=number(0, 1, lo_open=True, hi_open=True, null=True),
         ins_tuning=text("shipped", "navego")),
@@ -316,9 +316,13 @@ def cross_check(cfg: dict) -> None:
     data, tr, ev = cfg.get("data") or {}, cfg.get("train") or {}, cfg.get("evaluate") or {}
     nav = cfg.get("nav") or {}
     ns = nav.get("noise_scale")
-    if "noise_scale" in nav and ns != "auto" and (isinstance(ns, bool) or not isinstance(ns, (int, float))
-                                                  or not math.isfinite(ns) or ns <= 0):
-        raise ProfileError("nav.noise_scale", "a positive number or 'auto'", _fmt(ns))
+    if isinstance(ns, dict) and "default" not in ns:
+        raise ProfileError("nav.noise_scale", "a 'default' entry beside the per-dataset ones", _fmt(ns))
+    for key, value in (ns.items() if isinstance(ns, dict) else [(None, ns)] if "noise_scale" in nav else []):
+        if value != "auto" and (isinstance(value, bool) or not isinstance(value, (int, float))
+                                or not math.isfinite(value) or value <= 0):
+            raise ProfileError("nav.noise_scale" + (f".{key}" if key else ""),
+                               "a positive number or 'auto' (or per dataset, with a 'default')", _fmt(value))
     band = (nav.get("noise_search") or {}).get("range")
     if band and not band[0] < band[1]:
         raise ProfileError("nav.noise_search.range", "[low, high] with low < high", _fmt(band))

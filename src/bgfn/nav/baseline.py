@@ -11,7 +11,8 @@ outages are the profile's ``outage_windows`` (:func:`bgfn.nav.outages.outage_win
   or ``auto`` (reference when the drive has an attitude, else gnss), and the self-alignment's thresholds and stds;
 - ``bias_model`` (``random_walk`` | ``gauss_markov``): see :func:`bgfn.nav.state.noise_from_imu_errors`;
 - ``noise_scale``: factor on the IMU white-noise densities, a number or ``auto`` (the factor that makes the GNSS
-  innovations consistent, :mod:`bgfn.nav.tuning`, with the ``noise_search`` options);
+  innovations consistent, :mod:`bgfn.nav.tuning`, with the ``noise_search`` options), or a mapping of dataset
+  names to those with a ``default`` entry (:func:`noise_scale_of`);
 - ``ins_tuning``: ``shipped`` (the bias modelling above) or ``navego`` (NaveGo v1.4's: static biases removed
   from the IMU, Gauss-Markov bias states of the dynamic biases; :mod:`bgfn.nav.navego_setup`, which then
   ignores ``bias_model``);
@@ -49,6 +50,8 @@ NAV_DEFAULTS: dict = {
     "innovation_gate": None,
     "ins_tuning": navego_setup.DEFAULT_TUNING,
 }
+#: Key of the entry for every other drive when ``nav.noise_scale`` is a mapping per dataset.
+DEFAULT_SCALE_KEY = "default"
 #: ``nav.noise_scale`` that asks for the factor from the data.
 AUTO = "auto"
 
@@ -71,10 +74,24 @@ def nav_config(section: dict | None) -> dict:
     navego_setup.check_tuning(cfg["ins_tuning"], "params nav")
     if cfg["alignment"]["mode"] not in MODES:
         raise DataError("params nav.alignment", "mode", f"one of {MODES}", repr(cfg["alignment"]["mode"]))
-    scale = cfg["noise_scale"]
-    if scale != AUTO and (isinstance(scale, bool) or not isinstance(scale, (int, float)) or not scale > 0):
-        raise DataError("params nav", "noise_scale", f"a positive number or {AUTO!r}", repr(scale))
+    spec = cfg["noise_scale"]
+    for key, scale in (spec.items() if isinstance(spec, dict) else [(None, spec)]):
+        if scale != AUTO and (isinstance(scale, bool) or not isinstance(scale, (int, float)) or not scale > 0):
+            raise DataError("params nav", "noise_scale" + (f".{key}" if key else ""),
+                            f"a positive number or {AUTO!r}", repr(scale))
+    if isinstance(spec, dict) and DEFAULT_SCALE_KEY not in spec:
+        raise DataError("params nav", "noise_scale", f"a '{DEFAULT_SCALE_KEY}' entry beside the per-dataset ones",
+                        repr(spec))
     return cfg
+
+
+def noise_scale_of(cfg: dict, dataset: str):
+    """``nav.noise_scale`` for one drive: the number or ``auto``, or from a mapping its entry (else ``default``).
+
+    Drives differ: a simulated IMU's filter is set from the error model it was made with (1), a recorded IMU's
+    datasheet says nothing of the car's vibration (``auto``)."""
+    spec = cfg["noise_scale"]
+    return spec.get(dataset, spec[DEFAULT_SCALE_KEY]) if isinstance(spec, dict) else spec
 
 
 def run_drive(drive, section: dict | None = None, snapshots: dict | None = None) -> FilterResult:
@@ -201,11 +218,12 @@ def setup_filter(drive, cfg: dict) -> FilterSetup:
     -------
     FilterSetup
     """
-    auto = cfg["noise_scale"] == AUTO
-    noise = _noise(drive, cfg, 1.0 if auto else cfg["noise_scale"])
+    scale = noise_scale_of(cfg, drive.name)
+    auto = scale == AUTO
+    noise = _noise(drive, cfg, 1.0 if auto else scale)
     initial, alignment = _initial(drive, cfg, noise)
     if not auto:
-        return FilterSetup(initial, noise, float(cfg["noise_scale"]), alignment)
+        return FilterSetup(initial, noise, float(scale), alignment)
 
     def mean_nis(scale: float) -> tuple[float, float]:
         run = run_filter(filter_imu(drive, cfg), initial, _noise(drive, cfg, scale), drive.gnss, _lever(drive),

@@ -10,8 +10,8 @@ starts from the GPS-aided filter's state, so its drift depends on how that filte
 - ``navego-reset``: the same GPS-aided run, then each outage's INS started with its bias estimates cleared:
   only the profile's static biases are removed, as by NaveGo v1.4 whose bias estimate is the latest
   correction alone (:mod:`bgfn.nav.navego_setup`, "Not reproduced"; the latest correction is neglected);
-- ``paper``: the paper's INS row (:func:`bgfn.paper.outage_table`), only for a dataset that stands for one of
-  its tests.
+- ``paper``: the paper's INS row (:func:`bgfn.paper.published_values`: the field test's beside the real drive),
+  only for a dataset that stands for one of its tests.
 
 Table columns (:data:`COLUMNS`; ``tables/kf_ins_tuning.csv``, ``bgfn.config.SHARED_TABLES['kf_ins_tuning']``):
 ``dataset``, ``test`` (the paper's test or empty), ``outage`` (1, 2, ...), ``setup``, ``max_east_m``,
@@ -88,7 +88,7 @@ def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None
             m = metrics.outage_metrics(e, w)
             rows.append(_row(drive.name, test, k + 1, RESET, m["max_abs_east"], m["max_abs_north"]))
     if test:
-        for r in paper.outage_table(test).query("method == 'INS'").itertuples(index=False):
+        for r in paper.published_values(test).query("method == 'INS'").itertuples(index=False):
             rows.append(_row(drive.name, test, r.outage, PAPER, r.max_east_m, r.max_north_m))
     return pd.DataFrame(rows, columns=list(COLUMNS))
 
@@ -101,14 +101,14 @@ def ins_tuning_tables(drives, nav_section: dict | None, windows, baselines: dict
     drives : iterable of bgfn.data.Drive
     nav_section : dict or None
         A profile's ``nav:`` section (:func:`bgfn.nav.baseline.nav_config` fills and checks it).
-    windows : sequence of (start, duration)
-        The outages, s.
+    windows : sequence of (start, duration), or dict
+        The outages, s; or ``{drive name: outages}`` (each drive its own, :func:`bgfn.nav.outages.outage_windows`).
     baselines : dict, optional
         ``{drive name: Baseline}`` run with ``nav_section`` as it is, reused.
     """
     cfg = nav_config(nav_section)
-    return pd.concat([ins_tuning_table(d, cfg, windows, (baselines or {}).get(d.name)) for d in drives],
-                     ignore_index=True)
+    return pd.concat([ins_tuning_table(d, cfg, windows[d.name] if isinstance(windows, dict) else windows,
+                                       (baselines or {}).get(d.name)) for d in drives], ignore_index=True)
 
 
 def layouts(table: pd.DataFrame) -> pd.DataFrame:

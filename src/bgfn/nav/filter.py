@@ -126,8 +126,56 @@ def position_nis(P, H, dz, std):
 
 
 @numba.njit(cache=True)
+def sequential_update(P, H, dz, std, x, innov):
+    """Eq. (eq4) for the rows of ``H`` one scalar at a time (exactly the batch update for a diagonal R), Joseph
+    form for ``P``; the error-state estimate accumulates in ``x`` (zero on entry: closed loop).
+
+    A row whose ``std`` is not positive and finite is left out (its ``innov`` is NaN). Returns the sum of the
+    scalar normalized innovations squared. Shared by every measurement of the filter: position fixes
+    (:func:`update_position`) and the vehicle constraints (:mod:`bgfn.nav.constraints`).
+    """
+    n = P.shape[0]
+    eye = np.eye(n)
+    nis = 0.0
+    for a in range(H.shape[0]):
+        innov[a] = np.nan
+        if not (std[a] > 0.0 and np.isfinite(std[a])):
+            continue
+        hrow = H[a].copy()
+        ph = P @ hrow
+        s = hrow @ ph + std[a] ** 2
+        k = ph / s
+        y = dz[a] - hrow @ x
+        innov[a] = y
+        nis += y * y / s
+        x += k * y
+        ikh = eye - np.outer(k, hrow)
+        P[:, :] = ikh @ P @ ikh.T + np.outer(k, k) * std[a] ** 2
+    return nis
+
+
+@numba.njit(cache=True)
+def feedback(pos, v, c, ba, bg, x):
+    """Closed-loop feedback of the error-state estimate ``x`` (errors are computed - true) into the navigation
+    solution and the bias estimates, in place; the caller then starts from ``x = 0``."""
+    pos[0] -= x[em.DLAT]
+    pos[1] -= x[em.DLON]
+    pos[2] -= x[em.DH]
+    v[0] -= x[em.DV_N]
+    v[1] -= x[em.DV_E]
+    v[2] -= x[em.DV_D]
+    rv = np.array([x[em.PHI_N], x[em.PHI_E], x[em.PHI_D]])
+    dc = np.empty((3, 3))
+    rotvec_to_dcm_nb(rv, dc)  # C_true = (I - [phi])^-1 C_computed ~ exp([phi]) C_computed
+    c[:, :] = dc @ c
+    for a in range(3):
+        ba[a] += x[em.BA_X + a]
+        bg[a] += x[em.BG_X + a]
+
+
+@numba.njit(cache=True)
 def update_position(pos, v, c, ba, bg, P, lever, fix, std, lag, innov, gate):
-    """Eq. (eq4) position update (sequential scalar updates, Joseph form) and feedback.
+    """Eq. (eq4) position update (:func:`sequential_update`) and feedback (:func:`feedback`).
 
     ``gate`` > 0: the fix is first tested as a whole; when its NIS (:func:`position_nis`) exceeds ``gate`` it is
     rejected and the state and ``P`` are left untouched (an innovation gate; 0: every fix is fused, as in the
@@ -144,36 +192,8 @@ def update_position(pos, v, c, ba, bg, P, lever, fix, std, lag, innov, gate):
                 innov[a] = dz[a] if (std[a] > 0.0 and np.isfinite(std[a])) else np.nan
             return nis_fix, False
     x = np.zeros(n)
-    eye = np.eye(n)
-    nis = 0.0
-    for a in range(3):
-        innov[a] = np.nan
-        if not (std[a] > 0.0 and np.isfinite(std[a])):
-            continue
-        hrow = H[a].copy()
-        ph = P @ hrow
-        s = hrow @ ph + std[a] ** 2
-        k = ph / s
-        y = dz[a] - hrow @ x
-        innov[a] = y
-        nis += y * y / s
-        x += k * y
-        ikh = eye - np.outer(k, hrow)
-        P[:, :] = ikh @ P @ ikh.T + np.outer(k, k) * std[a] ** 2
-    # Closed-loop feedback (errors are computed - true).
-    pos[0] -= x[em.DLAT]
-    pos[1] -= x[em.DLON]
-    pos[2] -= x[em.DH]
-    v[0] -= x[em.DV_N]
-    v[1] -= x[em.DV_E]
-    v[2] -= x[em.DV_D]
-    rv = np.array([x[em.PHI_N], x[em.PHI_E], x[em.PHI_D]])
-    dc = np.empty((3, 3))
-    rotvec_to_dcm_nb(rv, dc)  # C_true = (I - [phi])^-1 C_computed ~ exp([phi]) C_computed
-    c[:, :] = dc @ c
-    for a in range(3):
-        ba[a] += x[em.BA_X + a]
-        bg[a] += x[em.BG_X + a]
+    nis = sequential_update(P, H, dz, std, x, innov)
+    feedback(pos, v, c, ba, bg, x)
     return nis, True
 
 

@@ -269,7 +269,7 @@ def _check_gnss(gnss, source):
 def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss: pd.DataFrame | None = None,
                lever_arm=(0.0, 0.0, 0.0), outage_windows=(), pseudo_gps=None, t_end: float | None = None,
                snapshots: dict | None = None, pseudo_rate_hz: float = PSEUDO_RATE_HZ,
-               gate_probability: float | None = None, source: str = "drive") -> FilterResult:
+               gate_probability: float | None = None, source: str = "drive", constraints=None) -> FilterResult:
     """Run the closed-loop GPS/INS filter from ``initial`` over the IMU rows after ``initial.time``.
 
     Parameters
@@ -301,6 +301,10 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
         fused (the paper's filter). Pseudo fixes are never gated.
     source : str
         Name used in error messages.
+    constraints : bgfn.nav.constraints.Constraints, optional
+        Vehicle constraints (NHC, and ZUPT where the stillness detector fires) applied at their aid epochs;
+        built for this ``imu`` (:func:`bgfn.nav.constraints.build_constraints`). None: none (the paper's filter).
+        Their updates are not rows of ``updates``.
 
     Returns
     -------
@@ -316,6 +320,9 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
         time, gyro, accel, dt = time[keep], gyro[keep], accel[keep], dt[keep]
     times = np.concatenate([[t0], time])  # output rows
     n_rows = times.size
+    aid = mount = None
+    if constraints is not None:
+        aid, mount = constraints.steps(time, source + ":imu")
     windows = check_windows(outage_windows, t0, times[-1], source + ":outage_windows")
     lever = np.asarray(lever_arm, dtype=float).reshape(3)
 
@@ -363,6 +370,17 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
     upd, P_upd = [], []
     states, window_start = {}, {}
     innov = np.empty(3)
+    out_bias_aid = np.zeros((n_rows, 6)) if aid is not None else None
+
+    def advance(r0, r1):
+        """Prediction over output rows r0..r1 (with the constraints' updates at their epochs)."""
+        if aid is None:
+            propagate_steps(r0, r1, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd)
+        else:
+            from .constraints import propagate_aided
+
+            propagate_aided(r0, r1, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd, aid,
+                            mount, *constraints.config.kernel_args(), out_bias_aid)
 
     def current(row):
         return FilterState(float(times[row]), pos.copy(), v.copy(), c.copy(), ba.copy(), bg.copy(), P.copy())
@@ -370,7 +388,7 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
     row = 0
     for r, kind, payload in events:
         if r > row:
-            propagate_steps(row, r, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd)
+            advance(row, r)
             row = r
         if kind == 0:
             window_start[payload[1]] = current(row)
@@ -398,8 +416,14 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
         upd.append((t_m, label, *innov, nis, int(np.sum(np.isfinite(innov))), bool(accepted)))
         P_upd.append(P.copy())
     if row < n_rows - 1:
-        propagate_steps(row, n_rows - 1, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd)
+        advance(row, n_rows - 1)
 
+    if aid is not None:
+        # the constraints' updates also move the bias estimates; at a row with both, the fix comes after
+        aided = np.flatnonzero(aid) + 1
+        order = np.lexsort((np.r_[np.zeros(aided.size), np.ones(len(bias_rows))], np.r_[aided, bias_rows]))
+        bias_rows = list(np.r_[aided, bias_rows][order])
+        bias_vals = list(np.concatenate([out_bias_aid[aided], np.array(bias_vals)])[order])
     # Bias estimates are piecewise constant between updates (random walk) or decay (Gauss-Markov).
     idx = np.searchsorted(np.array(bias_rows), np.arange(n_rows), side="right") - 1
     bias = np.array(bias_vals)[idx]
@@ -421,7 +445,7 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
 
 def run_outage(imu: pd.DataFrame, start_state: FilterState, window, noise: FilterNoise,
                lever_arm=(0.0, 0.0, 0.0), pseudo_gps=None, pseudo_rate_hz: float = PSEUDO_RATE_HZ,
-               source: str = "drive") -> FilterResult:
+               source: str = "drive", constraints=None) -> FilterResult:
     """One outage from a saved filter state: only the window's own IMU rows are processed.
 
     Without ``pseudo_gps`` this is the standalone INS (prediction only, biases held at their last
@@ -441,6 +465,8 @@ def run_outage(imu: pd.DataFrame, start_state: FilterState, window, noise: Filte
         See :func:`run_filter`.
     pseudo_rate_hz : float
     source : str
+    constraints : bgfn.nav.constraints.Constraints, optional
+        See :func:`run_filter`; the vehicle frame is held at its estimate at the start (no fix inside).
 
     Returns
     -------
@@ -450,8 +476,11 @@ def run_outage(imu: pd.DataFrame, start_state: FilterState, window, noise: Filte
     w = window if isinstance(window, OutageWindow) else OutageWindow(*map(float, window))
     if abs(start_state.time - w.start) > 0.5:
         raise DataError(source, "start_state.time", f"the outage start {w.start} s", str(start_state.time))
+    if constraints is not None:
+        constraints = constraints.frozen(start_state.time)
     return run_filter(imu, start_state, noise, None, lever_arm, [(start_state.time, w.end - start_state.time)],
-                      pseudo_gps, t_end=w.end, pseudo_rate_hz=pseudo_rate_hz, source=source)
+                      pseudo_gps, t_end=w.end, pseudo_rate_hz=pseudo_rate_hz, source=source,
+                      constraints=constraints)
 
 
 __all__ = ["FilterResult", "run_filter", "run_outage", "gate_thresholds"]

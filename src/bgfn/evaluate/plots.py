@@ -115,12 +115,14 @@ def plot_gps_row(result: TableResult, outage: int, title: str = ""):
 def plot_sweep_boxes(sweep: pd.DataFrame, dataset: str, methods=TABLE_METHODS):
     """Box plots of the max horizontal error per duration and method (log scale; ``+NHC`` rows hatched)."""
     import matplotlib.pyplot as plt
+    from matplotlib.patches import Patch
 
     d = sweep[sweep["dataset"] == dataset]
     durations = sorted(d["duration_s"].unique())
     methods = [m for m in methods if m in set(d["method"])]
-    fig, ax = plt.subplots(figsize=(max(6.0, 1.6 * len(durations) * len(methods) / 3), 4.5))
+    fig, ax = plt.subplots(figsize=(max(6.0, min(16.0, 1.6 * len(durations) * len(methods) / 3)), 4.5))
     width = 0.8 / len(methods)
+    handles = []
     for j, m in enumerate(methods):
         data = [d[(d["duration_s"] == du) & (d["method"] == m)]["max_h_m"].to_numpy() for du in durations]
         pos = np.arange(len(durations)) + (j - (len(methods) - 1) / 2) * width
@@ -133,7 +135,8 @@ def plot_sweep_boxes(sweep: pd.DataFrame, dataset: str, methods=TABLE_METHODS):
                 b.set_hatch("///")
         for med in bp["medians"]:
             med.set_color("white" if base_label(m) in ("AT-LSTM", "BGFN") else "black")
-        ax.plot([], [], "s", color=COLORS.get(m, "0.5"), alpha=0.6, label=m)
+        handles.append(Patch(facecolor=COLORS.get(m, "0.5"), alpha=0.6, label=m,
+                             hatch="///" if m.endswith(NHC_SUFFIX) else None))
     ax.set_xticks(np.arange(len(durations)))
     ax.set_xticklabels([f"{du:g} s" for du in durations])
     ax.set_yscale("log")
@@ -141,6 +144,6 @@ def plot_sweep_boxes(sweep: pd.DataFrame, dataset: str, methods=TABLE_METHODS):
     ax.set_ylabel("max horizontal error (m)")
     ax.set_title(f"{dataset}: outage sweep")
     ax.grid(alpha=0.3, axis="y")
-    ax.legend(fontsize=8, ncol=3)
+    ax.legend(handles=handles, fontsize=8, ncol=3)
     fig.tight_layout()
     return fig

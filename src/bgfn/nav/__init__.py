@@ -24,6 +24,10 @@ Modules (pyins style, one concept each; SI units, radians, NED, tables as in CON
 - :mod:`~bgfn.nav.filter` -- ``run_filter(imu, initial, noise, gnss, lever_arm, outage_windows,
   pseudo_gps, t_end, snapshots) -> FilterResult`` and ``run_outage(imu, start_state, window, noise,
   lever_arm, pseudo_gps)`` (one outage from a saved state).
+- :mod:`~bgfn.nav.constraints` -- the vehicle constraints of the ``+NHC`` rows: NHC and ZUPT velocity updates
+  (``nhc_measurement``, ``zupt_measurement``, ``propagate_aided``), the stillness detector ``stillness``, the
+  vehicle frame ``mounting_track``; ``build_constraints(imu, imu_errors, config, trajectory) -> Constraints``,
+  which ``run_filter`` / ``run_outage`` take as ``constraints``.
 - :mod:`~bgfn.nav.outages` -- ``OutageWindow``, ``check_windows``, ``outage_windows(profile, drive)`` (the profile's one key),
   the pseudo-GPS hook (``PseudoFix``, ``PseudoGpsContext``, ``IncrementPseudoGps`` = Eq. pred-gps,
   ``TablePseudoGps``).

@@ -14,7 +14,8 @@ time (exactly the batch update for the diagonal R), with the Joseph form for ``P
 fed back: position, velocity, ``C_bn <- exp([phi]) C_bn``, bias estimates ``+= (nabla, eps)``, ``x = 0``.
 
 Outage windows remove GNSS updates; inside them a pseudo-GPS source may supply fixes
-(:mod:`bgfn.nav.outages`, Eq. pred-gps).
+(:mod:`bgfn.nav.outages`, Eq. pred-gps). Beyond the paper, the vehicle constraints of
+:mod:`bgfn.nav.constraints` (NHC, ZUPT) may add velocity updates at their epochs (``constraints``; default none).
 """
 
 from __future__ import annotations

@@ -190,7 +190,7 @@ def stillness(imu: pd.DataFrame, imu_errors: dict, config: ConstraintConfig,
     for cols, sigma in ((ACCEL_COLUMNS, sigma_f), (GYRO_COLUMNS, sigma_w)):
         # the trailing window's variance per axis (pandas' rolling variance: no cancellation on g)
         var = imu[list(cols)].rolling(n_win).var(ddof=0).to_numpy(float).sum(axis=1)       # [M]
-        stats.append(np.sqrt(var / np.sum(sigma ** 2)))
+        stats.append(np.sqrt(np.maximum(var, 0.0) / np.sum(sigma ** 2)))   # (rounding can leave -0)
     t_f, t_w = stats
     with np.errstate(invalid="ignore"):
         still = (t_f < config.accel_ratio) & (t_w < config.gyro_ratio)

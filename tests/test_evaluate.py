@@ -122,6 +122,55 @@ def test_hybrid_equals_run_filter_fed_with_the_same_fixes(ctx5):
                                ref.trajectory[["v_n", "v_e", "roll", "yaw"]].to_numpy(), rtol=0, atol=1e-8)
 
 
+def test_constrained_runs_equal_the_filters_with_the_same_constraints(ctx5):
+    """INS+NHC and a network's +NHC run (the stepping kernels driven by bgfn.evaluate) are run_outage / run_filter
+    with the same constraints and fixes; the vehicle frame is the GPS-aided run's estimate at the start."""
+    s, d = WINDOWS[1]
+    con = ctx5.constraints
+    assert con is not None and np.count_nonzero(con.aid) > 0
+    run = ev.run_outages(ctx5, [(s, d)], None, "INS+NHC", None, constraints=con)[0]
+    ref = run_outage(ctx5.drive.imu, ctx5.state_at(s), OutageWindow(s, d), ctx5.noise, ctx5.lever, constraints=con)
+    np.testing.assert_allclose(run.trajectory[["lat", "lon"]].to_numpy(), ref.trajectory[["lat", "lon"]].to_numpy(),
+                               rtol=0, atol=1e-12)
+    np.testing.assert_allclose(run.trajectory[["v_n", "v_e", "yaw"]].to_numpy(),
+                               ref.trajectory[["v_n", "v_e", "yaw"]].to_numpy(), rtol=0, atol=1e-9)
+    ins = ev.run_outages(ctx5, [(s, d)], None)[0]
+    assert not np.allclose(ins.trajectory["lat"], run.trajectory["lat"], rtol=0, atol=1e-12)
+    f = Heading(window=20)
+    hyb = ev.run_outages(ctx5, [(s, d)], f, "BGFN+NHC", 0, {"std_m": 1.5, "fusion_rate_hz": 1.0}, constraints=con)[0]
+    fx = hyb.pseudo.rename(columns={"std_m": "std_n"}).assign(std_e=lambda x: x["std_n"], std_d=np.nan)
+    ref = run_filter(ctx5.drive.imu, ctx5.state_at(s), ctx5.noise, None, ctx5.lever, [(s, d)],
+                     pseudo_gps=TablePseudoGps(fx), t_end=s + d, pseudo_rate_hz=1.0,
+                     constraints=con.frozen(ctx5.state_at(s).time))
+    np.testing.assert_allclose(hyb.trajectory[["lat", "lon", "h"]].to_numpy(),
+                               ref.trajectory[["lat", "lon", "h"]].to_numpy(), rtol=0, atol=1e-11)
+    np.testing.assert_allclose(hyb.trajectory[["v_n", "v_e", "roll", "yaw"]].to_numpy(),
+                               ref.trajectory[["v_n", "v_e", "roll", "yaw"]].to_numpy(), rtol=0, atol=1e-8)
+
+
+def test_tables_have_the_nhc_rows_of_every_method(drive5):
+    cfg = {"outage_windows": [list(w) for w in WINDOWS], "nav": NAV}
+    ecfg = ev.evaluate_config({"methods": ["bgfn"], "seeds": [0, 1], "pseudo_gps": {"std_m": 1.5}})
+    models = {("bgfn", 0): Heading(window=20), ("bgfn", 1): Heading(window=20, speed=7.0)}
+    res = ev.evaluate_dataset(cfg, "none", drive5.name, drive=drive5, ecfg=ecfg, models=models)
+    assert list(res.table.loc[res.table["outage"] == 1, "method"]) == ["INS", "BGFN", "INS+NHC", "BGFN+NHC", "GPS"]
+    assert len(res.runs) == 2 * (2 + 2 * 2 + 1)
+    assert res.constraints["aid_epochs"] > 0
+    ins_nhc = [r for r in res.runs if r.method == "INS+NHC" and r.start == WINDOWS[0][0]][0]
+    ctx = ev.navigation_context(drive5, NAV, [s for s, _ in WINDOWS])
+    again = ev.run_outages(ctx, [WINDOWS[0]], None, "INS+NHC", None, ecfg["pseudo_gps"], constraints=ctx.constraints)
+    pd.testing.assert_frame_equal(ins_nhc.trajectory, again[0].trajectory, check_exact=True)
+    (line, _) = ev.describe_tables([res])
+    assert "INS+NHC" in line and "BGFN+NHC" in line and "INS+NHC)" in line
+    lay = ev.ours_above_paper(ev.TableResult("turin-sim-ekinox", "dataset", res.per_seed, res.table, []))
+    assert ("BGFN+NHC", "East") in lay.columns and np.isnan(lay.loc[("Outage 1", "paper"), ("BGFN+NHC", "East")])
+    without = ev.evaluate_dataset(cfg, "none", drive5.name, drive=drive5, ecfg={**ecfg, "nhc_rows": False},
+                                  models=models)
+    assert set(without.table["method"]) == {"INS", "BGFN", "GPS"} and without.constraints is None
+    pd.testing.assert_frame_equal(without.table, res.table[res.table["method"].isin(["INS", "BGFN", "GPS"])]
+                                  .reset_index(drop=True), check_exact=True)
+
+
 def test_inputs_use_the_runs_own_attitude(ctx5, drive5):
     """Windows = Eq. eq21 inputs from the solution being computed (pre-outage: GPS-aided run), no truth."""
     f = Heading(window=20, zero=True)
@@ -175,6 +224,8 @@ def test_evaluation_never_reads_gnss_inside_an_outage(drive5):
         for name, drv in (("with", drive5), ("nan", blind)):
             ctx = ev.navigation_context(drv, NAV, [s])
             runs = ev.run_outages(ctx, [(s, d)], None) + ev.run_outages(ctx, [(s, d)], Heading(), "BGFN", 0)
+            runs += (ev.run_outages(ctx, [(s, d)], None, "INS+NHC", constraints=ctx.constraints)       # the vehicle
+                     + ev.run_outages(ctx, [(s, d)], Heading(), "BGFN+NHC", 0, constraints=ctx.constraints))  # frame too
             out[name] = [r.trajectory for r in runs] + [r.pseudo for r in runs[1:]], ev.gps_run(ctx, s, d).trajectory
         for a, b in zip(out["with"][0], out["nan"][0]):
             pd.testing.assert_frame_equal(a, b, check_exact=True)
@@ -322,6 +373,22 @@ def test_sweep_summary_and_comparisons():
     c = ev.sweep_comparisons(df).set_index("baseline")
     assert c.loc["INS", "win_rate"] == 1.0 and c.loc["MLP", "wins"] == 36 and c.loc["INS", "p_value"] < 1e-6
     assert c.loc["INS", "n_starts"] == 12 and c.loc["INS", "p_value_by_start"] < 1e-2
+    assert set(c["method"]) == {"BGFN"}
+    # with the constraints' rows: BGFN against them too, and BGFN+NHC against INS+NHC (does it add to the free aid?)
+    nhc = df[df["method"] != "MLP"].assign(method=lambda x: x["method"] + "+NHC",
+                                           max_h_m=lambda x: np.where(x["method"] == "INS", 0.5, 0.3) * x["max_h_m"])
+    both = pd.concat([df, nhc], ignore_index=True)
+    s = ev.sweep_summary(both, n_boot=100)
+    assert s.loc[s["method"] == "INS+NHC", "n"].item() == 12                 # one value per start, like INS
+    c = ev.sweep_comparisons(both)
+    assert set(c.loc[c["method"] == "BGFN", "baseline"]) == {"INS", "MLP", "INS+NHC", "BGFN+NHC"}
+    pair = c[(c["method"] == "BGFN+NHC")].set_index("baseline")
+    assert list(pair.index) == ["INS+NHC"] and pair.loc["INS+NHC", "wins"] == 36
+    (line,) = ev.describe_sweep(s, c)
+    assert "BGFN vs INS: wins 36/36" in line and "BGFN+NHC vs INS+NHC: wins 36/36" in line
+    # a pairs table of older runs (no method column) still reads
+    (old,) = ev.describe_sweep(ev.sweep_summary(df, n_boot=100), ev.sweep_comparisons(df).drop(columns="method"))
+    assert "BGFN vs INS: wins 36/36" in old
 
 
 def test_validation_std_grows_with_the_accumulated_increments(ctx5):

@@ -140,7 +140,7 @@ def test_a_csv_log_named_by_its_path_runs_notebooks_01_to_04(tmp_path, monkeypat
     setup = ev.evaluation_setup(cfg)
     res, _ = ev.run_tables(cfg, "mine", setup.datasets, setup.config, out)
     table = res[name].table
-    assert set(table["method"]) == {"INS", "GPS", "BGFN", "MLP"}
+    assert set(table["method"]) == {"INS", "GPS", "BGFN", "MLP", "INS+NHC", "BGFN+NHC", "MLP+NHC"}
     assert np.isfinite(table[list(ev.METRIC_COLUMNS)].to_numpy(float)).all()
     assert res[name].test == did
     # notebook 04's displays beside the paper: a drive that stands for none of its tests has no paper values
@@ -148,7 +148,7 @@ def test_a_csv_log_named_by_its_path_runs_notebooks_01_to_04(tmp_path, monkeypat
     assert lay.xs("paper", level="source").isna().all().all() and lay.xs("ours", level="source").notna().any().any()
     red = ev.reduction_table(res[name])
     assert red["paper east_%"].isna().all() and red["paper east_%"].dtype == float
-    assert set(red["method"]) == {"GPS", "BGFN", "MLP"}                 # each against INS
+    assert set(red["method"]) == {"GPS", "BGFN", "MLP", "INS+NHC", "BGFN+NHC", "MLP+NHC"}   # each against INS
     assert ev.paper_table_title(did) == f"no table of the paper ({did})"
 
     written = [p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*") if p.is_file()]

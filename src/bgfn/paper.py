@@ -12,7 +12,9 @@ Vocabulary
   (Table ``tab-real``, the paper's own car with an MPU-6000 IMU) or ``real`` (ours: a recorded car drive with a
   MEMS IMU; the paper has no such table, so the paper's field test is shown beside it, :func:`published_test`);
 - *method label*: how a table names a method (``INS``, ``MLP``, ``AT-LSTM``, ``BGFN``, and ours beyond the
-  paper: ``Transformer``, ``GPS``); a *method id* is the key of :mod:`bgfn.models` (``bgfn``, ``mlp``, ...).
+  paper: ``Transformer``, ``GPS``, and each of them with the vehicle constraints of :mod:`bgfn.nav.constraints`,
+  ``INS+NHC``, ``BGFN+NHC``, ...: :func:`nhc_label`); a *method id* is the key of :mod:`bgfn.models`
+  (``bgfn``, ``mlp``, ...).
 """
 
 from __future__ import annotations
@@ -36,6 +38,9 @@ CLAIMS_FILE = PAPER_DIR / "claims.yaml"
 METHOD_LABELS: dict[str, str] = {"mlp": "MLP", "at_lstm": "AT-LSTM", "bgfn": "BGFN", "transformer": "Transformer"}
 #: The paper's methods, in the order of its tables.
 PAPER_METHODS: tuple[str, ...] = ("INS", "MLP", "AT-LSTM", "BGFN")
+#: Suffix of a row whose filter also applies the non-holonomic constraints (and a zero-velocity update whenever
+#: the stillness detector fires; :mod:`bgfn.nav.constraints`): ours, beyond the paper.
+NHC_SUFFIX = "+NHC"
 #: Max-error columns of an outage table and their axis labels in the paper's layout.
 AXES: tuple[tuple[str, str], ...] = (("max_east_m", "East"), ("max_north_m", "North"))
 #: Decimals of the paper's tables: values equal at this precision are called equal.
@@ -92,6 +97,16 @@ def label(method: str) -> str:
     return METHOD_LABELS.get(method, method)
 
 
+def nhc_label(method: str) -> str:
+    """Label of a method run with the vehicle constraints: ``INS`` -> ``INS+NHC``, ``bgfn`` -> ``BGFN+NHC``."""
+    return label(method) + NHC_SUFFIX
+
+
+def base_label(method: str) -> str:
+    """The label without the constraints' suffix: ``BGFN+NHC`` -> ``BGFN`` (others as given)."""
+    return method[: -len(NHC_SUFFIX)] if method.endswith(NHC_SUFFIX) else method
+
+
 @lru_cache(maxsize=None)
 def _outage_values() -> pd.DataFrame:
     return pd.read_csv(OUTAGE_TABLE_FILE)
@@ -144,14 +159,15 @@ def layout(ours: pd.DataFrame | None, paper: pd.DataFrame | None, methods: Seque
     -------
     DataFrame
         Rows ``Outage k``; columns a MultiIndex ``(source, method, axis)`` with source ``ours_label`` then
-        ``paper_label``, axis ``East``/``North``. A value one side lacks (or a side given as None) is NaN.
+        ``paper_label``, axis ``East``/``North``; the paper's side has only the paper's methods
+        (:data:`PAPER_METHODS`). A value one side lacks (or a side given as None) is NaN.
     """
     frames = [(ours_label, ours), (paper_label, paper)]
     outages = sorted({int(o) for _, df in frames if df is not None for o in df["outage"]})
     data = {}
     for src, df in frames:
         lookup = {} if df is None else {(int(r.outage), r.method): r for r in df.itertuples(index=False)}
-        for m in methods:
+        for m in methods if src == ours_label else [m for m in methods if m in PAPER_METHODS]:
             for col, axis in AXES:
                 data[(src, m, axis)] = [float(getattr(lookup[(o, m)], col)) if (o, m) in lookup else np.nan
                                         for o in outages]

@@ -145,13 +145,17 @@ SCHEMA = section(
         noise_scale=Spec("any"),             # a positive number or 'auto', or per dataset: checked in cross_check
         noise_search=section(range=seq(_POS, length=2), max_runs=integer(1), tolerance=_POS, bias_walk=flag()),
         innovation_gate=number(0, 1, lo_open=True, hi_open=True, null=True),
-        ins_tuning=text("shipped", "navego")),
+        ins_tuning=text("shipped", "navego"),
+        # the vehicle constraints of the +NHC rows (bgfn.nav.constraints)
+        nhc=section(std_mps=_POS, rate_hz=_POS, mounting=text("estimate", "none"), mounting_min_speed_mps=_NONNEG),
+        zupt=section(std_mps=_POS, window_s=_POS, accel_ratio=_NONNEG, gyro_ratio=_NONNEG, max_speed_mps=_NONNEG),
+        constraints_in_gps_run=flag()),
     train=TRAIN,
     evaluate=section(
         datasets=_NAMES, real_imu=flag(), methods=_NAMES, seeds=seq(_SEED, min_len=1, null=True),
         seed_aggregate=text("median", "first"),
         pseudo_gps=section(std_m=Spec("any"), std_growth_m_per_s=_NONNEG, fusion_rate_hz=_POS),
-        series_rate_hz=_POS, train_missing=flag(),
+        series_rate_hz=_POS, train_missing=flag(), nhc_rows=flag(),
         sweep=section(datasets=seq(text()), n_starts=integer(1), durations_s=seq(_POS, min_len=1),
                       folds=integer(1), seeds=seq(_SEED, min_len=1), warmup_s=_NONNEG,
                       train=Spec("section", fields=TRAIN.fields), n_boot=integer(1),

@@ -21,6 +21,11 @@ Protocol (notebook 04, the ``evaluate:`` section of a profile):
      position fix with the standard deviation of ``pseudo_gps.std_m`` (height not fused: the networks
      predict 2-D increments). Nothing inside the outage reads GNSS or the reference.
 
+   - **INS+NHC**, **<METHOD>+NHC** (beyond the paper, ``nhc_rows``): the same runs with the vehicle
+     constraints of :mod:`bgfn.nav.constraints` fused as well (non-holonomic constraints, and a zero-velocity
+     update whenever the IMU's stillness detector fires; ``ctx.constraints``, their vehicle frame estimated by
+     the GPS-aided run up to the start): the learning-free aid a learned one must beat, or add to.
+
    The increments have the length the networks were trained on: the drive's GNSS epoch interval (0.2 s for
    the 5 Hz Ekinox fixes, 1 s for the 1 Hz u-blox-like receiver); ``fusion_rate_hz`` must divide the GNSS
    rate. Runs that share a network advance in lockstep so that one forward pass serves all of them.

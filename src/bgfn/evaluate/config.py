@@ -8,15 +8,20 @@ from dataclasses import dataclass, field
 from typing import Any, Sequence
 
 from bgfn.errors import DataError
-from bgfn.paper import METHOD_LABELS, TESTS
+from bgfn.paper import METHOD_LABELS, TESTS, nhc_label
 
-
-#: Rows of the outage tables, in order.
-TABLE_METHODS: tuple[str, ...] = ("INS", "MLP", "AT-LSTM", "BGFN", "Transformer", "GPS")
-#: Methods of the paper's figures and their colours (red, yellow, black, blue).
-FIGURE_METHODS: tuple[str, ...] = ("INS", "MLP", "AT-LSTM", "BGFN")
-COLORS: dict[str, str] = {"INS": "red", "MLP": "goldenrod", "AT-LSTM": "black", "BGFN": "blue",
-                          "Transformer": "tab:purple", "GPS": "tab:green"}
+#: The standalone INS and the networks, each also with the vehicle constraints (``+NHC``, bgfn.nav.constraints).
+_AIDED: tuple[str, ...] = ("INS", "MLP", "AT-LSTM", "BGFN", "Transformer")
+#: Rows of the outage tables, in order: the paper's filter, the same with the vehicle constraints, then GPS.
+TABLE_METHODS: tuple[str, ...] = _AIDED + tuple(nhc_label(m) for m in _AIDED) + ("GPS",)
+#: Rows with one value per outage whatever the training seed (no network).
+SEEDLESS_METHODS: tuple[str, ...] = ("INS", nhc_label("INS"), "GPS")
+#: Methods of the paper's figures (and ours with the constraints, dashed) and their colours (red, yellow, black,
+#: blue; a ``+NHC`` row takes its method's colour).
+FIGURE_METHODS: tuple[str, ...] = ("INS", "MLP", "AT-LSTM", "BGFN", nhc_label("INS"), nhc_label("BGFN"))
+_BASE_COLORS: dict[str, str] = {"INS": "red", "MLP": "goldenrod", "AT-LSTM": "black", "BGFN": "blue",
+                                "Transformer": "tab:purple"}
+COLORS: dict[str, str] = {**_BASE_COLORS, **{nhc_label(m): c for m, c in _BASE_COLORS.items()}, "GPS": "tab:green"}
 #: Columns of the outage tables (``tables/outage_dataset.csv``, ``outage_field.csv``).
 METRIC_COLUMNS: tuple[str, ...] = ("max_east_m", "max_north_m", "rmse_h_m", "final_h_m")
 TABLE_COLUMNS: tuple[str, ...] = ("outage", "method") + METRIC_COLUMNS
@@ -39,6 +44,7 @@ EVALUATE_DEFAULTS: dict[str, Any] = {
     "pseudo_gps": {"std_m": None, "std_growth_m_per_s": 0.0, "fusion_rate_hz": 1.0},
     "series_rate_hz": 10.0,
     "train_missing": True,
+    "nhc_rows": True,                    # INS+NHC and <METHOD>+NHC rows (bgfn.nav.constraints)
     "sweep": {
         "datasets": ["turin-sim-mpu6000"],
         "n_starts": 20,

@@ -70,6 +70,10 @@ class NavContext:
     imu_static : ndarray [len(CHANNELS)] or None
         Static biases the strapdown of an outage run removes from ``imu`` (``nav.ins_tuning: navego``,
         :mod:`bgfn.nav.navego_setup`; zeros outside the IMU channels); None: the network inputs are read as is.
+    constraints : bgfn.nav.constraints.Constraints or None
+        The vehicle constraints of the ``+NHC`` rows: the stillness detector over the drive's IMU and the vehicle
+        frame from this GPS-aided run (:func:`bgfn.nav.baseline.outage_constraints`; held at its estimate at
+        each outage start).
     """
 
     drive: Any
@@ -83,6 +87,7 @@ class NavContext:
     gnss_interval_s: float
     gnss_std_m: float
     imu_static: np.ndarray | None = None
+    constraints: Any = None
 
     def attitude_table(self) -> pd.DataFrame:
         """The GPS-aided solution (reference schema; its attitude is the training input of notebook 03)."""
@@ -128,7 +133,8 @@ def navigation_context(drive, nav_section: dict | None, starts: Sequence[float])
     # The state is taken at the last IMU epoch *before* the start (bgfn.nav.outages.epochs_before).
     snaps = {f"start_{i}": float(t) for i, t in enumerate(epochs_before(imu_time, starts, drive.name))}
     full = run_filter(filter_imu, initial, noise, drive.gnss, lever, snapshots=snaps,
-                      gate_probability=cfg["innovation_gate"], source=drive.name)
+                      gate_probability=cfg["innovation_gate"], source=drive.name,
+                      constraints=baseline.gps_constraints(drive, cfg, initial, noise))
     states = {s: full.states[f"start_{i}"] for i, s in enumerate(starts)}
     imu = drive.imu[list(CHANNELS[IMU_CHANNELS])].to_numpy(float)          # [M, 6] in the input layout
     tr = full.trajectory
@@ -149,7 +155,8 @@ def navigation_context(drive, nav_section: dict | None, starts: Sequence[float])
         static = np.zeros(len(CHANNELS))
         static[ANGULAR_RATE_CHANNELS], static[SPECIFIC_FORCE_CHANNELS] = navego_setup.static_biases(
             drive.meta["imu_errors"], f"{drive.name} meta['imu_errors']")
-    return NavContext(drive, full, noise, lever, states, imu_time, imu, nav_at_imu, interval, std, static)
+    return NavContext(drive, full, noise, lever, states, imu_time, imu, nav_at_imu, interval, std, static,
+                      baseline.outage_constraints(drive, cfg, full.trajectory))
 
 
 # ----------------------------------------------------------------------------------------------- outage runs
@@ -203,9 +210,12 @@ class _Run:
     the network inputs at a pseudo epoch need the attitude the run itself computed up to that epoch, and one
     ``run_filter`` call per epoch costs ~2 ms of pandas overhead (the sweep has ~10^5 epochs).
     ``tests/test_evaluate.py`` checks that the result equals ``run_filter`` / ``run_outage`` fed the same fixes.
+    With ``constraints`` the prediction applies their NHC/ZUPT updates at their epochs
+    (:func:`bgfn.nav.constraints.propagate_aided`), the vehicle frame held at its estimate at the start.
     """
 
-    def __init__(self, ctx: NavContext, start: float, duration: float, n_window: int, extra: tuple):
+    def __init__(self, ctx: NavContext, start: float, duration: float, n_window: int, extra: tuple,
+                 constraints=None):
         from bgfn.nav import error_model as em
         from bgfn.nav.filter import noise_arrays
 
@@ -229,6 +239,10 @@ class _Run:
         self.out_c, self.out_sd = np.empty((n, 3, 3)), np.empty((n, em.N_STATES))
         self.out_pos[0], self.out_v[0], self.out_c[0] = self.pos, self.v, self.c
         self.row = 0
+        self.constraints = constraints
+        if constraints is not None:
+            self.aid, self.mount = constraints.frozen(s.time).steps(self.time, ctx.drive.name)
+            self.out_bias = np.zeros((n, 6))
         self.lever = ctx.lever
         self.p0 = s.antenna_position(ctx.lever)                     # P_GPS0 of Eq. (pred-gps)
         # Input features [roll, pitch, yaw, f, w, extra]: N samples up to the start from the GPS-aided run,
@@ -279,12 +293,17 @@ class _Run:
 
     def propagate_to(self, r: int) -> None:
         """Prediction (strapdown + covariance, Eq. eq3) up to output row ``r``."""
+        from bgfn.nav.constraints import propagate_aided
         from bgfn.nav.filter import propagate_steps
 
         r = min(int(r), len(self.times) - 1)
         if r > self.row:
-            propagate_steps(self.row, r, self.dt, self.gyro, self.accel, self.pos, self.v, self.c, self.ba, self.bg,
-                          self.P, *self.q, self.out_pos, self.out_v, self.out_c, self.out_sd)
+            args = (self.row, r, self.dt, self.gyro, self.accel, self.pos, self.v, self.c, self.ba, self.bg, self.P,
+                    *self.q, self.out_pos, self.out_v, self.out_c, self.out_sd)
+            if self.constraints is None:
+                propagate_steps(*args)
+            else:
+                propagate_aided(*args, self.aid, self.mount, *self.constraints.config.kernel_args(), self.out_bias)
             self._fill(self.row + 1, r)
             self.row = r
 
@@ -320,7 +339,7 @@ def _rows_at(times: np.ndarray, t) -> np.ndarray:
 
 
 def run_outages(ctx: NavContext, windows, predictor=None, method: str = "INS", seed: int | None = None,
-                pseudo: dict | None = None, errors: bool = True) -> list[OutageRun]:
+                pseudo: dict | None = None, errors: bool = True, constraints=None) -> list[OutageRun]:
     """Prediction mode over outage ``windows`` from the GPS-aided states (module docstring, step 2).
 
     Parameters
@@ -344,6 +363,8 @@ def run_outages(ctx: NavContext, windows, predictor=None, method: str = "INS", s
         ``fusion_rate_hz``.
     errors : bool
         Compute the errors against the reference.
+    constraints : bgfn.nav.constraints.Constraints, optional
+        Fuse the vehicle constraints too (``ctx.constraints``: the ``+NHC`` rows); None: the paper's filter.
 
     Returns
     -------
@@ -358,7 +379,7 @@ def run_outages(ctx: NavContext, windows, predictor=None, method: str = "INS", s
     opts = dict(getattr(predictor, "options", {}) or {}) if predictor is not None else {}
     n_window = int(opts.get("window", 1)) if predictor is not None else 1
     extra = _extra_columns(opts) if predictor is not None else ()
-    runs = [_Run(ctx, s, d, n_window, extra) for s, d in windows]
+    runs = [_Run(ctx, s, d, n_window, extra, constraints) for s, d in windows]
     inc_s = ctx.gnss_interval_s
     from_val = isinstance(pcfg["std_m"], str)
     if from_val and (pcfg["std_m"] != "validation" or predictor is not None

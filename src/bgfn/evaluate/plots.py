@@ -8,6 +8,12 @@ import pandas as pd
 
 from bgfn.evaluate.config import COLORS, FIGURE_METHODS, TABLE_METHODS
 from bgfn.evaluate.tables import TableResult, representative_seeds
+from bgfn.paper import NHC_SUFFIX, base_label, nhc_label
+
+
+def _style(method: str) -> str:
+    """Line style of a method: dashed with the vehicle constraints (``+NHC``), solid otherwise."""
+    return "--" if method.endswith(NHC_SUFFIX) else "-"
 
 
 def _ned_from_start(traj: pd.DataFrame, ref0) -> np.ndarray:
@@ -21,7 +27,8 @@ def plot_outage(result: TableResult, outage: int, reference: pd.DataFrame, metho
                 title: str = ""):
     """Paper Figs. 6-7, 9-10: east and north position error against time, plus a map of the outage segment.
 
-    The learned methods show their representative seed (:func:`representative_seeds`).
+    The learned methods show their representative seed (:func:`representative_seeds`); a ``+NHC`` row (with the
+    vehicle constraints) is dashed in its method's colour.
 
     Returns
     -------
@@ -43,15 +50,15 @@ def plot_outage(result: TableResult, outage: int, reference: pd.DataFrame, metho
     ax_m.plot(ned_ref[:, 1], ned_ref[:, 0], color="0.5", lw=3, alpha=0.5, label="reference")
     for m in methods:
         seed = rep.get((outage, m))
-        r = runs.get((m, seed if m not in ("INS", "GPS") else None))
+        r = runs.get((m, seed if m not in ("INS", nhc_label("INS"), "GPS") else None))
         if r is None:
             continue
         e = r.errors
         lab = m if r.seed is None else f"{m} (seed {r.seed})"
-        ax_e.plot(e["t_rel"], e["east"], color=COLORS[m], lw=1.2, label=lab)
-        ax_n.plot(e["t_rel"], e["north"], color=COLORS[m], lw=1.2, label=lab)
+        ax_e.plot(e["t_rel"], e["east"], color=COLORS[m], ls=_style(m), lw=1.2, label=lab)
+        ax_n.plot(e["t_rel"], e["north"], color=COLORS[m], ls=_style(m), lw=1.2, label=lab)
         ned = _ned_from_start(r.trajectory, reference.iloc[i0])
-        ax_m.plot(ned[:, 1], ned[:, 0], color=COLORS[m], lw=1.0, label=m)
+        ax_m.plot(ned[:, 1], ned[:, 0], color=COLORS[m], ls=_style(m), lw=1.0, label=m)
     for ax, lab in ((ax_e, "(a) east position error (m)"), (ax_n, "(b) north position error (m)")):
         ax.axhline(0.0, color="0.7", lw=0.6)
         ax.set_xlabel("time since outage start (s)")
@@ -106,14 +113,16 @@ def plot_gps_row(result: TableResult, outage: int, title: str = ""):
 
 
 def plot_sweep_boxes(sweep: pd.DataFrame, dataset: str, methods=TABLE_METHODS):
-    """Box plots of the max horizontal error per duration and method (log scale)."""
+    """Box plots of the max horizontal error per duration and method (log scale; ``+NHC`` rows hatched)."""
     import matplotlib.pyplot as plt
+    from matplotlib.patches import Patch
 
     d = sweep[sweep["dataset"] == dataset]
     durations = sorted(d["duration_s"].unique())
     methods = [m for m in methods if m in set(d["method"])]
-    fig, ax = plt.subplots(figsize=(max(6.0, 1.6 * len(durations) * len(methods) / 3), 4.5))
+    fig, ax = plt.subplots(figsize=(max(6.0, min(16.0, 1.6 * len(durations) * len(methods) / 3)), 4.5))
     width = 0.8 / len(methods)
+    handles = []
     for j, m in enumerate(methods):
         data = [d[(d["duration_s"] == du) & (d["method"] == m)]["max_h_m"].to_numpy() for du in durations]
         pos = np.arange(len(durations)) + (j - (len(methods) - 1) / 2) * width
@@ -122,9 +131,12 @@ def plot_sweep_boxes(sweep: pd.DataFrame, dataset: str, methods=TABLE_METHODS):
         for b in bp["boxes"]:
             b.set_facecolor(COLORS.get(m, "0.5"))
             b.set_alpha(0.6)
+            if m.endswith(NHC_SUFFIX):
+                b.set_hatch("///")
         for med in bp["medians"]:
-            med.set_color("white" if m in ("AT-LSTM", "BGFN") else "black")
-        ax.plot([], [], "s", color=COLORS.get(m, "0.5"), alpha=0.6, label=m)
+            med.set_color("white" if base_label(m) in ("AT-LSTM", "BGFN") else "black")
+        handles.append(Patch(facecolor=COLORS.get(m, "0.5"), alpha=0.6, label=m,
+                             hatch="///" if m.endswith(NHC_SUFFIX) else None))
     ax.set_xticks(np.arange(len(durations)))
     ax.set_xticklabels([f"{du:g} s" for du in durations])
     ax.set_yscale("log")
@@ -132,6 +144,6 @@ def plot_sweep_boxes(sweep: pd.DataFrame, dataset: str, methods=TABLE_METHODS):
     ax.set_ylabel("max horizontal error (m)")
     ax.set_title(f"{dataset}: outage sweep")
     ax.grid(alpha=0.3, axis="y")
-    ax.legend(fontsize=8, ncol=3)
+    ax.legend(handles=handles, fontsize=8, ncol=3)
     fig.tight_layout()
     return fig

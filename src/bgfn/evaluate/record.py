@@ -46,7 +46,7 @@ def evaluation_record(setup: EvaluationSetup, results: Mapping[str, TableResult]
         windows each table was evaluated in),
         ``datasets``, ``real_imu_notes``, ``tables`` and ``reduction_vs_ins_pct`` (keyed by the paper's test),
         ``paper_claims`` (the BGFN reductions the paper quotes, %), ``sweep`` (``rows``, ``info``),
-        ``timings_s``.
+        ``timings_s``, ``constraints`` (per test the vehicle constraints' facts of the ``+NHC`` rows, or None).
     """
     return {
         "profile": setup.profile, "evaluate": setup.config, "outage_windows": [list(w) for w in setup.windows],
@@ -59,6 +59,7 @@ def evaluation_record(setup: EvaluationSetup, results: Mapping[str, TableResult]
         "paper_claims": paper.claims()["bgfn_reduction_vs_ins_pct"],
         "sweep": {"rows": int(sweep_rows), "info": sweep_info},
         "timings_s": timings,
+        "constraints": {res.test: res.constraints for res in results.values()},
     }
 
 

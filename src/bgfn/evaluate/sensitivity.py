@@ -4,7 +4,8 @@ The tables fuse a pseudo-GPS fix (Eq. pred-gps) like a GNSS fix (``pseudo_gps.st
 GNSS std). The sensitivity run fuses it with each network's own held-out accuracy instead
 (``std_m: validation``: validation RMSE of one increment per axis times ``sqrt(k)`` after ``k`` accumulated
 increments, :func:`bgfn.evaluate.hybrid.run_outages`), for the same networks (the first training seed only, to
-save time) in the same outages. INS and GPS do not fuse pseudo fixes, so their rows do not change.
+save time) in the same outages, without the ``+NHC`` rows. INS and GPS do not fuse pseudo fixes, so their rows
+do not change.
 """
 
 from __future__ import annotations
@@ -74,7 +75,7 @@ def pseudo_std_sensitivity(cfg: dict, profile: str, result: TableResult, ecfg: d
     seed = ecfg["seeds"][0]
     alt_cfg = {**ecfg, "pseudo_gps": {**ecfg["pseudo_gps"], "std_m": "validation"}}
     alternative = evaluate_dataset(cfg, profile, result.dataset, drive=result.drive, ecfg=alt_cfg,
-                                   models={k: m for k, m in result.models.items() if k[1] == seed})
+                                   models={k: m for k, m in result.models.items() if k[1] == seed}, nhc_rows=False)
     return Sensitivity(seed, alternative, sensitivity_table(result, alternative, seed))
 
 

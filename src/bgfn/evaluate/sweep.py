@@ -11,11 +11,11 @@ import pandas as pd
 
 from bgfn.checkpoints import checkpoint_path
 from bgfn.errors import DataError
-from bgfn.evaluate.config import SWEEP_COLUMNS, TABLE_METHODS, evaluate_config
+from bgfn.evaluate.config import SEEDLESS_METHODS, SWEEP_COLUMNS, TABLE_METHODS, evaluate_config
 from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
 from bgfn.evaluate.networks import load_model
 from bgfn.nav.baseline import filter_start
-from bgfn.paper import METHOD_LABELS, label
+from bgfn.paper import METHOD_LABELS, NHC_SUFFIX, label, nhc_label
 
 
 def sweep_plan(drive, sweep: dict, window_samples: int = 200, t_first: float | None = None) -> pd.DataFrame:
@@ -64,8 +64,9 @@ def run_sweep(cfg: dict, profile: str, dataset: str, drive=None, ecfg: dict | No
     Returns
     -------
     rows : DataFrame
-        ``SWEEP_COLUMNS``; INS and GPS do not depend on a network and are repeated for every seed so that
-        every (start, seed) pair has every method.
+        ``SWEEP_COLUMNS``; INS, INS+NHC and GPS do not depend on a network and are repeated for every seed so
+        that every (start, seed) pair has every method. With ``nhc_rows`` every method also runs with the
+        vehicle constraints (``INS+NHC``, ``<METHOD>+NHC``).
     info : dict
         Sizes, training and evaluation wall times, fold windows.
     """
@@ -103,8 +104,12 @@ def run_sweep(cfg: dict, profile: str, dataset: str, drive=None, ecfg: dict | No
 
     fold_of = dict(zip(plan["start_s"], plan["fold"]))
     windows_all = [(s, dmax) for s in plan["start_s"]]
+    aids = ctx.constraints if ecfg.get("nhc_rows", True) else None
     for r in run_outages(ctx, windows_all, None, "INS", None, ecfg["pseudo_gps"]):
         add(r, fold_of[r.start])
+    if aids is not None:
+        for r in run_outages(ctx, windows_all, None, nhc_label("INS"), None, ecfg["pseudo_gps"], constraints=aids):
+            add(r, fold_of[r.start])
     for s in plan["start_s"]:
         add(gps_run(ctx, s, dmax), fold_of[s])
     t_nav = time.perf_counter() - t0
@@ -128,6 +133,9 @@ def run_sweep(cfg: dict, profile: str, dataset: str, drive=None, ecfg: dict | No
         tb = time.perf_counter()
         for r in run_outages(ctx, fw, model, METHOD_LABELS[method], seed, ecfg["pseudo_gps"]):
             add(r, k)
+        if aids is not None:
+            for r in run_outages(ctx, fw, model, nhc_label(method), seed, ecfg["pseudo_gps"], constraints=aids):
+                add(r, k)
         tc_ = time.perf_counter()
         t_train += tb - ta
         t_eval += tc_ - tb
@@ -139,7 +147,8 @@ def run_sweep(cfg: dict, profile: str, dataset: str, drive=None, ecfg: dict | No
             "fold_starts": {int(k): plan.loc[plan["fold"] == k, "start_s"].tolist() for k in plan["fold"].unique()},
             "train_wall_s": t_train, "eval_wall_s": t_eval + t_nav,
             "train_epochs_run": {f"{c['method']}_fold{c.get('fold')}_seed{c['seed']}": c["epochs_run"] for c in cards},
-            "fold_val_rmse_m": {f"{c['method']}_fold{c.get('fold')}_seed{c['seed']}": c["val_rmse_m"] for c in cards}}
+            "fold_val_rmse_m": {f"{c['method']}_fold{c.get('fold')}_seed{c['seed']}": c["val_rmse_m"] for c in cards},
+            "constraints": aids.summary() if aids is not None else None}
     return df, info
 
 
@@ -157,7 +166,7 @@ def sweep_summary(sweep: pd.DataFrame, n_boot: int = 2000, level: float = 0.95, 
     rows = []
     order = {m: i for i, m in enumerate(TABLE_METHODS)}
     for (ds, du, m), g in sweep.groupby(["dataset", "duration_s", "method"]):
-        if m in ("INS", "GPS"):          # one value per start (repeated per seed)
+        if m in SEEDLESS_METHODS:        # one value per start (repeated per seed)
             g = g.drop_duplicates("start_s")
         lo, hi = bootstrap_ci(g[metric], n_boot=n_boot, level=level, seed=seed, groups=g["start_s"])
         rows.append({"dataset": ds, "duration_s": du, "method": m, "n": len(g), "n_starts": g["start_s"].nunique(),
@@ -168,7 +177,9 @@ def sweep_summary(sweep: pd.DataFrame, n_boot: int = 2000, level: float = 0.95, 
 
 
 def sweep_comparisons(sweep: pd.DataFrame, method: str = "BGFN", metric: str = "max_h_m") -> pd.DataFrame:
-    """How often ``method`` beats each other method, paired by (start, seed), with the Wilcoxon test.
+    """How often ``method`` beats each other method, paired by (start, seed), with the Wilcoxon test; and, when the
+    sweep has it, how often ``method`` with the vehicle constraints (``BGFN+NHC``) beats each other ``+NHC`` row
+    (``INS+NHC`` first: does the learned aid add to the learning-free one?).
 
     ``p_value``: Wilcoxon signed-rank on the (start, seed) pairs; ``p_value_by_start``: on the per-start
     medians over seeds (pairs from the same start are not independent: the more conservative number).
@@ -176,23 +187,26 @@ def sweep_comparisons(sweep: pd.DataFrame, method: str = "BGFN", metric: str = "
     Returns
     -------
     DataFrame
-        ``dataset``, ``duration_s``, ``baseline``, ``n``, ``wins``, ``ties``, ``win_rate``, ``median_diff_m``
-        (method - baseline), ``median_ratio``, ``p_value``, ``n_starts``, ``p_value_by_start``.
+        ``dataset``, ``duration_s``, ``method``, ``baseline``, ``n``, ``wins``, ``ties``, ``win_rate``,
+        ``median_diff_m`` (method - baseline), ``median_ratio``, ``p_value``, ``n_starts``, ``p_value_by_start``.
     """
     from bgfn.stats import paired_comparison, wilcoxon_p
 
     rows = []
+    aided = nhc_label(method)
     for (ds, du), g in sweep.groupby(["dataset", "duration_s"]):
         piv = g.pivot_table(index=["start_s", "seed"], columns="method", values=metric, aggfunc="first")
-        if method not in piv.columns:
-            continue
-        for base in [m for m in TABLE_METHODS if m in piv.columns and m != method]:
-            pc = paired_comparison(piv[method].to_numpy(), piv[base].to_numpy())
-            by_start = (piv[method] - piv[base]).groupby(level="start_s").median()
-            rows.append({"dataset": ds, "duration_s": du, "baseline": base, "n": pc["n"], "wins": pc["wins"],
-                         "ties": pc["ties"], "win_rate": pc["win_rate"], "median_diff_m": pc["median_diff"],
-                         "median_ratio": pc["median_ratio"], "p_value": pc["p_value"],
-                         "n_starts": int(by_start.notna().sum()), "p_value_by_start": wilcoxon_p(by_start)})
+        pairs = [(method, b) for b in TABLE_METHODS if method in piv.columns and b in piv.columns and b != method]
+        pairs += [(aided, b) for b in TABLE_METHODS if aided in piv.columns and b in piv.columns and b != aided
+                  and b.endswith(NHC_SUFFIX)]
+        for m, base in pairs:
+            pc = paired_comparison(piv[m].to_numpy(), piv[base].to_numpy())
+            by_start = (piv[m] - piv[base]).groupby(level="start_s").median()
+            rows.append({"dataset": ds, "duration_s": du, "method": m, "baseline": base, "n": pc["n"],
+                         "wins": pc["wins"], "ties": pc["ties"], "win_rate": pc["win_rate"],
+                         "median_diff_m": pc["median_diff"], "median_ratio": pc["median_ratio"],
+                         "p_value": pc["p_value"], "n_starts": int(by_start.notna().sum()),
+                         "p_value_by_start": wilcoxon_p(by_start)})
     return pd.DataFrame(rows)
 
 
@@ -203,12 +217,18 @@ def describe_sweep(summary: pd.DataFrame, pairs: pd.DataFrame, method: str = "BG
         g = g.set_index("method")
         med = ", ".join(f"{m} {g.loc[m, 'median_m']:.1f} [{g.loc[m, 'ci_lo_m']:.1f}, {g.loc[m, 'ci_hi_m']:.1f}]"
                         for m in TABLE_METHODS if m in g.index)
-        pp = pairs[(pairs["dataset"] == ds) & (pairs["duration_s"] == du)].set_index("baseline")
-        cmp_ = "; ".join(f"vs {b}: wins {int(pp.loc[b, 'wins'])}/{int(pp.loc[b, 'n'])} "
-                         f"(p = {pp.loc[b, 'p_value']:.2g}, by start {pp.loc[b, 'p_value_by_start']:.2g})"
-                         for b in pp.index)
+        here = pairs[(pairs["dataset"] == ds) & (pairs["duration_s"] == du)]
+        text = []
+        for m in (method, nhc_label(method)):
+            # a pairs table written before the +NHC rows has no method column: all its rows are `method`'s
+            pp = (here[here["method"] == m] if "method" in here.columns else here if m == method
+                  else here.iloc[:0]).set_index("baseline")
+            if len(pp):
+                text.append(f"{m} " + "; ".join(
+                    f"vs {b}: wins {int(pp.loc[b, 'wins'])}/{int(pp.loc[b, 'n'])} "
+                    f"(p = {pp.loc[b, 'p_value']:.2g}, by start {pp.loc[b, 'p_value_by_start']:.2g})" for b in pp.index))
         lines.append(f"{ds}, {du:g} s outages: median max horizontal error (m) [95 % interval]: {med}. "
-                     f"{method} {cmp_}.")
+                     + ". ".join(text) + ("." if text else ""))
     return lines
 
 
@@ -224,6 +244,9 @@ def describe_sweep_setup(train_section: dict, ecfg: dict, datasets) -> list[str]
              f"{sw['folds']} folds x seeds {sw['seeds']} x methods {[label(m) for m in ecfg['methods']]} + INS + GPS",
              f"fold networks: window {tc.get('window')} samples, size block {tc.get('size')!r}, optimizer {budget}"]
     lines += [f"  {label(m):>12}: {tc['sizes'][m][tc['size']]}" for m in ecfg["methods"]]
+    if ecfg.get("nhc_rows", True):
+        lines.append("INS and every network also with the vehicle constraints (NHC, ZUPT when still): rows "
+                     + ", ".join(nhc_label(m) for m in ["INS"] + list(ecfg["methods"])))
     return lines
 
 

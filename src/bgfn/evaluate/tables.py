@@ -16,7 +16,7 @@ from bgfn.data.names import dataset_id
 from bgfn.evaluate.config import METRIC_COLUMNS, TABLE_COLUMNS, TABLE_FILES, TABLE_METHODS, evaluate_config
 from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
 from bgfn.evaluate.networks import ensure_models
-from bgfn.paper import METHOD_LABELS, test_of
+from bgfn.paper import METHOD_LABELS, nhc_label, test_of
 
 
 @dataclass
@@ -42,6 +42,8 @@ class TableResult:
         The drive evaluated (its reference draws the figures; the sensitivity run reuses it).
     windows : list of (float, float) or None
         The outages evaluated, ``(start, duration)``, s; ``Outage k`` is ``windows[k - 1]``.
+    constraints : dict or None
+        :meth:`bgfn.nav.constraints.Constraints.summary` of the ``+NHC`` rows' constraints (None without them).
     """
 
     dataset: str
@@ -54,6 +56,7 @@ class TableResult:
     gnss_errors: pd.DataFrame | None = None
     drive: Any = None
     windows: list | None = None
+    constraints: dict | None = None
 
 
 def fix_error_table(err: pd.DataFrame, windows) -> pd.DataFrame:
@@ -88,7 +91,7 @@ def aggregate_seeds(per_seed: pd.DataFrame, how: str = "median") -> pd.DataFrame
 
 
 def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: dict | None = None,
-                     models: dict | None = None, progress: bool = False) -> TableResult:
+                     models: dict | None = None, progress: bool = False, nhc_rows: bool | None = None) -> TableResult:
     """All methods in the profile's evaluation outages of one dataset (paper Tables 1-2).
 
     Parameters
@@ -103,6 +106,9 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
         :func:`evaluate_config` (default: from ``cfg``).
     models : dict, optional
         ``{(method, seed): predictor}``; default :func:`ensure_models`.
+    nhc_rows : bool, optional
+        Also run ``INS+NHC`` and every network with the vehicle constraints (``<METHOD>+NHC``); None:
+        ``ecfg['nhc_rows']``.
     """
     from bgfn.nav import outages
 
@@ -116,10 +122,15 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
     if models is None:
         models = ensure_models(cfg, profile, dataset, ctx, ecfg["methods"], ecfg["seeds"], windows,
                                ecfg["train_missing"], progress)
+    aids = ctx.constraints if (ecfg.get("nhc_rows", True) if nhc_rows is None else nhc_rows) else None
     runs = run_outages(ctx, windows, None, "INS", None, ecfg["pseudo_gps"])
+    if aids is not None:
+        runs += run_outages(ctx, windows, None, nhc_label("INS"), None, ecfg["pseudo_gps"], constraints=aids)
     runs += [gps_run(ctx, s, d) for s, d in windows]
     for (method, seed), model in models.items():
         runs += run_outages(ctx, windows, model, METHOD_LABELS[method], seed, ecfg["pseudo_gps"])
+        if aids is not None:
+            runs += run_outages(ctx, windows, model, nhc_label(method), seed, ecfg["pseudo_gps"], constraints=aids)
     outage_no = {s: i + 1 for i, (s, _) in enumerate(windows)}
     rows = [{"outage": outage_no[r.start], "start_s": r.start, "method": r.method, "seed": r.seed,
              **window_metrics(r.errors, r.start, r.duration)} for r in runs]
@@ -128,7 +139,8 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
     # a dataset that stands for none of the paper's tests names its table files by its id (never a folder path)
     return TableResult(dataset, test_of(dataset) or dataset_id(dataset), per_seed,
                        aggregate_seeds(per_seed, ecfg["seed_aggregate"]), runs, models, fixes,
-                       fix_error_table(fixes, windows), drive, list(windows))
+                       fix_error_table(fixes, windows), drive, list(windows),
+                       aids.summary() if aids is not None else None)
 
 
 def run_tables(cfg: dict, profile: str, datasets, ecfg: dict, out,
@@ -283,6 +295,14 @@ def describe_tables(results) -> list[str]:
                         f"not beat {', '.join(loses) or 'any'}")
             if best is not None:
                 txt += f"; best network: {best}"
+            ins_nhc, bgfn_nhc = nhc_label("INS"), nhc_label("BGFN")
+            if ins_nhc in g.index:      # the learning-free aid a learned one must beat or add to
+                txt += (f"; with the vehicle constraints INS+NHC {g.loc[ins_nhc, 'max_east_m']:.1f}/"
+                        f"{g.loc[ins_nhc, 'max_north_m']:.1f} m ({'better' if score[ins_nhc] < score['INS'] else 'not better'}"
+                        " than INS)")
+                if bgfn_nhc in g.index:
+                    txt += (f", BGFN+NHC {g.loc[bgfn_nhc, 'max_east_m']:.1f}/{g.loc[bgfn_nhc, 'max_north_m']:.1f} m "
+                            f"({'beats' if score[bgfn_nhc] < score[ins_nhc] else 'does not beat'} INS+NHC)")
             below = [f"{m} {c.replace('_m', '').replace('_', ' ')} {g.loc[m, c]:.1f} < GPS {g.loc['GPS', c]:.1f} m"
                      for c in METRIC_COLUMNS for m in g.index if m != "GPS" and g.loc[m, c] < g.loc["GPS", c]]
             if below:   # the GPS row follows the GNSS fixes, whose own error against the reference can exceed a drift

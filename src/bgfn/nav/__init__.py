@@ -29,6 +29,13 @@ Modules (pyins style, one concept each; SI units, radians, NED, tables as in CON
   ``PseudoGpsContext``, ``IncrementPseudoGps`` = Eq. pred-gps, ``TablePseudoGps``).
 - :mod:`~bgfn.nav.outage_rules` -- ``pick_windows(rule, reference, margin_s)``: a drive's outages picked by a
   rule (``cruise_and_manoeuvre``: one cruising, one manoeuvring, as the paper's field test).
+- :mod:`~bgfn.nav.constraints` -- the vehicle constraints of the ``+NHC`` rows: NHC and ZUPT velocity updates
+  (``nhc_measurement``, ``zupt_measurement``, ``propagate_aided``), the stillness detector ``stillness``, the
+  vehicle frame ``mounting_track``; ``build_constraints(imu, imu_errors, config, trajectory) -> Constraints``,
+  which ``run_filter`` / ``run_outage`` take as ``constraints``.
+- :mod:`~bgfn.nav.outages` -- ``OutageWindow``, ``check_windows``, ``outage_windows(profile, drive)`` (the profile's one key),
+  the pseudo-GPS hook (``PseudoFix``, ``PseudoGpsContext``, ``IncrementPseudoGps`` = Eq. pred-gps,
+  ``TablePseudoGps``).
 - :mod:`~bgfn.nav.metrics` -- ``navigation_errors``, ``outage_metrics`` (max |east|, max |north|,
   horizontal RMSE, end error), ``rms_table``; ``reference_rows`` (a drive's spans where the reference is not
   trusted, ``meta["reference_excluded_s"]``, left out of every comparison).

@@ -17,7 +17,10 @@ outages are the profile's ``outage_windows`` (:func:`bgfn.nav.outages.outage_win
   from the IMU, Gauss-Markov bias states of the dynamic biases; :mod:`bgfn.nav.navego_setup`, which then
   ignores ``bias_model``);
 - ``innovation_gate``: null (every GNSS fix fused, the paper's filter) or a probability ``p``: a fix whose NIS
-  exceeds the ``p`` quantile of chi-square is not fused (:func:`bgfn.nav.filter.run_filter`).
+  exceeds the ``p`` quantile of chi-square is not fused (:func:`bgfn.nav.filter.run_filter`);
+- ``nhc``, ``zupt``: the vehicle constraints of the ``INS+NHC`` rows (:mod:`bgfn.nav.constraints`; ZUPT whenever
+  the stillness detector fires, the label says NHC anyway); ``constraints_in_gps_run``: false (the paper's
+  GPS-aided filter) or true (the GPS-aided run applies them too, :func:`gps_constraints`).
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ from ..errors import DataError
 from . import metrics, navego_setup
 from .alignment import ALIGNMENT_DEFAULTS, MODES, Alignment, align
 from .consistency import nis_line, nis_summary
+from . import constraints as cn
 from .filter import FilterResult, gate_thresholds, run_filter, run_outage
 from .outages import check_windows, epochs_before
 from .state import FilterNoise, FilterState, initial_covariance, initial_state, noise_from_imu_errors
@@ -49,11 +53,16 @@ NAV_DEFAULTS: dict = {
     "noise_search": dict(NOISE_SEARCH_DEFAULTS),
     "innovation_gate": None,
     "ins_tuning": navego_setup.DEFAULT_TUNING,
+    "nhc": dict(cn.NHC_DEFAULTS),
+    "zupt": dict(cn.ZUPT_DEFAULTS),
+    "constraints_in_gps_run": False,
 }
 #: Key of the entry for every other drive when ``nav.noise_scale`` is a mapping per dataset.
 DEFAULT_SCALE_KEY = "default"
 #: ``nav.noise_scale`` that asks for the factor from the data.
 AUTO = "auto"
+#: Label of the standalone INS with the vehicle constraints (:func:`bgfn.paper.nhc_label`).
+INS_NHC = paper.nhc_label("INS")
 
 
 def nav_config(section: dict | None) -> dict:
@@ -62,7 +71,7 @@ def nav_config(section: dict | None) -> dict:
     for key, value in (section or {}).items():
         if key not in cfg:
             raise DataError("params nav", key, f"one of {sorted(cfg)}", "unknown key")
-        if isinstance(cfg[key], dict):                           # init, alignment, noise_search: key by key
+        if isinstance(cfg[key], dict):                           # init, alignment, noise_search, nhc, zupt: key by key
             unknown = set(value or {}) - set(cfg[key])
             if unknown:
                 raise DataError(f"params nav.{key}", sorted(unknown)[0], f"one of {sorted(cfg[key])}",
@@ -72,6 +81,7 @@ def nav_config(section: dict | None) -> dict:
             cfg[key] = value
     gate_thresholds(cfg["innovation_gate"], "params nav")      # a bad probability fails here, by name
     navego_setup.check_tuning(cfg["ins_tuning"], "params nav")
+    cn.constraint_config(cfg)                                   # and bad constraint settings
     if cfg["alignment"]["mode"] not in MODES:
         raise DataError("params nav.alignment", "mode", f"one of {MODES}", repr(cfg["alignment"]["mode"]))
     spec = cfg["noise_scale"]
@@ -94,6 +104,28 @@ def noise_scale_of(cfg: dict, dataset: str):
     return spec.get(dataset, spec[DEFAULT_SCALE_KEY]) if isinstance(spec, dict) else spec
 
 
+def gps_constraints(drive, cfg: dict, initial: FilterState, noise: FilterNoise):
+    """The vehicle constraints of the GPS-aided run: None unless ``constraints_in_gps_run``.
+
+    When asked, a first GPS-aided pass without them gives the vehicle frame (its causal running estimate,
+    :func:`bgfn.nav.constraints.mounting_track`), then the constraints hold the whole drive's detector and aid
+    epochs. Used by every GPS-aided run (:func:`run_drive`, :func:`run_baseline`,
+    :func:`bgfn.evaluate.navigation_context`) so that they agree.
+    """
+    if not cfg["constraints_in_gps_run"]:
+        return None
+    first = run_filter(filter_imu(drive, cfg), initial, noise, drive.gnss, drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0]),
+                       gate_probability=cfg["innovation_gate"], source=drive.name)
+    return outage_constraints(drive, cfg, first.trajectory)
+
+
+def outage_constraints(drive, cfg: dict, trajectory: pd.DataFrame):
+    """The vehicle constraints of the ``INS+NHC`` runs of ``drive``: the stillness detector over its IMU and the
+    vehicle frame from the GPS-aided ``trajectory`` (:func:`bgfn.nav.constraints.build_constraints`)."""
+    return cn.build_constraints(drive.imu, drive.meta["imu_errors"], cn.constraint_config(cfg), trajectory,
+                                source=drive.name)
+
+
 def run_drive(drive, section: dict | None = None, snapshots: dict | None = None) -> FilterResult:
     """GPS/INS filter over a whole drive with every GNSS fix (the paper's online-training mode).
 
@@ -112,7 +144,8 @@ def run_drive(drive, section: dict | None = None, snapshots: dict | None = None)
     cfg = nav_config(section)
     initial, noise = filter_setup(drive, cfg)
     return run_filter(filter_imu(drive, cfg), initial, noise, drive.gnss, _lever(drive), snapshots=snapshots,
-                      gate_probability=cfg["innovation_gate"], source=drive.name)
+                      gate_probability=cfg["innovation_gate"], source=drive.name,
+                      constraints=gps_constraints(drive, cfg, initial, noise))
 
 
 @dataclass
@@ -295,10 +328,14 @@ class Baseline:
     states : dict
         ``{"outage_1": FilterState, ...}`` at the outage starts.
     outage_errors : dict
-        ``{"outage_1": DataFrame}``: errors of the standalone INS in each outage.
+        ``{"outage_1": DataFrame}``: errors of the standalone INS in each outage, then those of ``INS+NHC``
+        (column ``method``).
     outage_table : DataFrame
-        One row per outage: ``dataset``, ``outage`` and ``metrics.outage_metrics``.
+        One row per outage and method (``INS``, then ``INS+NHC``): ``dataset``, ``outage``, ``method`` and
+        ``metrics.outage_metrics``.
     noise : FilterNoise
+    constraints : dict
+        :meth:`bgfn.nav.constraints.Constraints.summary` of the ``INS+NHC`` runs' constraints.
     """
 
     drive_name: str
@@ -310,6 +347,7 @@ class Baseline:
     outage_table: pd.DataFrame
     noise: FilterNoise
     setup: FilterSetup | None = None
+    constraints: dict | None = None
 
     def lines(self) -> list[str]:
         """Notebook 02's sentences of this run: the self-alignment and the noise search (when they ran) and the
@@ -319,7 +357,8 @@ class Baseline:
 
 
 def run_baseline(drive, cfg: dict, windows) -> Baseline:
-    """Full-drive GPS/INS run, then the standalone INS in each outage from the saved state at its start.
+    """Full-drive GPS/INS run, then the standalone INS in each outage from the saved state at its start, without
+    and with the vehicle constraints (``INS``, ``INS+NHC``: :func:`outage_constraints`).
 
     Parameters
     ----------
@@ -344,26 +383,35 @@ def run_baseline(drive, cfg: dict, windows) -> Baseline:
     names = [f"outage_{i + 1}" for i in range(len(windows))]
     starts = epochs_before(drive.imu["time"], [w.start for w in windows], drive.name)
     full = run_filter(imu, initial, noise, drive.gnss, lever, snapshots=dict(zip(names, starts)),
-                      gate_probability=cfg["innovation_gate"], source=drive.name)
+                      gate_probability=cfg["innovation_gate"], source=drive.name,
+                      constraints=gps_constraints(drive, cfg, initial, noise))
     errors = metrics.navigation_errors(full.trajectory, drive.reference, drive.meta)
+    aids = outage_constraints(drive, cfg, full.trajectory)
     rows, outage_errors = [], {}
     for n, w in zip(names, windows):
-        res = run_outage(imu, full.states[n], w, noise, lever, source=drive.name)
-        e = metrics.navigation_errors(res.trajectory, drive.reference, drive.meta)
-        e.insert(1, "t_rel", e["time"] - w.start)
-        outage_errors[n] = e
-        rows.append({"dataset": drive.name, "outage": n, **metrics.outage_metrics(e, w)})
-    return Baseline(drive.name, full, errors, metrics.rms_table(errors), full.states, outage_errors,
-                    pd.DataFrame(rows), noise, setup)
+        parts = []
+        for method, con in (("INS", None), (INS_NHC, aids)):
+            res = run_outage(imu, full.states[n], w, noise, lever, source=drive.name, constraints=con)
+            e = metrics.navigation_errors(res.trajectory, drive.reference, drive.meta)
+            e.insert(1, "t_rel", e["time"] - w.start)
+            e.insert(0, "method", method)
+            parts.append(e)
+            rows.append({"dataset": drive.name, "outage": n, "method": method, **metrics.outage_metrics(e, w)})
+        outage_errors[n] = pd.concat(parts, ignore_index=True)
+    table = pd.DataFrame(rows).sort_values("method", key=lambda m: m != "INS", kind="stable").reset_index(drop=True)
+    return Baseline(drive.name, full, errors, metrics.rms_table(errors), full.states, outage_errors, table, noise,
+                    setup, aids.summary())
 
 
 def ins_layout(outage_table: pd.DataFrame, dataset: str | None = None) -> pd.DataFrame:
-    """Standalone-INS max errors in the paper's layout (:func:`bgfn.paper.layout`, method ``INS``).
+    """Standalone-INS max errors in the paper's layout (:func:`bgfn.paper.layout`, methods ``INS`` and, when the
+    table has them, ``INS+NHC``).
 
     Parameters
     ----------
     outage_table : DataFrame
-        ``Baseline.outage_table`` of one dataset (one row per outage, in order).
+        ``Baseline.outage_table`` of one dataset (per method one row per outage, in order; no ``method``
+        column: all ``INS``).
     dataset : str, optional
         When it stands for one of the tests (:func:`bgfn.paper.test_of`), the paper's INS row of that test is
         beside ours (of its field test, labelled ``paper (field test)``, for the real drive).
@@ -371,22 +419,30 @@ def ins_layout(outage_table: pd.DataFrame, dataset: str | None = None) -> pd.Dat
     Returns
     -------
     DataFrame
-        Rows ``Outage k``; columns ``(source, "INS", East/North)``, m.
+        Rows ``Outage k``; columns ``(source, method, East/North)``, m (the paper's side: ``INS`` only).
     """
-    ours = pd.DataFrame({"outage": np.arange(1, len(outage_table) + 1), "method": "INS",
-                         "max_east_m": outage_table["max_abs_east"].to_numpy(float),
-                         "max_north_m": outage_table["max_abs_north"].to_numpy(float)})
+    method = outage_table["method"] if "method" in outage_table.columns else pd.Series("INS", outage_table.index)
+    parts = []
+    for m in dict.fromkeys(method):
+        rows = outage_table[method == m]
+        parts.append(pd.DataFrame({"outage": np.arange(1, len(rows) + 1), "method": m,
+                                   "max_east_m": rows["max_abs_east"].to_numpy(float),
+                                   "max_north_m": rows["max_abs_north"].to_numpy(float)}))
+    ours = pd.concat(parts, ignore_index=True)
     test = paper.test_of(dataset) if dataset else None
-    return paper.layout(ours, paper.published_values(test) if test else None, methods=("INS",),
+    return paper.layout(ours, paper.published_values(test) if test else None, methods=tuple(dict.fromkeys(method)),
                         paper_label=paper.paper_label(test) if test else "paper")
 
 
 def ins_max_error_file(outage_table: pd.DataFrame) -> pd.DataFrame:
     """:func:`ins_layout` (ours) flattened for ``tables/kf_outage_max_errors_<d>.csv``: ``outage``
-    (``Outage k``), ``INS_east_m``, ``INS_north_m`` (m, 2 decimals)."""
+    (``Outage k``), ``INS_east_m``, ``INS_north_m`` and, with the constraints' rows, ``INS+NHC_east_m``,
+    ``INS+NHC_north_m`` (m, 2 decimals)."""
     ours = ins_layout(outage_table)["ours"]
+    methods = list(dict.fromkeys(ours.columns.get_level_values("method")))
     return pd.DataFrame({"outage": list(ours.index),
-                         **{f"INS_{axis.lower()}_m": ours[("INS", axis)].round(2).to_numpy() for _, axis in paper.AXES}})
+                         **{f"{m}_{axis.lower()}_m": ours[(m, axis)].round(2).to_numpy()
+                            for m in methods for _, axis in paper.AXES}})
 
 
 def save_baseline(b: Baseline, out, lat=None) -> dict:
@@ -399,14 +455,14 @@ def save_baseline(b: Baseline, out, lat=None) -> dict:
     - ``tables/kf_rms_<d>.csv``: RMS / max-abs errors of the full GPS/INS run;
     - ``tables/kf_outage_max_errors_<d>.csv``: :func:`ins_max_error_file`;
     - ``tables/kf_outage_metrics_<d>.csv``: all outage metrics;
-    - ``tables/kf_outage_errors_<d>.csv``: standalone-INS error series (``outage``, ``t_rel``, ``east``,
-      ``north``, ``down``, ``horizontal``, m).
+    - ``tables/kf_outage_errors_<d>.csv``: standalone-INS error series (``outage``, ``method``, ``t_rel``,
+      ``east``, ``north``, ``down``, ``horizontal``, m).
 
     Returns
     -------
     dict
-        JSON-ready summary (RMS, outage metrics, mean NIS, the filter's start and noise factor:
-        :meth:`FilterSetup.record`) for ``kf_baseline.json``.
+        JSON-ready summary (RMS, outage metrics, mean NIS, the filter's start and noise factor
+        (:meth:`FilterSetup.record`), the constraints' facts) for ``kf_baseline.json``.
     """
     from pathlib import Path
 
@@ -420,7 +476,7 @@ def save_baseline(b: Baseline, out, lat=None) -> dict:
     atomic_write_csv(out / "tables" / f"kf_rms_{d}.csv", b.rms.reset_index(), float_format="%.6g")
     atomic_write_csv(out / "tables" / f"kf_outage_max_errors_{d}.csv", ins_max_error_file(b.outage_table))
     atomic_write_csv(out / "tables" / f"kf_outage_metrics_{d}.csv", b.outage_table, float_format="%.6g")
-    series = pd.concat([e.assign(outage=name)[["outage", "t_rel", "east", "north", "down", "horizontal"]]
+    series = pd.concat([e.assign(outage=name)[["outage", "method", "t_rel", "east", "north", "down", "horizontal"]]
                         for name, e in b.outage_errors.items()], ignore_index=True)
     atomic_write_csv(out / "tables" / f"kf_outage_errors_{d}.csv", series, float_format="%.6g")
     upd = b.full.updates
@@ -429,7 +485,7 @@ def save_baseline(b: Baseline, out, lat=None) -> dict:
             "gnss_updates": int(len(upd)), "gnss_rejected": int((~upd["accepted"]).sum()) if len(upd) else 0,
             "mean_nis": float(upd["nis"].mean()) if len(upd) else None,
             "mean_nis_dof": float(upd["dof"].mean()) if len(upd) else None,
-            "nis_verdict": nis_summary(upd)["verdict"],
+            "nis_verdict": nis_summary(upd)["verdict"], "constraints": b.constraints,
             "states_file": f"nav_states_{d}.npz", **(b.setup.record() if b.setup is not None else {})}
 
 
@@ -467,7 +523,7 @@ def gate_comparison(drive, cfg: dict, windows, probability: float, baseline: Bas
                "gnss_fixes": int(len(upd)), "gnss_rejected": int((~upd["accepted"]).sum()),
                "mean_nis": float(upd["nis"].mean()) if len(upd) else float("nan"),
                "rms_h_m": float(b.rms.loc["horizontal", "rms"]), "max_h_m": float(b.rms.loc["horizontal", "max_abs"])}
-        for k, r in enumerate(b.outage_table.itertuples(index=False)):
+        for k, r in enumerate(b.outage_table[b.outage_table["method"] == "INS"].itertuples(index=False)):
             row[f"outage_{k + 1}_max_east_m"] = float(r.max_abs_east)
             row[f"outage_{k + 1}_max_north_m"] = float(r.max_abs_north)
         rows.append(row)

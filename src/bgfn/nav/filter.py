@@ -14,7 +14,8 @@ time (exactly the batch update for the diagonal R), with the Joseph form for ``P
 fed back: position, velocity, ``C_bn <- exp([phi]) C_bn``, bias estimates ``+= (nabla, eps)``, ``x = 0``.
 
 Outage windows remove GNSS updates; inside them a pseudo-GPS source may supply fixes
-(:mod:`bgfn.nav.outages`, Eq. pred-gps).
+(:mod:`bgfn.nav.outages`, Eq. pred-gps). Beyond the paper, the vehicle constraints of
+:mod:`bgfn.nav.constraints` (NHC, ZUPT) may add velocity updates at their epochs (``constraints``; default none).
 """
 
 from __future__ import annotations
@@ -126,8 +127,56 @@ def position_nis(P, H, dz, std):
 
 
 @numba.njit(cache=True)
+def sequential_update(P, H, dz, std, x, innov):
+    """Eq. (eq4) for the rows of ``H`` one scalar at a time (exactly the batch update for a diagonal R), Joseph
+    form for ``P``; the error-state estimate accumulates in ``x`` (zero on entry: closed loop).
+
+    A row whose ``std`` is not positive and finite is left out (its ``innov`` is NaN). Returns the sum of the
+    scalar normalized innovations squared. Shared by every measurement of the filter: position fixes
+    (:func:`update_position`) and the vehicle constraints (:mod:`bgfn.nav.constraints`).
+    """
+    n = P.shape[0]
+    eye = np.eye(n)
+    nis = 0.0
+    for a in range(H.shape[0]):
+        innov[a] = np.nan
+        if not (std[a] > 0.0 and np.isfinite(std[a])):
+            continue
+        hrow = H[a].copy()
+        ph = P @ hrow
+        s = hrow @ ph + std[a] ** 2
+        k = ph / s
+        y = dz[a] - hrow @ x
+        innov[a] = y
+        nis += y * y / s
+        x += k * y
+        ikh = eye - np.outer(k, hrow)
+        P[:, :] = ikh @ P @ ikh.T + np.outer(k, k) * std[a] ** 2
+    return nis
+
+
+@numba.njit(cache=True)
+def feedback(pos, v, c, ba, bg, x):
+    """Closed-loop feedback of the error-state estimate ``x`` (errors are computed - true) into the navigation
+    solution and the bias estimates, in place; the caller then starts from ``x = 0``."""
+    pos[0] -= x[em.DLAT]
+    pos[1] -= x[em.DLON]
+    pos[2] -= x[em.DH]
+    v[0] -= x[em.DV_N]
+    v[1] -= x[em.DV_E]
+    v[2] -= x[em.DV_D]
+    rv = np.array([x[em.PHI_N], x[em.PHI_E], x[em.PHI_D]])
+    dc = np.empty((3, 3))
+    rotvec_to_dcm_nb(rv, dc)  # C_true = (I - [phi])^-1 C_computed ~ exp([phi]) C_computed
+    c[:, :] = dc @ c
+    for a in range(3):
+        ba[a] += x[em.BA_X + a]
+        bg[a] += x[em.BG_X + a]
+
+
+@numba.njit(cache=True)
 def update_position(pos, v, c, ba, bg, P, lever, fix, std, lag, innov, gate):
-    """Eq. (eq4) position update (sequential scalar updates, Joseph form) and feedback.
+    """Eq. (eq4) position update (:func:`sequential_update`) and feedback (:func:`feedback`).
 
     ``gate`` > 0: the fix is first tested as a whole; when its NIS (:func:`position_nis`) exceeds ``gate`` it is
     rejected and the state and ``P`` are left untouched (an innovation gate; 0: every fix is fused, as in the
@@ -144,36 +193,8 @@ def update_position(pos, v, c, ba, bg, P, lever, fix, std, lag, innov, gate):
                 innov[a] = dz[a] if (std[a] > 0.0 and np.isfinite(std[a])) else np.nan
             return nis_fix, False
     x = np.zeros(n)
-    eye = np.eye(n)
-    nis = 0.0
-    for a in range(3):
-        innov[a] = np.nan
-        if not (std[a] > 0.0 and np.isfinite(std[a])):
-            continue
-        hrow = H[a].copy()
-        ph = P @ hrow
-        s = hrow @ ph + std[a] ** 2
-        k = ph / s
-        y = dz[a] - hrow @ x
-        innov[a] = y
-        nis += y * y / s
-        x += k * y
-        ikh = eye - np.outer(k, hrow)
-        P[:, :] = ikh @ P @ ikh.T + np.outer(k, k) * std[a] ** 2
-    # Closed-loop feedback (errors are computed - true).
-    pos[0] -= x[em.DLAT]
-    pos[1] -= x[em.DLON]
-    pos[2] -= x[em.DH]
-    v[0] -= x[em.DV_N]
-    v[1] -= x[em.DV_E]
-    v[2] -= x[em.DV_D]
-    rv = np.array([x[em.PHI_N], x[em.PHI_E], x[em.PHI_D]])
-    dc = np.empty((3, 3))
-    rotvec_to_dcm_nb(rv, dc)  # C_true = (I - [phi])^-1 C_computed ~ exp([phi]) C_computed
-    c[:, :] = dc @ c
-    for a in range(3):
-        ba[a] += x[em.BA_X + a]
-        bg[a] += x[em.BG_X + a]
+    nis = sequential_update(P, H, dz, std, x, innov)
+    feedback(pos, v, c, ba, bg, x)
     return nis, True
 
 
@@ -249,7 +270,7 @@ def _check_gnss(gnss, source):
 def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss: pd.DataFrame | None = None,
                lever_arm=(0.0, 0.0, 0.0), outage_windows=(), pseudo_gps=None, t_end: float | None = None,
                snapshots: dict | None = None, pseudo_rate_hz: float = PSEUDO_RATE_HZ,
-               gate_probability: float | None = None, source: str = "drive") -> FilterResult:
+               gate_probability: float | None = None, source: str = "drive", constraints=None) -> FilterResult:
     """Run the closed-loop GPS/INS filter from ``initial`` over the IMU rows after ``initial.time``.
 
     Parameters
@@ -281,6 +302,10 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
         fused (the paper's filter). Pseudo fixes are never gated.
     source : str
         Name used in error messages.
+    constraints : bgfn.nav.constraints.Constraints, optional
+        Vehicle constraints (NHC, and ZUPT where the stillness detector fires) applied at their aid epochs;
+        built for this ``imu`` (:func:`bgfn.nav.constraints.build_constraints`). None: none (the paper's filter).
+        Their updates are not rows of ``updates``.
 
     Returns
     -------
@@ -296,6 +321,9 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
         time, gyro, accel, dt = time[keep], gyro[keep], accel[keep], dt[keep]
     times = np.concatenate([[t0], time])  # output rows
     n_rows = times.size
+    aid = mount = None
+    if constraints is not None:
+        aid, mount = constraints.steps(time, source + ":imu")
     windows = check_windows(outage_windows, t0, times[-1], source + ":outage_windows")
     lever = np.asarray(lever_arm, dtype=float).reshape(3)
 
@@ -343,6 +371,17 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
     upd, P_upd = [], []
     states, window_start = {}, {}
     innov = np.empty(3)
+    out_bias_aid = np.zeros((n_rows, 6)) if aid is not None else None
+
+    def advance(r0, r1):
+        """Prediction over output rows r0..r1 (with the constraints' updates at their epochs)."""
+        if aid is None:
+            propagate_steps(r0, r1, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd)
+        else:
+            from .constraints import propagate_aided
+
+            propagate_aided(r0, r1, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd, aid,
+                            mount, *constraints.config.kernel_args(), out_bias_aid)
 
     def current(row):
         return FilterState(float(times[row]), pos.copy(), v.copy(), c.copy(), ba.copy(), bg.copy(), P.copy())
@@ -350,7 +389,7 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
     row = 0
     for r, kind, payload in events:
         if r > row:
-            propagate_steps(row, r, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd)
+            advance(row, r)
             row = r
         if kind == 0:
             window_start[payload[1]] = current(row)
@@ -378,8 +417,14 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
         upd.append((t_m, label, *innov, nis, int(np.sum(np.isfinite(innov))), bool(accepted)))
         P_upd.append(P.copy())
     if row < n_rows - 1:
-        propagate_steps(row, n_rows - 1, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd)
+        advance(row, n_rows - 1)
 
+    if aid is not None:
+        # the constraints' updates also move the bias estimates; at a row with both, the fix comes after
+        aided = np.flatnonzero(aid) + 1
+        order = np.lexsort((np.r_[np.zeros(aided.size), np.ones(len(bias_rows))], np.r_[aided, bias_rows]))
+        bias_rows = list(np.r_[aided, bias_rows][order])
+        bias_vals = list(np.concatenate([out_bias_aid[aided], np.array(bias_vals)])[order])
     # Bias estimates are piecewise constant between updates (random walk) or decay (Gauss-Markov).
     idx = np.searchsorted(np.array(bias_rows), np.arange(n_rows), side="right") - 1
     bias = np.array(bias_vals)[idx]
@@ -401,7 +446,7 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
 
 def run_outage(imu: pd.DataFrame, start_state: FilterState, window, noise: FilterNoise,
                lever_arm=(0.0, 0.0, 0.0), pseudo_gps=None, pseudo_rate_hz: float = PSEUDO_RATE_HZ,
-               source: str = "drive") -> FilterResult:
+               source: str = "drive", constraints=None) -> FilterResult:
     """One outage from a saved filter state: only the window's own IMU rows are processed.
 
     Without ``pseudo_gps`` this is the standalone INS (prediction only, biases held at their last
@@ -421,6 +466,8 @@ def run_outage(imu: pd.DataFrame, start_state: FilterState, window, noise: Filte
         See :func:`run_filter`.
     pseudo_rate_hz : float
     source : str
+    constraints : bgfn.nav.constraints.Constraints, optional
+        See :func:`run_filter`; the vehicle frame is held at its estimate at the start (no fix inside).
 
     Returns
     -------
@@ -430,8 +477,11 @@ def run_outage(imu: pd.DataFrame, start_state: FilterState, window, noise: Filte
     w = window if isinstance(window, OutageWindow) else OutageWindow(*map(float, window))
     if abs(start_state.time - w.start) > 0.5:
         raise DataError(source, "start_state.time", f"the outage start {w.start} s", str(start_state.time))
+    if constraints is not None:
+        constraints = constraints.frozen(start_state.time)
     return run_filter(imu, start_state, noise, None, lever_arm, [(start_state.time, w.end - start_state.time)],
-                      pseudo_gps, t_end=w.end, pseudo_rate_hz=pseudo_rate_hz, source=source)
+                      pseudo_gps, t_end=w.end, pseudo_rate_hz=pseudo_rate_hz, source=source,
+                      constraints=constraints)
 
 
 __all__ = ["FilterResult", "run_filter", "run_outage", "gate_thresholds"]

@@ -67,14 +67,17 @@ def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None
     """
     test = paper.test_of(drive.name)
     checked = check_windows(windows, float(drive.reference["time"].iloc[0]), float(drive.imu["time"].iloc[-1]),
-                            f"{drive.name}: profile outage_windows")
+                            f"{drive.name}: profile outage_windows", sort=False)      # Outage k as in notebook 02
     lever = drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0])
     rows = []
     for tuning in navego_setup.INS_TUNINGS:
         c = {**cfg, "ins_tuning": tuning}
         same = baseline is not None and tuning == cfg.get("ins_tuning", navego_setup.DEFAULT_TUNING)
         b = baseline if same else run_baseline(drive, c, windows)
-        for k, r in enumerate(b.outage_table.itertuples(index=False)):
+        ins = b.outage_table
+        if "method" in ins.columns:                   # the standalone INS only (not the INS+NHC rows)
+            ins = ins[ins["method"] == "INS"]
+        for k, r in enumerate(ins.itertuples(index=False)):
             rows.append(_row(drive.name, test, k + 1, tuning, r.max_abs_east, r.max_abs_north))
         if tuning != "navego":
             continue

@@ -6,6 +6,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from ..paper import NHC_SUFFIX
 from .earth import curvature_radii
 
 
@@ -92,7 +93,8 @@ def plot_outage_errors(outage_errors: dict, title: str = ""):
     Parameters
     ----------
     outage_errors : dict
-        ``{label: errors DataFrame with t_rel}``, e.g. ``Baseline.outage_errors``.
+        ``{label: errors DataFrame with t_rel}``, e.g. ``Baseline.outage_errors``; with a ``method`` column,
+        one line per method (``INS`` solid red, ``INS+NHC`` dashed).
     title : str
 
     Returns
@@ -104,7 +106,10 @@ def plot_outage_errors(outage_errors: dict, title: str = ""):
     for row, (label, e) in enumerate(outage_errors.items()):
         for col, comp in enumerate(("east", "north")):
             ax = axes[row, col]
-            ax.plot(e["t_rel"], e[comp], color="tab:red", label="INS")
+            method = e["method"] if "method" in e.columns else pd.Series("INS", e.index)
+            for m in dict.fromkeys(method):
+                g = e[method == m]
+                ax.plot(g["t_rel"], g[comp], color="tab:red", ls="--" if m.endswith(NHC_SUFFIX) else "-", label=m)
             ax.set_title(f"{label}: {comp} error")
             ax.set_xlabel("time in outage (s)")
             ax.set_ylabel(f"{comp} error (m)")

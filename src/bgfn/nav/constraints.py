@@ -1,0 +1,448 @@
+"""Learning-free outage aids of a road vehicle: non-holonomic constraints (NHC) and zero-velocity updates (ZUPT).
+
+Beyond the paper (issue 17, the classic aids a learned one must beat or add to). Both are velocity measurements
+of the 15-state filter (:mod:`bgfn.nav.filter`), fused with the same sequential Joseph update and closed-loop
+feedback as a position fix, at the *aid epochs*: the first IMU row at or after every multiple of
+``1 / nhc_rate_hz`` of the time of week (the same epochs in every run of a drive).
+
+- **NHC**: a car neither slides sideways nor leaves the road, so its velocity in the *vehicle* frame has
+  zero lateral and vertical components: ``z = [v^v_y, v^v_z] = 0 + w``, ``w ~ N(0, nhc_std^2)``. With
+  ``v^v = R_vb C_bn^T v^n`` and the error conventions of :mod:`bgfn.nav.error_model`
+  (``C_computed = (I - [phi]) C_true``, ``dV = v_computed - v_true``) the computed value is
+  ``v^v_computed = v^v_true + M dV - M [v x] phi`` with ``M = R_vb C_bn^T``, so the two rows of ``H`` are
+  ``M`` on ``dV`` and ``-M [v x]`` on ``phi`` (rows y, z of the vehicle frame).
+- **ZUPT**: when the stillness detector fires at an aid epoch the vehicle stands still, so its velocity is
+  zero: ``z = v^n = 0 + w`` (3 rows, ``H = I`` on ``dV``, std ``zupt_std``). It replaces the NHC update of
+  that epoch (zero velocity holds the NHC rows too). It is refused (NHC instead) while the filter's own speed
+  exceeds ``max_speed_mps``: an IMU without vibration reads the same on a smooth straight road at constant
+  acceleration as at rest, and a zero-velocity update at speed would wreck the solution.
+
+Stillness detector (:func:`stillness`): a moving-variance test on a *trailing* window (causal: the samples up to
+the epoch) of ``window_s`` seconds, ``T_f = sqrt(sum_a var(f_a) / sum_a sigma_f,a^2)`` and the same ``T_w`` for
+the angular rate, with ``sigma`` the at-rest std of one IMU sample from the drive's sensor description
+(``meta['imu_errors']``, the one that sets the filter's Q: white noise at the IMU rate plus the idle engine
+vibration, :func:`rest_noise`); still when ``T_f < accel_ratio`` and ``T_w < gyro_ratio``. The variance of the
+*vectors* is used, not that of their norms, because a gentle manoeuvre turns the specific force without
+changing its norm (``|f| ~ sqrt(g^2 + a^2)``): on the Turin drive the norms' variance does not separate smooth
+cruising from a stop with a vibration-free IMU, the vectors' does. Thresholds relative to the at-rest noise
+make one setting serve sensors whose noise differs by orders of magnitude (the GLRT of Skog et al. 2010
+normalizes by the sensor noise for the same reason). Without vibration keys (a real drive's datasheet) the
+idle vibration is taken as zero, so a vibrating stop stays undetected: ZUPT then never fires, it never fires
+falsely.
+
+Vehicle frame (:func:`mounting_track`): the IMU body frame need not be the vehicle's (the Turin reference's
+body frame is about a degree off the direction of travel in yaw and pitch). The vehicle x axis is estimated,
+causally, from the GPS-aided solution: the running mean of ``v^b_y / v^b_x`` and ``v^b_z / v^b_x`` over the
+epochs with forward speed above ``mounting_min_speed_mps`` up to the epoch (``mounting: none``: the body frame).
+Inside an outage no fix updates it: it is held at its value at the outage start (:meth:`Constraints.frozen`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+import pandas as pd
+
+from ..errors import DataError
+from ..schema import ACCEL_COLUMNS, GYRO_COLUMNS
+from . import error_model as em
+from .filter import feedback, propagate_steps, sequential_update
+
+#: What happens at an IMU step (the aid schedule, one code per step).
+AID_NONE, AID_NHC, AID_ZUPT = 0, 1, 2
+#: Rows of the NHC measurement: vehicle-frame lateral (y) and vertical (z) velocity.
+NHC_AXES = (1, 2)
+#: Two IMU epochs closer than this are the same epoch, s.
+TIME_TOL = 1e-6
+
+#: Defaults of the ``nav.nhc`` and ``nav.zupt`` profile sections (keys of :class:`ConstraintConfig`).
+NHC_DEFAULTS: dict = {"std_mps": 0.1, "rate_hz": 1.0, "mounting": "estimate", "mounting_min_speed_mps": 5.0}
+ZUPT_DEFAULTS: dict = {"std_mps": 0.05, "window_s": 2.0, "accel_ratio": 1.5, "gyro_ratio": 1.5,
+                       "max_speed_mps": 2.0}
+#: Mounting choices: the vehicle frame estimated from the GPS-aided solution, or the IMU body frame.
+MOUNTINGS = ("estimate", "none")
+
+
+@dataclass(frozen=True)
+class ConstraintConfig:
+    """Settings of the vehicle constraints (a profile's ``nav.nhc`` and ``nav.zupt``).
+
+    Attributes
+    ----------
+    nhc_std_mps : float
+        Std of the lateral and vertical vehicle-frame velocity (the NHC's measurement noise), m/s.
+    nhc_rate_hz : float
+        Aid epochs per second (NHC, or ZUPT when still), Hz.
+    mounting : {"estimate", "none"}
+        Vehicle frame from the GPS-aided solution (module docstring), or the IMU body frame.
+    mounting_min_speed_mps : float
+        Forward speed above which an epoch enters the mounting estimate, m/s.
+    zupt_std_mps : float
+        Std of the zero-velocity measurement per NED axis, m/s.
+    window_s : float
+        Length of the detector's trailing window, s.
+    accel_ratio, gyro_ratio : float
+        Detector thresholds on ``T_f`` and ``T_w`` (multiples of the at-rest std; 0: ZUPT never fires).
+    zupt_max_speed_mps : float
+        No ZUPT while the filter's speed exceeds this, m/s (module docstring).
+    """
+
+    nhc_std_mps: float = NHC_DEFAULTS["std_mps"]
+    nhc_rate_hz: float = NHC_DEFAULTS["rate_hz"]
+    mounting: str = NHC_DEFAULTS["mounting"]
+    mounting_min_speed_mps: float = NHC_DEFAULTS["mounting_min_speed_mps"]
+    zupt_std_mps: float = ZUPT_DEFAULTS["std_mps"]
+    window_s: float = ZUPT_DEFAULTS["window_s"]
+    accel_ratio: float = ZUPT_DEFAULTS["accel_ratio"]
+    gyro_ratio: float = ZUPT_DEFAULTS["gyro_ratio"]
+    zupt_max_speed_mps: float = ZUPT_DEFAULTS["max_speed_mps"]
+
+    def __post_init__(self):
+        for name in ("nhc_std_mps", "nhc_rate_hz", "zupt_std_mps", "window_s"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value > 0):
+                raise DataError("params nav.nhc/nav.zupt", name, "a positive number", repr(value))
+        for name in ("mounting_min_speed_mps", "accel_ratio", "gyro_ratio", "zupt_max_speed_mps"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value >= 0):
+                raise DataError("params nav.nhc/nav.zupt", name, "a number >= 0", repr(value))
+        if self.mounting not in MOUNTINGS:
+            raise DataError("params nav.nhc", "mounting", f"one of {MOUNTINGS}", repr(self.mounting))
+
+    def kernel_args(self) -> tuple[float, float, float]:
+        """``(nhc_std, zupt_std, zupt_max_speed)`` in the order :func:`propagate_aided` takes them."""
+        return self.nhc_std_mps, self.zupt_std_mps, self.zupt_max_speed_mps
+
+
+def constraint_config(nav_cfg: dict) -> ConstraintConfig:
+    """:class:`ConstraintConfig` of a ``nav:`` section (:func:`bgfn.nav.baseline.nav_config`, defaults filled)."""
+    nhc = {**NHC_DEFAULTS, **(nav_cfg.get("nhc") or {})}
+    zupt = {**ZUPT_DEFAULTS, **(nav_cfg.get("zupt") or {})}
+    return ConstraintConfig(float(nhc["std_mps"]), float(nhc["rate_hz"]), str(nhc["mounting"]),
+                            float(nhc["mounting_min_speed_mps"]), float(zupt["std_mps"]), float(zupt["window_s"]),
+                            float(zupt["accel_ratio"]), float(zupt["gyro_ratio"]), float(zupt["max_speed_mps"]))
+
+
+# ---------------------------------------------------------------------------------------------------
+# stillness detector, aid epochs, vehicle frame (numpy, once per drive)
+# ---------------------------------------------------------------------------------------------------
+def rest_noise(imu_errors: dict, rate_hz: float, source: str = "meta['imu_errors']") -> tuple[np.ndarray, np.ndarray]:
+    """At-rest std of one IMU sample per axis: white noise at ``rate_hz`` and the idle engine vibration.
+
+    Parameters
+    ----------
+    imu_errors : dict
+        The drive's sensor description (:mod:`bgfn.data.imu_errors` keys): ``accel_noise_density``
+        (m/s/sqrt(s)), ``gyro_noise_density`` (rad/sqrt(s)) and, when present, ``vibration_accel_std``,
+        ``vibration_gyro_std`` and ``vibration_idle_fraction`` (zero vibration when absent).
+    rate_hz : float
+        IMU rate, Hz.
+
+    Returns
+    -------
+    sigma_f : ndarray (3,)
+        m/s^2.
+    sigma_w : ndarray (3,)
+        rad/s.
+    """
+    idle = float(imu_errors.get("vibration_idle_fraction", 0.0) or 0.0)
+    out = []
+    for s in ("accel", "gyro"):
+        dens = np.broadcast_to(np.asarray(imu_errors.get(f"{s}_noise_density", np.nan), dtype=float), (3,))
+        vib = np.broadcast_to(np.asarray(imu_errors.get(f"vibration_{s}_std", 0.0) or 0.0, dtype=float), (3,))
+        sigma = np.sqrt(dens ** 2 * rate_hz + (idle * vib) ** 2)
+        if not np.all(np.isfinite(sigma) & (sigma > 0)):
+            raise DataError(source, f"{s}_noise_density", "3 positive noise densities (the at-rest noise of the "
+                            "stillness detector)", repr(imu_errors.get(f"{s}_noise_density")))
+        out.append(sigma)
+    return out[0], out[1]
+
+
+def stillness(imu: pd.DataFrame, imu_errors: dict, config: ConstraintConfig,
+              source: str = "imu") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The moving-variance stillness detector of the module docstring, at every IMU row.
+
+    Parameters
+    ----------
+    imu : DataFrame
+        IMU table (CONTRIBUTING.md schema).
+    imu_errors : dict
+        Sensor description (:func:`rest_noise`).
+    config : ConstraintConfig
+
+    Returns
+    -------
+    still : ndarray of bool [M]
+        True where the trailing window ending at the row is still (False in the first ``window - 1`` rows).
+    t_f, t_w : ndarray [M]
+        The test statistics (dimensionless; NaN in the first rows).
+    """
+    t = imu["time"].to_numpy(float)
+    if t.size < 2:
+        raise DataError(source, "time", "at least two IMU rows", str(t.size))
+    rate = 1.0 / float(np.median(np.diff(t)))
+    n_win = max(2, int(round(config.window_s * rate)))
+    sigma_f, sigma_w = rest_noise(imu_errors, rate, source + " meta['imu_errors']")
+    stats = []
+    for cols, sigma in ((ACCEL_COLUMNS, sigma_f), (GYRO_COLUMNS, sigma_w)):
+        # the trailing window's variance per axis (pandas' rolling variance: no cancellation on g)
+        var = imu[list(cols)].rolling(n_win).var(ddof=0).to_numpy(float).sum(axis=1)       # [M]
+        stats.append(np.sqrt(np.maximum(var, 0.0) / np.sum(sigma ** 2)))   # (rounding can leave -0)
+    t_f, t_w = stats
+    with np.errstate(invalid="ignore"):
+        still = (t_f < config.accel_ratio) & (t_w < config.gyro_ratio)
+    return still, t_f, t_w
+
+
+def aid_epochs(time: np.ndarray, rate_hz: float) -> np.ndarray:
+    """Whether each IMU row is an aid epoch: the first row at or after a multiple of ``1 / rate_hz`` (bool [M])."""
+    k = np.floor(np.asarray(time, dtype=float) * rate_hz + 1e-9)
+    out = np.zeros(k.size, dtype=bool)
+    out[1:] = k[1:] > k[:-1]
+    return out
+
+
+def vehicle_velocity_ratios(trajectory: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
+    """Body-frame velocity ``v^b = C_bn^T v^n`` of a solution (reference schema) and its forward component.
+
+    Returns
+    -------
+    ratios : ndarray [T, 2]
+        ``v^b_y / v^b_x`` and ``v^b_z / v^b_x`` (tangents of the yaw and pitch of the velocity in the body frame).
+    forward : ndarray [T]
+        ``v^b_x``, m/s.
+    """
+    from .transform import dcm_from_euler
+
+    c = dcm_from_euler(trajectory["roll"].to_numpy(float), trajectory["pitch"].to_numpy(float),
+                       trajectory["yaw"].to_numpy(float))                                    # [T, 3, 3]
+    vb = np.einsum("tji,tj->ti", c, trajectory[["v_n", "v_e", "v_d"]].to_numpy(float))      # C^T v, [T, 3]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratios = vb[:, 1:] / vb[:, :1]
+    return ratios, vb[:, 0]
+
+
+def mounting_track(trajectory: pd.DataFrame | None, config: ConstraintConfig) -> tuple[np.ndarray, np.ndarray]:
+    """The causal estimate of the vehicle x axis in the body frame after each epoch of a GPS-aided solution.
+
+    Returns
+    -------
+    time : ndarray [T]
+        Epochs of ``trajectory``, s (empty without a trajectory or with ``mounting: none``).
+    tangents : ndarray [T, 2]
+        Running mean of ``v^b_y / v^b_x`` and ``v^b_z / v^b_x`` over the epochs up to each one with forward speed
+        above ``mounting_min_speed_mps`` (0 before the first: the body frame).
+    """
+    if trajectory is None or config.mounting == "none" or len(trajectory) == 0:
+        return np.empty(0), np.empty((0, 2))
+    ratios, forward = vehicle_velocity_ratios(trajectory)
+    use = forward > config.mounting_min_speed_mps
+    sums = np.cumsum(np.where(use[:, None], ratios, 0.0), axis=0)
+    count = np.cumsum(use)[:, None]
+    tangents = np.divide(sums, count, out=np.zeros_like(sums), where=count > 0)
+    return trajectory["time"].to_numpy(float), tangents
+
+
+def vehicle_rotation(tangents) -> np.ndarray:
+    """``R_vb`` (body to vehicle frame) whose x axis points along ``[1, tan_yaw, tan_pitch]`` of the body frame,
+    y axis level in the body's x-y plane (right), z completing the right-handed frame (down)."""
+    u = np.array([1.0, float(tangents[0]), float(tangents[1])])
+    u /= np.linalg.norm(u)
+    y = np.cross([0.0, 0.0, 1.0], u)
+    y /= np.linalg.norm(y)
+    return np.vstack([u, y, np.cross(u, y)])
+
+
+@dataclass
+class Constraints:
+    """The vehicle constraints of one drive, ready for :func:`bgfn.nav.filter.run_filter`.
+
+    Attributes
+    ----------
+    config : ConstraintConfig
+    imu_time : ndarray [M]
+        The drive's IMU epochs, s.
+    aid : ndarray of int8 [M]
+        ``AID_NONE`` / ``AID_NHC`` / ``AID_ZUPT`` after each IMU row (:func:`build_constraints`).
+    still : ndarray of bool [M]
+        The detector's output (:func:`stillness`).
+    mount_time : ndarray [T]
+    mount : ndarray [T, 2]
+        :func:`mounting_track`.
+    freeze_at : float or None
+        When set, the mounting estimate after this time is the one at it (an outage: no fix updates it).
+    """
+
+    config: ConstraintConfig
+    imu_time: np.ndarray
+    aid: np.ndarray
+    still: np.ndarray
+    mount_time: np.ndarray
+    mount: np.ndarray
+    freeze_at: float | None = None
+
+    def frozen(self, t: float) -> "Constraints":
+        """The same constraints with the mounting estimate held at its value at ``t`` (s)."""
+        return dataclasses.replace(self, freeze_at=float(t))
+
+    def mounting_at(self, time) -> np.ndarray:
+        """Mounting tangents [n, 2] in force at each of ``time`` (s): the track's last value at or before it."""
+        time = np.asarray(time, dtype=float)
+        if self.freeze_at is not None:
+            time = np.minimum(time, self.freeze_at)
+        out = np.zeros((time.size, 2))
+        if self.mount_time.size:
+            i = np.searchsorted(self.mount_time, time + TIME_TOL, side="right") - 1
+            ok = i >= 0
+            out[ok] = self.mount[i[ok]]
+        return out
+
+    def steps(self, time, source: str = "imu") -> tuple[np.ndarray, np.ndarray]:
+        """The aid code and mounting tangents of the IMU steps ending at ``time`` (s; rows of ``imu_time``).
+
+        Returns
+        -------
+        aid : ndarray of int8 [n]
+        mount : ndarray [n, 2]
+        """
+        time = np.asarray(time, dtype=float)
+        i = np.clip(np.searchsorted(self.imu_time, time - TIME_TOL), 0, max(self.imu_time.size - 1, 0))
+        if self.imu_time.size == 0 or np.any(np.abs(self.imu_time[i] - time) > TIME_TOL):
+            raise DataError(source, "time", "IMU epochs of the drive the constraints were built for",
+                            "an epoch it does not have")
+        return np.ascontiguousarray(self.aid[i]), np.ascontiguousarray(self.mounting_at(time))
+
+    def summary(self) -> dict:
+        """JSON-ready facts: aid epochs, ZUPT epochs, the share of still IMU rows, the final mounting angles (deg)."""
+        yaw, pitch = np.degrees(np.arctan(self.mount[-1])) if self.mount.size else (0.0, 0.0)
+        return {"aid_epochs": int(np.count_nonzero(self.aid)), "zupt_epochs": int(np.count_nonzero(self.aid == AID_ZUPT)),
+                "still_fraction": float(np.mean(self.still)) if self.still.size else 0.0,
+                "mounting_yaw_deg": float(yaw), "mounting_pitch_deg": float(pitch)}
+
+
+def build_constraints(imu: pd.DataFrame, imu_errors: dict, config: ConstraintConfig,
+                      trajectory: pd.DataFrame | None = None, source: str = "drive") -> Constraints:
+    """Detector, aid schedule and vehicle frame of a drive.
+
+    Parameters
+    ----------
+    imu : DataFrame
+        The drive's IMU table.
+    imu_errors : dict
+        Its sensor description (``Drive.meta['imu_errors']``).
+    config : ConstraintConfig
+    trajectory : DataFrame, optional
+        A GPS-aided solution (reference schema) for the vehicle frame; None: the body frame.
+    source : str
+        Name used in error messages.
+    """
+    t = imu["time"].to_numpy(float)
+    still, _, _ = stillness(imu, imu_errors, config, source)
+    epochs = aid_epochs(t, config.nhc_rate_hz)
+    aid = np.where(epochs, np.where(still, AID_ZUPT, AID_NHC), AID_NONE).astype(np.int8)
+    mount_time, mount = mounting_track(trajectory, config)
+    return Constraints(config, t, aid, still, mount_time, mount)
+
+
+# ---------------------------------------------------------------------------------------------------
+# numba kernels
+# ---------------------------------------------------------------------------------------------------
+@numba.njit(cache=True)
+def vehicle_rotation_nb(tan_yaw, tan_pitch, out):
+    """:func:`vehicle_rotation` (numba), written into ``out`` [3, 3]."""
+    u = np.array([1.0, tan_yaw, tan_pitch])
+    u /= np.sqrt(u @ u)
+    y = np.array([-u[1], u[0], 0.0])                 # e_z x u
+    y /= np.sqrt(y @ y)
+    out[0] = u
+    out[1] = y
+    out[2, 0] = u[1] * y[2] - u[2] * y[1]
+    out[2, 1] = u[2] * y[0] - u[0] * y[2]
+    out[2, 2] = u[0] * y[1] - u[1] * y[0]
+
+
+@numba.njit(cache=True)
+def nhc_measurement(v, c, r_vb, dz, H):
+    """NHC innovation (vehicle-frame lateral and vertical velocity, m/s) into ``dz`` [2] and ``H`` [2, 15]
+    (module docstring: ``M`` on ``dV``, ``-M [v x]`` on ``phi``)."""
+    m = r_vb @ c.T                                   # NED velocity -> vehicle frame
+    vv = m @ v
+    mv = m @ em.skew_nb(v)
+    H[:, :] = 0.0
+    for i in range(2):
+        row = NHC_AXES[i]
+        dz[i] = vv[row]
+        for j in range(3):
+            H[i, em.DV_NED[j]] = m[row, j]
+            H[i, em.PHI_NED[j]] = -mv[row, j]
+
+
+@numba.njit(cache=True)
+def zupt_measurement(v, dz, H):
+    """ZUPT innovation (the NED velocity, m/s) into ``dz`` [3] and ``H`` [3, 15] (identity on ``dV``)."""
+    H[:, :] = 0.0
+    for j in range(3):
+        dz[j] = v[j]
+        H[j, em.DV_NED[j]] = 1.0
+
+
+@numba.njit(cache=True)
+def apply_aid(kind, pos, v, c, ba, bg, P, tan_yaw, tan_pitch, nhc_std, zupt_std, zupt_max_speed):
+    """One NHC (``kind == AID_NHC``) or ZUPT (``AID_ZUPT``, while the speed is at most ``zupt_max_speed``)
+    update with feedback (:func:`bgfn.nav.filter.feedback`). Returns the code of the update applied."""
+    n = P.shape[0]
+    x = np.zeros(n)
+    if kind == AID_ZUPT and np.sqrt(v @ v) > zupt_max_speed:
+        kind = AID_NHC
+    if kind == AID_ZUPT:
+        dz = np.empty(3)
+        H = np.empty((3, n))
+        zupt_measurement(v, dz, H)
+        std = np.full(3, zupt_std)
+    else:
+        dz = np.empty(2)
+        H = np.empty((2, n))
+        r_vb = np.empty((3, 3))
+        vehicle_rotation_nb(tan_yaw, tan_pitch, r_vb)
+        nhc_measurement(v, c, r_vb, dz, H)
+        std = np.full(2, nhc_std)
+    innov = np.empty(dz.size)
+    sequential_update(P, H, dz, std, x, innov)
+    feedback(pos, v, c, ba, bg, x)
+    return kind
+
+
+@numba.njit(cache=True)
+def propagate_aided(i0, i1, dt, gyro, accel, pos, v, c, ba, bg, P, q_g, q_a, q_bg, q_ba, inv_tau_a, inv_tau_g,
+                    out_pos, out_v, out_c, out_sd, aid, mount, nhc_std, zupt_std, zupt_max_speed, out_bias):
+    """:func:`bgfn.nav.filter.propagate_steps` over steps ``i0..i1-1`` with the aid of ``aid[k]`` applied after
+    step ``k``; an aided output row ``k + 1`` holds the state after the update, and ``out_bias[k + 1]`` its
+    bias estimates (accelerometer then gyro)."""
+    n = P.shape[0]
+    k = i0
+    while k < i1:
+        j = k
+        while j < i1 and aid[j] == AID_NONE:
+            j += 1
+        end = min(j + 1, i1)
+        propagate_steps(k, end, dt, gyro, accel, pos, v, c, ba, bg, P, q_g, q_a, q_bg, q_ba, inv_tau_a, inv_tau_g,
+                        out_pos, out_v, out_c, out_sd)
+        if j < i1:
+            apply_aid(aid[j], pos, v, c, ba, bg, P, mount[j, 0], mount[j, 1], nhc_std, zupt_std, zupt_max_speed)
+            out_pos[j + 1] = pos
+            out_v[j + 1] = v
+            out_c[j + 1] = c
+            for r in range(n):
+                out_sd[j + 1, r] = np.sqrt(max(P[r, r], 0.0))
+            for a in range(3):
+                out_bias[j + 1, a] = ba[a]
+                out_bias[j + 1, 3 + a] = bg[a]
+        k = end
+
+
+__all__ = ["AID_NHC", "AID_NONE", "AID_ZUPT", "ConstraintConfig", "Constraints", "NHC_DEFAULTS", "ZUPT_DEFAULTS",
+           "aid_epochs", "build_constraints", "constraint_config", "mounting_track", "nhc_measurement",
+           "propagate_aided", "rest_noise", "stillness", "vehicle_rotation", "zupt_measurement"]

@@ -76,6 +76,9 @@ SHARED_TABLES: dict[str, str] = {
     "sweep": "outage_sweep.csv",                # notebook 04
     "sweep_summary": "outage_sweep_summary.csv",
     "sweep_pairs": "outage_sweep_pairs.csv",
+    "oracle": "outage_oracle.csv",              # notebook 04: the oracle rows (bgfn.evaluate.oracle)
+    "oracle_breakeven": "outage_oracle_breakeven.csv",
+    "oracle_runs": "outage_oracle_runs.csv",
 }
 #: Keys of earlier versions that now live elsewhere: ``section.key`` -> the key to set instead.
 MOVED_KEYS: dict[str, str] = {

@@ -179,7 +179,9 @@ def test_breakeven_table_against_ins_and_an_extra_baseline():
     assert nhc["breakeven_sigma_m"].iloc[0] == pytest.approx(0.05)
     lines = orc.describe_oracle(be)
     assert len(lines) == 2 and lines[0].startswith("d (field test), sweep, 30 s outages: ")
-    assert "below 0.15 m per axis" in lines[0] and "BGFN 0.6 m (4.0 times the break-even" in lines[0]
+    assert "below 0.15 m per axis and 1 s increment (break-even)" in lines[0] and "BGFN 0.6 m (4.0 times the break-even" in lines[0]
+    assert ("MLP 2.0 m (13.3 times the break-even; its aided error (50.0 m) exceeds the oracle's at every "
+            "sigma") in lines[0]
     # exact increments worse than the baseline: said so, no break-even
     never = orc.breakeven_table(table, levels.assign(median_m=[3.0, 0.5, 7.0, 50.0, 0.5]))
     row = never[never["baseline"] == "INS+NHC"].iloc[0]
@@ -263,5 +265,35 @@ def test_profiles_define_the_oracle_and_its_durations_fit_the_sweep():
     cfg["evaluate"]["oracle"]["durations_s"] = [1000.0]
     with pytest.raises(ProfileError, match="evaluate.oracle.durations_s"):
         validate(cfg)
-    with pytest.raises(DataError):
-        ev.evaluate_config(cfg["evaluate"], cfg["train"])
+    with pytest.raises(DataError, match="durations_s"):
+        orc.oracle_windows(cfg, None, ev.evaluate_config(cfg["evaluate"], cfg["train"]), [])
+
+
+def test_sweep_rows_carry_each_networks_increment_error(drive, monkeypatch, tmp_path):
+    # the sweep with stand-in networks (no training): exact increments score 0, white noise its sigma
+    from bgfn import config, train
+    from bgfn.evaluate import sweep as sweep_module
+
+    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)
+    truth = ev.AntennaTruth(drive.reference, LEVER)
+    t0 = float(drive.reference["time"].iloc[0])
+    noise = orc.oracle_noise("synthetic", 0, 1000)
+    stand_in = {"mlp": orc.OracleIncrements(truth, 0.2, 0.0, noise, t0),
+                "bgfn": orc.OracleIncrements(truth, 0.2, 0.5, noise, t0)}
+
+    def fake_train(method, data, size_cfg, tc, seed=0, extra_card=None, **kw):
+        return {"method": method, "seed": seed, "fold": extra_card["fold"], "epochs_run": 1, "val_rmse_m": 1.0}
+
+    monkeypatch.setattr(train, "train_model", fake_train)
+    monkeypatch.setattr(sweep_module, "load_model", lambda path: stand_in[path.name.split("_seed")[0]])
+    cfg = load_profile("smoke")
+    cfg = {**cfg, "nav": NAV, "train": {**cfg["train"], "window": 20, "margin_s": 5.0}}
+    ecfg = ev.evaluate_config({"methods": ["bgfn", "mlp"], "sweep": {
+        "n_starts": 2, "folds": 2, "durations_s": [10.0, 30.0], "warmup_s": 30.0, "seeds": [0]},
+        "oracle": _oracle([0.0], durations=[30.0])}, cfg["train"])
+    rows, _ = ev.run_sweep(cfg, "t", "synthetic", drive=drive, ecfg=ecfg, progress=False)
+    assert list(rows.columns) == list(ev.SWEEP_COLUMNS)
+    inc = rows.groupby(["method", "duration_s"])["increment_rmse_m"]
+    assert rows.loc[rows["method"].isin(["INS", "GPS"]), "increment_rmse_m"].isna().all()
+    assert inc.max()["MLP"].max() == pytest.approx(0.0, abs=1e-9)
+    assert inc.median()[("BGFN", 30.0)] == pytest.approx(0.5, rel=0.2)

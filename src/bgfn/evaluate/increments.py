@@ -58,7 +58,7 @@ class AntennaTruth:
         return np.column_stack([np.interp(t, self.time, x) for x in (self.lat, self.lon, self.h)])
 
     def increments(self, t_from, t_to) -> np.ndarray:
-        """True ``delta_p_gps`` (Eq. eq8-1) of the antenna over each interval ``[t_from, t_to]``: (dN, dE), m, [M, 2]."""
+        """True ``delta_p_gps`` (Eq. eq8-1) of the antenna over each ``[t_from, t_to]``: (dN, dE), m, [M, 2]."""
         a, b = self.positions(t_from), self.positions(t_to)
         return position_increment(a[:, 0], a[:, 1], a[:, 2], b[:, 0], b[:, 1], b[:, 2])
 

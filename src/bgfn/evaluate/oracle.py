@@ -131,6 +131,10 @@ def oracle_windows(cfg: dict, drive, ecfg: dict, windows) -> tuple[list[tuple[st
     sw, durations = ecfg["sweep"], ecfg["oracle"]["durations_s"]
     if not durations:
         return out, []
+    if max(durations) > max(sw["durations_s"]):
+        raise DataError("params evaluate.oracle", "durations_s", f"durations up to evaluate.sweep.durations_s's "
+                        f"longest {max(sw['durations_s']):g} s (the sweep's starts leave room for no more)",
+                        repr(durations))
     n_window = int(learning_options(sweep_train_config(cfg.get("train") or {}, sw))["window"])
     try:
         plan = sweep_plan(drive, sw, n_window)
@@ -357,6 +361,11 @@ def oracle_interval_table(table: pd.DataFrame) -> pd.DataFrame:
     return wide[[c for c in cols if c in wide.columns]]
 
 
+def _m(x: float) -> str:
+    """A length in the sentences: two significant digits below 1 m, one decimal above."""
+    return f"{x:.2g}" if abs(x) < 1 else f"{x:.1f}"
+
+
 def _windows_text(outage: str, duration: float) -> str:
     return f"sweep, {duration:g} s outages" if outage == SWEEP_OUTAGE else f"outage {outage} ({duration:g} s)"
 
@@ -376,20 +385,23 @@ def describe_oracle(breakeven: pd.DataFrame) -> list[str]:
         if r0["crossing"] == BEYOND_GRID:
             s = head + (f"the oracle beats {base} ({r0['baseline_m']:.1f} m) at every sigma of the grid: the "
                         "break-even lies beyond it")
-            be = float("nan")
         else:
-            be = float(r0["breakeven_sigma_m"])
             s = head + (f"the pseudo-GPS beats {base} ({r0['baseline_m']:.1f} m) while the increment error stays "
-                        f"below {be:.2g} m per axis (break-even)")
+                        f"below {_m(r0['breakeven_sigma_m'])} m per axis and {r0['increment_s']:.2g} s increment "
+                        "(break-even)")
         nets = []
         for r in g.dropna(subset=["method"]).itertuples(index=False):
             if not np.isfinite(r.increment_rmse_m):
                 continue
-            far = (f"{r.rmse_to_breakeven:.1f} times the break-even" if np.isfinite(r.rmse_to_breakeven)
-                   else "")
-            eq = (f"its aided error ({r.method_m:.1f} m) is the oracle's at sigma {r.equivalent_sigma_m:.2g} m"
-                  if r.equivalent_crossing == CROSSED else f"its aided error is {r.method_m:.1f} m")
-            nets.append(f"{r.method} {r.increment_rmse_m:.2g} m" + (f" ({far}; {eq})" if far else f" ({eq})"))
+            far = [f"{r.rmse_to_breakeven:.1f} times the break-even"] if np.isfinite(r.rmse_to_breakeven) else []
+            if r.equivalent_crossing == CROSSED:
+                far.append(f"its aided error ({r.method_m:.1f} m) is the oracle's at sigma "
+                           f"{_m(r.equivalent_sigma_m)} m")
+            elif r.equivalent_crossing == BEYOND_GRID:
+                far.append(f"its aided error ({r.method_m:.1f} m) exceeds the oracle's at every sigma of the grid")
+            else:
+                far.append(f"its aided error ({r.method_m:.1f} m) is below the exact oracle's")
+            nets.append(f"{r.method} {_m(r.increment_rmse_m)} m ({'; '.join(far)})")
         lines.append(s + ("; the networks' increment errors (RMS per axis): " + ", ".join(nets) if nets else "")
                      + ".")
     return lines

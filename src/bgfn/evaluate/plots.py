@@ -156,8 +156,12 @@ def plot_oracle(table: pd.DataFrame, levels: pd.DataFrame, breakeven: pd.DataFra
     d = table[table["dataset"] == dataset]
     groups = [k for k, _ in d.groupby(["outage", "duration_s"], sort=False)]
     groups.sort(key=lambda k: (k[0] != SWEEP_OUTAGE, k[0], k[1]))
-    fig, axes = plt.subplots(1, max(1, len(groups)), figsize=(4.3 * max(1, len(groups)), 4.2), squeeze=False)
-    for ax, (o, du) in zip(axes[0], groups):
+    ncol = min(2, max(1, len(groups)))
+    nrow = max(1, -(-len(groups) // ncol))
+    fig, axes = plt.subplots(nrow, ncol, figsize=(5.2 * ncol, 4.2 * nrow), squeeze=False)
+    for ax in axes.ravel()[len(groups):]:
+        ax.set_visible(False)
+    for ax, (o, du) in zip(axes.ravel(), groups):
         g = d[(d["outage"] == o) & (d["duration_s"] == du)]
         curve = g[g["method"] == ORACLE_METHOD].sort_values("sigma_m")
         lv = levels[(levels["dataset"] == dataset) & (levels["outage"] == o) & np.isclose(levels["duration_s"], du)]
@@ -197,7 +201,7 @@ def plot_oracle(table: pd.DataFrame, levels: pd.DataFrame, breakeven: pd.DataFra
         ax.set_xlabel("increment error per axis, sigma or network RMSE (m)")
         ax.set_ylabel("max horizontal error (m)")
         n_starts = int(curve["n_starts"].max()) if len(curve) else 0
-        ax.set_title(f"{dataset}\n" + (f"sweep, {du:g} s outages ({n_starts} starts)" if o == SWEEP_OUTAGE
+        ax.set_title(f"{dataset}: " + (f"sweep, {du:g} s outages ({n_starts} starts)" if o == SWEEP_OUTAGE
                                        else f"outage {o} ({du:g} s)"), fontsize=9)
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=7, loc="upper left")

@@ -161,7 +161,7 @@ def _hand_table():
     levels = pd.DataFrame({"dataset": "d", "outage": "sweep", "duration_s": 30.0,
                            "method": ["INS", "INS+NHC", "BGFN", "MLP", "GPS"], "n": 4,
                            "median_m": [3.0, 1.5, 7.0, 50.0, 0.5],
-                           "increment_rmse_m": [np.nan, np.nan, 0.6, 2.0, np.nan]})
+                           "increment_rmse_m": [np.nan, np.nan, 0.35, 2.0, np.nan]})
     return pd.DataFrame(rows, columns=list(orc.ORACLE_COLUMNS)), levels
 
 
@@ -172,14 +172,17 @@ def test_breakeven_table_against_ins_and_an_extra_baseline():
     assert sorted(set(be["baseline"])) == ["INS", "INS+NHC"] and set(be["method"]) == {"BGFN", "MLP"}
     ins = be[be["baseline"] == "INS"].set_index("method")
     assert ins.loc["BGFN", "breakeven_sigma_m"] == pytest.approx(0.15)
-    assert ins.loc["BGFN", "rmse_to_breakeven"] == pytest.approx(0.6 / 0.15)
+    assert ins.loc["BGFN", "rmse_to_breakeven"] == pytest.approx(0.35 / 0.15)
     assert ins.loc["BGFN", "equivalent_sigma_m"] == pytest.approx(0.35)     # 7 m is the oracle's at 0.35 m
+    assert ins.loc["BGFN", "oracle_at_rmse_m"] == pytest.approx(7.0)        # white errors of 0.35 m: 7 m
+    assert np.isnan(ins.loc["MLP", "oracle_at_rmse_m"])                     # 2 m: beyond the grid
     assert np.isnan(ins.loc["MLP", "equivalent_sigma_m"]) and ins.loc["MLP", "equivalent_crossing"] == orc.BEYOND_GRID
     nhc = be[be["baseline"] == "INS+NHC"]
     assert nhc["breakeven_sigma_m"].iloc[0] == pytest.approx(0.05)
     lines = orc.describe_oracle(be)
     assert len(lines) == 2 and lines[0].startswith("d (field test), sweep, 30 s outages: ")
-    assert "below 0.15 m per axis and 1 s increment (break-even)" in lines[0] and "BGFN 0.6 m (4.0 times the break-even" in lines[0]
+    assert "below 0.15 m per axis and 1 s increment (break-even)" in lines[0]
+    assert "BGFN 0.35 m (2.3 times the break-even" in lines[0]
     assert ("MLP 2.0 m (13.3 times the break-even; its aided error (50.0 m) exceeds the oracle's at every "
             "sigma") in lines[0]
     # exact increments worse than the baseline: said so, no break-even

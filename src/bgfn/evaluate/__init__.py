@@ -71,7 +71,7 @@ from bgfn.evaluate.hybrid import (NavContext, OutageRun, gps_run, navigation_con
 from bgfn.evaluate.networks import ensure_models, load_model
 from bgfn.evaluate.increments import AntennaTruth, increment_errors, increment_rmse
 from bgfn.evaluate.oracle import (BREAKEVEN_COLUMNS, ORACLE_COLUMNS, OracleIncrements, OracleResult, breakeven_table,
-                                  crossing_sigma, describe_oracle, method_levels, oracle_interval_table, oracle_runs,
+                                  crossing_sigma, curve_at, describe_oracle, method_levels, oracle_interval_table, oracle_runs,
                                   oracle_table, oracle_windows, run_oracle)
 from bgfn.evaluate.plots import plot_gps_row, plot_oracle, plot_outage, plot_sweep_boxes
 from bgfn.evaluate.record import RECORD_FILE, evaluation_record, write_evaluation_record
@@ -86,7 +86,7 @@ from bgfn.evaluate.tables import (TableResult, aggregate_seeds, describe_tables,
 
 __all__ = [
     "AntennaTruth", "BREAKEVEN_COLUMNS", "ORACLE_COLUMNS", "OracleIncrements", "OracleResult", "breakeven_table",
-    "crossing_sigma", "describe_oracle", "increment_errors", "increment_rmse", "method_levels",
+    "crossing_sigma", "curve_at", "describe_oracle", "increment_errors", "increment_rmse", "method_levels",
     "oracle_interval_table", "oracle_runs", "oracle_table", "oracle_windows", "plot_oracle", "run_oracle",
     "COLORS", "EVALUATE_DEFAULTS", "FIGURE_METHODS", "METRIC_COLUMNS", "REAL_IMU_DATASETS", "RECORD_FILE",
     "REDUCTION_COLUMNS", "SENSITIVITY_COLUMNS", "SWEEP_COLUMNS", "TABLE_COLUMNS", "TABLE_FILES",

@@ -59,8 +59,8 @@ LEVEL_COLUMNS: tuple[str, ...] = ("dataset", "outage", "duration_s", "method", "
 #: Columns of ``outage_oracle_breakeven.csv``.
 BREAKEVEN_COLUMNS: tuple[str, ...] = (
     "dataset", "test", "outage", "duration_s", "increment_s", "baseline", "baseline_m", "breakeven_sigma_m",
-    "crossing", "method", "method_m", "increment_rmse_m", "rmse_to_breakeven", "equivalent_sigma_m",
-    "equivalent_crossing")
+    "crossing", "method", "method_m", "increment_rmse_m", "rmse_to_breakeven", "oracle_at_rmse_m",
+    "equivalent_sigma_m", "equivalent_crossing")
 #: :func:`crossing_sigma` outcomes: the curve crosses the level inside the grid; it is above the level already at
 #: the smallest sigma; it stays below the level over the whole grid.
 CROSSED, NEVER_BELOW, BEYOND_GRID = "crossed", "never_below", "beyond_grid"
@@ -309,11 +309,23 @@ def crossing_sigma(sigmas, errors, level: float) -> tuple[float, str]:
     return float(s[i - 1] + frac * (s[i] - s[i - 1])), CROSSED
 
 
+def curve_at(sigmas, errors, sigma: float) -> float:
+    """The oracle curve at ``sigma`` (m), linear between grid points; NaN outside the grid."""
+    s, e = np.asarray(sigmas, float), np.asarray(errors, float)
+    order = np.argsort(s)
+    s, e = s[order], e[order]
+    if not (len(s) and np.isfinite(sigma) and s[0] <= sigma <= s[-1]):
+        return float("nan")
+    return float(np.interp(sigma, s, e))
+
+
 def breakeven_table(table: pd.DataFrame, levels: pd.DataFrame) -> pd.DataFrame:
     """Break-even sigma per dataset, windows, duration and baseline, and each network's distance from it.
 
     Baselines: the oracle's own INS row, and every learning-free row of ``levels`` other than INS (``INS+NHC``
-    when it exists). Networks: the rows of ``levels`` that :func:`is_network`.
+    when it exists). Networks: the rows of ``levels`` that :func:`is_network`, with ``oracle_at_rmse_m`` (the
+    oracle's error at the network's increment RMSE: what the network would reach were its errors white,
+    :func:`curve_at`) and ``equivalent_sigma_m`` (the oracle noise that gives the network's own error).
 
     Returns
     -------
@@ -345,6 +357,7 @@ def breakeven_table(table: pd.DataFrame, levels: pd.DataFrame) -> pd.DataFrame:
                 rows.append({**common, "method": n.method, "method_m": n.median_m,
                              "increment_rmse_m": n.increment_rmse_m,
                              "rmse_to_breakeven": n.increment_rmse_m / be if be > 0 else float("nan"),
+                             "oracle_at_rmse_m": curve_at(sig, err, n.increment_rmse_m),
                              "equivalent_sigma_m": eq, "equivalent_crossing": eq_status})
     return pd.DataFrame(rows, columns=list(BREAKEVEN_COLUMNS))
 

@@ -71,8 +71,8 @@ from bgfn.evaluate.hybrid import (NavContext, OutageRun, gps_run, navigation_con
 from bgfn.evaluate.networks import ensure_models, load_model
 from bgfn.evaluate.increments import AntennaTruth, increment_errors, increment_rmse
 from bgfn.evaluate.oracle import (BREAKEVEN_COLUMNS, ORACLE_COLUMNS, OracleIncrements, OracleResult, breakeven_table,
-                                  crossing_sigma, curve_at, describe_oracle, method_levels, oracle_interval_table, oracle_runs,
-                                  oracle_table, oracle_windows, run_oracle)
+                                  crossing_sigma, curve_at, describe_oracle, method_levels, oracle_interval_table,
+                                  oracle_runs, oracle_table, oracle_windows, run_oracle)
 from bgfn.evaluate.plots import plot_gps_row, plot_oracle, plot_outage, plot_sweep_boxes
 from bgfn.evaluate.record import RECORD_FILE, evaluation_record, write_evaluation_record
 from bgfn.evaluate.sensitivity import (SENSITIVITY_COLUMNS, Sensitivity, pseudo_std_sensitivity,

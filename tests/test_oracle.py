@@ -268,6 +268,10 @@ def test_profiles_define_the_oracle_and_its_durations_fit_the_sweep():
     cfg["evaluate"]["oracle"]["durations_s"] = [1000.0]
     with pytest.raises(ProfileError, match="evaluate.oracle.durations_s"):
         validate(cfg)
+    del cfg["evaluate"]["oracle"]["durations_s"]              # the default durations must fit too
+    cfg["evaluate"]["sweep"]["durations_s"] = [10.0]
+    with pytest.raises(ProfileError, match="evaluate.oracle.durations_s"):
+        validate(cfg)
     with pytest.raises(DataError, match="durations_s"):
         orc.oracle_windows(cfg, None, ev.evaluate_config(cfg["evaluate"], cfg["train"]), [])
 

@@ -256,11 +256,14 @@ def cross_check(cfg: dict) -> None:
     if "folds" in sw and "n_starts" in sw and sw["folds"] > sw["n_starts"]:
         raise ProfileError("evaluate.sweep.folds", f"at most evaluate.sweep.n_starts = {sw['n_starts']}",
                            _fmt(sw["folds"]))
-    oc = ev.get("oracle") or {}
-    if oc.get("durations_s") and sw.get("durations_s") and max(oc["durations_s"]) > max(sw["durations_s"]):
+    from bgfn.evaluate.config import EVALUATE_DEFAULTS
+
+    # the oracle runs at the sweep's starts (defaults filled in, as bgfn.evaluate.evaluate_config does)
+    o_dur = (ev.get("oracle") or {}).get("durations_s", EVALUATE_DEFAULTS["oracle"]["durations_s"])
+    s_dur = sw.get("durations_s") or EVALUATE_DEFAULTS["sweep"]["durations_s"]
+    if o_dur and max(o_dur) > max(s_dur):
         raise ProfileError("evaluate.oracle.durations_s", f"durations up to evaluate.sweep.durations_s's longest "
-                           f"{max(sw['durations_s']):g} s (the sweep's starts leave room for no more)",
-                           _fmt(oc["durations_s"]))
+                           f"{max(s_dur):g} s (the sweep's starts leave room for no more)", _fmt(o_dur))
     en = cfg.get("energy") or {}
     if en.get("dataset") is not None and en["dataset"] not in (tr.get("datasets") or []):
         raise ProfileError("energy.dataset", f"one of train.datasets {tr.get('datasets')} (its networks are "

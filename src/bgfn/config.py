@@ -77,6 +77,9 @@ SHARED_TABLES: dict[str, str] = {
     "sweep_summary": "outage_sweep_summary.csv",
     "sweep_pairs": "outage_sweep_pairs.csv",
     "kf_ins_tuning": "kf_ins_tuning.csv",       # notebook 02: the INS row under each filter setup
+    "oracle": "outage_oracle.csv",              # notebook 04: the oracle rows (bgfn.evaluate.oracle)
+    "oracle_breakeven": "outage_oracle_breakeven.csv",
+    "oracle_runs": "outage_oracle_runs.csv",
 }
 #: Where a top-level ``datasets:`` puts its list (the datasets of every notebook), unless the same file or a later
 #: one in the ``base:`` chain sets that section's own ``datasets``.

@@ -159,7 +159,8 @@ SCHEMA = section(
         sweep=section(datasets=seq(text()), n_starts=integer(1), durations_s=seq(_POS, min_len=1),
                       folds=integer(1), seeds=seq(_SEED, min_len=1), warmup_s=_NONNEG,
                       train=Spec("section", fields=TRAIN.fields), n_boot=integer(1),
-                      level=_FRACTION, boot_seed=_SEED)),
+                      level=_FRACTION, boot_seed=_SEED),
+        oracle=section(sigmas_m=seq(_NONNEG), seeds=seq(_SEED, min_len=1), durations_s=seq(_POS))),
     energy=section(
         e_mac_pj=_POS, e_ac_pj=_POS, dataset=text(null=True), seed=integer(0, null=True), allow_untrained=flag(),
         max_windows=integer(1, null=True), batch_size=integer(1), sweep_time_steps=seq(integer(1), min_len=1),
@@ -357,6 +358,14 @@ def cross_check(cfg: dict) -> None:
     if "folds" in sw and "n_starts" in sw and sw["folds"] > sw["n_starts"]:
         raise ProfileError("evaluate.sweep.folds", f"at most evaluate.sweep.n_starts = {sw['n_starts']}",
                            _fmt(sw["folds"]))
+    from bgfn.evaluate.config import EVALUATE_DEFAULTS
+
+    # the oracle runs at the sweep's starts (defaults filled in, as bgfn.evaluate.evaluate_config does)
+    o_dur = (ev.get("oracle") or {}).get("durations_s", EVALUATE_DEFAULTS["oracle"]["durations_s"])
+    s_dur = sw.get("durations_s") or EVALUATE_DEFAULTS["sweep"]["durations_s"]
+    if o_dur and max(o_dur) > max(s_dur):
+        raise ProfileError("evaluate.oracle.durations_s", f"durations up to evaluate.sweep.durations_s's longest "
+                           f"{max(s_dur):g} s (the sweep's starts leave room for no more)", _fmt(o_dur))
     en = cfg.get("energy") or {}
     if en.get("dataset") is not None and en["dataset"] not in (tr.get("datasets") or []):
         raise ProfileError("energy.dataset", f"one of train.datasets {tr.get('datasets')} (its networks are "

@@ -59,6 +59,8 @@ Modules, in the order of the protocol:
 - :mod:`bgfn.evaluate.plots` -- the paper's outage figures and the sweep's box plots;
 - :mod:`bgfn.evaluate.sensitivity` -- the tables again with each network's validation std for its pseudo fixes;
 - :mod:`bgfn.evaluate.sweep` -- the outage sweep and its statistics;
+- :mod:`bgfn.evaluate.increments` -- the true increments of a drive, a run's increment error;
+- :mod:`bgfn.evaluate.oracle` -- the oracle rows: true increments plus noise, the break-even accuracy;
 - :mod:`bgfn.evaluate.record` -- ``outage_evaluation.json``, the record notebook 06 reads.
 
 Everything public is re-exported here: ``from bgfn import evaluate as ev; ev.evaluate_dataset(...)``.
@@ -72,7 +74,11 @@ from bgfn.evaluate.config import (COLORS, EVALUATE_DEFAULTS, FIGURE_METHODS, MET
 from bgfn.evaluate.hybrid import (NavContext, OutageRun, gps_run, navigation_context, pseudo_gps_positions,
                                   run_outages, window_metrics)
 from bgfn.evaluate.networks import ensure_models, load_model
-from bgfn.evaluate.plots import plot_gps_row, plot_outage, plot_sweep_boxes
+from bgfn.evaluate.increments import AntennaTruth, increment_errors, increment_rmse
+from bgfn.evaluate.oracle import (BREAKEVEN_COLUMNS, ORACLE_COLUMNS, OracleIncrements, OracleResult, breakeven_table,
+                                  crossing_sigma, curve_at, describe_oracle, method_levels, oracle_interval_table,
+                                  oracle_runs, oracle_table, oracle_windows, run_oracle)
+from bgfn.evaluate.plots import plot_gps_row, plot_oracle, plot_outage, plot_sweep_boxes
 from bgfn.evaluate.record import RECORD_FILE, evaluation_record, write_evaluation_record
 from bgfn.evaluate.sensitivity import (SENSITIVITY_COLUMNS, Sensitivity, pseudo_std_sensitivity,
                                        save_sensitivity, sensitivity_table)
@@ -84,6 +90,9 @@ from bgfn.evaluate.tables import (TableResult, aggregate_seeds, describe_tables,
                                   representative_seeds, run_tables, save_table_result, table_file)
 
 __all__ = [
+    "AntennaTruth", "BREAKEVEN_COLUMNS", "ORACLE_COLUMNS", "OracleIncrements", "OracleResult", "breakeven_table",
+    "crossing_sigma", "curve_at", "describe_oracle", "increment_errors", "increment_rmse", "method_levels",
+    "oracle_interval_table", "oracle_runs", "oracle_table", "oracle_windows", "plot_oracle", "run_oracle",
     "COLORS", "EVALUATE_DEFAULTS", "FIGURE_METHODS", "METRIC_COLUMNS", "REAL_IMU_DATASETS", "RECORD_FILE",
     "REDUCTION_COLUMNS", "SENSITIVITY_COLUMNS", "SWEEP_COLUMNS", "TABLE_COLUMNS", "TABLE_FILES",
     "TABLE_METHODS", "EvaluationSetup", "NavContext", "OutageRun", "Sensitivity", "TableResult",

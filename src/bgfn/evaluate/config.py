@@ -25,9 +25,10 @@ COLORS: dict[str, str] = {**_BASE_COLORS, **{nhc_label(m): c for m, c in _BASE_C
 #: Columns of the outage tables (``tables/outage_dataset.csv``, ``outage_field.csv``).
 METRIC_COLUMNS: tuple[str, ...] = ("max_east_m", "max_north_m", "rmse_h_m", "final_h_m")
 TABLE_COLUMNS: tuple[str, ...] = ("outage", "method") + METRIC_COLUMNS
-#: Columns of ``tables/outage_sweep.csv``.
+#: Columns of ``tables/outage_sweep.csv``; ``increment_rmse_m``: a network's predicted delta_p_gps against the true
+#: ones inside the outage, RMSE per horizontal axis (:func:`bgfn.evaluate.increments.increment_rmse`; NaN for INS, GPS).
 SWEEP_COLUMNS: tuple[str, ...] = ("dataset", "start_s", "duration_s", "method", "seed", "fold", "max_east_m",
-                                  "max_north_m", "max_h_m", "rmse_h_m", "final_h_m")
+                                  "max_north_m", "max_h_m", "rmse_h_m", "final_h_m", "increment_rmse_m")
 #: The paper's test -> our outage table file (``results/<profile>/tables/``).
 TABLE_FILES: dict[str, str] = {test: spec["file"] for test, spec in TESTS.items()}
 #: Simulated dataset -> the dataset with NaveGo's recorded IMU, and the file it needs.
@@ -57,6 +58,9 @@ EVALUATE_DEFAULTS: dict[str, Any] = {
         "level": 0.95,
         "boot_seed": 0,
     },
+    # the pseudo-GPS from the true increments plus noise (bgfn.evaluate.oracle)
+    "oracle": {"sigmas_m": [0.0, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0], "seeds": [0, 1],
+               "durations_s": [30.0, 60.0]},
 }
 
 

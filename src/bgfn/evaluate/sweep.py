@@ -13,6 +13,7 @@ from bgfn.checkpoints import checkpoint_path
 from bgfn.errors import DataError
 from bgfn.evaluate.config import SEEDLESS_METHODS, SWEEP_COLUMNS, TABLE_METHODS, evaluate_config
 from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
+from bgfn.evaluate.increments import AntennaTruth, increment_rmse
 from bgfn.evaluate.networks import load_model
 from bgfn.nav.baseline import filter_start
 from bgfn.paper import METHOD_LABELS, NHC_SUFFIX, label, nhc_label
@@ -94,10 +95,14 @@ def run_sweep(cfg: dict, profile: str, dataset: str, drive=None, ecfg: dict | No
     t0 = time.perf_counter()
     ctx = navigation_context(drive, cfg.get("nav"), plan["start_s"])
     rows = []
+    truth = AntennaTruth.of(ctx)
 
     def add(run, fold):
         for du in durations:
             mtr = window_metrics(run.errors, run.start, du)
+            # the network's own increment error in this outage (the oracle's sigma axis, bgfn.evaluate.oracle)
+            mtr["increment_rmse_m"] = (increment_rmse(run, truth, ctx.gnss_interval_s, du) if len(run.increments)
+                                       else float("nan"))
             for seed in ([run.seed] if run.seed is not None else seeds):
                 rows.append({"dataset": dataset, "start_s": run.start, "duration_s": du, "method": run.method,
                              "seed": int(seed), "fold": int(fold), **{k: mtr[k] for k in SWEEP_COLUMNS[6:]}})

@@ -87,7 +87,8 @@ from bgfn.evaluate.sweep import (describe_sweep, describe_sweep_setup, describe_
                                  sweep_train_config)
 from bgfn.evaluate.tables import (TableResult, aggregate_seeds, describe_tables, error_reduction, error_series,
                                   evaluate_dataset, fix_error_table,
-                                  representative_seeds, run_tables, save_table_result, table_file)
+                                  representative_seeds, run_tables, save_table_result, table_file,
+                                  table_paths)
 
 __all__ = [
     "AntennaTruth", "BREAKEVEN_COLUMNS", "ORACLE_COLUMNS", "OracleIncrements", "OracleResult", "breakeven_table",
@@ -103,6 +104,6 @@ __all__ = [
     "plot_gps_row", "plot_outage", "plot_sweep_boxes", "pseudo_gps_positions", "pseudo_std_sensitivity",
     "reduction_table", "representative_seeds", "run_outages", "run_sweep", "run_sweeps", "run_tables",
     "save_sensitivity", "save_table_result", "sensitivity_table", "sweep_comparisons", "sweep_interval_table",
-    "sweep_plan", "sweep_summary", "sweep_train_config", "table_file", "window_metrics",
+    "sweep_plan", "sweep_summary", "sweep_train_config", "table_file", "table_paths", "window_metrics",
     "write_evaluation_record",
 ]

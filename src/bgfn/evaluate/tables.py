@@ -186,6 +186,16 @@ def table_file(test: str) -> str:
     return TABLE_FILES.get(test, f"outage_{test}.csv")
 
 
+def table_paths(out, test: str) -> dict[str, Path]:
+    """The files of one test under ``out`` (``results/<profile>``): ``{kind: path}`` for the kinds ``table``,
+    ``seeds``, ``series`` and ``gnss`` (:func:`save_table_result` writes them; the results page reads them)."""
+    stem = table_file(test)[: -len(".csv")]
+    tables = Path(out) / "tables"
+    return {"table": tables / f"{stem}.csv", "seeds": tables / f"{stem}_seeds.csv",
+            "series": tables / f"{stem.replace('outage_', 'outage_errors_', 1)}.csv",
+            "gnss": tables / f"{stem}_gnss.csv"}
+
+
 def save_table_result(out, result: TableResult, series_rate_hz: float = 10.0) -> dict:
     """Write one dataset's outage results under ``out`` (``results/<profile>``), atomically.
 
@@ -201,10 +211,8 @@ def save_table_result(out, result: TableResult, series_rate_hz: float = 10.0) ->
     """
     from bgfn.io import atomic_write_csv
 
-    out = Path(out)
-    stem = table_file(result.test)[: -len(".csv")]
-    paths = {"table": out / "tables" / f"{stem}.csv", "seeds": out / "tables" / f"{stem}_seeds.csv",
-             "series": out / "tables" / f"{stem.replace('outage_', 'outage_errors_', 1)}.csv"}
+    paths = table_paths(out, result.test)
+    gnss = paths.pop("gnss")
     atomic_write_csv(paths["table"], result.table[list(TABLE_COLUMNS)], float_format="%.4f")
     seeds = result.per_seed.assign(dataset=result.dataset)
     seeds["seed"] = seeds["seed"].astype("Int64")
@@ -214,8 +222,8 @@ def save_table_result(out, result: TableResult, series_rate_hz: float = 10.0) ->
         dict(zip(result.per_seed["start_s"], result.per_seed["outage"]))).astype(int))
     atomic_write_csv(paths["series"], series, float_format="%.4f")
     if result.gnss_errors is not None:
-        paths["gnss"] = out / "tables" / f"{stem}_gnss.csv"
-        atomic_write_csv(paths["gnss"], result.gnss_errors, float_format="%.4f")
+        paths["gnss"] = gnss
+        atomic_write_csv(gnss, result.gnss_errors, float_format="%.4f")
     return paths
 
 

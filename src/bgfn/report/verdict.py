@@ -1,0 +1,312 @@
+"""The verdict on top of the results page: per test one table of every aid in the paper's two outages and in the
+outage sweep, and sentences answering the five questions a navigation engineer asks of a learned outage aid
+(issue 17):
+
+1. *How accurate must the increments be?* The oracle's break-even noise against the network's own increment error
+   (:mod:`bgfn.evaluate.oracle`).
+2. *Does it beat the learning-free aids?* INS+NHC, and BGFN fused together with NHC (:mod:`bgfn.nav.constraints`).
+3. *Can the networks know the speed?* The velocity-input variant against Eq. (eq21)'s inputs.
+4. *Was the paper's protocol leaky?* The networks trained on the whole drive, test outages included.
+5. *Is the INS row comparable?* The INS row under NaveGo v1.4's bias modelling (:mod:`bgfn.nav.ins_setups`).
+
+Every number comes from ``results/<profile>/tables/``; a table that a notebook has not written leaves its cells
+empty and its sentence says so. Nothing here is typed by hand.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from bgfn import paper
+from bgfn.config import SHARED_TABLES
+from bgfn.report.reading import read_csv
+
+#: Rows of the verdict table, in order: (label, method label in the tables). The oracle row is built apart.
+METHOD_ROWS: tuple[tuple[str, str], ...] = (
+    ("INS", "INS"), ("INS+NHC", "INS+NHC"), ("MLP", "MLP"), ("AT-LSTM", "AT-LSTM"),
+    ("Transformer", "Transformer"), ("BGFN", "BGFN"), ("BGFN+NHC", "BGFN+NHC"))
+#: The network whose verdict the page gives (the paper's method).
+SUBJECT = "BGFN"
+#: Sweep durations of the verdict's columns, s.
+SWEEP_DURATIONS: tuple[float, ...] = (30.0, 60.0)
+#: Label of the oracle row: the true increments plus white noise of the subject's own increment error.
+ORACLE_ROW = "oracle at BGFN's increment error"
+#: Columns of :func:`verdict_table`.
+VERDICT_COLUMNS: tuple[str, ...] = ("row", "inputs", "protocol", "outage 1", "outage 2", "sweep 30 s", "sweep 60 s",
+                                    "p 30 s", "p 60 s", "runs")
+
+
+@dataclass
+class VerdictInputs:
+    """The tables one test's verdict reads (None where a notebook has not written one)."""
+
+    dataset: str
+    test: str
+    seeds: pd.DataFrame | None          # outage_<test>_seeds.csv: every run in the paper's outages
+    sweep_summary: pd.DataFrame | None  # outage_sweep_summary.csv
+    sweep_pairs: pd.DataFrame | None    # outage_sweep_pairs.csv
+    breakeven: pd.DataFrame | None      # outage_oracle_breakeven.csv
+    variants: pd.DataFrame | None       # outage_variants.csv
+    ins_tuning: pd.DataFrame | None     # kf_ins_tuning.csv
+
+    @classmethod
+    def read(cls, out: str | Path, dataset: str) -> "VerdictInputs":
+        """The tables of ``dataset`` under ``out`` (``results/<profile>``), each restricted to that dataset."""
+        from bgfn.data.names import dataset_id
+        from bgfn.evaluate.tables import table_paths
+
+        out = Path(out)
+        test = paper.test_of(dataset) or dataset_id(dataset)
+        tables = out / "tables"
+
+        def of(df):
+            return None if df is None or "dataset" not in df.columns else df[df["dataset"] == dataset]
+
+        return cls(dataset, test, of(read_csv(table_paths(out, test)["seeds"])),
+                   of(read_csv(tables / SHARED_TABLES["sweep_summary"])),
+                   of(read_csv(tables / SHARED_TABLES["sweep_pairs"])),
+                   of(read_csv(tables / SHARED_TABLES["oracle_breakeven"])),
+                   of(read_csv(tables / SHARED_TABLES["variants"])) if "variants" in SHARED_TABLES else None,
+                   of(read_csv(tables / SHARED_TABLES["kf_ins_tuning"])))
+
+
+def _outage_value(seeds: pd.DataFrame | None, method: str, outage: int) -> float:
+    """Median over seeds of the max horizontal error of ``method`` in the paper's outage ``outage`` (m)."""
+    if seeds is None:
+        return float("nan")
+    sel = seeds[(seeds["method"] == method) & (seeds["outage"].astype(int) == outage)]
+    return float(sel["max_h_m"].median()) if len(sel) else float("nan")
+
+
+def _sweep_value(summary: pd.DataFrame | None, method: str, duration: float) -> float:
+    if summary is None:
+        return float("nan")
+    sel = summary[(summary["method"] == method) & np.isclose(summary["duration_s"].astype(float), duration)]
+    return float(sel["median_m"].iloc[0]) if len(sel) else float("nan")
+
+
+def _p_value(pairs: pd.DataFrame | None, row: str, duration: float) -> float:
+    """Wilcoxon p in the sweep (paired by start and seed) of BGFN against the row; for the row ``BGFN+NHC``, of
+    BGFN+NHC against INS+NHC (does the learned aid add to the free one?); NaN for BGFN itself."""
+    if pairs is None or row == SUBJECT:
+        return float("nan")
+    method, baseline = (row, "INS+NHC") if row == f"{SUBJECT}+NHC" else (SUBJECT, row)
+    m = pairs["method"] if "method" in pairs.columns else pd.Series(SUBJECT, pairs.index)
+    sel = pairs[(m == method) & (pairs["baseline"] == baseline)
+                & np.isclose(pairs["duration_s"].astype(float), duration)]
+    return float(sel["p_value"].iloc[0]) if len(sel) else float("nan")
+
+
+def _oracle_value(breakeven: pd.DataFrame | None, outage: str, duration: float | None) -> float:
+    """The oracle's aided error at the subject's own increment RMSE (m), against INS, in one kind of window."""
+    if breakeven is None or not len(breakeven):
+        return float("nan")
+    sel = breakeven[(breakeven["method"] == SUBJECT) & (breakeven["baseline"] == "INS")
+                    & (breakeven["outage"].astype(str) == outage)]
+    if duration is not None:
+        sel = sel[np.isclose(sel["duration_s"].astype(float), duration)]
+    return float(sel["oracle_at_rmse_m"].iloc[0]) if len(sel) else float("nan")
+
+
+def verdict_table(inp: VerdictInputs) -> pd.DataFrame:
+    """One test's verdict: every aid in the paper's two outages (max horizontal error, median over the seeds) and
+    in the sweep (median over starts and seeds at 30 and 60 s), the Wilcoxon p of BGFN against the row in the sweep,
+    (of BGFN+NHC against INS+NHC in its own row), then BGFN under each input reading and protocol of the variants
+    (paper outages only; ``runs``: networks per cell).
+
+    Returns
+    -------
+    DataFrame
+        :data:`VERDICT_COLUMNS`; lengths in m.
+    """
+    rows = []
+    for label, method in METHOD_ROWS:
+        rows.append({"row": label, "inputs": "Eq. (eq21)" if method not in ("INS", "INS+NHC") else "-",
+                     "protocol": "honest" if method not in ("INS", "INS+NHC") else "-",
+                     "outage 1": _outage_value(inp.seeds, method, 1), "outage 2": _outage_value(inp.seeds, method, 2),
+                     **{f"sweep {d:g} s": _sweep_value(inp.sweep_summary, method, d) for d in SWEEP_DURATIONS},
+                     **{f"p {d:g} s": _p_value(inp.sweep_pairs, method, d) for d in SWEEP_DURATIONS},
+                     "runs": int((inp.seeds["method"] == method).sum()) if inp.seeds is not None else 0})
+        if method == "INS+NHC":
+            rows.append({"row": ORACLE_ROW, "inputs": "-", "protocol": "-",
+                         "outage 1": _oracle_value(inp.breakeven, "1", None),
+                         "outage 2": _oracle_value(inp.breakeven, "2", None),
+                         **{f"sweep {d:g} s": _oracle_value(inp.breakeven, "sweep", d) for d in SWEEP_DURATIONS},
+                         **{f"p {d:g} s": float("nan") for d in SWEEP_DURATIONS}, "runs": 0})
+    if inp.variants is not None and len(inp.variants):
+        v = inp.variants[(inp.variants["method"] == SUBJECT)]
+        for variant, g in v.groupby("variant", sort=False):
+            first = g.iloc[0]
+            cell = {int(o): float(x) for o, x in zip(g["outage"], g["max_h_m"])}
+            rows.append({"row": f"{SUBJECT} ({variant})", "inputs": first["inputs"], "protocol": first["protocol"],
+                         "outage 1": cell.get(1, np.nan), "outage 2": cell.get(2, np.nan),
+                         **{f"sweep {d:g} s": np.nan for d in SWEEP_DURATIONS},
+                         **{f"p {d:g} s": np.nan for d in SWEEP_DURATIONS}, "runs": int(g["n_runs"].max())})
+    return pd.DataFrame(rows, columns=list(VERDICT_COLUMNS))
+
+
+def _m(x: float) -> str:
+    return "n/a" if not np.isfinite(x) else f"{x:.1f} m" if x >= 1 else f"{x:.2f} m"
+
+
+def _row(table: pd.DataFrame, label: str) -> pd.Series | None:
+    sel = table[table["row"] == label]
+    return sel.iloc[0] if len(sel) else None
+
+
+def _mean_outages(row: pd.Series | None) -> float:
+    if row is None:
+        return float("nan")
+    vals = [row["outage 1"], row["outage 2"]]
+    return float(np.mean(vals)) if all(np.isfinite(vals)) else float("nan")
+
+
+def answer_accuracy(inp: VerdictInputs) -> str:
+    """Question 1: the break-even increment error against BGFN's own, in the sweep at 30 s (else the outages)."""
+    be = inp.breakeven
+    if be is None or not len(be):
+        return "How accurate must the increments be? Not measured: notebook 04's oracle has not run for this drive."
+    sel = be[(be["method"] == SUBJECT) & (be["baseline"] == "INS")]
+    sweep = sel[(sel["outage"].astype(str) == "sweep") & np.isclose(sel["duration_s"].astype(float), 30.0)]
+    r = (sweep if len(sweep) else sel).iloc[0] if len(sel) else None
+    if r is None:
+        return "How accurate must the increments be? The oracle ran, but BGFN has no increment error in its windows."
+    where = "in the 30 s sweep" if len(sweep) else f"in outage {r['outage']}"
+    bar = float(r["breakeven_sigma_m"])
+    own = float(r["increment_rmse_m"])
+    eq = float(r["equivalent_sigma_m"])
+    bar_text = (f"below {_m(bar)} per increment of {float(r['increment_s']):g} s" if r["crossing"] == "crossed"
+                else "no noise level of the grid (the oracle is worse than INS everywhere)" if r["crossing"] ==
+                "never_below" else f"any noise up to the grid's largest ({_m(bar)})")
+    verdict = ("clears the bar" if np.isfinite(own) and np.isfinite(bar) and own < bar else "misses the bar")
+    return (f"How accurate must the increments be? Fed the true increments plus white noise, the filter beats INS "
+            f"{where} for {bar_text}. BGFN's own increment error there is {_m(own)} ({verdict}); its errors act like "
+            f"white noise of {_m(eq)} (larger when they are correlated: they add up along the outage).")
+
+
+def answer_free_aids(table: pd.DataFrame) -> str:
+    """Question 2: INS+NHC against INS and BGFN, and whether BGFN adds to NHC."""
+    ins, nhc, bgfn, both = (_row(table, k) for k in ("INS", "INS+NHC", "BGFN", "BGFN+NHC"))
+    if nhc is None or not np.isfinite(_mean_outages(nhc)):
+        return "Does it beat the learning-free aids? Not measured: the INS+NHC row has not run."
+    col = "sweep 30 s" if np.isfinite(nhc["sweep 30 s"]) else None
+    if col:
+        text = (f"In the 30 s sweep the median error is {_m(ins['sweep 30 s'])} for INS, {_m(nhc['sweep 30 s'])} for "
+                f"INS+NHC (no learning), {_m(bgfn['sweep 30 s'])} for BGFN and {_m(both['sweep 30 s'])} for BGFN+NHC")
+        p = both["p 30 s"] if both is not None else float("nan")
+        text += f" (BGFN+NHC against INS+NHC: Wilcoxon p {p:.2g})." if np.isfinite(p) else "."
+    else:
+        text = (f"In the paper's two outages (mean of their max errors) INS reaches {_m(_mean_outages(ins))}, INS+NHC "
+                f"{_m(_mean_outages(nhc))}, BGFN {_m(_mean_outages(bgfn))} and BGFN+NHC {_m(_mean_outages(both))}.")
+    a, b = (both[col], nhc[col]) if col else (_mean_outages(both), _mean_outages(nhc))
+    add = ("BGFN adds to the free aid" if np.isfinite(a) and np.isfinite(b) and a < b
+           else "BGFN does not add to the free aid: fused with NHC it is worse than NHC alone")
+    return f"Does it beat the learning-free aids? {text} {add}."
+
+
+#: The variants' ``inputs`` of Eq. (eq21) alone (:func:`bgfn.train.variants.describe_options`); more channels are
+#: written ``eq21+<channel>...``.
+EQ21_INPUTS = "eq21"
+
+
+def _variant_rows(table: pd.DataFrame, velocity: bool | None = None, protocol: str | None = None) -> pd.DataFrame:
+    """The subject's variant rows; ``velocity``: with extra input channels (True) or Eq. (eq21)'s alone (False)."""
+    rows = table[table["row"].str.startswith(f"{SUBJECT} (")]
+    if velocity is not None:
+        rows = rows[(rows["inputs"].astype(str) != EQ21_INPUTS) == velocity]
+    if protocol is not None:
+        rows = rows[rows["protocol"] == protocol]
+    return rows
+
+
+def answer_speed(table: pd.DataFrame) -> str:
+    """Question 3: BGFN with velocity inputs against Eq. (eq21)'s inputs, honest protocol, paper outages."""
+    base = _variant_rows(table, False, "honest")
+    fast = _variant_rows(table, True, "honest")
+    if not len(fast):
+        return "Can the networks know the speed? Not measured: the velocity-input variant has not run."
+    b = _mean_outages(base.iloc[0]) if len(base) else _mean_outages(_row(table, SUBJECT))
+    f = _mean_outages(fast.iloc[0])
+    ins = _mean_outages(_row(table, "INS"))
+    return (f"Can the networks know the speed? Eq. (eq21) gives no velocity. With Eq. (eq21)'s inputs BGFN's max error "
+            f"in the paper's two outages averages {_m(b)}; given the INS velocity {_m(f)} (INS: {_m(ins)}; "
+            f"{int(fast.iloc[0]['runs'])} network(s) per cell).")
+
+
+def answer_protocol(table: pd.DataFrame, claims: dict | None = None) -> str:
+    """Question 4: trained on the whole drive (test outages included), BGFN's reduction against INS."""
+    leaky = _variant_rows(table, None, "leaky")
+    if not len(leaky):
+        return "Was the paper's protocol leaky? Not measured: the variant trained on the whole drive has not run."
+    ins = _mean_outages(_row(table, "INS"))
+    lines = []
+    for _, r in leaky.iterrows():
+        red = 100.0 * (ins - _mean_outages(r)) / ins if np.isfinite(ins) and ins > 0 else float("nan")
+        lines.append(f"{r['row']}: {_m(_mean_outages(r))}, "
+                     + (f"{red:.0f} % below INS" if red >= 0 else f"{-red:.0f} % above INS"))
+    stated = ""
+    if claims:
+        pct = [v for v in _numbers(claims.get("bgfn_reduction_vs_ins_pct")) if 0 < v <= 100]
+        if pct:
+            stated = f" The paper states reductions of {min(pct):g}-{max(pct):g} %."
+    return ("Was the paper's protocol leaky? Trained on the whole drive, the test outages included, "
+            + "; ".join(lines) + f" (INS {_m(ins)})." + stated)
+
+
+def _numbers(node) -> list[float]:
+    if isinstance(node, dict):
+        return [x for v in node.values() for x in _numbers(v)]
+    if isinstance(node, (list, tuple)):
+        return [x for v in node for x in _numbers(v)]
+    return [float(node)] if isinstance(node, (int, float)) and not isinstance(node, bool) else []
+
+
+def answer_ins_tuning(inp: VerdictInputs) -> str:
+    """Question 5: the INS row under NaveGo v1.4's bias modelling beside ours and the paper's."""
+    if inp.ins_tuning is None or not len(inp.ins_tuning):
+        return "Is the INS row comparable? Not measured: notebook 02's INS-setup table has not run."
+    from bgfn.nav.ins_setups import gap_explained
+
+    gap = gap_explained(inp.ins_tuning)
+    g = gap[gap["setup"] == "navego"]
+    if not len(g):
+        return "Is the INS row comparable? The paper has no INS row for this drive's test."
+    r = g.iloc[0]
+    return (f"Is the INS row comparable? Mean of the INS row's max errors: {_m(r['shipped_m'])} with our filter, "
+            f"{_m(r['setup_m'])} with NaveGo v1.4's bias modelling, {_m(r['paper_m'])} in the paper "
+            f"({paper.paper_label(inp.test) if inp.test in paper.TESTS else 'paper'}).")
+
+
+def verdict_sentences(inp: VerdictInputs, table: pd.DataFrame, claims: dict | None = None) -> list[str]:
+    """The five answers for one test, in the issue's order."""
+    return [answer_accuracy(inp), answer_free_aids(table), answer_speed(table), answer_protocol(table, claims),
+            answer_ins_tuning(inp)]
+
+
+def headline(inp: VerdictInputs, table: pd.DataFrame) -> str:
+    """One line per test for the book's first page: BGFN against INS and INS+NHC where both were measured."""
+    title = paper.TESTS[inp.test]["title"] if inp.test in paper.TESTS else inp.test
+    b, i, n = (_row(table, k) for k in (SUBJECT, "INS", "INS+NHC"))
+    col = "sweep 30 s" if b is not None and np.isfinite(b["sweep 30 s"]) else None
+    if b is None or i is None:
+        return f"{title} ({inp.dataset}): not evaluated."
+    if col:
+        vals = (b[col], i[col], n[col] if n is not None else np.nan)
+        where = "median max error over the 30 s sweep"
+    else:
+        vals = (_mean_outages(b), _mean_outages(i), _mean_outages(n))
+        where = "mean max error in the paper's two outages"
+    word = "below" if vals[0] < vals[1] else "above"
+    return (f"{title} ({inp.dataset}), {where}: BGFN {_m(vals[0])}, {word} standalone INS ({_m(vals[1])}); "
+            f"INS with non-holonomic constraints {_m(vals[2])}.")
+
+
+def format_table(table: pd.DataFrame):
+    """The verdict table styled for the page (lengths with one decimal, p with two digits, n/a for empty)."""
+    fmt = {c: "{:.1f}" for c in ("outage 1", "outage 2", "sweep 30 s", "sweep 60 s")}
+    fmt.update({c: "{:.2g}" for c in ("p 30 s", "p 60 s")})
+    return table.style.format(fmt, na_rep="-").hide(axis="index")

@@ -1,0 +1,80 @@
+"""The verdict (results page, first section): its table and the five answers from hand-made tables."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from bgfn.report.verdict import (ORACLE_ROW, VerdictInputs, answer_accuracy, answer_free_aids, answer_protocol,
+                                 answer_speed, headline, verdict_sentences, verdict_table)
+
+
+def _seeds():
+    rows = []
+    for method, vals in {"INS": [10.0], "INS+NHC": [4.0], "BGFN": [30.0, 50.0, 40.0], "BGFN+NHC": [20.0, 22.0, 24.0],
+                         "MLP": [60.0, 60.0, 60.0]}.items():
+        for outage in (1, 2):
+            for seed, v in enumerate(vals):
+                rows.append({"outage": outage, "method": method, "seed": seed, "max_h_m": v * outage,
+                             "dataset": "d"})
+    return pd.DataFrame(rows)
+
+
+def _inputs(**kw):
+    summary = pd.DataFrame([{"dataset": "d", "duration_s": du, "method": m, "median_m": v * du / 30}
+                            for du in (30.0, 60.0) for m, v in
+                            {"INS": 19.0, "INS+NHC": 5.0, "BGFN": 85.0, "BGFN+NHC": 76.0}.items()])
+    pairs = pd.DataFrame([{"dataset": "d", "duration_s": 30.0, "method": "BGFN", "baseline": "INS", "p_value": 1e-9},
+                          {"dataset": "d", "duration_s": 30.0, "method": "BGFN+NHC", "baseline": "INS+NHC",
+                           "p_value": 2e-10}])
+    be = pd.DataFrame([{"dataset": "d", "test": "field", "outage": "sweep", "duration_s": 30.0, "increment_s": 1.0,
+                        "baseline": "INS", "baseline_m": 19.0, "breakeven_sigma_m": 1.9, "crossing": "crossed",
+                        "method": "BGFN", "method_m": 85.0, "increment_rmse_m": 2.5, "rmse_to_breakeven": 1.3,
+                        "oracle_at_rmse_m": 24.0, "equivalent_sigma_m": 7.0, "equivalent_crossing": "crossed"}])
+    variants = pd.DataFrame([
+        {"dataset": "d", "outage": o, "variant": v, "inputs": i, "protocol": p, "method": "BGFN", "max_h_m": x * o,
+         "n_runs": 1}
+        for v, i, p, x in (("main", "eq21", "honest", 40.0), ("velocity", "eq21+v_along+v_cross", "honest", 8.0),
+                           ("leaky", "eq21", "leaky", 2.0))
+        for o in (1, 2)])
+    base = dict(dataset="d", test="field", seeds=_seeds(), sweep_summary=summary, sweep_pairs=pairs, breakeven=be,
+                variants=variants, ins_tuning=None)
+    base.update(kw)
+    return VerdictInputs(**base)
+
+
+def test_table_takes_medians_p_values_oracle_and_variants():
+    inp = _inputs()
+    t = verdict_table(inp).set_index("row")
+    assert t.loc["BGFN", "outage 1"] == 40.0 and t.loc["BGFN", "outage 2"] == 80.0       # median of 3 seeds
+    assert t.loc["INS", "sweep 60 s"] == pytest.approx(38.0)
+    assert t.loc["INS", "p 30 s"] == pytest.approx(1e-9)                               # BGFN against INS
+    assert np.isnan(t.loc["BGFN", "p 30 s"])                                           # not against itself
+    assert t.loc["BGFN+NHC", "p 30 s"] == pytest.approx(2e-10)                         # BGFN+NHC against INS+NHC
+    assert np.isnan(t.loc["INS+NHC", "p 30 s"])                                        # BGFN vs INS+NHC not run
+    assert t.loc[ORACLE_ROW, "sweep 30 s"] == 24.0 and np.isnan(t.loc[ORACLE_ROW, "outage 1"])
+    assert t.loc["BGFN (velocity)", "outage 2"] == 16.0 and t.loc["BGFN (velocity)", "runs"] == 1
+    assert np.isnan(t.loc["AT-LSTM", "outage 1"])                                      # not run: empty, not 0
+    assert list(t.index[:3]) == ["INS", "INS+NHC", ORACLE_ROW]
+
+
+def test_answers_say_the_measured_numbers():
+    inp = _inputs()
+    t = verdict_table(inp)
+    acc = answer_accuracy(inp)
+    assert "below 1.9 m per increment of 1 s" in acc and "2.5 m (misses the bar)" in acc and "7.0 m" in acc
+    free = answer_free_aids(t)
+    assert "5.0 m for INS+NHC" in free and "does not add" in free and "p 2e-10" in free
+    speed = answer_speed(t)
+    assert "averages 60.0 m" in speed and "velocity 12.0 m" in speed
+    prot = answer_protocol(t, {"bgfn_reduction_vs_ins_pct": {"a": {"east": 79.7}, "b": {"north": 90.0}}})
+    assert "80 % below INS" in prot and "79.7-90 %" in prot                           # (15 - 3) / 15
+    assert headline(inp, t).endswith("INS with non-holonomic constraints 5.0 m.")
+
+
+def test_missing_tables_say_not_measured():
+    inp = _inputs(breakeven=None, variants=None, sweep_summary=None, sweep_pairs=None, ins_tuning=None)
+    t = verdict_table(inp)
+    lines = verdict_sentences(inp, t)
+    assert lines[0].endswith("oracle has not run for this drive.")
+    assert "Not measured" in lines[2] and "Not measured" in lines[3] and "Not measured" in lines[4]
+    assert "paper's two outages" in lines[1]                                           # falls back to them

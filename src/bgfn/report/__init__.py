@@ -22,7 +22,8 @@ Modules, in the order the page needs them:
 - :mod:`bgfn.report.variants` -- profiles side by side, and one profile against the untrained references;
 - :mod:`bgfn.report.glance` -- the run header, the *At a glance* lines and ``findings.md``;
 - :mod:`bgfn.report.figures` -- the page's figure lists and the four drawings made from the profile;
-- :mod:`bgfn.report.sections` -- each section of the page as the pieces to display.
+- :mod:`bgfn.report.sections` -- each section of the page as the pieces to display;
+- :mod:`bgfn.report.verdict` -- the verdict on top: every aid per test and the answers to five questions.
 
 Everything public is re-exported here: ``from bgfn import report; report.outage_section(res, "dataset")``.
 """
@@ -40,6 +41,7 @@ from bgfn.report.sentences import (BASELINES, EXTRA_METHODS, EXTRA_TAGS, bullets
 from bgfn.report.tables import (REFERENCE_LABELS, TABLE_STYLES, TRAINING_COLUMNS, best_mask, compact, energy_table,
                                 fmt_num, kf_table, reduction_comparison, reductions, style_layout, sweep_table,
                                 training_table)
+from bgfn.report.verdict import Verdict, VerdictInputs, verdict_of, verdict_table
 from bgfn.report.variants import (compared_profiles, profile_tables, reference_sentences, variant_outage_table,
                                   variant_sentences, variant_sweep_table, variant_training_table, variants_section)
 
@@ -56,6 +58,7 @@ __all__ = [
     "compared_profiles", "profile_tables", "variant_training_table", "variant_outage_table", "variant_sentences",
     "variant_sweep_table", "REFERENCE_LABELS", "TRAINING_COLUMNS",
     # the page as sections of pieces to display (notebook 06)
+    "Verdict", "VerdictInputs", "verdict_of", "verdict_table",
     "ProfileResults", "read_results", "OutageSection", "header_section", "outage_section", "energy_section",
     "kf_section", "training_section", "sweep_section", "variants_section", "paper_figure_section",
     "extra_figure_section", "draw_diagrams", "bullets", "run_meta",

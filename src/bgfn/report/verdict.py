@@ -82,6 +82,14 @@ def _outage_value(seeds: pd.DataFrame | None, method: str, outage: int) -> float
     return float(sel["max_h_m"].median()) if len(sel) else float("nan")
 
 
+def _runs(seeds: pd.DataFrame | None, method: str) -> int:
+    """How many runs one outage cell of ``method`` holds (its seeds; 1 for the learning-free rows)."""
+    if seeds is None:
+        return 0
+    sel = seeds[seeds["method"] == method]
+    return int(sel.groupby("outage").size().max()) if len(sel) else 0
+
+
 def _sweep_value(summary: pd.DataFrame | None, method: str, duration: float) -> float:
     if summary is None:
         return float("nan")
@@ -130,7 +138,7 @@ def verdict_table(inp: VerdictInputs) -> pd.DataFrame:
                      "outage 1": _outage_value(inp.seeds, method, 1), "outage 2": _outage_value(inp.seeds, method, 2),
                      **{f"sweep {d:g} s": _sweep_value(inp.sweep_summary, method, d) for d in SWEEP_DURATIONS},
                      **{f"p {d:g} s": _p_value(inp.sweep_pairs, method, d) for d in SWEEP_DURATIONS},
-                     "runs": int((inp.seeds["method"] == method).sum()) if inp.seeds is not None else 0})
+                     "runs": _runs(inp.seeds, method)})
         if method == "INS+NHC":
             rows.append({"row": ORACLE_ROW, "inputs": "-", "protocol": "-",
                          "outage 1": _oracle_value(inp.breakeven, "1", None),
@@ -276,9 +284,10 @@ def answer_ins_tuning(inp: VerdictInputs) -> str:
     if not len(g):
         return "Is the INS row comparable? The paper has no INS row for this drive's test."
     r = g.iloc[0]
-    return (f"Is the INS row comparable? Mean of the INS row's max errors: {_m(r['shipped_m'])} with our filter, "
-            f"{_m(r['setup_m'])} with NaveGo v1.4's bias modelling, {_m(r['paper_m'])} in the paper "
-            f"({paper.paper_label(inp.test) if inp.test in paper.TESTS else 'paper'}).")
+    whose = "" if paper.has_own_values(inp.test) else " (its field test: it has no table of this drive)"
+    return (f"Is the INS row comparable? Mean of the INS row's max east and north errors: {_m(r['shipped_m'])} with "
+            f"our filter, {_m(r['setup_m'])} with NaveGo v1.4's bias modelling, {_m(r['paper_m'])} in the paper"
+            f"{whose}.")
 
 
 def verdict_sentences(inp: VerdictInputs, table: pd.DataFrame, claims: dict | None = None) -> list[str]:
@@ -292,7 +301,7 @@ def headline(inp: VerdictInputs, table: pd.DataFrame) -> str:
     title = paper.TESTS[inp.test]["title"] if inp.test in paper.TESTS else inp.test
     b, i, n = (_row(table, k) for k in (SUBJECT, "INS", "INS+NHC"))
     col = "sweep 30 s" if b is not None and np.isfinite(b["sweep 30 s"]) else None
-    if b is None or i is None:
+    if b is None or i is None or not (np.isfinite(_mean_outages(b)) and np.isfinite(_mean_outages(i))):
         return f"{title} ({inp.dataset}): not evaluated."
     if col:
         vals = (b[col], i[col], n[col] if n is not None else np.nan)
@@ -310,3 +319,35 @@ def format_table(table: pd.DataFrame):
     fmt = {c: "{:.1f}" for c in ("outage 1", "outage 2", "sweep 30 s", "sweep 60 s")}
     fmt.update({c: "{:.2g}" for c in ("p 30 s", "p 60 s")})
     return table.style.format(fmt, na_rep="-").hide(axis="index")
+
+
+@dataclass
+class Verdict:
+    """The verdict of a profile: per evaluated dataset its inputs, table and answers."""
+
+    inputs: dict[str, VerdictInputs]
+    tables: dict[str, pd.DataFrame]
+    answers: dict[str, list[str]]
+
+    def headlines(self) -> list[str]:
+        """One line per test (:func:`headline`): the book's first page."""
+        return [headline(self.inputs[d], self.tables[d]) for d in self.inputs]
+
+    def pieces(self) -> list:
+        """What the results page shows: per test a title, the table and the five answers."""
+        out = []
+        for d, inp in self.inputs.items():
+            title = paper.TESTS[inp.test]["title"] if inp.test in paper.TESTS else inp.test
+            out += [f"### {title}: `{d}`", format_table(self.tables[d]),
+                    "\n".join(f"{k}. {a}" for k, a in enumerate(self.answers[d], 1))]
+        return out
+
+
+def verdict_of(res) -> Verdict:
+    """The verdict of every dataset notebook 04 evaluated for ``res`` (:class:`bgfn.report.reading.ProfileResults`).
+    """
+    datasets = list(dict.fromkeys(res.cfg["evaluate"]["datasets"]))
+    inputs = {d: VerdictInputs.read(res.out, d) for d in datasets}
+    tables = {d: verdict_table(inp) for d, inp in inputs.items()}
+    answers = {d: verdict_sentences(inputs[d], tables[d], res.claims) for d in datasets}
+    return Verdict(inputs, tables, answers)

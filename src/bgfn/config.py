@@ -76,6 +76,7 @@ SHARED_TABLES: dict[str, str] = {
     "sweep": "outage_sweep.csv",                # notebook 04
     "sweep_summary": "outage_sweep_summary.csv",
     "sweep_pairs": "outage_sweep_pairs.csv",
+    "variants": "outage_variants.csv",          # notebook 03: the learning-problem variants in the two outages
 }
 #: Keys of earlier versions that now live elsewhere: ``section.key`` -> the key to set instead.
 MOVED_KEYS: dict[str, str] = {

@@ -54,7 +54,8 @@ Modules, in the order of the protocol:
 - :mod:`bgfn.evaluate.plots` -- the paper's outage figures and the sweep's box plots;
 - :mod:`bgfn.evaluate.sensitivity` -- the tables again with each network's validation std for its pseudo fixes;
 - :mod:`bgfn.evaluate.sweep` -- the outage sweep and its statistics;
-- :mod:`bgfn.evaluate.record` -- ``outage_evaluation.json``, the record notebook 06 reads.
+- :mod:`bgfn.evaluate.record` -- ``outage_evaluation.json``, the record notebook 06 reads;
+- :mod:`bgfn.evaluate.variants` -- the learning-problem variants of notebook 03 in the two outages.
 
 Everything public is re-exported here: ``from bgfn import evaluate as ev; ev.evaluate_dataset(...)``.
 """
@@ -77,6 +78,8 @@ from bgfn.evaluate.sweep import (describe_sweep, describe_sweep_setup, describe_
 from bgfn.evaluate.tables import (TableResult, aggregate_seeds, describe_tables, error_reduction, error_series,
                                   evaluate_dataset, fix_error_table,
                                   representative_seeds, run_tables, save_table_result, table_file)
+from bgfn.evaluate.variants import (NO_VARIANT, VARIANT_COLUMNS, VARIANT_METRICS, load_variant_network,
+                                    variant_pivot, variant_runs, variant_table)
 
 __all__ = [
     "COLORS", "EVALUATE_DEFAULTS", "FIGURE_METHODS", "METRIC_COLUMNS", "REAL_IMU_DATASETS", "RECORD_FILE",
@@ -91,4 +94,6 @@ __all__ = [
     "save_sensitivity", "save_table_result", "sensitivity_table", "sweep_comparisons", "sweep_interval_table",
     "sweep_plan", "sweep_summary", "sweep_train_config", "table_file", "window_metrics",
     "write_evaluation_record",
+    # the learning-problem variants (notebook 03)
+    "NO_VARIANT", "VARIANT_COLUMNS", "VARIANT_METRICS", "load_variant_network", "variant_runs", "variant_table", "variant_pivot",
 ]

@@ -38,11 +38,17 @@ def _split(tables, protocol):
 
 def _touches(ws, intervals) -> np.ndarray:
     """Boolean per window: its input span or target interval meets one of ``intervals`` (closed)."""
-    lo, hi = np.minimum(ws.t_start, ws.t_from), np.maximum(ws.t_end, ws.t_to)
+    lo, hi = ws.span
     return np.array([any(a <= h and l <= b for a, b in intervals) for l, h in zip(lo, hi)], dtype=bool)
 
 
 # ----------------------------------------------------------------------------------------------- protocols
+def test_merged_spans_is_the_union_of_the_spans():
+    lo, hi = np.array([5.0, 0.0, 1.0, 9.0]), np.array([6.0, 2.0, 3.0, 9.5])
+    np.testing.assert_array_equal(L.merged_spans(lo, hi), [[0.0, 3.0], [5.0, 6.0], [9.0, 9.5]])
+    assert L.merged_spans(np.array([]), np.array([])).shape == (0, 2)
+
+
 def test_honest_keeps_the_outages_and_their_margin_out_of_training(tables):
     data = _split(tables, "honest")
     widened = [(s - MARGIN_S, s + d + MARGIN_S) for s, d in OUTAGES]
@@ -71,11 +77,18 @@ def test_leaky_trains_on_the_test_outages_and_validates_where_honest_does(tables
     assert leaky.info["n_outage_in_train"] == int(extra.sum()) > 0
     with pytest.raises(DataError, match="protocol"):
         _split(tables, "paper")
-    # a validation block around an outage would keep it out of training: refused by name
+    # a validation block whose two parts lie either side of an outage: the outage still trains when leaky
     imu, att, gnss = tables
-    with pytest.raises(DataError, match="val_position"):
-        L.build_learning_data(imu, att, gnss, [(1100.0, 20.0)], window=100, margin_s=MARGIN_S, val_fraction=0.25,
-                              val_position="middle", protocol="leaky")
+    one = [(1100.0, 20.0)]
+    split = {p: L.build_learning_data(imu, att, gnss, one, window=100, margin_s=MARGIN_S, val_fraction=0.25,
+                                      val_position="middle", protocol=p) for p in L.PROTOCOLS}
+    lo, hi = split["honest"].info["val_block"]
+    assert lo < 1100.0 and hi > 1120.0                                  # the block's hull spans the outage
+    np.testing.assert_array_equal(split["leaky"].val.t_to, split["honest"].val.t_to)
+    inside = every.t_to[(every.t_from >= 1100.0) & (every.t_to <= 1120.0)]
+    assert np.isin(inside, split["leaky"].train.t_to).all()
+    vlo, vhi = split["leaky"].val.span
+    assert not _touches(split["leaky"].train, list(zip(vlo, vhi))).any()   # no time shared with validation
 
 
 # ----------------------------------------------------------------------------------------------- profile keys

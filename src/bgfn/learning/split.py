@@ -7,9 +7,9 @@ dropped too, so no training window shares an IMU sample or GNSS epoch with a val
 (:func:`split_windows`).
 
 ``protocol='leaky'`` (what the paper may have done: it does not say that its test outages were kept out of
-training): the same validation block, but nothing else is excluded, so the windows of the test outages and of
+training): the same validation windows, but nothing else is excluded, so the windows of the test outages and of
 their margin are training windows. The two protocols share their validation windows; the leaky training set is
-the honest one plus the windows the honest protocol excludes (those overlapping the validation block aside).
+the honest one plus the windows the honest protocol excludes (those sharing time with a validation window aside).
 """
 
 from __future__ import annotations
@@ -57,7 +57,8 @@ def split_windows(ws: WindowSet, outage_windows=(), margin_s: float = 30.0, val_
         Where the block lies: a float p in [0, 1] puts it at fraction p of the remaining windows.
     protocol : {'honest', 'leaky'}
         ``'leaky'``: the windows touching the outages and their margin are training windows too (the validation
-        block is placed as with ``'honest'``, outside them, so both protocols validate on the same windows).
+        block is placed as with ``'honest'``, outside them, so both protocols validate on the same windows;
+        training windows sharing time with a validation window are dropped).
 
     Returns
     -------
@@ -85,20 +86,31 @@ def split_windows(ws: WindowSet, outage_windows=(), margin_s: float = 30.0, val_
     s = int(round(float(pos) * (len(allowed) - n_val)))
     val_idx = allowed[s:s + n_val]
     block = np.array([[lo[val_idx].min(), hi[val_idx].max()]])
-    if protocol == "leaky":
-        # the block is placed among the windows outside the outages, but may span one that lies between them
-        inside = overlaps(block[:, 0], block[:, 1], forbidden_intervals(outage_windows, 0.0))
-        if inside.any():
-            raise DataError("train", "val_position", "a validation block without an evaluation outage in it (the "
-                            "leaky protocol trains on the outages)", f"block {block_label(block[0])} s")
-    # leaky: every window outside the validation block may train, the outages' own windows included
-    rest = np.setdiff1d(allowed if protocol == "honest" else np.arange(len(ws)), val_idx)
-    train_idx = rest[~overlaps(lo[rest], hi[rest], block)]
+    if protocol == "honest":
+        rest = np.setdiff1d(allowed, val_idx)
+        train_idx = rest[~overlaps(lo[rest], hi[rest], block)]
+    else:
+        # leaky: every other window trains, the outages' own included; purged are those sharing time with a
+        # validation window (not the block's hull, which may span an outage lying between two of its parts)
+        rest = np.setdiff1d(np.arange(len(ws)), val_idx)
+        train_idx = rest[~overlaps(lo[rest], hi[rest], merged_spans(lo[val_idx], hi[val_idx]))]
     info = {"forbidden": forb.tolist(), "val_block": block[0].tolist(), "n_windows": int(len(ws)),
             "n_outage_excluded": int(len(ws) - len(allowed)) if protocol == "honest" else 0,
             "n_outage_in_train": int(touching[train_idx].sum()), "protocol": protocol,
             "n_purged": int(len(rest) - len(train_idx)), "n_train": int(len(train_idx)), "n_val": int(len(val_idx))}
     return train_idx, val_idx, info
+
+
+def merged_spans(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The union of the closed spans ``[lo_i, hi_i]`` as disjoint intervals, shape [K, 2], sorted."""
+    order = np.argsort(lo, kind="stable")
+    out: list[list[float]] = []
+    for a, b in zip(lo[order], hi[order]):
+        if out and a <= out[-1][1]:
+            out[-1][1] = max(out[-1][1], float(b))
+        else:
+            out.append([float(a), float(b)])
+    return np.array(out, dtype=float).reshape(-1, 2)
 
 
 def block_label(block) -> str:

@@ -165,13 +165,13 @@ def test_variant_plan_takes_variant_runs_and_describes_each_variant():
     smoke = T.VariantPlan.of(T.TrainingPlan.of("smoke", methods=["mlp", "at_lstm"]))
     assert (smoke.methods, smoke.datasets) == (["mlp"], ["turin-sim-mpu6000"])
     assert T.describe_options(vplan.train_section(MAIN_VARIANT)) == {"inputs": "eq21", "protocol": "honest"}
-    assert T.describe_options(vplan.train_section("velocity-leaky")) == {"inputs": "eq21+v_along+v_cross",
-                                                                        "protocol": "leaky"}
+    velocity = "eq21+v_along+v_cross; yaw relative; heading frame"
+    assert T.describe_options(vplan.train_section("velocity-leaky")) == {"inputs": velocity, "protocol": "leaky"}
     folder = vplan.models_dir("leaky", "turin-sim-mpu6000", create=False)
     assert folder.parts[-4:] == ("models", "variants", "leaky", "turin-sim-mpu6000")
     assert vplan.models_dir(MAIN_VARIANT, "turin-sim-mpu6000", create=False).parts[-2:] == ("models",
                                                                                             "turin-sim-mpu6000")
-    assert "velocity-leaky: inputs eq21+v_along+v_cross, protocol leaky" in vplan.describe()
+    assert f"velocity-leaky: inputs {velocity}, protocol leaky" in vplan.describe()
 
 
 # ----------------------------------------------------------------------------------------------- outage table

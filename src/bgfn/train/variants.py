@@ -23,7 +23,7 @@ from typing import Any, Callable
 
 from bgfn import checkpoints
 from bgfn.config import merge_sections
-from bgfn.learning import LearningData, build_learning_data, learning_options
+from bgfn.learning import LEARNING_DEFAULTS, LearningData, build_learning_data, learning_options
 from bgfn.profile_schema import MAIN_VARIANT, variant_config
 from bgfn.train.loop import train_model
 from bgfn.train.options import size_config
@@ -40,11 +40,16 @@ def variant_train_section(train_cfg: dict, overrides: dict | None) -> dict:
 
 
 def describe_options(train_cfg: dict) -> dict:
-    """What a variant changes in the learning problem, in two words: ``inputs`` (``eq21``: the nine channels of
-    Eq. (eq21); ``eq21+<extra channels>`` otherwise) and ``protocol`` (``honest`` / ``leaky``)."""
+    """What a variant changes in the learning problem, in a few words: ``inputs`` (``eq21``: the nine channels
+    of Eq. (eq21), ``+<channel>`` per extra channel, ``; yaw <encoding>`` and ``; <frame> frame`` where they are
+    not the paper's ``unwrap`` and ``ned``) and ``protocol`` (``honest`` / ``leaky``)."""
     opts = learning_options(train_cfg)
-    extra = list(opts["extra_channels"] or [])
-    return {"inputs": "eq21" + ("+" + "+".join(extra) if extra else ""), "protocol": opts["protocol"]}
+    inputs = "+".join(["eq21", *(opts["extra_channels"] or [])])
+    if opts["yaw_encoding"] != LEARNING_DEFAULTS["yaw_encoding"]:
+        inputs += f"; yaw {opts['yaw_encoding']}"
+    if opts["target_frame"] != LEARNING_DEFAULTS["target_frame"]:
+        inputs += f"; {opts['target_frame']} frame"
+    return {"inputs": inputs, "protocol": opts["protocol"]}
 
 
 @dataclass
@@ -111,9 +116,7 @@ class VariantPlan:
         for name in [MAIN_VARIANT] + self.names:
             tc = self.train_section(name)
             what = describe_options(tc)
-            lines.append(f"  {name}: inputs {what['inputs']}, protocol {what['protocol']}, "
-                         f"yaw {learning_options(tc)['yaw_encoding']!r}, target frame "
-                         f"{learning_options(tc)['target_frame']!r}")
+            lines.append(f"  {name}: inputs {what['inputs']}, protocol {what['protocol']}")
         return "\n".join(lines)
 
 

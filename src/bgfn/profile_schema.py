@@ -100,7 +100,7 @@ TRAIN = section(
     target_screen_sigma=number(0, lo_open=True, null=True),
     optimizer=OPTIMIZER, lr=mapping(_POS),
     lr_search=section(grid=seq(_POS, null=True), fraction=_FRACTION, seed=_SEED, extend=integer(0),
-                        epochs=integer(1, null=True), patience=integer(1, null=True)),
+                      epochs=integer(1, null=True), patience=integer(1, null=True)),
     size=text(), sizes=mapping(mapping(mapping(ANY))))
 
 #: ``variants``: name -> overrides of the profile (a partial ``train:`` section), merged over it as a ``base:``
@@ -293,7 +293,6 @@ def _check_variants(cfg: dict) -> None:
     that ``train:`` trains: :meth:`bgfn.train.variants.VariantPlan.of`)."""
     import re
 
-    tr = cfg.get("train") or {}
     for name, own in (cfg.get("variants") or {}).items():
         where = f"variants.{name}"
         if not re.match(VARIANT_NAME, str(name)) or name == MAIN_VARIANT:

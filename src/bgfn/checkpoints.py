@@ -6,6 +6,9 @@ One network = one ``(dataset, method, seed)`` of a profile (a fold ``k`` for the
                                                  <method>_seed<seed>.json      its card (metrics, config hash)
                                                  <method>_seed<seed>.last.pt   while training: resumable state
 
+A variant of the profile's learning problem (:mod:`bgfn.train.variants`) keeps its networks apart, under
+``results/<profile>/models/variants/<variant>/<dataset>/`` (:func:`variant_models_dir`), with the same names.
+
 Every module builds these names with :func:`checkpoint_path` (or :func:`checkpoint_name` under a folder it
 was given) and reads them back with :func:`parse_checkpoint`; nothing else spells the pattern. The folder is the
 dataset's id (:func:`bgfn.data.names.dataset_id`: a shipped dataset's name, a CSV drive's ``meta.yaml`` name or
@@ -47,6 +50,19 @@ def models_dir(profile: str, dataset: str, fold: int | None = None, create: bool
     d = results_dir(profile, create=create) / "models" / dataset_id(dataset)
     if fold is not None:
         d = d / f"fold{int(fold)}"
+    if create:
+        d.mkdir(parents=True, exist_ok=True)
+    return d
+
+
+#: Folder of ``results/<profile>/models/`` that holds the variants' networks (:func:`variant_models_dir`).
+VARIANTS_DIR = "variants"
+
+
+def variant_models_dir(profile: str, variant: str, dataset: str, create: bool = True) -> Path:
+    """``results/<profile>/models/variants/<variant>/<dataset>/`` (a variant's networks), created unless
+    ``create`` is False."""
+    d = results_dir(profile, create=create) / "models" / VARIANTS_DIR / variant / dataset
     if create:
         d.mkdir(parents=True, exist_ok=True)
     return d

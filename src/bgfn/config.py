@@ -80,6 +80,7 @@ SHARED_TABLES: dict[str, str] = {
     "oracle": "outage_oracle.csv",              # notebook 04: the oracle rows (bgfn.evaluate.oracle)
     "oracle_breakeven": "outage_oracle_breakeven.csv",
     "oracle_runs": "outage_oracle_runs.csv",
+    "variants": "outage_variants.csv",          # notebook 03: the learning-problem variants in the two outages
 }
 #: Where a top-level ``datasets:`` puts its list (the datasets of every notebook), unless the same file or a later
 #: one in the ``base:`` chain sets that section's own ``datasets``.

@@ -103,11 +103,12 @@ TRAIN = section(
     attitude_source=text("kf", "reference"), window=integer(2),
     alignment=text("ending", "next"), yaw_encoding=text("unwrap", "relative", "raw"),
     target_frame=text("ned", "heading"), extra_channels=seq(text()), epoch_stride=integer(1),
-    margin_s=_NONNEG, val_fraction=_FRACTION,
+    margin_s=_NONNEG, protocol=text("honest", "leaky"), val_fraction=_FRACTION,
     val_position=Spec("any"),            # 'start' | 'middle' | 'end' | fraction: checked in cross_check
     target_screen_sigma=number(0, lo_open=True, null=True),
     optimizer=OPTIMIZER, lr=mapping(_POS),
-    lr_search=section(grid=seq(_POS, null=True), fraction=_FRACTION, seed=_SEED, extend=integer(0)),
+    lr_search=section(grid=seq(_POS, null=True), fraction=_FRACTION, seed=_SEED, extend=integer(0),
+                      epochs=integer(1, null=True), patience=integer(1, null=True)),
     size=text(), sizes=mapping(mapping(mapping(ANY))))
 
 #: The parameters of the real car drive ``rtklib-drive0708`` (``data.rtklib-drive0708``; the defaults and the
@@ -125,10 +126,23 @@ OUTAGE_RULE = section(
 #: ``outage_windows``: one list for every dataset, or per dataset name (and ``default``) a list or a rule.
 OUTAGE_WINDOWS = either(OUTAGE_LIST, mapping(either(OUTAGE_LIST, OUTAGE_RULE)))
 
+#: ``variants``: name -> overrides of the profile (a partial ``train:`` section), merged over it as a ``base:``
+#: chain merges (:func:`bgfn.config.merge_sections`); ``variant_runs``: which networks every variant trains
+#: (null: ``train.datasets`` / ``train.methods``). Read by :mod:`bgfn.train.variants`.
+VARIANT = section(train=Spec("section", fields=TRAIN.fields))
+VARIANT_RUNS = section(datasets=seq(text(), min_len=1, null=True), methods=seq(text(), min_len=1, null=True),
+                       seeds=seq(_SEED, min_len=1))
+#: Variant names: a folder name of ``models/variants/`` (``main`` is the profile itself).
+VARIANT_NAME = r"^[A-Za-z0-9][A-Za-z0-9_-]*$"
+MAIN_VARIANT = "main"
+#: Keys a variant may not set: which networks it trains is ``variant_runs``'s.
+VARIANT_RUN_KEYS = ("datasets", "methods", "seeds")
+
 #: The whole profile.
 SCHEMA = section(
     profile=text(), description=text(), seed=_SEED, base=text(), datasets=_NAMES,
     outage_windows=OUTAGE_WINDOWS,
+    variants=mapping(VARIANT), variant_runs=VARIANT_RUNS,
     data=section(
         datasets=_NAMES, seed=_SEED, imu_rate_hz=_POS, smoothing_degree=integer(1, 5),
         position_sigma_m=_POS, attitude_sigma_rad=_POS, t_start=number(null=True), t_end=number(null=True),
@@ -372,6 +386,42 @@ def cross_check(cfg: dict) -> None:
                            "measured)", _fmt(en["dataset"]))
     if en.get("seed") is not None and en["seed"] not in (tr.get("seeds") or []):
         raise ProfileError("energy.seed", f"one of train.seeds {tr.get('seeds')}", _fmt(en["seed"]))
+    _check_variants(cfg)          # last: the profile itself passed, so an error here is the variant's
+
+
+def variant_config(cfg: dict, name: str) -> dict:
+    """The profile ``cfg`` with variant ``name``'s overrides merged over it (:func:`bgfn.config.merge_sections`,
+    as a ``base:`` chain merges), without the ``variants`` and ``variant_runs`` keys; not checked."""
+    from bgfn.config import merge_sections
+
+    own = {k: v for k, v in cfg.items() if k not in ("variants", "variant_runs")}
+    return merge_sections(own, (cfg.get("variants") or {})[name] or {})
+
+
+def _check_variants(cfg: dict) -> None:
+    """Every variant's name, and the profile it makes checked as a whole profile (:func:`validate`): an error
+    is named ``variants.<name>.<key>``; ``variant_runs.methods`` are method ids (notebook 03 trains those of them
+    that ``train:`` trains: :meth:`bgfn.train.variants.VariantPlan.of`)."""
+    import re
+
+    for name, own in (cfg.get("variants") or {}).items():
+        where = f"variants.{name}"
+        if not re.match(VARIANT_NAME, str(name)) or name == MAIN_VARIANT:
+            raise ProfileError(where, f"a name of letters, digits, '_' or '-' other than {MAIN_VARIANT!r} (the "
+                               "profile's own networks)", _fmt(name))
+        for key in VARIANT_RUN_KEYS:
+            if key in ((own or {}).get("train") or {}):
+                raise ProfileError(f"{where}.train.{key}", f"no {key} here: variant_runs.{key} says what every "
+                                   "variant trains", "set")
+        try:
+            validate(variant_config(cfg, name))
+        except ProfileError as exc:
+            raise ProfileError(f"{where}.{exc.path}", exc.expected, exc.found) from None
+    from bgfn.paper import METHOD_LABELS
+
+    bad = [m for m in (cfg.get("variant_runs") or {}).get("methods") or [] if m not in METHOD_LABELS]
+    if bad:
+        raise ProfileError("variant_runs.methods", f"method ids among {', '.join(METHOD_LABELS)}", _fmt(bad))
 
 
 def validate(cfg: dict) -> None:

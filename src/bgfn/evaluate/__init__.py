@@ -61,7 +61,8 @@ Modules, in the order of the protocol:
 - :mod:`bgfn.evaluate.sweep` -- the outage sweep and its statistics;
 - :mod:`bgfn.evaluate.increments` -- the true increments of a drive, a run's increment error;
 - :mod:`bgfn.evaluate.oracle` -- the oracle rows: true increments plus noise, the break-even accuracy;
-- :mod:`bgfn.evaluate.record` -- ``outage_evaluation.json``, the record notebook 06 reads.
+- :mod:`bgfn.evaluate.record` -- ``outage_evaluation.json``, the record notebook 06 reads;
+- :mod:`bgfn.evaluate.variants` -- the learning-problem variants of notebook 03 in the two outages.
 
 Everything public is re-exported here: ``from bgfn import evaluate as ev; ev.evaluate_dataset(...)``.
 """
@@ -89,6 +90,8 @@ from bgfn.evaluate.tables import (TableResult, aggregate_seeds, describe_tables,
                                   evaluate_dataset, fix_error_table,
                                   representative_seeds, run_tables, save_table_result, table_file,
                                   table_paths)
+from bgfn.evaluate.variants import (NO_VARIANT, VARIANT_COLUMNS, VARIANT_METRICS, load_variant_network,
+                                    variant_pivot, variant_runs, variant_table)
 
 __all__ = [
     "AntennaTruth", "BREAKEVEN_COLUMNS", "ORACLE_COLUMNS", "OracleIncrements", "OracleResult", "breakeven_table",
@@ -106,4 +109,6 @@ __all__ = [
     "save_sensitivity", "save_table_result", "sensitivity_table", "sweep_comparisons", "sweep_interval_table",
     "sweep_plan", "sweep_summary", "sweep_train_config", "table_file", "table_paths", "window_metrics",
     "write_evaluation_record",
+    # the learning-problem variants (notebook 03)
+    "NO_VARIANT", "VARIANT_COLUMNS", "VARIANT_METRICS", "load_variant_network", "variant_runs", "variant_table", "variant_pivot",
 ]

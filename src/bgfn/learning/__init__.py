@@ -62,7 +62,7 @@ from bgfn.learning.inputs import (ANGULAR_RATE_CHANNELS, ATTITUDE_CHANNELS, CHAN
                                   heading_velocity, sample_features, with_derived_channels, wrap_angle)
 from bgfn.learning.normalize import Normalizer
 from bgfn.learning.references import REFERENCES, reference_columns, reference_rmse, rmse
-from bgfn.learning.split import block_label, forbidden_intervals, overlaps, split_windows
+from bgfn.learning.split import PROTOCOLS, block_label, forbidden_intervals, merged_spans, overlaps, split_windows
 from bgfn.learning.synthetic import synthetic_tables
 from bgfn.learning.targets import (TARGET_FRAMES, TARGETS, from_target_frame, gnss_increments, ins_increments,
                                    position_increment, screen_increments, to_target_frame)
@@ -79,7 +79,7 @@ __all__ = [
     # windows
     "ALIGNMENTS", "WindowSet", "make_windows", "prediction_windows",
     # split, normalization
-    "forbidden_intervals", "overlaps", "split_windows", "block_label", "Normalizer",
+    "PROTOCOLS", "forbidden_intervals", "overlaps", "merged_spans", "split_windows", "block_label", "Normalizer",
     # references, coverage
     "rmse", "REFERENCES", "reference_rmse", "reference_columns", "VAL_POSITIONS", "motion_of_windows",
     "motion_in_windows", "motion_sets", "unseen_fraction", "val_position_coverage",

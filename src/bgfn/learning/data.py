@@ -17,7 +17,7 @@ from bgfn.learning.windows import WindowSet, make_windows
 #: Defaults of the learning-problem keys of a profile's ``train:`` section.
 LEARNING_DEFAULTS = {"window": 200, "alignment": "ending", "yaw_encoding": "unwrap", "target_frame": "ned",
                      "extra_channels": [], "epoch_stride": 1, "margin_s": 30.0, "val_fraction": 0.2,
-                     "val_position": "middle", "target_screen_sigma": None}
+                     "val_position": "middle", "target_screen_sigma": None, "protocol": "honest"}
 
 
 @dataclass
@@ -54,10 +54,11 @@ def build_learning_data(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.Data
     imu, attitude, gnss : DataFrame
         Drive tables (CONTRIBUTING.md schemas; ``attitude`` = INS/KF solution with ``time, roll, pitch, yaw``).
     outage_windows : sequence of (start, duration)
-        Evaluation outages (s) excluded from training and validation.
+        Evaluation outages (s) excluded from training and validation (``protocol='honest'``; with ``'leaky'``
+        only from validation: :func:`bgfn.learning.split_windows`).
     **options
         ``window``, ``alignment``, ``yaw_encoding``, ``target_frame``, ``extra_channels``, ``epoch_stride``,
-        ``margin_s``, ``val_fraction``, ``val_position``, ``target_screen_sigma`` (defaults:
+        ``margin_s``, ``val_fraction``, ``val_position``, ``target_screen_sigma``, ``protocol`` (defaults:
         :data:`LEARNING_DEFAULTS`).
     """
     unknown = set(options) - set(LEARNING_DEFAULTS)
@@ -66,7 +67,8 @@ def build_learning_data(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.Data
     opt = learning_options(options)
     ws = all_windows(imu, attitude, gnss, **opt)
     tr, va, info = split_windows(ws, outage_windows, margin_s=float(opt["margin_s"]),
-                                 val_fraction=float(opt["val_fraction"]), val_position=opt["val_position"])
+                                 val_fraction=float(opt["val_fraction"]), val_position=opt["val_position"],
+                                 protocol=opt["protocol"])
     train, val = ws.subset(tr), ws.subset(va)
     info["outage_windows"] = [list(map(float, o)) for o in outage_windows]
     info["n_screened"] = int(ws.n_screened)

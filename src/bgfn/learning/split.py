@@ -1,9 +1,15 @@
-"""Training and validation windows from GPS-available time only.
+"""Training and validation windows, and the protocol that decides whether the evaluation outages are among them.
 
-A window whose input span or target interval touches an evaluation outage widened by ``margin_s`` is dropped
-(:func:`forbidden_intervals`); validation is one held-out block of time (``val_fraction`` of the windows at
-``val_position``), and training windows overlapping that block are dropped too, so no training window shares an
-IMU sample or GNSS epoch with a validation window (:func:`split_windows`).
+``protocol='honest'`` (ours): a window whose input span or target interval touches an evaluation outage widened
+by ``margin_s`` is dropped (:func:`forbidden_intervals`); validation is one held-out block of time
+(``val_fraction`` of the remaining windows at ``val_position``), and training windows overlapping that block are
+dropped too, so no training window shares an IMU sample or GNSS epoch with a validation window
+(:func:`split_windows`).
+
+``protocol='leaky'`` (what the paper may have done: it does not say that its test outages were kept out of
+training): the same validation windows, but nothing else is excluded, so the windows of the test outages and of
+their margin are training windows. The two protocols share their validation windows; the leaky training set is
+the honest one plus the windows the honest protocol excludes (those sharing time with a validation window aside).
 """
 
 from __future__ import annotations
@@ -12,6 +18,9 @@ import numpy as np
 
 from bgfn.errors import DataError
 from bgfn.learning.windows import WindowSet
+
+#: ``train.protocol``: ``honest`` keeps the evaluation outages (+- ``margin_s``) out of training, ``leaky`` does not.
+PROTOCOLS: tuple[str, ...] = ("honest", "leaky")
 
 
 def forbidden_intervals(outage_windows, margin_s: float) -> np.ndarray:
@@ -30,8 +39,8 @@ def overlaps(lo: np.ndarray, hi: np.ndarray, intervals: np.ndarray) -> np.ndarra
 
 
 def split_windows(ws: WindowSet, outage_windows=(), margin_s: float = 30.0, val_fraction: float = 0.2,
-                  val_position="end") -> tuple[np.ndarray, np.ndarray, dict]:
-    """Training and validation window indices from GPS-available time only.
+                  val_position="end", protocol: str = "honest") -> tuple[np.ndarray, np.ndarray, dict]:
+    """Training and validation window indices (from GPS-available time only, unless ``protocol='leaky'``).
 
     Parameters
     ----------
@@ -46,13 +55,21 @@ def split_windows(ws: WindowSet, outage_windows=(), margin_s: float = 30.0, val_
         Fraction (0 < f < 1) of the remaining windows held out for validation, as one block of time.
     val_position : {'end', 'start', 'middle'} or float
         Where the block lies: a float p in [0, 1] puts it at fraction p of the remaining windows.
+    protocol : {'honest', 'leaky'}
+        ``'leaky'``: the windows touching the outages and their margin are training windows too (the validation
+        block is placed as with ``'honest'``, outside them, so both protocols validate on the same windows;
+        training windows sharing time with a validation window are dropped).
 
     Returns
     -------
     train_idx, val_idx : ndarray of int
     info : dict
-        ``forbidden`` intervals, ``val_block`` ``[lo, hi]`` (s), counts of dropped windows.
+        ``forbidden`` intervals, ``val_block`` ``[lo, hi]`` (s), counts of dropped windows
+        (``n_outage_excluded``: windows kept out of both sets because they touch the forbidden intervals) and
+        ``n_outage_in_train`` (training windows that touch them: 0 unless ``'leaky'``), ``protocol``.
     """
+    if protocol not in PROTOCOLS:
+        raise DataError("train", "protocol", f"one of {', '.join(PROTOCOLS)}", repr(protocol))
     if not 0.0 < val_fraction < 1.0:
         raise DataError("train", "val_fraction", "a fraction in (0, 1)", repr(val_fraction))
     pos = {"start": 0.0, "middle": 0.5, "end": 1.0}.get(val_position, val_position)
@@ -61,19 +78,39 @@ def split_windows(ws: WindowSet, outage_windows=(), margin_s: float = 30.0, val_
                         repr(val_position))
     lo, hi = ws.span
     forb = forbidden_intervals(outage_windows, margin_s)
-    allowed = np.flatnonzero(~overlaps(lo, hi, forb))
+    touching = overlaps(lo, hi, forb)
+    allowed = np.flatnonzero(~touching)
     if len(allowed) < 2:
         raise DataError("train", "outage_windows", "GPS-available windows outside the outages", f"{len(allowed)}")
     n_val = max(1, int(round(val_fraction * len(allowed))))
     s = int(round(float(pos) * (len(allowed) - n_val)))
     val_idx = allowed[s:s + n_val]
     block = np.array([[lo[val_idx].min(), hi[val_idx].max()]])
-    rest = np.setdiff1d(allowed, val_idx)
-    train_idx = rest[~overlaps(lo[rest], hi[rest], block)]
+    if protocol == "honest":
+        rest = np.setdiff1d(allowed, val_idx)
+        train_idx = rest[~overlaps(lo[rest], hi[rest], block)]
+    else:
+        # leaky: every other window trains, the outages' own included; purged are those sharing time with a
+        # validation window (not the block's hull, which may span an outage lying between two of its parts)
+        rest = np.setdiff1d(np.arange(len(ws)), val_idx)
+        train_idx = rest[~overlaps(lo[rest], hi[rest], merged_spans(lo[val_idx], hi[val_idx]))]
     info = {"forbidden": forb.tolist(), "val_block": block[0].tolist(), "n_windows": int(len(ws)),
-            "n_outage_excluded": int(len(ws) - len(allowed)), "n_purged": int(len(rest) - len(train_idx)),
-            "n_train": int(len(train_idx)), "n_val": int(len(val_idx))}
+            "n_outage_excluded": int(len(ws) - len(allowed)) if protocol == "honest" else 0,
+            "n_outage_in_train": int(touching[train_idx].sum()), "protocol": protocol,
+            "n_purged": int(len(rest) - len(train_idx)), "n_train": int(len(train_idx)), "n_val": int(len(val_idx))}
     return train_idx, val_idx, info
+
+
+def merged_spans(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The union of the closed spans ``[lo_i, hi_i]`` as disjoint intervals, shape [K, 2], sorted."""
+    order = np.argsort(lo, kind="stable")
+    out: list[list[float]] = []
+    for a, b in zip(lo[order], hi[order]):
+        if out and a <= out[-1][1]:
+            out[-1][1] = max(out[-1][1], float(b))
+        else:
+            out.append([float(a), float(b)])
+    return np.array(out, dtype=float).reshape(-1, 2)
 
 
 def block_label(block) -> str:

@@ -11,6 +11,8 @@ Modules, one concept each (every public name is re-exported here):
 - :mod:`bgfn.train.lr_search`: the learning rate of every method from one grid on a tuning split;
 - :mod:`bgfn.train.profile`: a profile's runs (:class:`TrainingPlan`), its drives and windows, the INS attitude
   input, the training over datasets x methods x seeds;
+- :mod:`bgfn.train.variants`: the profile's input and protocol variants (:class:`VariantPlan`), trained beside the
+  main networks with their learning rates;
 - :mod:`bgfn.train.tables`: the run and summary tables, the windows table, ``training.json``;
 - :mod:`bgfn.train.plots`: the figures of notebook 03;
 - :mod:`bgfn.train.estimate`: how long the paper profile would train here, from ``make bench``;
@@ -23,8 +25,8 @@ from bgfn.train.estimate import estimate_lines, measure_paper_step, paper_traini
 from bgfn.train.loop import set_seed, train_model
 from bgfn.train.lr_search import (LR_SEARCH_COLUMNS, LR_SEARCH_DEFAULTS, LR_SEARCH_FILE, chosen_learning_rates,
                                   lr_search_options, next_learning_rate, search_learning_rates,
-                                  search_profile_learning_rates, selected_train_configs, tuned_train_config,
-                                  with_selected_lr)
+                                  search_profile_learning_rates, search_train_config, selected_train_configs,
+                                  tuned_train_config, with_selected_lr)
 from bgfn.train.options import (OPTIMIZER_DEFAULTS, even_subset, method_lr, optimizer_options, size_config,
                                 train_subsection)
 from bgfn.train.plots import plot_motion_coverage, plot_training_curves, plot_val_predictions
@@ -33,6 +35,8 @@ from bgfn.train.profile import (TrainingDataset, TrainingPlan, ins_attitude, pre
 from bgfn.train.tables import (TIMING_COLUMNS, card_line, cards_table, summary_table, timing_table, training_metrics,
                                windows_table, without_timing)
 from bgfn.train.trained import TrainedModel, checkpoint_predictions, load_trained, pick_device, predict_normalized
+from bgfn.train.variants import (VARIANT_RUN_DEFAULTS, VariantPlan, describe_options, train_variants,
+                                 variant_cards_table, variant_learning_data, variant_train_section)
 
 __all__ = [
     "estimate_lines", "measure_paper_step", "paper_training_estimate",
@@ -43,7 +47,7 @@ __all__ = [
     "checkpoint_predictions",
     # learning-rate search
     "LR_SEARCH_DEFAULTS", "LR_SEARCH_FILE", "LR_SEARCH_COLUMNS", "lr_search_options", "search_learning_rates",
-    "next_learning_rate", "with_selected_lr", "tuned_train_config", "search_profile_learning_rates",
+    "next_learning_rate", "search_train_config", "with_selected_lr", "tuned_train_config", "search_profile_learning_rates",
     "selected_train_configs", "chosen_learning_rates",
     # a profile's training
     "TrainingPlan", "TrainingDataset", "prepare_datasets", "prepare_learning_data", "ins_attitude",
@@ -52,6 +56,9 @@ __all__ = [
     "REFERENCES", "VAL_POSITIONS", "TIMING_COLUMNS", "cards_table", "summary_table", "without_timing",
     "timing_table", "windows_table", "card_line", "training_metrics", "plot_training_curves",
     "plot_val_predictions", "plot_motion_coverage",
+    # input and protocol variants
+    "VARIANT_RUN_DEFAULTS", "VariantPlan", "describe_options", "variant_train_section", "variant_learning_data",
+    "train_variants", "variant_cards_table",
     # command line
     "main",
 ]

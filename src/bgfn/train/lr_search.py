@@ -1,6 +1,10 @@
 """The learning rate of every method, chosen the same way: one grid, one budget, one seed, on a tuning split
 inside the training windows (:func:`bgfn.learning.inner_split`); the validation block is never used.
 
+The budget of one tuning run is the profile's optimizer with ``train.lr_search.epochs`` and ``patience`` laid
+over its ``epochs`` and early-stopping ``patience`` (:func:`search_train_config`): the same shorter budget for
+every method and rate, so that the search costs less than training every rate to the end.
+
 Notebook 03 runs the search per dataset (:func:`search_profile_learning_rates`) and saves it as
 ``tables/lr_search.csv``; the networks it trains, and those the outage evaluation trains later
 (:func:`tuned_train_config`), use the selected rates.
@@ -23,8 +27,10 @@ from bgfn.train.options import method_lr, size_config, train_subsection
 #: ``train.lr_search``: learning rates tried for every method on :func:`bgfn.learning.inner_split` (null: none).
 #: ``extend``: when a method's best rate is the grid's smallest or largest, up to this many further rates are
 #: tried beyond it, one grid step (the ratio of the two rates at that end) at a time, so no method's choice
-#: is cut off by the grid's ends.
-LR_SEARCH_DEFAULTS: dict[str, Any] = {"grid": None, "fraction": 0.2, "seed": 0, "extend": 0}
+#: is cut off by the grid's ends. ``epochs``, ``patience``: the budget of one tuning run (null: the optimizer's
+#: ``epochs`` / ``patience``), the same for every method and rate.
+LR_SEARCH_DEFAULTS: dict[str, Any] = {"grid": None, "fraction": 0.2, "seed": 0, "extend": 0, "epochs": None,
+                                      "patience": None}
 #: The saved search of notebook 03 (``results/<profile>/tables/``): one row per dataset, method and rate.
 LR_SEARCH_FILE = "lr_search.csv"
 LR_SEARCH_COLUMNS = ("dataset", "method", "lr", "tuning_rmse_m", "tuning_loss", "epochs_run", "selected")
@@ -35,13 +41,24 @@ def lr_search_options(train_cfg: dict | None) -> dict:
     return train_subsection(train_cfg, "lr_search", LR_SEARCH_DEFAULTS)
 
 
+def search_train_config(train_cfg: dict) -> dict:
+    """The ``train:`` section one tuning run trains with: ``train.lr_search.epochs`` and ``patience`` (when set)
+    replace the optimizer's ``epochs`` and early-stopping ``patience``; everything else as the profile's."""
+    ls = lr_search_options(train_cfg)
+    budget = {k: int(ls[k]) for k in ("epochs", "patience") if ls[k] is not None}
+    if not budget:
+        return train_cfg
+    return {**train_cfg, "optimizer": {**(train_cfg.get("optimizer") or {}), **budget}}
+
+
 def search_learning_rates(data: LearningData, methods, train_cfg: dict, out_dir: str | Path | None = None,
                           progress: bool = False) -> pd.DataFrame:
     """Train every method once per learning rate of ``train.lr_search.grid`` on a tuning split inside the
     training windows (:func:`bgfn.learning.inner_split`) and mark the rate with the lowest tuning loss.
 
-    Every method gets the same grid, budget (the profile's optimizer) and seed, so none is tuned more than
-    another; the validation block of ``data`` is never used.
+    Every method gets the same grid, budget (the profile's optimizer, capped by ``train.lr_search.epochs`` and
+    ``patience``: :func:`search_train_config`) and seed, so none is tuned more than another; the validation block
+    of ``data`` is never used.
 
     Returns
     -------
@@ -54,10 +71,11 @@ def search_learning_rates(data: LearningData, methods, train_cfg: dict, out_dir:
         raise DataError("train.lr_search", "grid", "a non-empty list of learning rates", repr(ls["grid"]))
     grid = sorted(set(grid))
     inner = inner_split(data, float(ls["fraction"]))
+    budget = search_train_config(train_cfg)
     rows = []
     for method in methods:
         def tune(lr: float) -> dict:
-            cfg = {**train_cfg, "lr": {**(train_cfg.get("lr") or {}), method: lr}}
+            cfg = {**budget, "lr": {**(budget.get("lr") or {}), method: lr}}
             sub = Path(out_dir) / f"lr{lr:g}" if out_dir is not None else None
             card = train_model(method, inner, size_config(train_cfg, method), cfg, seed=int(ls["seed"]),
                                out_dir=sub, progress=progress)

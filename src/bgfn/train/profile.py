@@ -26,7 +26,7 @@ from bgfn.train.tables import card_line
 #: Learning options :meth:`TrainingPlan.describe` shows (the rest of :data:`bgfn.learning.LEARNING_DEFAULTS`
 #: is in the profile).
 DESCRIBED_OPTIONS = ("window", "alignment", "yaw_encoding", "target_frame", "extra_channels", "val_position",
-                     "target_screen_sigma")
+                     "target_screen_sigma", "protocol")
 
 
 @dataclass
@@ -96,8 +96,10 @@ class TrainingPlan:
         return "\n".join([
             f"profile {self.cfg['profile']!r}: {self.cfg['description']}",
             f"datasets {self.datasets}, methods {self.methods}, seeds {self.seeds}, size {tc.get('size')!r}",
-            f"evaluation outages excluded from training (start, duration) s: {self._windows_text()} "
-            f"+- {opts['margin_s']} s",
+            (f"evaluation outages excluded from training (start, duration) s: {self._windows_text()} "
+             f"+- {opts['margin_s']} s" if opts["protocol"] == "honest" else
+             f"protocol {opts['protocol']!r}: the evaluation outages (start, duration) s {self._windows_text()} "
+             "are training windows too"),
             f"optimizer: {optimizer_options(tc)}",
             f"learning problem: { {k: opts[k] for k in DESCRIBED_OPTIONS} }",
         ])

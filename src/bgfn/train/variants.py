@@ -1,0 +1,180 @@
+"""Variants of a profile's learning problem, trained beside its main networks (issue 17, outcome 3).
+
+A profile names them at its top level (schema: :data:`bgfn.profile_schema.VARIANT`)::
+
+    variants:                                  # name -> overrides of the train: section
+      velocity: {train: {extra_channels: [v_along, v_cross], ...}}     # params/quick-heading.yaml's inputs
+      leaky: {train: {protocol: leaky}}        # the test outages are training windows (bgfn.learning.split)
+    variant_runs: {datasets: null, methods: null, seeds: [0]}          # null: train.datasets / train.methods
+
+A variant's overrides are merged over the profile as a ``base:`` chain merges (:func:`bgfn.config.merge_sections`)
+and the result is checked as a whole profile when the profile loads (a misspelt key fails naming the file and
+``variants.<name>.train.<key>``). Its networks train on the same drives, with the same INS attitude input, the
+same budget and **the learning rates the main search selected** for each dataset and method
+(:mod:`bgfn.train.lr_search`; the variants are not searched again, so a variant is compared at the rate its
+main network uses). They are stored under ``results/<profile>/models/variants/<variant>/<dataset>/``
+(:func:`bgfn.checkpoints.variant_models_dir`); :mod:`bgfn.evaluate.variants` evaluates them in the outages.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable
+
+from bgfn import checkpoints
+from bgfn.config import merge_sections
+from bgfn.learning import LEARNING_DEFAULTS, LearningData, build_learning_data, learning_options
+from bgfn.profile_schema import MAIN_VARIANT, variant_config
+from bgfn.train.loop import train_model
+from bgfn.train.options import size_config
+from bgfn.train.tables import card_line
+
+#: Defaults of ``variant_runs`` (null datasets / methods: the ``train:`` section's).
+VARIANT_RUN_DEFAULTS: dict[str, Any] = {"datasets": None, "methods": None, "seeds": [0]}
+
+
+def variant_train_section(train_cfg: dict, overrides: dict | None) -> dict:
+    """``train_cfg`` (a ``train:`` section, e.g. with a dataset's selected learning rates) with a variant's
+    ``train`` overrides merged over it key by key (:func:`bgfn.config.merge_sections`)."""
+    return merge_sections(train_cfg, (overrides or {}).get("train") or {})
+
+
+def describe_options(train_cfg: dict) -> dict:
+    """What a variant changes in the learning problem, in a few words: ``inputs`` (``eq21``: the nine channels
+    of Eq. (eq21), ``+<channel>`` per extra channel, ``; yaw <encoding>`` and ``; <frame> frame`` where they are
+    not the paper's ``unwrap`` and ``ned``) and ``protocol`` (``honest`` / ``leaky``)."""
+    opts = learning_options(train_cfg)
+    inputs = "+".join(["eq21", *(opts["extra_channels"] or [])])
+    if opts["yaw_encoding"] != LEARNING_DEFAULTS["yaw_encoding"]:
+        inputs += f"; yaw {opts['yaw_encoding']}"
+    if opts["target_frame"] != LEARNING_DEFAULTS["target_frame"]:
+        inputs += f"; {opts['target_frame']} frame"
+    return {"inputs": inputs, "protocol": opts["protocol"]}
+
+
+@dataclass
+class VariantPlan:
+    """The variant networks of a profile: every ``(variant, dataset, method, seed)``.
+
+    Attributes
+    ----------
+    profile : str
+    cfg : dict
+        The profile (:func:`bgfn.config.load_profile`).
+    variants : dict
+        ``{name: overrides}`` (the profile's ``variants``, in its order).
+    datasets, methods : list of str
+    seeds : list of int
+    outage_windows : list of (start, duration)
+        The main plan's outages, s (its ``default`` when each dataset has its own: training and evaluation take
+        each dataset's, ``TrainingDataset.windows`` and :func:`bgfn.nav.outages.outage_windows`).
+    """
+
+    profile: str
+    cfg: dict
+    variants: dict
+    datasets: list[str]
+    methods: list[str]
+    seeds: list[int]
+    outage_windows: list
+
+    @classmethod
+    def of(cls, plan) -> "VariantPlan":
+        """The variants of a :class:`bgfn.train.profile.TrainingPlan`'s profile; ``variant_runs``' null datasets
+        and methods are the plan's (notebook 03's parameters), its own lists are cut to the plan's."""
+        runs = {**VARIANT_RUN_DEFAULTS, **(plan.cfg.get("variant_runs") or {})}
+        datasets = [d for d in (runs["datasets"] or plan.datasets) if d in plan.datasets]
+        methods = [m for m in (runs["methods"] or plan.methods) if m in plan.methods]
+        return cls(plan.profile, plan.cfg, dict(plan.cfg.get("variants") or {}), datasets, methods,
+                   [int(s) for s in runs["seeds"]], list(plan.outage_windows or []))
+
+    @property
+    def names(self) -> list[str]:
+        """The variant names, in the profile's order."""
+        return list(self.variants)
+
+    def profile_of(self, name: str) -> dict:
+        """The profile with variant ``name`` merged over it (:func:`bgfn.profile_schema.variant_config`);
+        ``main``: the profile itself."""
+        return self.cfg if name == MAIN_VARIANT else variant_config(self.cfg, name)
+
+    def train_section(self, name: str, train_cfg: dict | None = None) -> dict:
+        """Variant ``name``'s ``train:`` section over ``train_cfg`` (default the profile's; pass a dataset's
+        section with its selected learning rates)."""
+        base = self.cfg["train"] if train_cfg is None else train_cfg
+        return base if name == MAIN_VARIANT else variant_train_section(base, self.variants[name])
+
+    def models_dir(self, name: str, dataset: str, create: bool = True):
+        """Where variant ``name``'s networks of ``dataset`` are (``main``: notebook 03's own folder)."""
+        if name == MAIN_VARIANT:
+            return checkpoints.models_dir(self.profile, dataset, create=create)
+        return checkpoints.variant_models_dir(self.profile, name, dataset, create=create)
+
+    def describe(self) -> str:
+        """One line per variant (its inputs and protocol) and the networks each trains."""
+        lines = [f"variants {self.names or 'none'}: datasets {self.datasets}, methods {self.methods}, "
+                 f"seeds {self.seeds}, each with the learning rate the main search chose for its dataset and method"]
+        for name in [MAIN_VARIANT] + self.names:
+            tc = self.train_section(name)
+            what = describe_options(tc)
+            lines.append(f"  {name}: inputs {what['inputs']}, protocol {what['protocol']}")
+        return "\n".join(lines)
+
+
+def variant_learning_data(train_section: dict, prepared, outage_windows) -> LearningData:
+    """The learning data of one variant on one prepared dataset (:class:`bgfn.train.profile.TrainingDataset`):
+    its drive and INS attitude, the variant's learning options (inputs, protocol) and the evaluation outages."""
+    opts = learning_options(train_section)
+    return build_learning_data(prepared.drive.imu, prepared.attitude, prepared.drive.gnss, outage_windows, **opts)
+
+
+def train_variants(vplan: VariantPlan, prepared: dict, train_cfgs: dict[str, dict], device: str | None = None,
+                   progress: bool = False, echo: Callable[[str], Any] | None = None) -> list[dict]:
+    """Train every variant network of ``vplan`` into ``results/<profile>/models/variants/<variant>/<dataset>/``.
+
+    Parameters
+    ----------
+    prepared : dict
+        ``{dataset: TrainingDataset}`` (:func:`bgfn.train.profile.prepare_datasets`): drives and INS attitude.
+    train_cfgs : dict
+        ``{dataset: train: section with the selected learning rates}``
+        (:func:`bgfn.train.lr_search.selected_train_configs`); the variant's overrides are merged over it.
+    echo : callable, optional
+        Called with :func:`bgfn.train.tables.card_line` of each card, prefixed by the variant.
+
+    Returns
+    -------
+    list of dict
+        The cards (:func:`bgfn.train.loop.train_model`) with ``variant``, ``inputs``, ``protocol``, ``dataset``,
+        ``profile`` and ``size``; a completed network is not trained again.
+    """
+    cards = []
+    for name in vplan.names:
+        for dataset in vplan.datasets:
+            tc = vplan.train_section(name, train_cfgs[dataset])
+            own = prepared[dataset].windows
+            data = variant_learning_data(tc, prepared[dataset], vplan.outage_windows if own is None else own)
+            out = vplan.models_dir(name, dataset)
+            for method in vplan.methods:
+                for seed in vplan.seeds:
+                    card = train_model(method, data, size_config(tc, method), tc, seed=seed, out_dir=out,
+                                       device=device, progress=progress,
+                                       extra_card={"variant": name, **describe_options(tc), "dataset": dataset,
+                                                   "profile": vplan.profile, "size": tc.get("size"),
+                                                   "lr_from": "main search"})
+                    cards.append(card)
+                    if echo is not None:
+                        echo(f"{name:>15} " + card_line(card))
+    return cards
+
+
+def variant_cards_table(cards: list[dict]):
+    """:func:`bgfn.train.tables.cards_table` of variant cards, with ``variant``, ``inputs`` and ``protocol``
+    first and the training windows that touch an outage (``n_outage_in_train``: 0 when honest)."""
+    from bgfn.train.tables import cards_table
+
+    table = cards_table(cards)
+    for i, col in enumerate(("variant", "inputs", "protocol")):
+        table.insert(i, col, [c.get(col) for c in cards])
+    table["n_outage_in_train"] = [(c.get("split") or {}).get("n_outage_in_train") for c in cards]
+    return table

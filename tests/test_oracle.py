@@ -304,3 +304,19 @@ def test_sweep_rows_carry_each_networks_increment_error(drive, monkeypatch, tmp_
     assert rows.loc[rows["method"].isin(["INS", "GPS"]), "increment_rmse_m"].isna().all()
     assert inc.max()["MLP"].max() == pytest.approx(0.0, abs=1e-9)
     assert inc.median()[("BGFN", 30.0)] == pytest.approx(0.5, rel=0.2)
+
+
+def test_increments_past_the_reference_are_left_out():
+    """A window at a drive's end: its last GNSS epoch may lie past the last reference row; it is not scored."""
+    from types import SimpleNamespace
+
+    from bgfn.evaluate.increments import AntennaTruth, increment_errors
+
+    t = np.arange(0.0, 10.001, 0.01)
+    ref = pd.DataFrame({"time": t, "lat": 0.7 + 1e-7 * t, "lon": 0.1 + 0 * t, "h": 100.0 + 0 * t,
+                        "roll": 0 * t, "pitch": 0 * t, "yaw": 0 * t})
+    truth = AntennaTruth(ref, [0.0, 0.0, 0.0], "sim")
+    run = SimpleNamespace(start=7.0, increments=pd.DataFrame({"time": [8.0, 9.0, 10.0, 10.5], "dn": 0.0, "de": 0.0}))
+    e = increment_errors(run, truth, 1.0)
+    assert e.shape == (3, 2)                                   # the increment ending at 10.5 s is left out
+    assert np.allclose(e[:, 0], -1e-7 * 6.37e6, rtol=0.01)     # north: minus the true 0.64 m per second

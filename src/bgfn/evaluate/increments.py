@@ -75,13 +75,15 @@ def increment_errors(run, truth: AntennaTruth, interval_s: float, duration: floa
         Length of one increment (the drive's GNSS interval, ``NavContext.gnss_interval_s``), s.
     duration : float, optional
         Only the increments ending within ``duration`` s of the start (a prefix of the run, as the sweep's
-        shorter outages are); None: all.
+        shorter outages are); None: all. Increments ending after the reference's last row (a window at the end
+        of a drive: its last GNSS epoch may lie a sample past the reference) are left out.
     """
     inc = run.increments
     t_to = inc["time"].to_numpy(float)
+    keep = t_to <= truth.time[-1] + _TIME_TOL          # an increment ending after the reference cannot be scored
     if duration is not None:
-        keep = t_to <= run.start + float(duration) + _TIME_TOL
-        inc, t_to = inc.loc[keep], t_to[keep]
+        keep &= t_to <= run.start + float(duration) + _TIME_TOL
+    inc, t_to = inc.loc[keep], t_to[keep]
     pred = inc[["dn", "de"]].to_numpy(float).reshape(-1, 2)
     return pred - truth.increments(t_to - float(interval_s), t_to)
 

@@ -126,6 +126,7 @@ def oracle_windows(cfg: dict, drive, ecfg: dict, windows) -> tuple[list[tuple[st
     """
     from bgfn.evaluate.sweep import sweep_plan, sweep_train_config
     from bgfn.learning import learning_options
+    from bgfn.nav.baseline import filter_start
 
     out = [(str(k + 1), float(s), float(d)) for k, (s, d) in enumerate(windows)]
     sw, durations = ecfg["sweep"], ecfg["oracle"]["durations_s"]
@@ -136,8 +137,8 @@ def oracle_windows(cfg: dict, drive, ecfg: dict, windows) -> tuple[list[tuple[st
                         f"longest {max(sw['durations_s']):g} s (the sweep's starts leave room for no more)",
                         repr(durations))
     n_window = int(learning_options(sweep_train_config(cfg.get("train") or {}, sw))["window"])
-    try:
-        plan = sweep_plan(drive, sw, n_window)
+    try:        # the sweep's own starts (a self-aligned filter starts late: none before it)
+        plan = sweep_plan(drive, sw, n_window, t_first=filter_start(drive, cfg.get("nav")))
     except DataError as exc:
         return out, [f"{drive.name}: no sweep starts ({exc.expected}; found {exc.found}): the paper's outages only"]
     return out + [(SWEEP_OUTAGE, float(s), float(max(durations))) for s in plan["start_s"]], []
@@ -482,6 +483,7 @@ def run_oracle(cfg: dict, profile: str, setup, out=None, results: dict | None = 
     from bgfn.config import SHARED_TABLES
     from bgfn.data import load_drive
     from bgfn.evaluate.plots import plot_oracle
+    from bgfn.nav.outages import outage_windows
     from bgfn.io import atomic_write_csv, save_figure
 
     ecfg = setup.config
@@ -493,7 +495,11 @@ def run_oracle(cfg: dict, profile: str, setup, out=None, results: dict | None = 
         t0 = time.perf_counter()
         res = results.get(name)
         drive = res.drive if res is not None and res.drive is not None else load_drive(name, profile=profile)
-        wins, why = oracle_windows(cfg, drive, ecfg, setup.windows)
+        if res is not None and res.windows:          # each drive its own outages (notebook 04's tables)
+            own = res.windows
+        else:
+            own = outage_windows(cfg, drive, name) if cfg.get("outage_windows") else setup.windows
+        wins, why = oracle_windows(cfg, drive, ecfg, own)
         notes += why
         ctx = navigation_context(drive, cfg.get("nav"), [s for _, s, _ in wins])
         interval[name] = float(ctx.gnss_interval_s)

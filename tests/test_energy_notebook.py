@@ -213,3 +213,27 @@ def test_the_energy_network_is_the_median_seed_and_must_be_trained(tmp_path, mon
     assert err.value.source == "bgfn_seed0.json" and err.value.field == "best_epoch"
     check_trained({"best_epoch": 0}, "bgfn_seed0.json", allow_untrained=True)
     check_trained({"best_epoch": 3}, "bgfn_seed0.json")
+
+
+def test_only_the_spiking_network_must_have_learned(tmp_path, monkeypatch):
+    """BGFN's firing rates depend on training, the twin's MAC count does not: an untrained twin is accepted, an
+    untrained BGFN refused."""
+    from bgfn import config
+    from bgfn.energy import checkpoint
+    from bgfn.errors import DataError
+
+    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)
+    monkeypatch.setattr(checkpoint, "load_trained",
+                        lambda p, device=None: TrainedModel("x", build_model("mlp", {"hidden": 4}), None, {},
+                                                            {**TINY, "time_steps": 3}))
+    cfg = {"energy": {"dataset": "d", "seed": 0}, "train": {"datasets": ["d"], "seeds": [0]}}
+    folder = tmp_path / "smoke" / "models" / "d"
+    folder.mkdir(parents=True)
+    for m in energy.MEASURED:
+        (folder / f"{m}_seed0.pt").write_bytes(b"")
+    (folder / "transformer_seed0.json").write_text(json.dumps({"best_epoch": 0}))
+    (folder / "bgfn_seed0.json").write_text(json.dumps({"best_epoch": 4}))
+    assert energy.load_measured("smoke", cfg).cards["transformer"]["best_epoch"] == 0
+    (folder / "bgfn_seed0.json").write_text(json.dumps({"best_epoch": 0}))
+    with pytest.raises(DataError, match="best epoch >= 1"):
+        energy.load_measured("smoke", cfg)

@@ -61,13 +61,15 @@ def test_answers_say_the_measured_numbers():
     inp = _inputs()
     t = verdict_table(inp)
     acc = answer_accuracy(inp)
-    assert "below 1.9 m per increment of 1 s" in acc and "2.5 m (misses the bar)" in acc and "7.0 m" in acc
+    assert "below 1.9 m per increment of 1 s" in acc and "2.5 m (misses the bar)" in acc
+    assert "white noise of 7.0 m" in acc
     free = answer_free_aids(t)
     assert "5.0 m for INS+NHC" in free and "does not add" in free and "p 2e-10" in free
     speed = answer_speed(t)
     assert "averages 60.0 m" in speed and "velocity 12.0 m" in speed
     prot = answer_protocol(t, {"bgfn_reduction_vs_ins_pct": {"a": {"east": 79.7}, "b": {"north": 90.0}}})
-    assert "80 % below INS" in prot and "79.7-90 %" in prot                           # (15 - 3) / 15
+    assert "leaky: 3.0 m, 80 % below INS" in prot and "79.7-90 %" in prot            # (15 - 3) / 15
+    assert "main), honest: 60.0 m, 4.0 times INS" in prot
     assert headline(inp, t).endswith("INS with non-holonomic constraints 5.0 m.")
 
 

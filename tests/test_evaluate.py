@@ -540,7 +540,9 @@ def test_evaluation_setup_applies_the_notebook_parameters_over_the_profile(monke
     assert setup.windows == outage_windows(cfg) and repr(section) == before         # the profile is not modified
     lines = setup.describe()
     assert lines[0].startswith("profile 'smoke': ") and "seeds: [3, 4]" in lines[2]
-    assert lines[3] == f"outages (start, duration) s: {[list(w) for w in outage_windows(cfg)]}"
+    assert lines[3].startswith(f"outages (start, duration) s: {[list(w) for w in outage_windows(cfg)]}")
+    # the recorded drive's outages come from the profile's rule, said beside the default list
+    assert lines[3].endswith("; rtklib-drive0708: rule cruise_and_manoeuvre (picked from the drive)")
     with pytest.raises(DataError):
         ev.evaluation_setup(cfg, methods=["no_such_network"])
     # real_imu: one line per note, the tables' and the sweep's, said once
@@ -668,4 +670,5 @@ def test_evaluation_record_is_what_notebook_06_reads(tmp_path):
     assert bgfn1["east_%"] == pytest.approx(80.0)
     assert rec["paper_claims"] == paper.claims()["bgfn_reduction_vs_ins_pct"]
     assert rec["sweep"] == {"rows": 0, "info": {}} and rec["timings_s"] == {"tables_x_s": 1.0}
-    assert report.outage_datasets(rec) == {"dataset": "turin-sim-ekinox", "field": "turin-sim-mpu6000"}
+    assert report.outage_datasets(rec) == {"dataset": "turin-sim-ekinox", "field": "turin-sim-mpu6000",
+                                           "real": "rtklib-drive0708"}

@@ -5,6 +5,8 @@ A small synthetic drive (demo trajectory, Ekinox-grade IMU errors, 5 Hz GNSS) ke
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -315,6 +317,12 @@ def test_sweep_plan_spreads_starts_in_contiguous_folds(drive5):
     assert len(plan) == 7 and plan["start_s"].is_monotonic_increasing
     assert plan["start_s"].min() >= 20.0 and plan["start_s"].max() + 30.0 <= drive5.imu["time"].iloc[-1]
     assert plan["fold"].tolist() == [0, 0, 0, 1, 1, 2, 2]
+    # a recorded drive's IMU may run on past its reference: the last outage still ends inside the reference
+    ref_end = float(drive5.reference["time"].iloc[-1]) - 7.05
+    short = copy.copy(drive5)
+    short.reference = drive5.reference[drive5.reference["time"] <= ref_end].reset_index(drop=True)
+    cut = ev.sweep_plan(short, sw, window_samples=50)
+    assert cut["start_s"].max() + 30.0 <= ref_end < plan["start_s"].max() + 30.0
 
 
 # ----------------------------------------------------------------------------------------------- statistics

@@ -23,7 +23,7 @@ def sweep_plan(drive, sweep: dict, window_samples: int = 200, t_first: float | N
     """Outage starts spread evenly over the drive and their folds (contiguous blocks of starts).
 
     The first start leaves ``warmup_s`` after the first epoch (filter convergence; at least the input window),
-    the last one room for the longest duration. ``t_first``: the filter's start when it is later than the
+    the last one room for the longest duration before the end of the IMU and of the reference. ``t_first``: the filter's start when it is later than the
     reference's first row (a self-aligned filter, :func:`bgfn.nav.baseline.filter_start`), s.
 
     Returns
@@ -36,7 +36,10 @@ def sweep_plan(drive, sweep: dict, window_samples: int = 200, t_first: float | N
     t0 = float(drive.reference["time"].iloc[0]) if t_first is None else max(float(t_first),
                                                                            float(drive.reference["time"].iloc[0]))
     lo = t0 + max(float(sweep["warmup_s"]), (window_samples + 1) / rate)
-    hi = float(t[-1]) - max(sweep["durations_s"]) - 1.0 / rate
+    # the last outage ends inside both the IMU and the reference (the errors are scored against the
+    # reference; a recorded drive's IMU may run on past it); floored to the 0.1 s grid of the starts
+    end = min(float(t[-1]), float(drive.reference["time"].iloc[-1]))
+    hi = np.floor((end - max(sweep["durations_s"]) - 1.0 / rate) * 10.0) / 10.0
     n = int(sweep["n_starts"])
     if hi < lo:
         raise DataError(drive.name, "time", f"room for {n} outages of {max(sweep['durations_s'])} s after a "

@@ -345,6 +345,12 @@ def test_source_code_page_lists_every_module():
                if p.name not in ("__init__.py", "__main__.py")]
     missing = [m for m in modules if f"../{m}" not in code]
     assert not missing, f"add these modules to book/code.md: {missing}"
+    # every entry is whole (a merge once left dropdowns open, which the book build only warns about) and once
+    labels = re.findall(r"^\((code-[^)]+)\)=$", code, flags=re.M)
+    assert len(labels) == len(set(labels)), "book/code.md: a module's label appears twice"
+    includes = re.findall(r"```\{literalinclude\} (\S+)\n(.*?)\n```\n````", code, flags=re.S)
+    assert len(includes) == code.count("{literalinclude}") == len(labels), "book/code.md: an unclosed source block"
+    assert all(opts == ":language: python\n:linenos:" for _, opts in includes)
 
 
 def test_variant_tables_put_profiles_side_by_side():

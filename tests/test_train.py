@@ -37,7 +37,9 @@ def test_card_checkpoint_and_references(data, tmp_path):
     for key in ("params", "epochs_run", "best_val_loss", "wall_time_s", "device", "history", "val_rmse_m",
                 "val_rmse_zero_m", "val_rmse_last_m", "val_rmse_ins_m", "n_train", "n_val", "dataset"):
         assert key in card
-    assert card["epochs_run"] == 3 and len(card["history"]) == 3
+    # epoch 0 is the initial network (validated, not trained), then the 3 training epochs
+    assert card["epochs_run"] == 3 and [h["epoch"] for h in card["history"]] == [0, 1, 2, 3]
+    assert card["history"][0]["train_loss"] is None and card["history"][1]["train_loss"] > 0
     assert {"train_loss", "val_loss", "val_rmse_m"} <= set(card["history"][0])
     assert card["val_rmse_zero_m"] == pytest.approx(L.reference_rmse(data.val)["zero"])
     assert card["val_rmse_last_m"] == pytest.approx(L.reference_rmse(data.val)["last"])
@@ -68,15 +70,19 @@ def test_card_checkpoint_and_references(data, tmp_path):
 def test_training_learns_and_beats_zero(data, method, size):
     card = T.train_model(method, data, size, _cfg(epochs=15), seed=0, progress=False)
     h = card["history"]
-    assert h[-1]["train_loss"] < 0.5 * h[0]["train_loss"]
+    assert h[-1]["train_loss"] < 0.5 * h[1]["train_loss"]
     assert card["val_rmse_m"] < 0.8 * card["val_rmse_zero_m"]
-    assert card["best_epoch"] > 0
+    # it improved on the initial network (epoch 0), whose validation error the card keeps
+    assert card["best_epoch"] >= 1 and card["val_rmse_m"] < h[0]["val_rmse_m"]
 
 
 def test_early_stopping(data):
     card = T.train_model("mlp", data, {"hidden": 8}, _cfg(epochs=20, lr=0.0, patience=2, schedule="none"),
                          seed=0, progress=False)
-    assert card["epochs_run"] == 3 and card["stopped_early"] and card["best_epoch"] == 0
+    # nothing learns at lr 0: two training epochs without improvement stop it, and the reported network is the
+    # initial one, said as best_epoch 0 (bgfn.energy refuses such a BGFN)
+    assert card["epochs_run"] == 2 and card["stopped_early"] and card["best_epoch"] == 0
+    assert card["val_rmse_m"] == pytest.approx(card["history"][0]["val_rmse_m"], rel=1e-6)
 
 
 def test_bgfn_resets_and_is_deterministic(data):
@@ -418,3 +424,19 @@ def test_paper_training_estimate_is_epochs_times_windows_over_the_measured_rate(
     assert "at most 461.2 h" in T.estimate_lines(table)[0]
     assert T.paper_training_estimate({"a": 1}, paper, {"train_windows_per_s": {"bgfn": {"quick": 5.0}}}) is None
     assert "make bench" in T.estimate_lines(None)[0]
+
+
+def test_learning_check_names_the_runs_that_never_improved_on_their_initial_network():
+    def card(method, seed, best, initial=2.0):
+        return {"dataset": "d", "method": method, "seed": seed, "best_epoch": best, "epochs_run": 7,
+                "history": [{"epoch": 0, "val_rmse_m": initial}, {"epoch": 1, "val_rmse_m": 1.0}]}
+
+    cards = [card("bgfn", 0, 3), card("mlp", 0, 0), card("mlp", 1, 1)]
+    lines = T.learning_check(cards)
+    assert lines[0] == "2 of 3 runs improved on their initial network (best epoch >= 1)"
+    assert lines[1] == "  not improved: d mlp seed 0 (the initial network is kept)"
+    assert lines[2].startswith("1 runs kept their first training epoch") and lines[2].endswith("d mlp seed 1")
+    assert T.learning_check([card("bgfn", 0, 2)]) == ["1 of 1 runs improved on their initial network (best epoch >= 1)"]
+    # the table carries the initial network's validation error; an older card (no epoch 0) leaves it empty
+    runs = T.cards_table([card("bgfn", 0, 3, initial=4.5), {**card("mlp", 0, 2), "history": [{"epoch": 1}]}])
+    assert runs["val_rmse_initial_m"].tolist()[0] == 4.5 and runs["val_rmse_initial_m"].isna().tolist()[1]

@@ -4,8 +4,8 @@ The firing rates, hence the SOPs, are those of a *trained* BGFN; the twin's MACs
 but loading its checkpoint of the same run proves it was trained on the same windows. The dataset is the
 profile's ``energy.dataset`` (default: the first of ``train.datasets``); the seed is ``energy.seed`` or, by
 default, the seed whose BGFN has the median validation error over ``train.seeds`` (a representative network,
-not the luckiest or the first). A BGFN whose best epoch is 0 -- its validation loss never improved after the
-first epoch, so its firing rates are those of a barely trained network -- is refused unless the profile says
+not the luckiest or the first). A BGFN whose best epoch is 0 -- epoch 0 is the initial network, so training never
+improved on it and its firing rates are those of an untrained network -- is refused unless the profile says
 ``energy.allow_untrained: true`` (the smoke profile, whose numbers mean nothing).
 """
 
@@ -70,8 +70,8 @@ def median_seed(profile: str, dataset: str, seeds, method: str = "bgfn") -> int:
 
 
 def check_trained(card: dict, card_file: str | Path, allow_untrained: bool = False) -> None:
-    """Refuse a network whose best epoch is 0 (never better than after its first epoch): its firing rates would
-    be those of a barely trained network.
+    """Refuse a network whose best epoch is 0 (the initial network: training never improved on it): its firing
+    rates would be those of an untrained network.
 
     Raises
     ------
@@ -81,7 +81,8 @@ def check_trained(card: dict, card_file: str | Path, allow_untrained: bool = Fal
     from bgfn.errors import DataError
 
     if not allow_untrained and int(card.get("best_epoch", 1)) < 1:
-        raise DataError(card_file, "best_epoch", "a network that improved after its first epoch (best epoch >= 1) "
+        raise DataError(card_file, "best_epoch", "a network that training improved on its initial weights (best epoch >= 1; "
+                        "epoch 0 is the initial network) "
                         "-- its firing rates decide the energy; train longer (train.optimizer.epochs, patience), "
                         "set energy.seed to a trained seed, or energy.allow_untrained: true", "0")
 

@@ -32,8 +32,8 @@ from bgfn.train.options import (OPTIMIZER_DEFAULTS, even_subset, method_lr, opti
 from bgfn.train.plots import plot_motion_coverage, plot_training_curves, plot_val_predictions
 from bgfn.train.profile import (TrainingDataset, TrainingPlan, ins_attitude, prepare_datasets, prepare_learning_data,
                                 train_dataset, train_profile, val_position_table, val_position_tables)
-from bgfn.train.tables import (TIMING_COLUMNS, card_line, cards_table, summary_table, timing_table, training_metrics,
-                               windows_table, without_timing)
+from bgfn.train.tables import (TIMING_COLUMNS, card_line, cards_table, learning_check, summary_table, timing_table,
+                               training_metrics, windows_table, without_timing)
 from bgfn.train.trained import TrainedModel, checkpoint_predictions, load_trained, pick_device, predict_normalized
 from bgfn.train.variants import (VARIANT_RUN_DEFAULTS, VariantPlan, describe_options, train_variants,
                                  variant_cards_table, variant_learning_data, variant_train_section)
@@ -53,7 +53,7 @@ __all__ = [
     "TrainingPlan", "TrainingDataset", "prepare_datasets", "prepare_learning_data", "ins_attitude",
     "val_position_table", "val_position_tables", "train_dataset", "train_profile",
     # tables and figures
-    "REFERENCES", "VAL_POSITIONS", "TIMING_COLUMNS", "cards_table", "summary_table", "without_timing",
+    "REFERENCES", "VAL_POSITIONS", "TIMING_COLUMNS", "cards_table", "learning_check", "summary_table", "without_timing",
     "timing_table", "windows_table", "card_line", "training_metrics", "plot_training_curves",
     "plot_val_predictions", "plot_motion_coverage",
     # input and protocol variants

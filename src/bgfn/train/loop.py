@@ -6,6 +6,8 @@
   learning options and model size, enough for :func:`bgfn.train.trained.load_trained`;
 - ``<out_dir>/<method>_seed<k>.json``: the card (parameters, epochs run, best validation loss, wall time,
   device, per-epoch history, validation RMSE of delta_p_gps and of the zero / last-increment references);
+  epoch 0 of the history is the initial network, validated before training, so that ``best_epoch >= 1`` says
+  that training improved on it;
 - ``<out_dir>/<method>_seed<k>.last.pt`` while training: the state after the last finished epoch (optimizer,
   scheduler, RNG), from which an interrupted run resumes; removed when the run completes.
 
@@ -49,6 +51,11 @@ def set_seed(seed: int, deterministic: bool = True) -> None:
         os.environ.setdefault("CUBLAS_WORKSPACE_CONFIG", ":4096:8")
         torch.use_deterministic_algorithms(True, warn_only=True)
         torch.backends.cudnn.benchmark = False
+
+
+#: Version of the card's layout in the configuration hash: a card of an older layout is trained again
+#: (2: epoch 0 is the initial network).
+CARD_VERSION = 2
 
 
 def _config_hash(obj: Any) -> str:
@@ -128,7 +135,7 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
         raise DataError("train", "windows", "at least one training and one validation window",
                         f"{len(train_ws)} and {len(val_ws)}")
     in_channels = train_ws.x.shape[-1]
-    config = {"method": method, "seed": int(seed), "size_cfg": size_cfg, "optimizer": o, "lr": lr,
+    config = {"method": method, "seed": int(seed), "card": CARD_VERSION, "size_cfg": size_cfg, "optimizer": o, "lr": lr,
               "options": data.options, "data": _data_fingerprint(data), "device": dev.type}
     chash = _config_hash(config)
 
@@ -178,9 +185,29 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
             history, best, bad_epochs = st["history"], st["best"], st["bad_epochs"]
             start_epoch, elapsed_before = st["epoch"] + 1, st["elapsed"]
 
+    def keep_best(epoch):                                   # the weights of the best epoch so far
+        if best_path is not None:
+            _save_torch({"method": method, "size_cfg": size_cfg, "in_channels": in_channels,
+                         "state_dict": model.state_dict(), "norm": data.norm.to_dict(),
+                         "options": data.options, "epoch": epoch, "config_hash": chash}, best_path)
+        else:
+            best["state"] = copy.deepcopy(model.state_dict())
+
     t0 = time.perf_counter()
-    bar = tqdm(range(start_epoch, int(o["epochs"])), desc=f"{method} seed {seed}", disable=not progress, leave=False)
-    for epoch in bar:
+    if start_epoch == 0:
+        # epoch 0 is the initial network, validated before any step: best_epoch >= 1 then says that training
+        # improved on it, and a run that never does reports its initial weights as such (no RNG is drawn here)
+        te = time.perf_counter()
+        pred = predict_normalized(model, xva, o["eval_batch_size"], dev)
+        val_loss = float(loss_fn(torch.as_tensor(pred), yva))
+        history.append({"epoch": 0, "train_loss": None, "val_loss": val_loss, "val_rmse_m": rmse(to_metres(pred),
+                        val_ws.y), "lr": optim.param_groups[0]["lr"], "time_s": time.perf_counter() - te})
+        best = {"val_loss": val_loss, "epoch": 0}
+        keep_best(0)
+        start_epoch = 1
+    bar = tqdm(range(start_epoch, int(o["epochs"]) + 1), desc=f"{method} seed {seed}", disable=not progress,
+               leave=False)
+    for epoch in bar:                                       # training epochs 1 .. epochs
         if bad_epochs >= o["patience"]:
             break
         te = time.perf_counter()
@@ -213,12 +240,7 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
         if val_loss < best["val_loss"] * (1.0 - o["min_delta"]):
             best = {"val_loss": val_loss, "epoch": epoch}
             bad_epochs = 0
-            if best_path is not None:
-                _save_torch({"method": method, "size_cfg": size_cfg, "in_channels": in_channels,
-                             "state_dict": model.state_dict(), "norm": data.norm.to_dict(),
-                             "options": data.options, "epoch": epoch, "config_hash": chash}, best_path)
-            else:
-                best["state"] = copy.deepcopy(model.state_dict())
+            keep_best(epoch)
         else:
             bad_epochs += 1
         bar.set_postfix(train=f"{history[-1]['train_loss']:.3f}", val=f"{val_loss:.3f}", rmse=f"{val_rmse:.2f}")
@@ -230,6 +252,7 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
                          "epoch": epoch, "elapsed": elapsed_before + time.perf_counter() - t0,
                          "config_hash": chash}, last_path)
     wall = elapsed_before + time.perf_counter() - t0
+    epochs_run = sum(1 for h in history if h["epoch"] >= 1)    # training epochs (epoch 0: the initial network)
 
     # best weights -> validation metrics
     if best_path is not None and best_path.exists():
@@ -241,11 +264,11 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
     card = {
         "method": method, "seed": int(seed), "params": count_parameters(model), "size_cfg": size_cfg,
         "lr": lr, "optimizer": o, "options": data.options, "in_channels": in_channels,
-        "epochs_run": len(history), "best_epoch": best["epoch"], "best_val_loss": best["val_loss"],
-        "stopped_early": len(history) < int(o["epochs"]),
+        "epochs_run": epochs_run, "best_epoch": best["epoch"], "best_val_loss": best["val_loss"],
+        "stopped_early": epochs_run < int(o["epochs"]),
         "val_rmse_m": rmse(pred_m, val_ws.y), **reference_columns(refs),
         "n_train": len(train_ws), "n_val": len(val_ws), "split": data.info,
-        "wall_time_s": wall, "train_windows_per_s": (len(train_ws) * len(history) / wall) if wall > 0 else None,
+        "wall_time_s": wall, "train_windows_per_s": (len(train_ws) * epochs_run / wall) if wall > 0 else None,
         "device": dev.type if dev.type == "cpu" else torch.cuda.get_device_name(dev),
         "torch_threads": torch.get_num_threads(), "torch": torch.__version__,
         "history": history, "complete": True, "config_hash": chash, **(extra_card or {}),

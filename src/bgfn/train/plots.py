@@ -9,7 +9,8 @@ from bgfn.learning import LearningData
 
 
 def plot_training_curves(cards: list[dict], title: str = ""):
-    """Training (dashed) and validation (solid) loss per epoch, one panel per method, one line per seed."""
+    """Training (dashed) and validation (solid) loss per epoch, one panel per method, one line per seed; epoch 0
+    is the initial network (validation only), the dot each run's best epoch."""
     import matplotlib.pyplot as plt
 
     methods = list(dict.fromkeys(c["method"] for c in cards))
@@ -18,7 +19,8 @@ def plot_training_curves(cards: list[dict], title: str = ""):
         for i, c in enumerate(c for c in cards if c["method"] == m):
             ep = [h["epoch"] for h in c["history"]]
             color = f"C{i}"
-            ax.plot(ep, [h["train_loss"] for h in c["history"]], "--", color=color, lw=1)
+            train = [np.nan if h["train_loss"] is None else h["train_loss"] for h in c["history"]]
+            ax.plot(ep, train, "--", color=color, lw=1)      # epoch 0 (the initial network) has none
             ax.plot(ep, [h["val_loss"] for h in c["history"]], "-", color=color, lw=1.5,
                     label=f"seed {c['seed']}")
             ax.plot(c["best_epoch"], c["best_val_loss"], "o", color=color, ms=4)

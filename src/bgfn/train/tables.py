@@ -16,8 +16,31 @@ def cards_table(cards: list[dict]):
     """One row per run: dataset, method, seed, params, learning rate, epochs, wall time, validation RMSE and
     references (m)."""
     cols = ["dataset", "method", "seed", "params", "lr", "epochs_run", "best_epoch", "wall_time_s", "n_train", "n_val",
-            "val_rmse_m", *REFERENCES.values(), "device"]
-    return pd.DataFrame([{c: card.get(c) for c in cols} for card in cards], columns=cols)
+            "val_rmse_m", "val_rmse_initial_m", *REFERENCES.values(), "device"]
+    return pd.DataFrame([{**{c: card.get(c) for c in cols}, "val_rmse_initial_m": initial_val_rmse(card)}
+                         for card in cards], columns=cols)
+
+
+def initial_val_rmse(card: dict) -> float | None:
+    """Validation RMSE (m) of the run's initial network (epoch 0 of its history), None for an older card."""
+    first = (card.get("history") or [{}])[0]
+    return first.get("val_rmse_m") if first.get("epoch") == 0 else None
+
+
+def learning_check(cards: list[dict]) -> list[str]:
+    """Did every run learn? Lines for notebook 03: how many runs improved on their initial network
+    (``best_epoch >= 1``; epoch 0 is the initial network), which did not, and how many kept their first training
+    epoch (their validation loss only grew after one pass over the data)."""
+    done = [c for c in cards if c.get("best_epoch") is not None]
+    untrained = [c for c in done if int(c["best_epoch"]) < 1]
+    first = [c for c in done if int(c["best_epoch"]) == 1]
+    lines = [f"{len(done) - len(untrained)} of {len(done)} runs improved on their initial network (best epoch >= 1)"]
+    lines += [f"  not improved: {c.get('dataset', '')} {c['method']} seed {c['seed']} (the initial network is kept)"
+              for c in untrained]
+    if first:
+        lines.append(f"{len(first)} runs kept their first training epoch (validation loss grew after it): "
+                     + ", ".join(f"{c.get('dataset', '')} {c['method']} seed {c['seed']}" for c in first))
+    return lines
 
 
 #: Wall-clock columns of :func:`cards_table` / :func:`summary_table`: they vary from run to run, so the result

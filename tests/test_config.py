@@ -188,11 +188,16 @@ def test_a_variant_profile_holds_only_its_changes(tmp_path, monkeypatch):
     assert [p.name for p in config.profile_chain("variant")] == ["variant.yaml", "mine.yaml"]
 
 
-def test_a_variant_must_name_its_own_description_and_a_real_base(tmp_path, monkeypatch):
+def test_a_variant_never_inherits_its_description_and_needs_a_real_base(tmp_path, monkeypatch):
     _write_profile(tmp_path, monkeypatch, "mine", _complete("mine"))
-    path = _write_profile(tmp_path, monkeypatch, "nodesc", {"profile": "nodesc", "base": "mine"})
+    # a derived profile without a description says what it is (the base's own text would describe the base)
+    _write_profile(tmp_path, monkeypatch, "nodesc", {"profile": "nodesc", "base": "mine"})
+    assert config.load_profile("nodesc")["description"] == "profile 'nodesc': 'mine' with its own settings"
+    # a profile without a base must describe itself
+    path = _write_profile(tmp_path, monkeypatch, "bare", {k: v for k, v in _complete("bare").items()
+                                                            if k != "description"})
     with pytest.raises(DataError) as err:
-        config.load_profile("nodesc")
+        config.load_profile("bare")
     assert err.value.source == str(path) and err.value.field == "description"
     _write_profile(tmp_path, monkeypatch, "orphan", {"profile": "orphan", "base": "nosuch", "description": "o"})
     with pytest.raises(DataError, match="nosuch") as err:

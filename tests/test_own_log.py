@@ -94,9 +94,9 @@ def test_a_csv_log_named_by_its_path_runs_notebooks_01_to_04(tmp_path, monkeypat
     params = tmp_path / "params"
     params.mkdir()
     shutil.copy(config.PARAMS_DIR / "quick.yaml", params / "quick.yaml")
-    # the README's four lines, then what keeps this test under a minute (tiny networks, one epoch, no sweep)
+    # the README's three lines, then what keeps this test under a minute (tiny networks, one epoch, no sweep)
     (params / "mine.yaml").write_text(
-        f"base: quick\ndescription: my car\ndatasets: [{log}]\noutage_windows: [{OUTAGE}]\n"
+        f"base: quick\ndatasets: [{log}]\noutage_windows: [{OUTAGE}]\n"
         "train: {methods: [bgfn, mlp], seeds: [0], size: smoke, lr_search: {grid: null},\n"
         "        optimizer: {epochs: 1, max_train_windows: 64, max_val_windows: 32}}\n"
         "evaluate: {methods: [bgfn, mlp], sweep: {datasets: []}}\n")
@@ -107,6 +107,7 @@ def test_a_csv_log_named_by_its_path_runs_notebooks_01_to_04(tmp_path, monkeypat
 
     cfg = config.load_profile("mine")
     assert cfg["profile"] == "mine"                               # the file's name
+    assert cfg["description"] == "profile 'mine': 'quick' with its own settings"     # none written
     from bgfn.profile_schema import check_with_drives
 
     assert check_with_drives("mine")[0].startswith(f"{log}: {T0:.2f}..")    # make's check step, with the data

@@ -77,6 +77,8 @@ SHARED_TABLES: dict[str, str] = {
     "sweep_summary": "outage_sweep_summary.csv",
     "sweep_pairs": "outage_sweep_pairs.csv",
     "kf_ins_tuning": "kf_ins_tuning.csv",       # notebook 02: the INS row under each filter setup
+    "kf_ins_drift": "kf_ins_drift.csv",         # notebook 02: INS drift over the sweep's starts, drive by drive
+    "kf_ins_drift_runs": "kf_ins_drift_runs.csv",
     "oracle": "outage_oracle.csv",              # notebook 04: the oracle rows (bgfn.evaluate.oracle)
     "oracle_breakeven": "outage_oracle_breakeven.csv",
     "oracle_runs": "outage_oracle_runs.csv",
@@ -178,12 +180,12 @@ def load_profile(profile: str) -> dict[str, Any]:
     A profile may name another one as ``base:``; it then holds only what differs: its sections are laid
     over the base's key by key (:func:`merge_sections`), so ``params/quick-heading.yaml`` lists only the
     settings it changes in ``params/quick.yaml``. ``profile`` and ``description`` are always the file's own
-    (``profile`` may be left out: it is the file's name). A top-level ``datasets:`` list sets the datasets of
-    every notebook (:data:`DATASET_KEYS`) over the base's; a section's own ``datasets`` in the same file wins.
-    So a user's drive needs four lines (README, "Your own log")::
+    (``profile`` may be left out: it is the file's name; so may a derived profile's ``description``). A
+    top-level ``datasets:`` list sets the datasets of every notebook (:data:`DATASET_KEYS`) over the base's; a
+    section's own ``datasets`` in the same file wins. So a user's drive needs three lines (README, "Your own
+    log")::
 
         base: quick
-        description: "my car, 2024-05-01"
         datasets: [/home/me/logs/drive-0501]      # a CSV folder (data/README.md)
         outage_windows: [[243100.0, 30.0], [243400.0, 30.0]]
 
@@ -216,6 +218,8 @@ def load_profile(profile: str) -> dict[str, Any]:
         own = {k: v for k, v in own.items() if k != "base"}
         if i == len(chain) - 1:
             own.setdefault("profile", profile)     # the file's name unless it says otherwise
+            if len(chain) > 1:                     # a derived profile may leave its description out
+                own.setdefault("description", f"profile '{profile}': '{chain[0][1]['base']}' with its own settings")
         if cfg:   # the base's name and description are not inherited; a comments-only section changes nothing
             cfg = {k: v for k, v in cfg.items() if k not in ("profile", "description")}
             own = {k: v for k, v in own.items() if not (k in SECTION_KEYS and v is None)}

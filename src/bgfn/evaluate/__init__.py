@@ -76,6 +76,8 @@ from bgfn.evaluate.hybrid import (NavContext, OutageRun, gps_run, navigation_con
                                   run_outages, window_metrics)
 from bgfn.evaluate.networks import ensure_models, load_model
 from bgfn.evaluate.increments import AntennaTruth, increment_errors, increment_rmse
+from bgfn.evaluate.ins_drift import (DRIFT_COLUMNS, DRIFT_RUN_COLUMNS, drift_sentences, drift_starts, drift_summary,
+                                     ins_drift_runs, plot_ins_drift)
 from bgfn.evaluate.oracle import (BREAKEVEN_COLUMNS, ORACLE_COLUMNS, OracleIncrements, OracleResult, breakeven_table,
                                   crossing_sigma, curve_at, describe_oracle, method_levels, oracle_interval_table,
                                   oracle_runs, oracle_table, oracle_windows, run_oracle)
@@ -94,6 +96,8 @@ from bgfn.evaluate.variants import (NO_VARIANT, VARIANT_COLUMNS, VARIANT_METRICS
                                     variant_pivot, variant_runs, variant_table)
 
 __all__ = [
+    "DRIFT_COLUMNS", "DRIFT_RUN_COLUMNS", "drift_sentences", "drift_starts", "drift_summary", "ins_drift_runs",
+    "plot_ins_drift",
     "AntennaTruth", "BREAKEVEN_COLUMNS", "ORACLE_COLUMNS", "OracleIncrements", "OracleResult", "breakeven_table",
     "crossing_sigma", "curve_at", "describe_oracle", "increment_errors", "increment_rmse", "method_levels",
     "oracle_interval_table", "oracle_runs", "oracle_table", "oracle_windows", "plot_oracle", "run_oracle",

@@ -1,0 +1,150 @@
+"""Standalone-INS drift over the outage sweep's starts, drive against drive (notebook 02).
+
+How far does the INS alone drift in an outage of 10, 30, 60 s? Two outages per drive (the paper's tables) say
+little; the sweep's starts (:func:`bgfn.evaluate.sweep_plan`: evenly spread over the drive, the same starts
+notebook 04 evaluates every network in) say it for the whole drive. Notebook 02 puts the drives side by side:
+the simulated field-test stand-in ``turin-sim-mpu6000``, whose MEMS error model was set from levels measured
+on the recorded drive (:mod:`bgfn.data.imu_levels`), against that recorded drive ``rtklib-drive0708`` --
+does the stand-in drift as a real MEMS IMU does? -- and the INS with the vehicle constraints (``INS+NHC``,
+:mod:`bgfn.nav.constraints`) beside the INS alone.
+
+Each run starts from the GPS-aided filter's state at its start (:func:`bgfn.evaluate.navigation_context`) and
+runs the longest duration once; the shorter ones are its prefixes (a prefix's maximum error never exceeds the
+whole run's).
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+
+#: Columns of the per-run rows (``tables/kf_ins_drift_runs.csv``).
+DRIFT_RUN_COLUMNS: tuple[str, ...] = ("dataset", "test", "start_s", "duration_s", "method", "max_h_m", "final_h_m")
+#: Columns of :func:`drift_summary` (``tables/kf_ins_drift.csv``).
+DRIFT_COLUMNS: tuple[str, ...] = ("dataset", "test", "duration_s", "method", "n_starts", "median_max_h_m",
+                                  "q25_max_h_m", "q75_max_h_m")
+
+
+def drift_starts(cfg: dict, drive) -> list[float]:
+    """The sweep's starts on ``drive`` (``evaluate.sweep`` of the profile; after the filter's start), s."""
+    from bgfn.evaluate.config import evaluate_config
+    from bgfn.evaluate.sweep import sweep_plan, sweep_train_config
+    from bgfn.learning import learning_options
+    from bgfn.nav.baseline import filter_start
+
+    sw = evaluate_config(cfg.get("evaluate"), cfg.get("train"))["sweep"]
+    n_window = int(learning_options(sweep_train_config(cfg.get("train") or {}, sw))["window"])
+    plan = sweep_plan(drive, sw, n_window, t_first=filter_start(drive, cfg.get("nav")))
+    return [float(s) for s in plan["start_s"]]
+
+
+def ins_drift_runs(cfg: dict, drives: list, durations=None, nhc: bool = True,
+                   report: Callable[[str], None] | None = None) -> pd.DataFrame:
+    """INS (and ``INS+NHC``) from every sweep start of every drive.
+
+    Parameters
+    ----------
+    cfg : dict
+        The profile (its ``nav:`` section runs the filter, ``evaluate.sweep`` places the starts).
+    drives : list of bgfn.data.Drive
+    durations : list of float, optional
+        Outage durations, s; default ``evaluate.sweep.durations_s``.
+    nhc : bool
+        Also the INS with the vehicle constraints (``INS+NHC``).
+    report : callable, optional
+        Called with one line per drive.
+
+    Returns
+    -------
+    DataFrame
+        :data:`DRIFT_RUN_COLUMNS`, one row per drive, start, duration and method.
+    """
+    from bgfn.evaluate.config import evaluate_config
+    from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
+    from bgfn.paper import nhc_label, test_of
+
+    ecfg = evaluate_config(cfg.get("evaluate"), cfg.get("train"))
+    durations = sorted(float(d) for d in (durations or ecfg["sweep"]["durations_s"]))
+    rows = []
+    for drive in drives:
+        starts = drift_starts(cfg, drive)
+        ctx = navigation_context(drive, cfg.get("nav"), starts)
+        windows = [(s, durations[-1]) for s in starts]
+        runs = run_outages(ctx, windows, None, "INS", None, ecfg["pseudo_gps"])
+        if nhc and ctx.constraints is not None:
+            runs += run_outages(ctx, windows, None, nhc_label("INS"), None, ecfg["pseudo_gps"],
+                                constraints=ctx.constraints)
+        for r in runs:
+            for du in durations:
+                m = window_metrics(r.errors, r.start, du)
+                rows.append({"dataset": drive.name, "test": test_of(drive.name) or "", "start_s": r.start,
+                             "duration_s": du, "method": r.method, "max_h_m": m["max_h_m"],
+                             "final_h_m": m["final_h_m"]})
+        if report is not None:
+            report(f"{drive.name}: {len(starts)} starts x {len(durations)} durations, "
+                   f"{len(runs)} standalone runs")
+    return pd.DataFrame(rows, columns=list(DRIFT_RUN_COLUMNS))
+
+
+def drift_summary(runs: pd.DataFrame) -> pd.DataFrame:
+    """Median and quartiles of the max horizontal error over the starts, per drive, duration and method."""
+    g = runs.groupby(["dataset", "test", "duration_s", "method"], sort=False)["max_h_m"]
+    out = g.agg(n_starts="count", median_max_h_m="median", q25_max_h_m=lambda x: float(np.quantile(x, 0.25)),
+                q75_max_h_m=lambda x: float(np.quantile(x, 0.75))).reset_index()
+    return out[list(DRIFT_COLUMNS)]
+
+
+def drift_sentences(summary: pd.DataFrame, stand_in: str = "turin-sim-mpu6000",
+                    recorded: str = "rtklib-drive0708") -> list[str]:
+    """One sentence per duration: the stand-in's median drift against the recorded drive's, INS and INS+NHC.
+
+    Empty when either drive is missing from ``summary``.
+    """
+    have = set(summary["dataset"])
+    if stand_in not in have or recorded not in have:
+        return []
+    lines = []
+    for du, g in summary.groupby("duration_s", sort=True):
+        parts = []
+        for method, gm in g.groupby("method", sort=False):
+            level = gm.set_index("dataset")["median_max_h_m"]
+            if stand_in in level and recorded in level:
+                a, b = float(level[stand_in]), float(level[recorded])
+                parts.append(f"{method} {a:.1f} m on the stand-in {stand_in}, {b:.1f} m on the recorded drive "
+                             f"{recorded} ({b / a:.1f} times)" if a > 0 else f"{method}: stand-in 0 m")
+        n = int(g["n_starts"].max())
+        lines.append(f"{du:g} s outages, median max horizontal error over up to {n} starts: " + "; ".join(parts))
+    return lines
+
+
+def plot_ins_drift(runs: pd.DataFrame, title: str = ""):
+    """Max horizontal error of every start against the outage duration, one panel per method, a box per drive."""
+    import matplotlib.pyplot as plt
+
+    methods = list(dict.fromkeys(runs["method"]))
+    names = list(dict.fromkeys(runs["dataset"]))
+    durations = sorted(runs["duration_s"].unique())
+    fig, axes = plt.subplots(1, len(methods), figsize=(5.0 * len(methods), 3.6), squeeze=False, sharey=True)
+    width = 0.8 / max(len(names), 1)
+    for ax, method in zip(axes[0], methods):
+        for k, name in enumerate(names):
+            sel = runs[(runs["method"] == method) & (runs["dataset"] == name)]
+            data = [sel.loc[sel["duration_s"] == d, "max_h_m"].to_numpy() for d in durations]
+            pos = np.arange(len(durations)) + (k - (len(names) - 1) / 2) * width
+            bp = ax.boxplot(data, positions=pos, widths=width * 0.9, patch_artist=True, manage_ticks=False)
+            for patch in bp["boxes"]:
+                patch.set_facecolor(f"C{k}")
+                patch.set_alpha(0.6)
+            ax.plot([], [], "s", color=f"C{k}", label=name)
+        ax.set_xticks(np.arange(len(durations)), [f"{d:g}" for d in durations])
+        ax.set_yscale("log")
+        ax.set_xlabel("outage duration (s)")
+        ax.set_title(method)
+        ax.grid(alpha=0.3)
+    axes[0, 0].set_ylabel("max horizontal error (m)")
+    axes[0, -1].legend(fontsize=8)
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig

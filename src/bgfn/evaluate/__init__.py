@@ -81,7 +81,7 @@ from bgfn.evaluate.ins_drift import (DRIFT_COLUMNS, DRIFT_RUN_COLUMNS, drift_sen
 from bgfn.evaluate.oracle import (BREAKEVEN_COLUMNS, ORACLE_COLUMNS, OracleIncrements, OracleResult, breakeven_table,
                                   crossing_sigma, curve_at, describe_oracle, method_levels, oracle_interval_table,
                                   oracle_runs, oracle_table, oracle_windows, run_oracle)
-from bgfn.evaluate.plots import plot_gps_row, plot_oracle, plot_outage, plot_sweep_boxes
+from bgfn.evaluate.plots import outage_figures, plot_gps_row, plot_oracle, plot_outage, plot_sweep_boxes
 from bgfn.evaluate.record import RECORD_FILE, evaluation_record, write_evaluation_record
 from bgfn.evaluate.sensitivity import (SENSITIVITY_COLUMNS, Sensitivity, pseudo_std_sensitivity,
                                        save_sensitivity, sensitivity_table)
@@ -97,7 +97,7 @@ from bgfn.evaluate.variants import (NO_VARIANT, VARIANT_COLUMNS, VARIANT_METRICS
 
 __all__ = [
     "DRIFT_COLUMNS", "DRIFT_RUN_COLUMNS", "drift_sentences", "drift_starts", "drift_summary", "ins_drift_runs",
-    "plot_ins_drift",
+    "plot_ins_drift", "outage_figures",
     "AntennaTruth", "BREAKEVEN_COLUMNS", "ORACLE_COLUMNS", "OracleIncrements", "OracleResult", "breakeven_table",
     "crossing_sigma", "curve_at", "describe_oracle", "increment_errors", "increment_rmse", "method_levels",
     "oracle_interval_table", "oracle_runs", "oracle_table", "oracle_windows", "plot_oracle", "run_oracle",

@@ -78,6 +78,20 @@ def plot_outage(result: TableResult, outage: int, reference: pd.DataFrame, metho
     return fig
 
 
+def outage_figures(result: TableResult, gps_row: bool = False):
+    """Notebook 04's figures of one drive, outage by outage: ``(outage, figure)`` of :func:`plot_outage` (each
+    drive its own windows in the title), or of :func:`plot_gps_row` with ``gps_row``."""
+    name = result.dataset
+    for o in sorted(int(k) for k in result.table["outage"].unique()):
+        start, duration = result.windows[o - 1]
+        if gps_row:
+            yield o, plot_gps_row(result, o, title=f"{name} ({result.test} test), outage {o}: the GPS row and "
+                                                  "the fixes it follows")
+        else:
+            yield o, plot_outage(result, o, result.drive.reference,
+                                 title=f"{name} ({result.test} test), outage {o}: {duration:g} s from {start:g} s")
+
+
 def plot_gps_row(result: TableResult, outage: int, title: str = ""):
     """Why the GPS row is where it is: its east and north error during an outage beside the errors of the GNSS
     fixes it follows (dots; ``result.fix_errors``, fix minus true antenna position) and the standalone INS

@@ -80,3 +80,20 @@ def test_missing_tables_say_not_measured():
     assert lines[0].endswith("oracle has not run for this drive.")
     assert "Not measured" in lines[2] and "Not measured" in lines[3] and "Not measured" in lines[4]
     assert "paper's two outages" in lines[1]                                           # falls back to them
+
+
+def test_speed_answer_says_which_networks_learned_with_and_without_velocity():
+    main = pd.DataFrame({"dataset": "d", "method": ["bgfn", "mlp", "at_lstm", "bgfn"], "seed": [0, 0, 0, 1],
+                         "best_epoch": [0, 3, 0, 1], "val_rmse_m": [4.0, 3.0, 5.0, 4.5],
+                         "val_rmse_zero_m": 5.5})
+    variants = pd.DataFrame({"dataset": "d", "variant": ["velocity", "velocity", "leaky", "velocity-leaky"],
+                             "inputs": ["eq21+v_along+v_cross", "eq21+v_along+v_cross", "eq21", "eq21+v_along"],
+                             "protocol": ["honest", "honest", "leaky", "leaky"], "method": ["bgfn", "mlp"] * 2,
+                             "best_epoch": [4, 2, 0, 0], "val_rmse_m": [0.8, 1.0, 4.0, 0.7]})
+    inp = _inputs(training=main, training_variants=variants)
+    speed = answer_speed(verdict_table(inp), inp)
+    # 2 of the 4 main runs have a best epoch >= 1; the leaky rows are not the velocity reading's
+    assert ("2 of 4 networks with Eq. (eq21)'s inputs improved on their initial weights (median RMSE per "
+            "increment 4.25 m; predicting zero: 5.50 m); given the INS velocity 2 of 2 did (median 0.90 m).") in speed
+    assert verdict_sentences(inp, verdict_table(inp))[2] == speed
+    assert "initial weights" not in answer_speed(verdict_table(_inputs()), _inputs())      # no training tables

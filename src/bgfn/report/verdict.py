@@ -5,7 +5,8 @@ outage sweep, and sentences answering the five questions a navigation engineer a
 1. *How accurate must the increments be?* The oracle's break-even noise against the network's own increment error
    (:mod:`bgfn.evaluate.oracle`).
 2. *Does it beat the learning-free aids?* INS+NHC, and BGFN fused together with NHC (:mod:`bgfn.nav.constraints`).
-3. *Can the networks know the speed?* The velocity-input variant against Eq. (eq21)'s inputs.
+3. *Can the networks know the speed?* The velocity-input variant against Eq. (eq21)'s inputs, in the outages and
+   on the validation block (which networks improved on their initial weights, and how far).
 4. *Was the paper's protocol leaky?* The networks trained on the whole drive, test outages included.
 5. *Is the INS row comparable?* The INS row under NaveGo v1.4's bias modelling (:mod:`bgfn.nav.ins_setups`).
 
@@ -52,6 +53,8 @@ class VerdictInputs:
     breakeven: pd.DataFrame | None      # outage_oracle_breakeven.csv
     variants: pd.DataFrame | None       # outage_variants.csv
     ins_tuning: pd.DataFrame | None     # kf_ins_tuning.csv
+    training: pd.DataFrame | None = None            # training_runs.csv: the main networks' cards
+    training_variants: pd.DataFrame | None = None   # training_variants.csv: the variants' cards
 
     @classmethod
     def read(cls, out: str | Path, dataset: str) -> "VerdictInputs":
@@ -71,7 +74,9 @@ class VerdictInputs:
                    of(read_csv(tables / SHARED_TABLES["sweep_pairs"])),
                    of(read_csv(tables / SHARED_TABLES["oracle_breakeven"])),
                    of(read_csv(tables / SHARED_TABLES["variants"])) if "variants" in SHARED_TABLES else None,
-                   of(read_csv(tables / SHARED_TABLES["kf_ins_tuning"])))
+                   of(read_csv(tables / SHARED_TABLES["kf_ins_tuning"])),
+                   of(read_csv(tables / SHARED_TABLES["training_runs"])),
+                   of(read_csv(tables / SHARED_TABLES["training_variants"])))
 
 
 def _outage_value(seeds: pd.DataFrame | None, method: str, outage: int) -> float:
@@ -233,18 +238,46 @@ def _variant_rows(table: pd.DataFrame, velocity: bool | None = None, protocol: s
     return rows
 
 
-def answer_speed(table: pd.DataFrame) -> str:
-    """Question 3: BGFN with velocity inputs against Eq. (eq21)'s inputs, honest protocol, paper outages."""
+def _learned(cards: pd.DataFrame | None) -> tuple[int, int, float] | None:
+    """(runs that improved on their initial network, runs, median validation RMSE in m) of a cards table."""
+    if cards is None or not len(cards) or "best_epoch" not in cards.columns:
+        return None
+    return int((cards["best_epoch"] >= 1).sum()), len(cards), float(cards["val_rmse_m"].median())
+
+
+def learning_evidence(inp: VerdictInputs) -> str:
+    """Did the networks learn the increments at all? On the validation block: how many runs improved on their
+    initial weights (``best_epoch >= 1``) and their median RMSE per increment, with Eq. (eq21)'s inputs (the main
+    networks) and given the INS velocity (the honest velocity variant), beside predicting zero. Empty when
+    the training tables are missing."""
+    variants = inp.training_variants
+    if variants is not None and len(variants) and {"inputs", "protocol"} <= set(variants.columns):
+        variants = variants[(variants["inputs"].astype(str) != EQ21_INPUTS) & (variants["protocol"] == "honest")]
+    base, fast = _learned(inp.training), _learned(variants)
+    if base is None:
+        return ""
+    zero = float(inp.training["val_rmse_zero_m"].median()) if "val_rmse_zero_m" in inp.training else float("nan")
+    text = (f" On the validation block {base[0]} of {base[1]} networks with Eq. (eq21)'s inputs improved on their "
+            f"initial weights (median RMSE per increment {base[2]:.2f} m; predicting zero: {zero:.2f} m)")
+    if fast is not None:
+        text += f"; given the INS velocity {fast[0]} of {fast[1]} did (median {fast[2]:.2f} m)"
+    return text + "."
+
+
+def answer_speed(table: pd.DataFrame, inp: VerdictInputs | None = None) -> str:
+    """Question 3: BGFN with velocity inputs against Eq. (eq21)'s inputs, honest protocol, paper outages; with
+    ``inp`` also :func:`learning_evidence` (did the networks learn at all?)."""
     base = _variant_rows(table, False, "honest")
     fast = _variant_rows(table, True, "honest")
+    evidence = learning_evidence(inp) if inp is not None else ""
     if not len(fast):
-        return "Can the networks know the speed? Not measured: the velocity-input variant has not run."
+        return "Can the networks know the speed? Not measured: the velocity-input variant has not run." + evidence
     b = _mean_outages(base.iloc[0]) if len(base) else _mean_outages(_row(table, SUBJECT))
     f = _mean_outages(fast.iloc[0])
     ins = _mean_outages(_row(table, "INS"))
     return (f"Can the networks know the speed? Eq. (eq21) gives no velocity. With Eq. (eq21)'s inputs BGFN's max error "
             f"in the paper's two outages averages {_m(b)}; given the INS velocity {_m(f)} (INS: {_m(ins)}; "
-            f"{int(fast.iloc[0]['runs'])} network(s) per cell).")
+            f"{int(fast.iloc[0]['runs'])} network(s) per cell)." + evidence)
 
 
 def answer_protocol(table: pd.DataFrame, claims: dict | None = None) -> str:
@@ -296,7 +329,7 @@ def answer_ins_tuning(inp: VerdictInputs) -> str:
 
 def verdict_sentences(inp: VerdictInputs, table: pd.DataFrame, claims: dict | None = None) -> list[str]:
     """The five answers for one test, in the issue's order."""
-    return [answer_accuracy(inp), answer_free_aids(table), answer_speed(table), answer_protocol(table, claims),
+    return [answer_accuracy(inp), answer_free_aids(table), answer_speed(table, inp), answer_protocol(table, claims),
             answer_ins_tuning(inp)]
 
 

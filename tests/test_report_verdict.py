@@ -55,6 +55,10 @@ def test_table_takes_medians_p_values_oracle_and_variants():
     assert t.loc["BGFN (velocity)", "outage 2"] == 16.0 and t.loc["BGFN (velocity)", "runs"] == 1
     assert np.isnan(t.loc["AT-LSTM", "outage 1"])                                      # not run: empty, not 0
     assert list(t.index[:3]) == ["INS", "INS+NHC", ORACLE_ROW]
+    assert t.loc["BGFN", "inputs"] == "Eq. (eq21)" and t.loc["INS", "inputs"] == "-"
+    # a profile whose main networks take other inputs (quick-heading) is labelled with them
+    heading = inp.variants.assign(inputs=lambda v: v["inputs"].where(v["variant"] != "main", "eq21+v_along"))
+    assert verdict_table(_inputs(variants=heading)).set_index("row").loc["MLP", "inputs"] == "eq21+v_along"
 
 
 def test_answers_say_the_measured_numbers():

@@ -125,6 +125,18 @@ def _oracle_value(breakeven: pd.DataFrame | None, outage: str, duration: float |
     return float(sel["oracle_at_rmse_m"].iloc[0]) if len(sel) else float("nan")
 
 
+def _main_inputs(variants: pd.DataFrame | None) -> str:
+    """The main networks' inputs as the variants table describes them (its ``main`` rows), ``Eq. (eq21)`` for
+    the paper's; the paper's when there is no variants table."""
+    from bgfn.profile_schema import MAIN_VARIANT
+
+    if variants is not None and len(variants) and "inputs" in variants.columns:
+        rows = variants[variants["variant"] == MAIN_VARIANT]
+        if len(rows) and str(rows["inputs"].iloc[0]) != EQ21_INPUTS:
+            return str(rows["inputs"].iloc[0])
+    return "Eq. (eq21)"
+
+
 def verdict_table(inp: VerdictInputs) -> pd.DataFrame:
     """One test's verdict: every aid in the paper's two outages (max horizontal error, median over the seeds) and
     in the sweep (median over starts and seeds at 30 and 60 s), the Wilcoxon p of BGFN against the row in the sweep,
@@ -137,8 +149,9 @@ def verdict_table(inp: VerdictInputs) -> pd.DataFrame:
         :data:`VERDICT_COLUMNS`; lengths in m.
     """
     rows = []
+    main = _main_inputs(inp.variants)
     for label, method in METHOD_ROWS:
-        rows.append({"row": label, "inputs": "Eq. (eq21)" if method not in ("INS", "INS+NHC") else "-",
+        rows.append({"row": label, "inputs": main if method not in ("INS", "INS+NHC") else "-",
                      "protocol": "honest" if method not in ("INS", "INS+NHC") else "-",
                      "outage 1": _outage_value(inp.seeds, method, 1), "outage 2": _outage_value(inp.seeds, method, 2),
                      **{f"sweep {d:g} s": _sweep_value(inp.sweep_summary, method, d) for d in SWEEP_DURATIONS},
@@ -257,7 +270,9 @@ def learning_evidence(inp: VerdictInputs) -> str:
     if base is None:
         return ""
     zero = float(inp.training["val_rmse_zero_m"].median()) if "val_rmse_zero_m" in inp.training else float("nan")
-    text = (f" On the validation block {base[0]} of {base[1]} networks with Eq. (eq21)'s inputs improved on their "
+    label = _main_inputs(inp.variants)
+    words = "Eq. (eq21)'s inputs" if label == "Eq. (eq21)" else f"the inputs {label}"
+    text = (f" On the validation block {base[0]} of {base[1]} networks with {words} improved on their "
             f"initial weights (median RMSE per increment {base[2]:.2f} m; predicting zero: {zero:.2f} m)")
     if fast is not None:
         text += f"; given the INS velocity {fast[0]} of {fast[1]} did (median {fast[2]:.2f} m)"

@@ -12,6 +12,8 @@ from bgfn.profile_schema import SCHEMA
 
 pytestmark = pytest.mark.usefixtures("repo_untouched")
 
+#: The variant cases train these methods (a variant_runs method must be one of them).
+T = "train: {methods: [bgfn, mlp]}\n"
 # variant text over the shipped smoke profile -> (key path named, words of the message)
 BAD = {
     "top-level typo": ("trian: {window: 50}", "trian", "did you mean train?"),
@@ -37,6 +39,17 @@ BAD = {
     "alignment mode": ("nav: {alignment: {mode: compass}}", "nav.alignment.mode", "'reference', 'gnss', 'auto'"),
     "alignment key typo": ("nav: {alignment: {heading_s: 5.0}}", "nav.alignment.heading_s", "heading_time_s"),
     "noise search range": ("nav: {noise_search: {range: [10.0, 1.0]}}", "nav.noise_search.range", "low < high"),
+    # variants (their own train: overrides merged like a base profile) and variant_runs
+    "misspelt key": (T + "variants: {mine: {train: {protocl: leaky}}}", "variants.mine.train.protocl",
+                     "did you mean variants.mine.train.protocol?"),
+    "bad value": (T + "variants: {mine: {train: {protocol: sloppy}}}", "variants.mine.train.protocol", "'sloppy'"),
+    "not a train key": (T + "variants: {mine: {evaluate: {seeds: [0]}}}", "variants.mine.evaluate", "unknown key"),
+    "merged profile breaks a cross-field fact": (T + "variants: {mine: {train: {size: huge}}}",
+                                                 "variants.mine.train.size", "'huge'"),
+    "the main networks' name": (T + "variants: {main: {train: {protocol: leaky}}}", "variants.main", "'main'"),
+    "runs set inside a variant": (T + "variants: {mine: {train: {seeds: [1]}}}", "variants.mine.train.seeds",
+                                  "variant_runs.seeds"),
+    "runs of an unknown method": (T + "variant_runs: {methods: [mlp, lstm]}", "variant_runs.methods", "'lstm'"),
 }
 
 

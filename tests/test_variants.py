@@ -101,31 +101,6 @@ def params(tmp_path, monkeypatch):
     return folder
 
 
-BAD_VARIANTS = {
-    "misspelt key": ("variants: {mine: {train: {protocl: leaky}}}", "variants.mine.train.protocl",
-                     "did you mean variants.mine.train.protocol?"),
-    "bad value": ("variants: {mine: {train: {protocol: sloppy}}}", "variants.mine.train.protocol", "'sloppy'"),
-    "not a train key": ("variants: {mine: {evaluate: {seeds: [0]}}}", "variants.mine.evaluate", "unknown key"),
-    "merged profile breaks a cross-field fact": ("variants: {mine: {train: {size: huge}}}",
-                                                 "variants.mine.train.size", "'huge'"),
-    "the main networks' name": ("variants: {main: {train: {protocol: leaky}}}", "variants.main", "'main'"),
-    "runs set inside a variant": ("variants: {mine: {train: {seeds: [1]}}}", "variants.mine.train.seeds",
-                                  "variant_runs.seeds"),
-    "runs of an unknown method": ("variant_runs: {methods: [mlp, lstm]}", "variant_runs.methods", "'lstm'"),
-}
-
-
-@pytest.mark.parametrize("case", list(BAD_VARIANTS))
-def test_a_bad_variant_names_the_file_and_the_key(params, case):
-    text, key, words = BAD_VARIANTS[case]
-    path = params / "mine.yaml"
-    path.write_text(f"profile: mine\nbase: smoke\ndescription: a variant\ntrain: {{methods: [bgfn, mlp]}}\n{text}\n")
-    with pytest.raises(DataError) as err:
-        config.load_profile("mine")
-    assert err.value.source == str(path), str(err.value)
-    assert err.value.field == key and words in str(err.value), str(err.value)
-
-
 def test_variants_merge_into_the_profile_as_profiles_merge(params):
     (params / "mine.yaml").write_text(
         "profile: mine\nbase: smoke\ndescription: v\n"

@@ -18,28 +18,19 @@ from bgfn import stats
 from bgfn.config import PROFILES, load_profile
 from bgfn.data import Drive
 from bgfn.data.gnss import fix_errors
-from bgfn.data import imu_errors as ie
 from bgfn.errors import DataError
-from bgfn.nav import earth, metrics, sim
+from bgfn.nav import earth, metrics
 from bgfn.nav.filter import run_filter, run_outage
 from bgfn.nav.outages import OutageWindow, TablePseudoGps
+from synthetic_drive import demo_drive
 
-LEVER = [0.4, -0.2, -1.0]
 WINDOWS = [(60.0, 20.0), (110.0, 20.0)]
 NAV = {"init": {"position_std_m": 1.0, "height_std_m": 2.0, "velocity_std_mps": 0.1, "level_std_deg": 0.2,
                 "azimuth_std_deg": 1.0}}
 
 
 def _drive(gnss_rate=5.0, duration=150.0, seed=3) -> Drive:
-    ref = sim.demo_trajectory(duration)
-    imu_true = sim.imu_from_trajectory(ref)
-    params = ie.error_params("ekinox-d", {"gyro_bias_fixed": [2e-4, -3e-4, 4e-4],
-                                          "accel_bias_fixed": [0.03, -0.02, 0.02]})
-    speed = np.hypot(ref["v_n"], ref["v_e"]).to_numpy()[1:]
-    imu, errs, _ = ie.apply_imu_errors(imu_true, params, seed=seed, speed=speed)
-    gnss = sim.gnss_from_trajectory(ref, gnss_rate, 1.0, 2.0, LEVER, seed=seed + 1)
-    meta = {"lever_arm_m": LEVER, "imu_errors": errs, "gnss_rate_hz": gnss_rate, "imu_rate_hz": 100.0}
-    return Drive("synthetic", ref, imu, gnss, meta)
+    return demo_drive("synthetic", duration, gnss_rate, seed)
 
 
 class Heading:

@@ -9,21 +9,13 @@ import pytest
 from bgfn import evaluate as ev
 from bgfn.config import load_profile, with_overrides
 from bgfn.data import Drive
-from bgfn.data import imu_errors as ie
-from bgfn.nav import sim
+from synthetic_drive import demo_drive
 
-LEVER = [0.4, -0.2, -1.0]
 
 
 def _drive(name: str, imu: str, seed: int = 3) -> Drive:
     """The demo trajectory with a tactical (``ekinox-d``) or a consumer MEMS (``mpu6000``) IMU."""
-    ref = sim.demo_trajectory(150.0)
-    params = ie.error_params(imu)
-    speed = np.hypot(ref["v_n"], ref["v_e"]).to_numpy()[1:]
-    imu, errs, _ = ie.apply_imu_errors(sim.imu_from_trajectory(ref), params, seed=seed, speed=speed)
-    gnss = sim.gnss_from_trajectory(ref, 5.0, 1.0, 2.0, LEVER, seed=seed + 1)
-    return Drive(name, ref, imu, gnss, {"lever_arm_m": LEVER, "imu_errors": errs, "gnss_rate_hz": 5.0,
-                                        "imu_rate_hz": 100.0})
+    return demo_drive(name, 150.0, 5.0, seed, imu=imu, overrides=None)
 
 
 @pytest.fixture(scope="module")

@@ -21,8 +21,8 @@ from bgfn.nav import navego_setup as ns
 from bgfn.nav import state as st
 from bgfn.nav.filter import noise_arrays, run_outage
 from bgfn.nav.outages import OutageWindow
+from synthetic_drive import demo_drive
 
-LEVER = [0.4, -0.2, -1.0]
 WINDOWS = [(60.0, 20.0), (110.0, 20.0)]
 NAV = {"init": {"position_std_m": 1.0, "height_std_m": 2.0, "velocity_std_mps": 0.1, "level_std_deg": 0.2,
                 "azimuth_std_deg": 1.0}}
@@ -31,15 +31,7 @@ DEG = np.pi / 180.0
 
 def _drive(name="turin-sim-ekinox", duration=150.0, seed=3) -> Drive:
     """A short synthetic drive with Ekinox-grade errors and large static biases (their ``bias_fixed``)."""
-    ref = sim.demo_trajectory(duration)
-    imu_true = sim.imu_from_trajectory(ref)
-    params = ie.error_params("ekinox-d", {"gyro_bias_fixed": [2e-4, -3e-4, 4e-4],
-                                          "accel_bias_fixed": [0.03, -0.02, 0.02]})
-    speed = np.hypot(ref["v_n"], ref["v_e"]).to_numpy()[1:]
-    imu, errs, _ = ie.apply_imu_errors(imu_true, params, seed=seed, speed=speed)
-    gnss = sim.gnss_from_trajectory(ref, 5.0, 1.0, 2.0, LEVER, seed=seed + 1)
-    meta = {"lever_arm_m": LEVER, "imu_errors": errs, "gnss_rate_hz": 5.0, "imu_rate_hz": 100.0}
-    return Drive(name, ref, imu, gnss, meta)
+    return demo_drive(name, duration, 5.0, seed)
 
 
 @pytest.fixture(scope="module")

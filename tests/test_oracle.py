@@ -13,13 +13,12 @@ import pytest
 from bgfn import evaluate as ev
 from bgfn.config import load_profile
 from bgfn.data import Drive
-from bgfn.data import imu_errors as ie
 from bgfn.errors import DataError
 from bgfn.evaluate import oracle as orc
 from bgfn.nav import sim
 from bgfn.profile_schema import ProfileError, validate
+from synthetic_drive import LEVER, demo_drive
 
-LEVER = [0.4, -0.2, -1.0]
 NAV = {"init": {"position_std_m": 1.0, "height_std_m": 2.0, "velocity_std_mps": 0.1, "level_std_deg": 0.2,
                 "azimuth_std_deg": 1.0}}
 #: (outage, start, duration): three 30 s windows of the synthetic drive.
@@ -27,15 +26,7 @@ WINDOWS = [("1", 40.0, 30.0), ("2", 75.0, 30.0), ("3", 110.0, 30.0)]
 
 
 def _drive(seed=3) -> Drive:
-    ref = sim.demo_trajectory(150.0)
-    imu_true = sim.imu_from_trajectory(ref)
-    params = ie.error_params("ekinox-d", {"gyro_bias_fixed": [2e-4, -3e-4, 4e-4],
-                                          "accel_bias_fixed": [0.03, -0.02, 0.02]})
-    speed = np.hypot(ref["v_n"], ref["v_e"]).to_numpy()[1:]
-    imu, errs, _ = ie.apply_imu_errors(imu_true, params, seed=seed, speed=speed)
-    gnss = sim.gnss_from_trajectory(ref, 5.0, 1.0, 2.0, LEVER, seed=seed + 1)
-    meta = {"lever_arm_m": LEVER, "imu_errors": errs, "gnss_rate_hz": 5.0, "imu_rate_hz": 100.0}
-    return Drive("synthetic", ref, imu, gnss, meta)
+    return demo_drive("synthetic", 150.0, 5.0, seed)
 
 
 @pytest.fixture(scope="module")

@@ -28,3 +28,15 @@ def demo_drive(name: str = "synthetic", duration: float = 150.0, gnss_rate: floa
     gnss = sim.gnss_from_trajectory(ref, gnss_rate, 1.0, 2.0, LEVER, seed=seed + 1)
     meta = {"lever_arm_m": LEVER, "imu_errors": errs, "gnss_rate_hz": gnss_rate, "imu_rate_hz": 100.0}
     return Drive(name, ref, imu_table, gnss, meta)
+
+
+def exact_drive(duration: float = 60.0, **meta) -> Drive:
+    """The demo trajectory with an error-free IMU and exact 1 Hz fixes at the IMU (lever arm 0; std 1 m / 3 m
+    written); ``meta`` is added to the drive's ``meta``."""
+    import pandas as pd
+
+    ref = sim.demo_trajectory(duration_s=duration, rate_hz=100.0)
+    g = ref.iloc[::100].reset_index(drop=True)
+    gnss = pd.DataFrame({"time": g["time"], "lat": g["lat"], "lon": g["lon"], "h": g["h"], "v_n": g["v_n"],
+                         "v_e": g["v_e"], "v_d": g["v_d"], "std_n": 1.0, "std_e": 1.0, "std_d": 3.0})
+    return Drive("demo", ref, sim.imu_from_trajectory(ref), gnss, {"lever_arm_m": [0.0, 0.0, 0.0], **meta})

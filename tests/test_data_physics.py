@@ -3,26 +3,21 @@
 from __future__ import annotations
 
 import numpy as np
-import pandas as pd
 import pytest
 
 from bgfn.data import Drive, load_drive, write_csv_drive
 from bgfn.data.imu_errors import error_params
 from bgfn.data.physics import G, check_drive
 from bgfn.errors import DataError
-from bgfn.nav.sim import demo_trajectory, imu_from_trajectory
+from bgfn.nav.sim import demo_trajectory
+from synthetic_drive import exact_drive
 
 pytestmark = pytest.mark.usefixtures("repo_untouched")
 
 
 @pytest.fixture(scope="module")
 def drive():
-    ref = demo_trajectory(duration_s=60.0, rate_hz=100.0)
-    g = ref.iloc[::100].reset_index(drop=True)
-    gnss = pd.DataFrame({"time": g["time"], "lat": g["lat"], "lon": g["lon"], "h": g["h"], "v_n": g["v_n"],
-                         "v_e": g["v_e"], "v_d": g["v_d"], "std_n": 1.0, "std_e": 1.0, "std_d": 3.0})
-    meta = {"lever_arm_m": [0.0, 0.0, 0.0], "imu_errors": error_params("mpu6000"), "source": "demo"}
-    return Drive("demo", ref, imu_from_trajectory(ref), gnss, meta)
+    return exact_drive(60.0, imu_errors=error_params("mpu6000"), source="demo")
 
 
 def _imu(d, **cols):

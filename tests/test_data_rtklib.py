@@ -20,8 +20,7 @@ from bgfn.data.physics import check_drive
 from bgfn.errors import ChecksumError, DataError
 from bgfn.nav import metrics
 from bgfn.nav.earth import normal_gravity
-from bgfn.nav.sim import demo_trajectory, imu_from_trajectory
-from bgfn.nav.transform import dcm_from_euler
+from synthetic_drive import exact_drive
 
 pytestmark = pytest.mark.usefixtures("repo_untouched")
 
@@ -189,11 +188,7 @@ def test_quality_spans_bracket_each_run_of_other_epochs():
 # ------------------------------------------------------------------------- references without attitude
 @pytest.fixture(scope="module")
 def demo():
-    ref = demo_trajectory(duration_s=60.0, rate_hz=100.0)
-    g = ref.iloc[::100].reset_index(drop=True)
-    gnss = pd.DataFrame({"time": g["time"], "lat": g["lat"], "lon": g["lon"], "h": g["h"], "v_n": g["v_n"],
-                         "v_e": g["v_e"], "v_d": g["v_d"], "std_n": 1.0, "std_e": 1.0, "std_d": 3.0})
-    return Drive("demo", ref, imu_from_trajectory(ref), gnss, {"lever_arm_m": [0.0, 0.0, 0.0]})
+    return exact_drive(60.0)
 
 
 def test_a_reference_without_attitude_is_accepted_but_not_a_partial_one(demo):

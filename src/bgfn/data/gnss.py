@@ -247,17 +247,13 @@ def simulate_fixes(truth: pd.DataFrame, lever_arm_m, seed: int, *, rate_hz: floa
         Seed of the error draws.
     rate_hz : float
         Fix rate, Hz (fixes at the truth epochs that are integer multiples of ``1 / rate_hz``).
-    white_std_m, correlated_std_m : array_like, shape (3,)
-        North, east, down std, m.
-    correlated_tau_s : float
-        Correlation time of the correlated part, s.
+    white_std_m, correlated_std_m, correlated_tau_s
+        As :func:`degrade_fixes`, which adds the errors to the exact antenna positions.
 
     Returns
     -------
-    gnss : DataFrame
-        GNSS table (``GNSS_COLUMNS``), velocities NaN.
-    errors : DataFrame
-        ``time``, ``err_n``, ``err_e``, ``err_d`` (m): the simulated position error (fix - antenna truth).
+    gnss, errors : DataFrame
+        As :func:`degrade_fixes` (velocities NaN).
     """
     t = truth["time"].to_numpy(float)
     k = t * rate_hz

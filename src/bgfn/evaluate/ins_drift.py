@@ -30,13 +30,9 @@ DRIFT_COLUMNS: tuple[str, ...] = ("dataset", "test", "duration_s", "method", "n_
 def drift_starts(cfg: dict, drive) -> list[float]:
     """The sweep's starts on ``drive`` (``evaluate.sweep`` of the profile; after the filter's start), s."""
     from bgfn.evaluate.config import evaluate_config
-    from bgfn.evaluate.sweep import sweep_plan, sweep_train_config
-    from bgfn.learning import learning_options
-    from bgfn.nav.baseline import filter_start
+    from bgfn.evaluate.sweep import profile_sweep_plan
 
-    sw = evaluate_config(cfg.get("evaluate"), cfg.get("train"))["sweep"]
-    n_window = int(learning_options(sweep_train_config(cfg.get("train") or {}, sw))["window"])
-    plan = sweep_plan(drive, sw, n_window, t_first=filter_start(drive, cfg.get("nav")))
+    plan = profile_sweep_plan(cfg, drive, evaluate_config(cfg.get("evaluate"), cfg.get("train"))["sweep"])
     return [float(s) for s in plan["start_s"]]
 
 

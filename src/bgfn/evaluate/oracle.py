@@ -124,9 +124,7 @@ def oracle_windows(cfg: dict, drive, ecfg: dict, windows) -> tuple[list[tuple[st
     notes : list of str
         Why a drive has no sweep starts.
     """
-    from bgfn.evaluate.sweep import sweep_plan, sweep_train_config
-    from bgfn.learning import learning_options
-    from bgfn.nav.baseline import filter_start
+    from bgfn.evaluate.sweep import profile_sweep_plan
 
     out = [(str(k + 1), float(s), float(d)) for k, (s, d) in enumerate(windows)]
     sw, durations = ecfg["sweep"], ecfg["oracle"]["durations_s"]
@@ -136,9 +134,8 @@ def oracle_windows(cfg: dict, drive, ecfg: dict, windows) -> tuple[list[tuple[st
         raise DataError("params evaluate.oracle", "durations_s", f"durations up to evaluate.sweep.durations_s's "
                         f"longest {max(sw['durations_s']):g} s (the sweep's starts leave room for no more)",
                         repr(durations))
-    n_window = int(learning_options(sweep_train_config(cfg.get("train") or {}, sw))["window"])
     try:        # the sweep's own starts (a self-aligned filter starts late: none before it)
-        plan = sweep_plan(drive, sw, n_window, t_first=filter_start(drive, cfg.get("nav")))
+        plan = profile_sweep_plan(cfg, drive, sw)
     except DataError as exc:
         return out, [f"{drive.name}: no sweep starts ({exc.expected}; found {exc.found}): the paper's outages only"]
     return out + [(SWEEP_OUTAGE, float(s), float(max(durations))) for s in plan["start_s"]], []

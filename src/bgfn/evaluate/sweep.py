@@ -50,6 +50,15 @@ def sweep_plan(drive, sweep: dict, window_samples: int = 200, t_first: float | N
     return pd.DataFrame({"start_s": starts, "fold": folds.astype(int)})
 
 
+def profile_sweep_plan(cfg: dict, drive, sweep: dict) -> pd.DataFrame:
+    """:func:`sweep_plan` of ``drive`` under a profile: the input window of the sweep's networks (``train:`` with
+    ``sweep.train``'s overrides) and the filter's start (``nav:``; a self-aligned filter starts late)."""
+    from bgfn.learning import learning_options
+
+    n_window = int(learning_options(sweep_train_config(cfg.get("train") or {}, sweep))["window"])
+    return sweep_plan(drive, sweep, n_window, t_first=filter_start(drive, cfg.get("nav")))
+
+
 def sweep_train_config(train_section: dict, sweep: dict) -> dict:
     """The ``train:`` section with the sweep's overrides (``sweep.train``; ``optimizer`` merged key by key)."""
     tc = copy.deepcopy(train_section or {})

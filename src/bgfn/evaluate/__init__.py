@@ -85,9 +85,9 @@ from bgfn.evaluate.plots import outage_figures, plot_gps_row, plot_oracle, plot_
 from bgfn.evaluate.record import RECORD_FILE, evaluation_record, write_evaluation_record
 from bgfn.evaluate.sensitivity import (SENSITIVITY_COLUMNS, Sensitivity, pseudo_std_sensitivity,
                                        save_sensitivity, sensitivity_table)
-from bgfn.evaluate.sweep import (describe_sweep, describe_sweep_setup, describe_sweep_size, run_sweep, run_sweeps,
-                                 sweep_comparisons, sweep_interval_table, profile_sweep_plan, sweep_plan, sweep_summary,
-                                 sweep_train_config)
+from bgfn.evaluate.sweep import (describe_sweep, describe_sweep_setup, describe_sweep_size, profile_sweep_plan,
+                                 run_sweep, run_sweeps, sweep_comparisons, sweep_interval_table, sweep_plan,
+                                 sweep_summary, sweep_train_config)
 from bgfn.evaluate.tables import (TableResult, aggregate_seeds, describe_tables, error_reduction, error_series,
                                   evaluate_dataset, fix_error_table,
                                   representative_seeds, run_tables, save_table_result, table_file,
@@ -111,7 +111,8 @@ __all__ = [
     "plot_gps_row", "plot_outage", "plot_sweep_boxes", "pseudo_gps_positions", "pseudo_std_sensitivity",
     "reduction_table", "representative_seeds", "run_outages", "run_sweep", "run_sweeps", "run_tables",
     "save_sensitivity", "save_table_result", "sensitivity_table", "sweep_comparisons", "sweep_interval_table",
-    "profile_sweep_plan", "sweep_plan", "sweep_summary", "sweep_train_config", "table_file", "table_paths", "window_metrics",
+    "profile_sweep_plan", "sweep_plan", "sweep_summary", "sweep_train_config", "table_file", "table_paths",
+    "window_metrics",
     "write_evaluation_record",
     # the learning-problem variants (notebook 03)
     "NO_VARIANT", "VARIANT_COLUMNS", "VARIANT_METRICS", "load_variant_network", "variant_runs", "variant_table", "variant_pivot",

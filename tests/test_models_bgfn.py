@@ -81,6 +81,15 @@ def test_fused_lif_equals_eq_lif_and_spikingjelly_forward_and_backward(tau, thr,
     assert x_f.grad.abs().sum() > 0
 
 
+def test_fused_lif_refuses_a_second_backward_pass_through_the_same_forward():
+    # its backward pass computes the surrogate in the memory of the saved potentials
+    x = (torch.rand(3, 4, 5) * 2).requires_grad_(True)
+    s = make_lif()(x)
+    s.sum().backward(retain_graph=True)
+    with pytest.raises(RuntimeError, match="runs once per forward pass"):
+        s.sum().backward()
+
+
 def test_fused_lif_falls_back_to_spikingjelly_when_the_membrane_is_not_at_rest():
     fused, sj = make_lif(), make_lif(fused=False)
     x = torch.rand(3, 4, 5) * 1.5

@@ -75,37 +75,45 @@ class FusedLIF(torch.autograd.Function):
 
     @staticmethod
     def forward(ctx, current: torch.Tensor, tau: float, u_thr: float, alpha: float):    # current [T, ...]
+        # Every step writes into tensors allocated once: at the paper's size a fresh [B, N, D] tensor per op costs
+        # page faults that took as long as the arithmetic (torch.profiler, make bench).
         spikes = torch.empty_like(current)                                             # [T, ...]
         potential = torch.empty_like(current)                                          # U(t), [T, ...]
-        v = None                                                # SpikingJelly's V = (1 - S) U; H = beta V
+        fired = torch.empty(current.shape[1:], dtype=torch.bool, device=current.device)
+        v = torch.zeros_like(current[0])                        # SpikingJelly's V = (1 - S) U; H = beta V
         exact_half = tau == 2.0                                 # V - V/2 == V/2 exactly in floating point
         for t in range(current.shape[0]):
+            u = potential[t]
             # charge with SpikingJelly's rounding, V - V/tau + I (= beta V + I), so spikes are bit-identical
-            if v is None:
-                u = current[t]
+            if t == 0:
+                u.copy_(current[0])
             elif exact_half:
-                u = torch.add(current[t], v, alpha=0.5)
+                torch.add(current[t], v, alpha=0.5, out=u)
             else:
-                u = v - v / tau + current[t]
-            potential[t] = u
-            fired = u >= u_thr                                                         # fire
-            spikes[t] = fired
-            v = u.masked_fill(fired, 0.0)                                              # hard reset to 0
+                u.copy_(v - v / tau + current[t])
+            torch.ge(u, u_thr, out=fired)                                              # fire
+            spikes[t].copy_(fired)
+            v.copy_(u).masked_fill_(fired, 0.0)                                        # hard reset to 0
         ctx.save_for_backward(potential, spikes)
-        ctx.beta, ctx.u_thr, ctx.alpha = beta_from_tau(tau), u_thr, alpha
+        ctx.beta, ctx.u_thr, ctx.alpha, ctx.used = beta_from_tau(tau), u_thr, alpha, False
         ctx.mark_non_differentiable(v)          # the state between calls; every forward pass starts at rest
         return spikes, v                                        # spikes, SpikingJelly's v after the last step
 
     @staticmethod
     def backward(ctx, grad_spikes: torch.Tensor, grad_v: torch.Tensor):
+        if ctx.used:
+            raise RuntimeError("FusedLIF's backward reuses the memory of its saved potentials, so it runs once per "
+                               "forward pass (no retain_graph=True); use make_lif(fused=False) for repeated passes")
+        ctx.used = True
         potential, spikes = ctx.saved_tensors
         k = math.pi / 2.0 * ctx.alpha
-        # g'(U - U_thr) for every step at once, then the direct term dL/dS g'
-        grad = (potential - ctx.u_thr).mul_(k).square_().add_(1.0).reciprocal_().mul_(ctx.alpha / 2.0)
+        # g'(U - U_thr) for every step at once, in the potentials' memory (no longer needed), then dL/dS g'
+        grad = potential.sub_(ctx.u_thr).mul_(k).square_().add_(1.0).reciprocal_().mul_(ctx.alpha / 2.0)
         grad.mul_(grad_spikes)
-        keep = (1.0 - spikes).mul_(ctx.beta)                    # dH(t)/dU(t) with the reset detached
+        keep = torch.empty_like(grad[0])                        # dH(t)/dU(t) = (1 - S(t)) beta, reset detached
         for t in range(grad.shape[0] - 2, -1, -1):              # the membrane carries dL/dU(t+1) back
-            grad[t].addcmul_(grad[t + 1], keep[t])
+            torch.mul(spikes[t], -ctx.beta, out=keep).add_(ctx.beta)
+            grad[t].addcmul_(grad[t + 1], keep)
         return grad, None, None, None
 
 

@@ -431,12 +431,19 @@ def test_learning_check_names_the_runs_that_never_improved_on_their_initial_netw
         return {"dataset": "d", "method": method, "seed": seed, "best_epoch": best, "epochs_run": 7,
                 "history": [{"epoch": 0, "val_rmse_m": initial}, {"epoch": 1, "val_rmse_m": 1.0}]}
 
-    cards = [card("bgfn", 0, 3), card("mlp", 0, 0), card("mlp", 1, 1)]
+    fitted = {**card("at_lstm", 2, 0), "history": [{"epoch": 0, "train_loss": None}, {"epoch": 1, "train_loss": 0.8},
+                                                   {"epoch": 2, "train_loss": 0.456}, {"epoch": 3, "train_loss": 0.5}]}
+    cards = [card("bgfn", 0, 3), card("mlp", 0, 0), card("mlp", 1, 1), fitted]
     lines = T.learning_check(cards)
-    assert lines[0] == "2 of 3 runs improved on their initial network (best epoch >= 1)"
+    assert lines[0] == "2 of 4 runs improved on their initial network (best epoch >= 1)"
     assert lines[1] == "  not improved: d mlp seed 0 (the initial network is kept)"
+    # the lowest training loss of epochs >= 1 (epoch 0 has none), against the 1.0 of predicting the mean
+    assert lines[2] == ("  not improved: d at_lstm seed 2 (the initial network is kept; its training loss fell to "
+                        "0.46 (predicting the mean: 1.00))")
+    lines = T.learning_check(cards[:3])
     assert lines[2].startswith("1 runs kept their first training epoch") and lines[2].endswith("d mlp seed 1")
     assert T.learning_check([card("bgfn", 0, 2)]) == ["1 of 1 runs improved on their initial network (best epoch >= 1)"]
     # the table carries the initial network's validation error; an older card (no epoch 0) leaves it empty
-    runs = T.cards_table([card("bgfn", 0, 3, initial=4.5), {**card("mlp", 0, 2), "history": [{"epoch": 1}]}])
+    runs = T.cards_table([card("bgfn", 0, 3, initial=4.5), {**card("mlp", 0, 2), "history": [{"epoch": 1}]}, fitted])
     assert runs["val_rmse_initial_m"].tolist()[0] == 4.5 and runs["val_rmse_initial_m"].isna().tolist()[1]
+    assert runs["train_loss_min"].isna().tolist()[:2] == [True, True] and runs["train_loss_min"].tolist()[2] == 0.456

@@ -276,7 +276,24 @@ def learning_evidence(inp: VerdictInputs) -> str:
             f"initial weights (median RMSE per increment {base[2]:.2f} m; predicting zero: {zero:.2f} m)")
     if fast is not None:
         text += f"; given the INS velocity {fast[0]} of {fast[1]} did (median {fast[2]:.2f} m)"
-    return text + "."
+    return text + "." + _fitted_but_not_improved(inp.training)
+
+
+def _fitted_but_not_improved(cards: pd.DataFrame) -> str:
+    """Why the networks that never improved did not: their lowest training loss against predicting the mean
+    (1.0 in normalized units). Empty when every run improved or the column is missing."""
+    if "train_loss_min" not in cards.columns:
+        return ""
+    stuck = cards[(cards["best_epoch"] < 1) & cards["train_loss_min"].notna()]
+    if not len(stuck):
+        return ""
+    fit = float(stuck["train_loss_min"].median())
+    if fit >= 0.9:
+        return (f" The {len(stuck)} that never improved did not fit their training windows either (median lowest "
+                f"training loss {fit:.2f}; predicting the mean: 1.00).")
+    return (f" The {len(stuck)} that never improved did fit their training windows (median lowest training loss "
+            f"{fit:.2f}; predicting the mean: 1.00): what they learned there does not carry over to the "
+            f"validation block.")
 
 
 def answer_speed(table: pd.DataFrame, inp: VerdictInputs | None = None) -> str:

@@ -29,7 +29,10 @@ than its ANN twin. :class:`FusedLIFNode` is a ``LIFNode`` whose multi-step pass 
 node (:class:`FusedLIF`): the forward loop stores U(t) and S(t), the backward pass applies the same chain rule
 in reverse (the surrogate derivative evaluated once over all steps, then one fused multiply-add per step).
 Spikes are bit-identical and gradients equal within float32 rounding (tests compare it with
-:func:`lif_reference` and with SpikingJelly's ``LIFNode``). On a CUDA device, or for any setting it does not
+:func:`lif_reference` and with SpikingJelly's ``LIFNode``). It writes every step into tensors allocated once and
+computes the surrogate in the memory of its saved potentials: at the paper's size each fresh [B, N, D]
+tensor cost page faults that took as long as the arithmetic (torch.profiler), so its backward pass runs once
+per forward pass (``retain_graph=True`` is refused). On a CUDA device, or for any setting it does not
 cover, it falls back to SpikingJelly's own implementation (whose CUDA kernels are fused already).
 """
 

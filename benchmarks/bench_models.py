@@ -7,6 +7,10 @@ Adds to ``results/bench.json``:
 - ``infer_ms.<model>.<size>``: latency of one window (batch 1, eval mode, 1 CPU thread), ms;
 - ``train_ratio_bgfn_over_twin.<size>``: BGFN's training throughput divided by its ANN twin's (Transformer),
   both measured in the same run;
+- ``train_step_profile.<model>.<size>``: one training step of BGFN and its twin under ``torch.profiler``: all
+  operators and the dense matrix products alone, s (:func:`bgfn.speed.training_step_profile`);
+  ``train_ratio_ceiling.<size>``: the twin's profiled step over BGFN's matrix products alone, the ratio BGFN
+  would reach if everything but its matrix arithmetic (LIF, BatchNorm, copies) cost nothing;
 - ``models_bench``: what ran (threads, device, batch, window, parameter counts, repeats).
 
 Sizes come from ``train.sizes`` of ``params/<size>.yaml`` (the same blocks in every profile). Median of a
@@ -22,7 +26,7 @@ import torch
 from bgfn.config import load_profile
 from bgfn.io import update_json
 from bgfn.models import METHODS, build_model, count_parameters
-from bgfn.speed import bench_file, median_time, training_throughput
+from bgfn.speed import bench_file, median_time, training_step_profile, training_throughput
 
 SIZES = ("quick", "paper")
 #: (training steps, inference calls) measured per size, after one warm-up each.
@@ -50,6 +54,13 @@ def bench(model_name: str, size: str) -> tuple[float, float, int, dict]:
                                                                       "repeats": [n_train, n_infer]}
 
 
+def step_profile(model_name: str, size: str) -> dict:
+    cfg = load_profile(size)["train"]
+    torch.manual_seed(0)
+    model = build_model(model_name, dict(cfg["sizes"][model_name][size]))
+    return training_step_profile(model, int(cfg["window"]), int(cfg["optimizer"]["batch_size"]))
+
+
 def main(sizes=SIZES, methods=METHODS) -> dict:
     train_rate: dict = {m: {} for m in methods}
     infer_ms: dict = {m: {} for m in methods}
@@ -67,11 +78,19 @@ def main(sizes=SIZES, methods=METHODS) -> dict:
     # BGFN's training throughput over its ANN twin's, both measured in this run (issue: at least 1/3)
     ratio = {size: train_rate["bgfn"][size] / train_rate["transformer"][size] for size in sizes
              if "bgfn" in train_rate and "transformer" in train_rate}
+    profiles: dict = {m: {} for m in ("bgfn", "transformer") if m in methods}
+    ceiling: dict = {}
+    for size in sizes:
+        for m in profiles:
+            profiles[m][size] = step_profile(m, size)
+        if len(profiles) == 2:
+            ceiling[size] = profiles["transformer"][size]["step_s"] / profiles["bgfn"][size]["matmul_s"]
     for size, r in ratio.items():
-        print(f"BGFN / Transformer training throughput, {size}: {r:.2f}", flush=True)
+        print(f"BGFN / Transformer training throughput, {size}: {r:.2f} (ceiling: twin's step / BGFN's matrix "
+              f"products alone {ceiling.get(size, float('nan')):.2f})", flush=True)
     update_json(bench_file(),
                 {"train_windows_per_s": train_rate, "infer_ms": infer_ms, "models_bench": info,
-                 "train_ratio_bgfn_over_twin": ratio})
+                 "train_ratio_bgfn_over_twin": ratio, "train_step_profile": profiles, "train_ratio_ceiling": ceiling})
     return {"train_windows_per_s": train_rate, "infer_ms": infer_ms, "train_ratio_bgfn_over_twin": ratio}
 
 

@@ -367,3 +367,25 @@ def test_timing_helpers_restore_threads_and_count_calls():
     assert speed.throughput(model, window=5, batch=4, repeats=1, threads=1) > 0
     assert speed.latency_ms(model, window=5, repeats=1, threads=1) > 0
     assert torch.get_num_threads() == before
+
+
+def test_matmul_share_of_a_training_step_counts_only_dense_products():
+    from types import SimpleNamespace
+
+    from bgfn import speed
+
+    ev = [SimpleNamespace(key=k, self_cpu_time_total=us) for k, us in
+          [("aten::mm", 3e5), ("aten::addmm", 1e5), ("aten::add_", 5e5), ("aten::bmm", 1e5)]]
+    assert speed.matmul_seconds(ev) == pytest.approx((0.5, 1.0))              # (0.3 + 0.1 + 0.1) s of 1.0 s
+
+    class Scale(torch.nn.Module):                                            # elementwise only: no product
+        def __init__(self):
+            super().__init__()
+            self.w = torch.nn.Parameter(torch.ones(9))
+
+        def forward(self, x):                                                # [B, N, 9] -> [B, 2]
+            return (x * self.w).mean(1)[:, :2]
+
+    assert speed.training_step_profile(Scale(), window=5, batch=4)["matmul_s"] == 0.0
+    p = speed.training_step_profile(build_model("mlp", {"hidden": 64}), window=5, batch=16)
+    assert 0.0 < p["matmul_s"] < p["step_s"]

@@ -109,6 +109,47 @@ def training_throughput(model: nn.Module, window: int, batch: int, in_channels: 
     return batch / median_time(step, repeats)
 
 
+#: torch operators whose self time is dense matrix arithmetic (Linear, attention products, convolution).
+MATMUL_OPS = ("aten::mm", "aten::addmm", "aten::bmm", "aten::baddbmm", "aten::matmul",
+              "aten::_scaled_dot_product_flash_attention_for_cpu",
+              "aten::_scaled_dot_product_flash_attention_for_cpu_backward", "aten::mkldnn_convolution",
+              "aten::convolution_backward")
+
+
+def matmul_seconds(events) -> tuple[float, float]:
+    """(Seconds in :data:`MATMUL_OPS`, seconds in all operators) of ``torch.profiler`` key averages (self CPU
+    time, so nested operators are not counted twice)."""
+    total = sum(e.self_cpu_time_total for e in events) / 1e6
+    dense = sum(e.self_cpu_time_total for e in events if e.key in MATMUL_OPS) / 1e6
+    return dense, total
+
+
+def training_step_profile(model: nn.Module, window: int, batch: int, in_channels: int = 9,
+                          seed: int = 0) -> dict[str, float]:
+    """One training step (as :func:`training_throughput`) under ``torch.profiler``, after a warm-up step.
+
+    Returns ``{'step_s', 'matmul_s'}``: profiled time of all operators and of the dense matrix products alone,
+    s. Their ratio says how much of a step is arithmetic that no change of the other layers can remove.
+    """
+    from torch.profiler import ProfilerActivity, profile
+
+    g = torch.Generator().manual_seed(seed)
+    x, y = torch.randn(batch, window, in_channels, generator=g), torch.randn(batch, 2, generator=g)
+    opt = torch.optim.AdamW(model.parameters(), lr=1e-3)
+
+    def step():
+        model.train()
+        opt.zero_grad(set_to_none=True)
+        torch.nn.functional.mse_loss(model(x), y).backward()
+        opt.step()
+
+    step()
+    with profile(activities=[ProfilerActivity.CPU]) as prof:
+        step()
+    dense, total = matmul_seconds(prof.key_averages())
+    return {"step_s": total, "matmul_s": dense}
+
+
 def realtime_flags(latency_ms_value: float, imu_rate_hz: float = IMU_RATE_HZ,
                    gnss_rate_hz: float = GNSS_RATE_HZ) -> dict[str, bool]:
     """Whether a batch-1 latency (ms) keeps up with the IMU and the GNSS rates.

@@ -426,6 +426,20 @@ def test_paper_training_estimate_is_epochs_times_windows_over_the_measured_rate(
     assert "make bench" in T.estimate_lines(None)[0]
 
 
+def test_speed_lines_give_the_ratio_to_the_twin_and_the_ceiling_of_the_matrix_products():
+    bench = {"train_ratio_bgfn_over_twin": {"quick": 0.85, "paper": 0.25},
+             "train_step_profile": {"bgfn": {"paper": {"matmul_s": 0.5, "step_s": 0.7}},
+                                    "transformer": {"paper": {"matmul_s": 0.1, "step_s": 0.2}}},
+             "train_ratio_ceiling": {"paper": 0.2 / 0.5}}
+    lines = T.speed_lines(bench, time_steps=4)
+    assert lines[0] == ("BGFN trains at 0.85 at the quick size, 0.25 at the paper size of its ANN twin's throughput "
+                        "(windows/s, both measured in one run)")
+    assert "take 0.50 s of its 0.70 s, the twin's whole step 0.20 s" in lines[1]
+    assert "at most 0.40 of the twin's throughput: with T_s = 4 SNN steps" in lines[1]
+    assert len(T.speed_lines({k: v for k, v in bench.items() if k != "train_ratio_ceiling"})) == 1   # older bench
+    assert T.speed_lines({}) == [] and T.speed_lines(None) == []
+
+
 def test_learning_check_names_the_runs_that_never_improved_on_their_initial_network():
     def card(method, seed, best, initial=2.0):
         return {"dataset": "d", "method": method, "seed": seed, "best_epoch": best, "epochs_run": 7,

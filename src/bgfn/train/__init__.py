@@ -21,7 +21,7 @@ Modules, one concept each (every public name is re-exported here):
 
 from bgfn.learning import REFERENCES, VAL_POSITIONS
 from bgfn.train.cli import main
-from bgfn.train.estimate import estimate_lines, measure_paper_step, paper_training_estimate
+from bgfn.train.estimate import estimate_lines, measure_paper_step, paper_training_estimate, speed_lines
 from bgfn.train.loop import set_seed, train_model
 from bgfn.train.lr_search import (LR_SEARCH_COLUMNS, LR_SEARCH_DEFAULTS, LR_SEARCH_FILE, chosen_learning_rates,
                                   lr_search_options, next_learning_rate, search_learning_rates,
@@ -39,7 +39,7 @@ from bgfn.train.variants import (VARIANT_RUN_DEFAULTS, VariantPlan, describe_opt
                                  variant_cards_table, variant_learning_data, variant_train_section)
 
 __all__ = [
-    "estimate_lines", "measure_paper_step", "paper_training_estimate",
+    "estimate_lines", "measure_paper_step", "paper_training_estimate", "speed_lines",
     # options
     "OPTIMIZER_DEFAULTS", "train_subsection", "optimizer_options", "method_lr", "size_config", "even_subset",
     # the loop and a trained network

@@ -53,16 +53,45 @@ def measure_paper_step(paper_cfg: dict, repeats: int = 2) -> dict:
     import torch
 
     from bgfn.models import build_model
-    from bgfn.speed import training_throughput
+    from bgfn.speed import training_step_profile, training_throughput
 
     tc = paper_cfg["train"]
-    rates = {}
-    for method in tc["methods"]:
+    window, batch = int(tc["window"]), int(tc["optimizer"]["batch_size"])
+    rates, profiles = {}, {}
+    for method in dict.fromkeys([*tc["methods"], "transformer"]):         # the twin too, for the speed ratio
         torch.manual_seed(0)
         model = build_model(method, dict(tc["sizes"][method]["paper"]))
-        rates[method] = {"paper": training_throughput(model, int(tc["window"]), int(tc["optimizer"]["batch_size"]),
-                                                       repeats=repeats)}
-    return {"train_windows_per_s": rates, "measured_by": "bgfn.train.estimate.measure_paper_step"}
+        rates[method] = {"paper": training_throughput(model, window, batch, repeats=repeats)}
+        if method in ("bgfn", "transformer"):
+            profiles[method] = {"paper": training_step_profile(model, window, batch)}
+    out = {"train_windows_per_s": rates, "measured_by": "bgfn.train.estimate.measure_paper_step",
+           "train_step_profile": profiles}
+    if {"bgfn", "transformer"} <= set(rates):
+        out["train_ratio_bgfn_over_twin"] = {"paper": rates["bgfn"]["paper"] / rates["transformer"]["paper"]}
+        out["train_ratio_ceiling"] = {"paper": profiles["transformer"]["paper"]["step_s"]
+                                      / profiles["bgfn"]["paper"]["matmul_s"]}
+    return out
+
+
+def speed_lines(bench: dict | None, time_steps: int | None = None) -> list[str]:
+    """Plain lines for notebook 03: BGFN's training throughput over its ANN twin's (``make bench``'s
+    ``train_ratio_bgfn_over_twin``) at each measured size, and at the paper size the ceiling that the
+    twin's profiled step over BGFN's matrix products alone sets (``train_ratio_ceiling``). Empty without them."""
+    ratio = (bench or {}).get("train_ratio_bgfn_over_twin") or {}
+    if not ratio:
+        return []
+    sizes = ", ".join(f"{r:.2f} at the {size} size" for size, r in ratio.items())
+    lines = [f"BGFN trains at {sizes} of its ANN twin's throughput (windows/s, both measured in one run)"]
+    ceiling = ((bench or {}).get("train_ratio_ceiling") or {}).get("paper")
+    prof = ((bench or {}).get("train_step_profile") or {})
+    if ceiling is not None and "paper" in ratio:
+        b, t = prof["bgfn"]["paper"], prof["transformer"]["paper"]
+        steps = f"with T_s = {time_steps} SNN steps " if time_steps else ""
+        lines.append(f"paper size, one profiled training step: BGFN's matrix products alone take {b['matmul_s']:.2f} s "
+                     f"of its {b['step_s']:.2f} s, the twin's whole step {t['step_s']:.2f} s; even if its LIF, "
+                     f"BatchNorm and copies cost nothing BGFN would reach at most {ceiling:.2f} of the twin's "
+                     f"throughput: {steps}every spiking layer multiplies T_s times as many rows as the twin's")
+    return lines
 
 
 def estimate_lines(table: pd.DataFrame | None) -> list[str]:

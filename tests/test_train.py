@@ -431,7 +431,7 @@ def test_speed_lines_give_the_ratio_to_the_twin_and_the_ceiling_of_the_matrix_pr
              "train_step_profile": {"bgfn": {"paper": {"matmul_s": 0.5, "step_s": 0.7}},
                                     "transformer": {"paper": {"matmul_s": 0.1, "step_s": 0.2}}},
              "train_ratio_ceiling": {"paper": 0.2 / 0.5}}
-    lines = T.speed_lines(bench, time_steps=4)
+    lines = T.speed_lines(bench, {"train": {"sizes": {"bgfn": {"paper": {"time_steps": 4}}}}})
     assert lines[0] == ("BGFN trains at 0.85 at the quick size, 0.25 at the paper size of its ANN twin's throughput "
                         "(windows/s, both measured in one run)")
     assert "take 0.50 s of its 0.70 s, the twin's whole step 0.20 s" in lines[1]

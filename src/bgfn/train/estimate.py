@@ -73,10 +73,13 @@ def measure_paper_step(paper_cfg: dict, repeats: int = 2) -> dict:
     return out
 
 
-def speed_lines(bench: dict | None, time_steps: int | None = None) -> list[str]:
+def speed_lines(bench: dict | None, paper_cfg: dict | None = None) -> list[str]:
     """Plain lines for notebook 03: BGFN's training throughput over its ANN twin's (``make bench``'s
     ``train_ratio_bgfn_over_twin``) at each measured size, and at the paper size the ceiling that the
-    twin's profiled step over BGFN's matrix products alone sets (``train_ratio_ceiling``). Empty without them."""
+    twin's profiled step over BGFN's matrix products alone sets (``train_ratio_ceiling``; with ``paper_cfg``, the
+    ``paper`` profile, its T_s is named). Empty without them."""
+    time_steps = (((paper_cfg or {}).get("train") or {}).get("sizes") or {}).get("bgfn", {}).get("paper", {}).get(
+        "time_steps")
     ratio = (bench or {}).get("train_ratio_bgfn_over_twin") or {}
     if not ratio:
         return []

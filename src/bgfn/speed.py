@@ -14,7 +14,9 @@ from __future__ import annotations
 
 import contextlib
 import json
+import os
 import statistics
+import sys
 import time
 from pathlib import Path
 from typing import Callable, Iterator
@@ -124,6 +126,21 @@ def matmul_seconds(events) -> tuple[float, float]:
     return dense, total
 
 
+@contextlib.contextmanager
+def _without_native_stderr() -> Iterator[None]:
+    """Discard what native code writes to file descriptor 2 inside the block: torch's profiler (Kineto) prints
+    a line from C++ when it starts and stops, which a notebook would show (Python's ``sys.stderr`` is kept)."""
+    sys.stderr.flush()
+    saved, null = os.dup(2), os.open(os.devnull, os.O_WRONLY)
+    os.dup2(null, 2)
+    try:
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(null)
+
+
 def training_step_profile(model: nn.Module, window: int, batch: int, in_channels: int = 9,
                           seed: int = 0) -> dict[str, float]:
     """One training step (as :func:`training_throughput`) under ``torch.profiler``, after a warm-up step.
@@ -144,7 +161,7 @@ def training_step_profile(model: nn.Module, window: int, batch: int, in_channels
         opt.step()
 
     step()
-    with profile(activities=[ProfilerActivity.CPU]) as prof:
+    with _without_native_stderr(), profile(activities=[ProfilerActivity.CPU]) as prof:
         step()
     dense, total = matmul_seconds(prof.key_averages())
     return {"step_s": total, "matmul_s": dense}

@@ -106,9 +106,9 @@ def test_speed_answer_says_which_networks_learned_with_and_without_velocity():
     fitted = _inputs(training=main.assign(train_loss_min=[0.3, 0.2, 0.5, 0.9]), training_variants=variants)
     assert answer_speed(verdict_table(fitted), fitted).endswith(
         " The 2 that never improved did fit their training windows (median lowest training loss 0.40; predicting "
-        "the mean: 1.00): what they learned there does not carry over to the validation block.")
+        "the training mean: about 1): what they learned there does not carry over to the validation block.")
     # ... or they did not fit them either
     unfit = _inputs(training=main.assign(train_loss_min=[0.95, 0.2, 1.1, 0.9]), training_variants=variants)
     assert answer_speed(verdict_table(unfit), unfit).endswith(
         " The 2 that never improved did not fit their training windows either (median lowest training loss 1.02; "
-        "predicting the mean: 1.00).")
+        "predicting the training mean: about 1).")

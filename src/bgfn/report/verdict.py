@@ -281,7 +281,7 @@ def learning_evidence(inp: VerdictInputs) -> str:
 
 def _fitted_but_not_improved(cards: pd.DataFrame) -> str:
     """Why the networks that never improved did not: their lowest training loss against predicting the mean
-    (1.0 in normalized units). Empty when every run improved or the column is missing."""
+    (about 1 in normalized units). Empty when every run improved or the column is missing."""
     if "train_loss_min" not in cards.columns:
         return ""
     stuck = cards[(cards["best_epoch"] < 1) & cards["train_loss_min"].notna()]
@@ -290,9 +290,9 @@ def _fitted_but_not_improved(cards: pd.DataFrame) -> str:
     fit = float(stuck["train_loss_min"].median())
     if fit >= 0.9:
         return (f" The {len(stuck)} that never improved did not fit their training windows either (median lowest "
-                f"training loss {fit:.2f}; predicting the mean: 1.00).")
+                f"training loss {fit:.2f}; predicting the training mean: about 1).")
     return (f" The {len(stuck)} that never improved did fit their training windows (median lowest training loss "
-            f"{fit:.2f}; predicting the mean: 1.00): what they learned there does not carry over to the "
+            f"{fit:.2f}; predicting the training mean: about 1): what they learned there does not carry over to the "
             f"validation block.")
 
 

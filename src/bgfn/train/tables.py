@@ -30,8 +30,9 @@ def initial_val_rmse(card: dict) -> float | None:
 def lowest_train_loss(card: dict) -> float | None:
     """Lowest training loss over the run's training epochs (MSE of the normalized increments), None before any.
 
-    The targets are standardized on the training windows, so predicting their mean scores 1.0 there: a value
-    well below 1 says that the network fitted its training windows, whatever it does on the validation block.
+    The targets are standardized on all training windows, so predicting their mean scores 1.0 there (about 1 on
+    an evenly spaced subsample, ``max_train_windows``): a value well below 1 says that the network fitted its
+    training windows, whatever it does on the validation block.
     """
     losses = [h["train_loss"] for h in card.get("history") or [] if h.get("epoch", 0) >= 1
               and h.get("train_loss") is not None]
@@ -49,7 +50,7 @@ def learning_check(cards: list[dict]) -> list[str]:
     lines = [f"{len(done) - len(untrained)} of {len(done)} runs improved on their initial network (best epoch >= 1)"]
     for c in untrained:
         fit = lowest_train_loss(c)
-        fitted = "" if fit is None else f"; its training loss fell to {fit:.2f} (predicting the mean: 1.00)"
+        fitted = "" if fit is None else f"; its training loss fell to {fit:.2f} (predicting the training mean: about 1)"
         lines.append(f"  not improved: {c.get('dataset', '')} {c['method']} seed {c['seed']} (the initial network "
                      f"is kept{fitted})")
     if first:

@@ -1,4 +1,6 @@
-"""Fixtures shared by the data tests."""
+"""Fixtures shared by the tests: data folders, the NaveGo mirror, a private copy of the shipped profiles."""
+
+import shutil
 
 import pytest
 
@@ -30,3 +32,17 @@ def mirror():
         if folder is not None and all((folder / f).is_file() for f in REQUIRED):
             return folder
     pytest.skip("NaveGo mirror not available (set BGFN_DATA_MIRROR)")
+
+
+@pytest.fixture()
+def params(tmp_path, monkeypatch):
+    """A private ``params/`` folder holding copies of the shipped profiles (``smoke`` derives from ``quick``, so a
+    test's own profile can say ``base: smoke``), and ``bgfn.config`` reading from it."""
+    from bgfn import config
+
+    folder = tmp_path / "params"
+    folder.mkdir()
+    for path in config.PARAMS_DIR.glob("*.yaml"):
+        shutil.copy(path, folder / path.name)
+    monkeypatch.setattr(config, "PARAMS_DIR", folder)
+    return folder

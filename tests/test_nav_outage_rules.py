@@ -153,20 +153,13 @@ def test_the_reader_takes_the_datasets_entry_or_the_default():
     assert outages.default_windows({"outage_windows": {"default": dict(RULE)}}) is None
 
 
-def test_a_rule_in_a_profile_file_is_checked_with_the_schema(tmp_path, monkeypatch):
-    import shutil
-
+def test_a_rule_in_a_profile_file_is_checked_with_the_schema(params):
     from bgfn import config
     from bgfn.profile_schema import OUTAGE_RULE
 
     assert set(OUTAGE_RULE.fields) == {"rule", *R.RULE_DEFAULTS["cruise_and_manoeuvre"]}
-    folder = tmp_path / "params"
-    folder.mkdir()
-    shutil.copy(config.PARAMS_DIR / "smoke.yaml", folder / "smoke.yaml")
-    monkeypatch.setattr(config, "PARAMS_DIR", folder)
-
     def load(text):
-        (folder / "mine.yaml").write_text(f"profile: mine\nbase: smoke\ndescription: v\n{text}\n")
+        (params / "mine.yaml").write_text(f"profile: mine\nbase: smoke\ndescription: v\n{text}\n")
         return config.load_profile("mine")
 
     cfg = load("outage_windows: {sim: {rule: cruise_and_manoeuvre, gap_s: 10.0}}")      # merged over smoke's
@@ -185,25 +178,19 @@ def test_a_rule_in_a_profile_file_is_checked_with_the_schema(tmp_path, monkeypat
             load(text)
         assert err.value.field == key and words in str(err.value), str(err.value)
     # a mapping without a default must name every dataset of the profile
-    (folder / "smoke.yaml").write_text((folder / "smoke.yaml").read_text().replace("  default: [[", "  turin: [["))
+    (params / "quick.yaml").write_text((params / "quick.yaml").read_text().replace("  default: [[", "  turin: [["))
     with pytest.raises(DataError, match="none for turin-sim-ekinox"):
-        config.load_profile("smoke")
+        config.load_profile("smoke")                             # smoke takes its outages from quick
 
 
-def test_check_with_drives_applies_the_rule_to_each_drive(tmp_path, monkeypatch):
-    import shutil
-
+def test_check_with_drives_applies_the_rule_to_each_drive(params, monkeypatch):
     import bgfn.data
     from bgfn import config
     from bgfn.profile_schema import check_with_drives
 
-    folder = tmp_path / "params"
-    folder.mkdir()
-    shutil.copy(config.PARAMS_DIR / "smoke.yaml", folder / "smoke.yaml")
-    monkeypatch.setattr(config, "PARAMS_DIR", folder)
     monkeypatch.setattr(bgfn.data, "load_drive", lambda name, profile=None: SimpleNamespace(
         name=name, reference=drive_reference(), imu=drive_reference()[["time"]], meta={"imu_rate_hz": 10.0}))
-    path = folder / "mine.yaml"
+    path = params / "mine.yaml"
     head = ("profile: mine\nbase: smoke\ndescription: v\ndata: {t_start: null, t_end: null}\n"
             "nav: {datasets: [sim]}\ntrain: {datasets: [sim]}\n"
             "evaluate: {datasets: [sim], sweep: {datasets: []}}\n")

@@ -4,7 +4,6 @@ variants of a profile (bgfn.train.variants) merged and schema-checked like profi
 
 from __future__ import annotations
 
-import shutil
 from types import SimpleNamespace
 
 import numpy as np
@@ -92,15 +91,6 @@ def test_leaky_trains_on_the_test_outages_and_validates_where_honest_does(tables
 
 
 # ----------------------------------------------------------------------------------------------- profile keys
-@pytest.fixture()
-def params(tmp_path, monkeypatch):
-    folder = tmp_path / "params"
-    folder.mkdir()
-    shutil.copy(config.PARAMS_DIR / "smoke.yaml", folder / "smoke.yaml")
-    monkeypatch.setattr(config, "PARAMS_DIR", folder)
-    return folder
-
-
 def test_variants_merge_into_the_profile_as_profiles_merge(params):
     (params / "mine.yaml").write_text(
         "profile: mine\nbase: smoke\ndescription: v\n"

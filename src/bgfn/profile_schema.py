@@ -172,7 +172,7 @@ SCHEMA = section(
         series_rate_hz=_POS, train_missing=flag(), nhc_rows=flag(),
         sweep=section(datasets=seq(text()), n_starts=integer(1), durations_s=seq(_POS, min_len=1),
                       folds=integer(1), seeds=seq(_SEED, min_len=1), warmup_s=_NONNEG,
-                      train=Spec("section", fields=TRAIN.fields), n_boot=integer(1),
+                      train=Spec("section", null=True, fields=TRAIN.fields), n_boot=integer(1),
                       level=_FRACTION, boot_seed=_SEED),
         oracle=section(sigmas_m=seq(_NONNEG), seeds=seq(_SEED, min_len=1), durations_s=seq(_POS))),
     energy=section(

@@ -244,3 +244,22 @@ def test_a_capped_search_is_the_prefix_of_the_full_budget(data):
                              progress=False)
         assert card["epochs_run"] == 6
         assert loss == pytest.approx(min(h["val_loss"] for h in card["history"][:4]), rel=1e-6)
+
+
+def test_the_command_line_trains_the_variants_only_when_asked(monkeypatch, tmp_path):
+    import bgfn.train.profile as P
+    import bgfn.train.variants as V
+    from bgfn.train.cli import main
+
+    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)                  # no search ran: train.lr
+    monkeypatch.setattr(P, "prepare_datasets", lambda plan: {d: T.TrainingDataset(d, None, None, f"data {d}")
+                                                             for d in plan.datasets})
+    monkeypatch.setattr(P, "train_dataset", lambda plan, d, data, tc, **kw: [{"dataset": d, "data": data}])
+    calls = []
+    monkeypatch.setattr(V, "train_variants", lambda vplan, prepared, cfgs, **kw: calls.append(
+        (vplan.names, vplan.datasets, sorted(prepared), sorted(cfgs))) or [])
+    main(["--profile", "smoke", "--dataset", "turin-sim-mpu6000"])
+    assert calls == []
+    main(["--profile", "smoke", "--dataset", "turin-sim-mpu6000", "--variants"])
+    smoke = config.load_profile("smoke")
+    assert calls == [(list(smoke["variants"]), ["turin-sim-mpu6000"], ["turin-sim-mpu6000"], ["turin-sim-mpu6000"])]

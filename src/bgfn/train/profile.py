@@ -256,17 +256,24 @@ def train_dataset(plan: TrainingPlan, dataset: str, data: LearningData, train_cf
 
 
 def train_profile(profile: str, datasets=None, methods=None, seeds=None, device: str | None = None,
-                  progress: bool = True, outage_windows=None, echo: Callable[[str], Any] | None = None) -> list[dict]:
+                  progress: bool = True, outage_windows=None, echo: Callable[[str], Any] | None = None,
+                  variants: bool = False) -> list[dict]:
     """Train every ``(dataset, method, seed)`` of a profile's ``train:`` section; return the cards.
 
     The learning rates are those notebook 03 selected (:func:`bgfn.train.lr_search.tuned_train_config`) when its
-    search has run.
+    search has run. ``variants``: also the profile's input and protocol variants (``variants:`` and
+    ``variant_runs:``, :func:`bgfn.train.variants.train_variants`), as notebook 03 trains them.
     """
+    from bgfn.train.variants import VariantPlan, train_variants
+
     plan = TrainingPlan.of(profile, datasets, methods, seeds, outage_windows)
+    prepared = prepare_datasets(plan)       # each dataset's own outages unless outage_windows is given
+    train_cfgs = {name: tuned_train_config(plan.cfg, profile, name) for name in plan.datasets}
     cards = []
-    for dataset in plan.datasets:
-        tc = tuned_train_config(plan.cfg, profile, dataset)
-        data = prepare_learning_data(plan.cfg, dataset,   # None: the dataset's own outages, from its drive
-                                     outage_windows=None if plan.per_dataset else plan.outage_windows)
-        cards += train_dataset(plan, dataset, data, tc, device=device, progress=progress, echo=echo)
+    for name in plan.datasets:
+        cards += train_dataset(plan, name, prepared[name].data, train_cfgs[name], device=device, progress=progress,
+                               echo=echo)
+    if variants:
+        cards += train_variants(VariantPlan.of(plan), prepared, train_cfgs, device=device, progress=progress,
+                                echo=echo)
     return cards

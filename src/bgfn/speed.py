@@ -94,10 +94,8 @@ def throughput(model: nn.Module, window: int, batch: int = 64, in_channels: int 
         return batch / median_time(_infer(model, x), repeats)
 
 
-def training_throughput(model: nn.Module, window: int, batch: int, in_channels: int = 9, repeats: int = 3,
-                        seed: int = 0) -> float:
-    """Training windows per second: forward, BPTT backward and an AdamW step on random inputs (median of
-    ``repeats`` steps after one warm-up), torch's current CPU threads."""
+def _training_step(model: nn.Module, window: int, batch: int, in_channels: int, seed: int) -> Callable[[], None]:
+    """One training step on a fixed random batch: forward, BPTT backward and an AdamW step."""
     g = torch.Generator().manual_seed(seed)
     x, y = torch.randn(batch, window, in_channels, generator=g), torch.randn(batch, 2, generator=g)
     opt = torch.optim.AdamW(model.parameters(), lr=1e-3)
@@ -108,7 +106,14 @@ def training_throughput(model: nn.Module, window: int, batch: int, in_channels: 
         torch.nn.functional.mse_loss(model(x), y).backward()
         opt.step()
 
-    return batch / median_time(step, repeats)
+    return step
+
+
+def training_throughput(model: nn.Module, window: int, batch: int, in_channels: int = 9, repeats: int = 3,
+                        seed: int = 0) -> float:
+    """Training windows per second: forward, BPTT backward and an AdamW step on random inputs (median of
+    ``repeats`` steps after one warm-up), torch's current CPU threads."""
+    return batch / median_time(_training_step(model, window, batch, in_channels, seed), repeats)
 
 
 #: torch operators whose self time is dense matrix arithmetic (Linear, attention products, convolution).
@@ -150,16 +155,7 @@ def training_step_profile(model: nn.Module, window: int, batch: int, in_channels
     """
     from torch.profiler import ProfilerActivity, profile
 
-    g = torch.Generator().manual_seed(seed)
-    x, y = torch.randn(batch, window, in_channels, generator=g), torch.randn(batch, 2, generator=g)
-    opt = torch.optim.AdamW(model.parameters(), lr=1e-3)
-
-    def step():
-        model.train()
-        opt.zero_grad(set_to_none=True)
-        torch.nn.functional.mse_loss(model(x), y).backward()
-        opt.step()
-
+    step = _training_step(model, window, batch, in_channels, seed)
     step()
     with _without_native_stderr(), profile(activities=[ProfilerActivity.CPU]) as prof:
         step()

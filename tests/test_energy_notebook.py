@@ -198,13 +198,16 @@ def test_the_energy_network_is_the_median_seed_and_must_be_trained(tmp_path, mon
     from bgfn.errors import DataError
 
     monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)
-    for seed, rmse in ((0, 3.0), (1, 1.0), (2, 2.0), (3, 9.0)):
+    for seed, rmse, best in ((0, 3.0, 4), (1, 1.0, 1), (2, 2.0, 2), (3, 9.0, 3), (4, 1.5, 0), (5, 0.5, 0)):
         pt = checkpoint_path("p", "d", "bgfn", seed)
         pt.write_bytes(b"")
-        card_path(pt).write_text(json.dumps({"val_rmse_m": rmse, "best_epoch": seed}))
+        card_path(pt).write_text(json.dumps({"val_rmse_m": rmse, "best_epoch": best}))
     assert median_seed("p", "d", [0, 1, 2]) == 2                 # 1.0 < 2.0 < 3.0: the median is seed 2
     assert median_seed("p", "d", [0, 1, 2, 3]) == 2             # even count: the lower median
     assert median_seed("p", "d", [7]) == 7                      # no card yet: the first seed
+    # seeds 4 and 5 never improved on their initial network: the median is taken among the others
+    assert median_seed("p", "d", [0, 1, 2, 4, 5]) == 2
+    assert median_seed("p", "d", [4, 5, 7]) == 5                # none trained: all cards (then refused)
     cfg = {"energy": {"dataset": None, "seed": None}, "train": {"datasets": ["d"], "seeds": [0, 1, 2]}}
     assert energy_checkpoint("p", "bgfn", cfg).name == "bgfn_seed2.pt"
     assert energy_checkpoint("p", "bgfn", {**cfg, "energy": {"seed": 0}}).name == "bgfn_seed0.pt"

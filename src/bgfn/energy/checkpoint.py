@@ -3,8 +3,9 @@
 The firing rates, hence the SOPs, are those of a *trained* BGFN; the twin's MACs do not depend on its weights,
 but loading its checkpoint of the same run proves it was trained on the same windows. The dataset is the
 profile's ``energy.dataset`` (default: the first of ``train.datasets``); the seed is ``energy.seed`` or, by
-default, the seed whose BGFN has the median validation error over ``train.seeds`` (a representative network,
-not the luckiest or the first). A BGFN whose best epoch is 0 -- epoch 0 is the initial network, so training never
+default, the seed whose BGFN has the median validation error among the seeds of ``train.seeds`` whose training
+improved on the initial network (a representative trained network, not the luckiest or the first; among all
+seeds when none did). A BGFN whose best epoch is 0 -- epoch 0 is the initial network, so training never
 improved on it and its firing rates are those of an untrained network -- is refused unless the profile says
 ``energy.allow_untrained: true`` (the smoke profile, whose numbers mean nothing).
 """
@@ -57,16 +58,18 @@ def energy_checkpoint(profile: str, method: str, cfg: dict | None = None, datase
 
 def median_seed(profile: str, dataset: str, seeds, method: str = "bgfn") -> int:
     """The seed whose ``method`` network has the median validation RMSE (the lower median; ties: the smaller
-    seed) among the cards of ``seeds``; the first seed when no card is there yet."""
-    scored = []
+    seed) among the cards of ``seeds`` whose best epoch is at least 1 (training improved on the initial network),
+    among all cards when none is; the first seed when no card is there yet."""
+    scored, trained = [], []
     for seed in seeds:
         card = card_path(checkpoint_path(profile, dataset, method, int(seed), create=False))
         if card.is_file():
-            scored.append((float(json.loads(card.read_text()).get("val_rmse_m", float("inf"))), int(seed)))
-    if not scored:
-        return int(list(seeds)[0])
-    scored.sort()
-    return scored[(len(scored) - 1) // 2][1]
+            c = json.loads(card.read_text())
+            scored.append((float(c.get("val_rmse_m", float("inf"))), int(seed)))
+            if int(c.get("best_epoch", 1)) >= 1:
+                trained.append(scored[-1])
+    pool = sorted(trained or scored)
+    return pool[(len(pool) - 1) // 2][1] if pool else int(list(seeds)[0])
 
 
 def check_trained(card: dict, card_file: str | Path, allow_untrained: bool = False) -> None:
@@ -83,8 +86,9 @@ def check_trained(card: dict, card_file: str | Path, allow_untrained: bool = Fal
     if not allow_untrained and int(card.get("best_epoch", 1)) < 1:
         raise DataError(card_file, "best_epoch", "a network that training improved on its initial weights (best epoch >= 1; "
                         "epoch 0 is the initial network) "
-                        "-- its firing rates decide the energy; train longer (train.optimizer.epochs, patience), "
-                        "set energy.seed to a trained seed, or energy.allow_untrained: true", "0")
+                        "-- its firing rates decide the energy, and no seed of this dataset improved on its initial weights; "
+                        "train longer (train.optimizer.epochs, patience), set energy.dataset to a dataset whose BGFN "
+                        "learned, energy.seed to a trained seed, or energy.allow_untrained: true", "0")
 
 
 @dataclass

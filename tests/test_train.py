@@ -450,10 +450,10 @@ def test_learning_check_names_the_runs_that_never_improved_on_their_initial_netw
     cards = [card("bgfn", 0, 3), card("mlp", 0, 0), card("mlp", 1, 1), fitted]
     lines = T.learning_check(cards)
     assert lines[0] == "2 of 4 runs improved on their initial network (best epoch >= 1)"
-    assert lines[1] == "  not improved: d mlp seed 0 (the initial network is kept)"
+    assert lines[1] == "  not improved: d mlp seed 0: the initial network is kept"
     # the lowest training loss of epochs >= 1 (epoch 0 has none), against the 1.0 of predicting the mean
-    assert lines[2] == ("  not improved: d at_lstm seed 2 (the initial network is kept; its training loss fell to "
-                        "0.46 (predicting the training mean: about 1))")
+    assert lines[2] == ("  not improved: d at_lstm seed 2: the initial network is kept; its training loss fell to "
+                        "0.46 (predicting the training mean: about 1)")
     lines = T.learning_check(cards[:3])
     assert lines[2].startswith("1 runs kept their first training epoch") and lines[2].endswith("d mlp seed 1")
     assert T.learning_check([card("bgfn", 0, 2)]) == ["1 of 1 runs improved on their initial network (best epoch >= 1)"]

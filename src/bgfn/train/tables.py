@@ -51,8 +51,8 @@ def learning_check(cards: list[dict]) -> list[str]:
     for c in untrained:
         fit = lowest_train_loss(c)
         fitted = "" if fit is None else f"; its training loss fell to {fit:.2f} (predicting the training mean: about 1)"
-        lines.append(f"  not improved: {c.get('dataset', '')} {c['method']} seed {c['seed']} (the initial network "
-                     f"is kept{fitted})")
+        lines.append(f"  not improved: {c.get('dataset', '')} {c['method']} seed {c['seed']}: the initial network "
+                     f"is kept{fitted}")
     if first:
         lines.append(f"{len(first)} runs kept their first training epoch (validation loss grew after it): "
                      + ", ".join(f"{c.get('dataset', '')} {c['method']} seed {c['seed']}" for c in first))

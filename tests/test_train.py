@@ -432,8 +432,8 @@ def test_speed_lines_give_the_ratio_to_the_twin_and_the_ceiling_of_the_matrix_pr
                                     "transformer": {"paper": {"matmul_s": 0.1, "step_s": 0.2}}},
              "train_ratio_ceiling": {"paper": 0.2 / 0.5}}
     lines = T.speed_lines(bench, {"train": {"sizes": {"bgfn": {"paper": {"time_steps": 4}}}}})
-    assert lines[0] == ("BGFN trains at 0.85 at the quick size, 0.25 at the paper size of its ANN twin's throughput "
-                        "(windows/s, both measured in one run)")
+    assert lines[0] == ("BGFN's training throughput over its ANN twin's (windows/s, both measured in one run): 0.85 "
+                        "at the quick size, 0.25 at the paper size")
     assert "take 0.50 s of its 0.70 s, the twin's whole step 0.20 s" in lines[1]
     assert "at most 0.40 of the twin's throughput: with T_s = 4 SNN steps" in lines[1]
     assert len(T.speed_lines({k: v for k, v in bench.items() if k != "train_ratio_ceiling"})) == 1   # older bench

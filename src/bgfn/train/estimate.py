@@ -84,7 +84,7 @@ def speed_lines(bench: dict | None, paper_cfg: dict | None = None) -> list[str]:
     if not ratio:
         return []
     sizes = ", ".join(f"{r:.2f} at the {size} size" for size, r in ratio.items())
-    lines = [f"BGFN trains at {sizes} of its ANN twin's throughput (windows/s, both measured in one run)"]
+    lines = [f"BGFN's training throughput over its ANN twin's (windows/s, both measured in one run): {sizes}"]
     ceiling = ((bench or {}).get("train_ratio_ceiling") or {}).get("paper")
     prof = ((bench or {}).get("train_step_profile") or {})
     if ceiling is not None and "paper" in ratio:

@@ -107,6 +107,14 @@ def test_speed_answer_says_which_networks_learned_with_and_without_velocity():
     assert answer_speed(verdict_table(fitted), fitted).endswith(
         " The 2 that never improved did fit their training windows (median lowest training loss 0.40; predicting "
         "the training mean: about 1): what they learned there does not carry over to the validation block.")
+    # trained again on all windows (bgfn.train.recheck): how many of the capped runs then improved
+    recheck = pd.DataFrame({"dataset": "d", "method": ["bgfn", "at_lstm"], "seed": 0, "n_train": 1000,
+                            "best_epoch": 0, "n_train_all": 4187, "best_epoch_all": [0, 3]})
+    again = _inputs(training=main.assign(train_loss_min=[0.3, 0.2, 0.5, 0.9]), training_variants=variants,
+                    training_all_windows=recheck)
+    assert answer_speed(verdict_table(again), again).endswith(
+        "does not carry over to the validation block. The 2 of them whose training windows had been capped were "
+        "trained again on all of them (1000 -> 4187): 1 then improved.")
     # ... or they did not fit them either
     unfit = _inputs(training=main.assign(train_loss_min=[0.95, 0.2, 1.1, 0.9]), training_variants=variants)
     assert answer_speed(verdict_table(unfit), unfit).endswith(

@@ -461,3 +461,38 @@ def test_learning_check_names_the_runs_that_never_improved_on_their_initial_netw
     runs = T.cards_table([card("bgfn", 0, 3, initial=4.5), {**card("mlp", 0, 2), "history": [{"epoch": 1}]}, fitted])
     assert runs["val_rmse_initial_m"].tolist()[0] == 4.5 and runs["val_rmse_initial_m"].isna().tolist()[1]
     assert runs["train_loss_min"].isna().tolist()[:2] == [True, True] and runs["train_loss_min"].tolist()[2] == 0.456
+
+
+def test_runs_that_never_improved_are_trained_again_on_all_windows_only_when_the_cap_left_some_out(
+        data, tmp_path, monkeypatch):
+    from bgfn import config
+
+    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)
+    n = len(data.train)
+    tc = {"size": "s", "sizes": {"mlp": {"s": {"n_recent": 5, "hidden": 16}}}, "lr": {"mlp": 3e-3},
+          **_cfg(epochs=2, max_train_windows=n // 4), "recheck_all_windows": True}
+    prepared = {"toy": T.TrainingDataset("toy", None, None, data), "small": T.TrainingDataset("small", None, None,
+                                                                                                SimpleNamespace(train=[0] * 10))}
+    cfgs = {"toy": tc, "small": tc}
+
+    def card(dataset, seed, best):
+        return {"dataset": dataset, "method": "mlp", "seed": seed, "best_epoch": best, "n_train": n // 4}
+
+    cards = [card("toy", 0, 0), card("toy", 1, 3), card("small", 0, 0)]
+    # seed 1 improved; 'small' has fewer windows than the cap (it trained on all): only toy seed 0 is rechecked
+    assert T.capped_runs(cards, prepared, cfgs) == [cards[0]]
+    plan = SimpleNamespace(profile="p", train_cfg=tc)
+    assert T.recheck_all_windows(SimpleNamespace(profile="p", train_cfg={**tc, "recheck_all_windows": False}),
+                                 cards, prepared, cfgs) == []
+    (pair,) = T.recheck_all_windows(plan, cards, prepared, cfgs)
+    assert pair["capped"] is cards[0] and pair["all"]["n_train"] == n > n // 4     # every training window
+    assert (tmp_path / "p" / "models" / "all_windows" / "toy" / "mlp_seed0.pt").exists()
+    assert not (tmp_path / "p" / "models" / "toy").exists()                         # reported networks untouched
+    table = T.recheck_table([pair])
+    assert list(table.columns) == list(T.RECHECK_COLUMNS) and table["n_train_all"].tolist() == [n]
+    lines = T.recheck_lines(table, tc)
+    improved = int(pair["all"]["best_epoch"] >= 1)
+    assert lines[0].startswith(f"trained again on all their training windows, {improved} of 1 runs")
+    assert lines[1] == f"  toy mlp seed 0: {n // 4} -> {n} windows, best epoch 0 -> {pair['all']['best_epoch']}"
+    assert T.recheck_lines(table.iloc[:0], tc)[0].startswith("no run to recheck")
+    assert T.recheck_lines(table, {})[0] == "not rechecked (train.recheck_all_windows is false)"

@@ -68,6 +68,21 @@ def variant_models_dir(profile: str, variant: str, dataset: str, create: bool = 
     return d
 
 
+#: Folder of ``results/<profile>/models/`` that holds the runs trained again on all windows (:mod:`bgfn.train.recheck`).
+ALL_WINDOWS_DIR = "all_windows"
+
+
+def all_windows_models_dir(profile: str, dataset: str, create: bool = True) -> Path:
+    """``results/<profile>/models/all_windows/<dataset id>/`` (runs trained again on all their training windows),
+    created unless ``create`` is False."""
+    from bgfn.data.names import dataset_id
+
+    d = results_dir(profile, create=create) / "models" / ALL_WINDOWS_DIR / dataset_id(dataset)
+    if create:
+        d.mkdir(parents=True, exist_ok=True)
+    return d
+
+
 def checkpoint_path(profile: str, dataset: str, method: str, seed: int, fold: int | None = None,
                     create: bool = True) -> Path:
     """``results/<profile>/models/<dataset id>/[fold<k>/]<method>_seed<seed>.pt``."""

@@ -74,6 +74,7 @@ SHARED_TABLES: dict[str, str] = {
     "training_summary": "training_summary.csv",
     "training_times": "training_times.csv",     # wall clock, apart from the deterministic tables
     "training_variants": "training_variants.csv",   # the variants' networks (inputs, protocol)
+    "training_all_windows": "training_all_windows.csv",   # runs that never learned, trained again on all windows
     "sweep": "outage_sweep.csv",                # notebook 04
     "sweep_summary": "outage_sweep_summary.csv",
     "sweep_pairs": "outage_sweep_pairs.csv",

@@ -55,6 +55,7 @@ class VerdictInputs:
     ins_tuning: pd.DataFrame | None     # kf_ins_tuning.csv
     training: pd.DataFrame | None = None            # training_runs.csv: the main networks' cards
     training_variants: pd.DataFrame | None = None   # training_variants.csv: the variants' cards
+    training_all_windows: pd.DataFrame | None = None    # training_all_windows.csv: untrained runs, all windows
 
     @classmethod
     def read(cls, out: str | Path, dataset: str) -> "VerdictInputs":
@@ -76,7 +77,8 @@ class VerdictInputs:
                    of(read_csv(tables / SHARED_TABLES["variants"])) if "variants" in SHARED_TABLES else None,
                    of(read_csv(tables / SHARED_TABLES["kf_ins_tuning"])),
                    of(read_csv(tables / SHARED_TABLES["training_runs"])),
-                   of(read_csv(tables / SHARED_TABLES["training_variants"])))
+                   of(read_csv(tables / SHARED_TABLES["training_variants"])),
+                   of(read_csv(tables / SHARED_TABLES["training_all_windows"])))
 
 
 def _outage_value(seeds: pd.DataFrame | None, method: str, outage: int) -> float:
@@ -276,7 +278,17 @@ def learning_evidence(inp: VerdictInputs) -> str:
             f"initial weights (median RMSE per increment {base[2]:.2f} m; predicting zero: {zero:.2f} m)")
     if fast is not None:
         text += f"; given the INS velocity {fast[0]} of {fast[1]} did (median {fast[2]:.2f} m)"
-    return text + "." + _fitted_but_not_improved(inp.training)
+    return text + "." + _fitted_but_not_improved(inp.training) + _all_windows(inp.training_all_windows)
+
+
+def _all_windows(recheck: pd.DataFrame | None) -> str:
+    """How many of the networks that never improved did once trained on all their training windows
+    (:mod:`bgfn.train.recheck`); empty without such runs."""
+    if recheck is None or not len(recheck) or "best_epoch_all" not in recheck.columns:
+        return ""
+    improved = int((recheck["best_epoch_all"] >= 1).sum())
+    return (f" The {len(recheck)} of them whose training windows had been capped were trained again on all of them "
+            f"({int(recheck['n_train'].max())} -> {int(recheck['n_train_all'].max())}): {improved} then improved.")
 
 
 def _fitted_but_not_improved(cards: pd.DataFrame) -> str:

@@ -13,6 +13,8 @@ Modules, one concept each (every public name is re-exported here):
   input, the training over datasets x methods x seeds;
 - :mod:`bgfn.train.variants`: the profile's input and protocol variants (:class:`VariantPlan`), trained beside the
   main networks with their learning rates;
+- :mod:`bgfn.train.recheck`: the runs that never improved on their initial network, trained again on all their
+  training windows;
 - :mod:`bgfn.train.tables`: the run and summary tables, the windows table, ``training.json``;
 - :mod:`bgfn.train.plots`: the figures of notebook 03;
 - :mod:`bgfn.train.estimate`: how long the paper profile would train here, from ``make bench``;
@@ -32,11 +34,13 @@ from bgfn.train.options import (OPTIMIZER_DEFAULTS, even_subset, method_lr, opti
 from bgfn.train.plots import plot_motion_coverage, plot_training_curves, plot_val_predictions
 from bgfn.train.profile import (TrainingDataset, TrainingPlan, ins_attitude, prepare_datasets, prepare_learning_data,
                                 train_dataset, train_profile, val_position_table, val_position_tables)
+from bgfn.train.recheck import RECHECK_COLUMNS, capped_runs, recheck_all_windows, recheck_lines, recheck_table
 from bgfn.train.tables import (TIMING_COLUMNS, card_line, cards_table, learning_check, summary_table, timing_table,
                                training_metrics, windows_table, without_timing)
 from bgfn.train.trained import TrainedModel, checkpoint_predictions, load_trained, pick_device, predict_normalized
 from bgfn.train.variants import (VARIANT_RUN_DEFAULTS, VariantPlan, describe_options, train_variants,
-                                 variant_cards_table, variant_learning_data, variant_train_section)
+                                 variant_cards_table, variant_learning_data, variant_train_section,
+                                 wall_time_by_variant)
 
 __all__ = [
     "estimate_lines", "measure_paper_step", "paper_training_estimate", "speed_lines",
@@ -56,9 +60,11 @@ __all__ = [
     "REFERENCES", "VAL_POSITIONS", "TIMING_COLUMNS", "cards_table", "learning_check", "summary_table", "without_timing",
     "timing_table", "windows_table", "card_line", "training_metrics", "plot_training_curves",
     "plot_val_predictions", "plot_motion_coverage",
+    # runs that never learned, trained again on all windows
+    "RECHECK_COLUMNS", "capped_runs", "recheck_all_windows", "recheck_table", "recheck_lines",
     # input and protocol variants
     "VARIANT_RUN_DEFAULTS", "VariantPlan", "describe_options", "variant_train_section", "variant_learning_data",
-    "train_variants", "variant_cards_table",
+    "train_variants", "variant_cards_table", "wall_time_by_variant",
     # command line
     "main",
 ]

@@ -178,3 +178,11 @@ def variant_cards_table(cards: list[dict]):
         table.insert(i, col, [c.get(col) for c in cards])
     table["n_outage_in_train"] = [(c.get("split") or {}).get("n_outage_in_train") for c in cards]
     return table
+
+
+def wall_time_by_variant(cards: list[dict]) -> dict[str, float]:
+    """Variant -> training wall time of its networks, s (rounded to 0.1 s; notebook 03 prints it)."""
+    times: dict[str, float] = {}
+    for c in cards:
+        times[c["variant"]] = times.get(c["variant"], 0.0) + float(c["wall_time_s"])
+    return {v: round(t, 1) for v, t in times.items()}

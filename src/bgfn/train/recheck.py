@@ -1,0 +1,104 @@
+"""Were the runs that never learned short of data? Each one trained again on all its training windows.
+
+A profile may cap the training windows of a run (``train.optimizer.max_train_windows``; quick: 1000, evenly
+spaced in time, deviations row 63), so a run whose validation loss never beats its initial network
+(``best_epoch`` 0) might have learned from more. With ``train.recheck_all_windows: true``, every such run whose
+cap left windows out is trained once more, the same method, seed, learning rate and budget, on all of them,
+into ``results/<profile>/models/all_windows/<dataset>/`` (:func:`bgfn.checkpoints.all_windows_models_dir`; the
+reported networks are not touched). The table
+(:func:`recheck_table`) and the lines of notebook 03 (:func:`recheck_lines`) say whether it then improved.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable
+
+import pandas as pd
+
+from bgfn import checkpoints
+from bgfn.train.loop import train_model
+from bgfn.train.options import optimizer_options, size_config
+from bgfn.train.tables import initial_val_rmse, lowest_train_loss
+
+#: Columns of :func:`recheck_table`: the run as reported (capped) and trained again on all windows.
+RECHECK_COLUMNS = ("dataset", "method", "seed", "lr", "n_train", "best_epoch", "n_train_all", "best_epoch_all",
+                   "epochs_run_all", "val_rmse_initial_m", "val_rmse_m_all", "train_loss_min_all")
+
+
+def enabled(train_cfg: dict) -> bool:
+    """``train.recheck_all_windows`` of a ``train:`` section (default false)."""
+    return bool(train_cfg.get("recheck_all_windows", False))
+
+
+def capped_runs(cards: list[dict], prepared: dict, train_cfgs: dict[str, dict]) -> list[dict]:
+    """The cards of the runs that never improved on their initial network (``best_epoch`` 0) and whose
+    ``max_train_windows`` left some of their dataset's training windows out."""
+    out = []
+    for card in cards:
+        if card.get("best_epoch") is None or int(card["best_epoch"]) >= 1:
+            continue
+        cap = optimizer_options(train_cfgs[card["dataset"]])["max_train_windows"]
+        if cap is not None and len(prepared[card["dataset"]].data.train) > int(cap):
+            out.append(card)
+    return out
+
+
+def recheck_all_windows(plan, cards: list[dict], prepared: dict, train_cfgs: dict[str, dict],
+                        device: str | None = None, progress: bool = False,
+                        echo: Callable[[str], Any] | None = None) -> list[dict]:
+    """Train every run of :func:`capped_runs` again on all training windows when the plan's profile sets
+    ``train.recheck_all_windows`` (else nothing); return pairs ``{'capped': card, 'all': new card}`` (a completed
+    network is not trained again).
+
+    Parameters
+    ----------
+    plan : bgfn.train.TrainingPlan
+    prepared : dict
+        ``{dataset: TrainingDataset}`` (:func:`bgfn.train.profile.prepare_datasets`).
+    train_cfgs : dict
+        ``{dataset: train: section with the selected learning rates}``, as the reported runs had.
+    """
+    if not enabled(plan.train_cfg):
+        return []
+    pairs = []
+    for card in capped_runs(cards, prepared, train_cfgs):
+        dataset, method, seed = card["dataset"], card["method"], int(card["seed"])
+        tc = dict(train_cfgs[dataset])
+        tc["optimizer"] = {**(tc.get("optimizer") or {}), "max_train_windows": None}
+        out = checkpoints.all_windows_models_dir(plan.profile, dataset)
+        new = train_model(method, prepared[dataset].data, size_config(tc, method), tc, seed=seed, out_dir=out,
+                          device=device, progress=progress,
+                          extra_card={"dataset": dataset, "profile": plan.profile, "size": tc.get("size")})
+        pairs.append({"capped": card, "all": new})
+        if echo is not None:
+            echo(f"  {dataset} {method} seed {seed}: {card['n_train']} -> {new['n_train']} training windows, "
+                 f"best epoch {card['best_epoch']} -> {new['best_epoch']}")
+    return pairs
+
+
+def recheck_table(pairs: list[dict]) -> pd.DataFrame:
+    """One row per rechecked run (:data:`RECHECK_COLUMNS`)."""
+    rows = [{"dataset": c["dataset"], "method": c["method"], "seed": c["seed"], "lr": c.get("lr"),
+             "n_train": c.get("n_train"), "best_epoch": c.get("best_epoch"), "n_train_all": a.get("n_train"),
+             "best_epoch_all": a.get("best_epoch"), "epochs_run_all": a.get("epochs_run"),
+             "val_rmse_initial_m": initial_val_rmse(a), "val_rmse_m_all": a.get("val_rmse_m"),
+             "train_loss_min_all": lowest_train_loss(a)}
+            for c, a in ((p["capped"], p["all"]) for p in pairs)]
+    return pd.DataFrame(rows, columns=list(RECHECK_COLUMNS))
+
+
+def recheck_lines(table: pd.DataFrame, train_cfg: dict) -> list[str]:
+    """Plain lines for notebook 03: how many of the rechecked runs improved on their initial network once
+    they had every training window (``train_cfg``: the ``train:`` section, whether the recheck is on)."""
+    if not enabled(train_cfg):
+        return ["not rechecked (train.recheck_all_windows is false)"]
+    if not len(table):
+        return ["no run to recheck: every run improved on its initial network, or trained on all its windows"]
+    improved = int((table["best_epoch_all"] >= 1).sum())
+    fit = float(table["train_loss_min_all"].median())
+    lines = [f"trained again on all their training windows, {improved} of {len(table)} runs that never improved on "
+             f"their initial network then did (median lowest training loss {fit:.2f}; predicting the training "
+             f"mean: about 1):"]
+    lines += [f"  {r.dataset} {r.method} seed {r.seed}: {r.n_train} -> {r.n_train_all} windows, best epoch "
+              f"{r.best_epoch} -> {r.best_epoch_all}" for r in table.itertuples()]
+    return lines

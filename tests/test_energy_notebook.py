@@ -211,6 +211,17 @@ def test_the_energy_network_is_the_median_seed_and_must_be_trained(tmp_path, mon
     cfg = {"energy": {"dataset": None, "seed": None}, "train": {"datasets": ["d"], "seeds": [0, 1, 2]}}
     assert energy_checkpoint("p", "bgfn", cfg).name == "bgfn_seed2.pt"
     assert energy_checkpoint("p", "bgfn", {**cfg, "energy": {"seed": 0}}).name == "bgfn_seed0.pt"
+    # the dataset: the first of train.datasets where some seed's BGFN learned ('u' has only an untrained one)
+    from bgfn.energy.checkpoint import energy_dataset
+
+    pt = checkpoint_path("p", "u", "bgfn", 0)
+    pt.write_bytes(b"")
+    card_path(pt).write_text(json.dumps({"val_rmse_m": 1.0, "best_epoch": 0}))
+    assert energy_dataset("p", {"datasets": ["u", "d"], "seeds": [0, 1]}) == "d"
+    assert energy_dataset("p", {"datasets": ["u"], "seeds": [0]}) == "u"      # none learned: the first (refused)
+    assert energy_dataset("p", {"datasets": []}) is None
+    both = {**cfg, "train": {"datasets": ["u", "d"], "seeds": [0, 1, 2]}}
+    assert energy_checkpoint("p", "bgfn", both).parent.name == "d"
     with pytest.raises(DataError, match="best epoch >= 1") as err:
         check_trained({"best_epoch": 0}, "bgfn_seed0.json")
     assert err.value.source == "bgfn_seed0.json" and err.value.field == "best_epoch"

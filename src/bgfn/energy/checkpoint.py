@@ -2,7 +2,8 @@
 
 The firing rates, hence the SOPs, are those of a *trained* BGFN; the twin's MACs do not depend on its weights,
 but loading its checkpoint of the same run proves it was trained on the same windows. The dataset is the
-profile's ``energy.dataset`` (default: the first of ``train.datasets``); the seed is ``energy.seed`` or, by
+profile's ``energy.dataset`` (default: the first of ``train.datasets`` whose BGFN improved on its initial
+network for at least one seed, :func:`energy_dataset`); the seed is ``energy.seed`` or, by
 default, the seed whose BGFN has the median validation error among the seeds of ``train.seeds`` whose training
 improved on the initial network (a representative trained network, not the luckiest or the first; among all
 seeds when none did). A BGFN whose best epoch is 0 -- epoch 0 is the initial network, so training never
@@ -33,7 +34,7 @@ def energy_checkpoint(profile: str, method: str, cfg: dict | None = None, datase
     """The checkpoint of the energy estimate (:func:`bgfn.checkpoints.checkpoint_path`).
 
     ``dataset``/``seed`` default to the profile's ``energy.dataset``/``energy.seed`` and, when those are
-    null, to the first of ``train.datasets`` and to :func:`median_seed` over ``train.seeds``.
+    null, to :func:`energy_dataset` and to :func:`median_seed` over ``train.seeds``.
 
     Raises
     ------
@@ -42,7 +43,7 @@ def energy_checkpoint(profile: str, method: str, cfg: dict | None = None, datase
     """
     cfg = cfg if cfg is not None else load_profile(profile)
     ecfg, tcfg = cfg.get("energy") or {}, cfg.get("train") or {}
-    dataset = dataset or ecfg.get("dataset") or (tcfg.get("datasets") or [None])[0]
+    dataset = dataset or ecfg.get("dataset") or energy_dataset(profile, tcfg)
     if dataset is None:
         raise ValueError(f"profile {profile!r}: no dataset (energy.dataset and train.datasets are empty)")
     seed = seed if seed is not None else ecfg.get("seed")
@@ -54,6 +55,19 @@ def energy_checkpoint(profile: str, method: str, cfg: dict | None = None, datase
             f"(run `make reproduce PROFILE={profile}`, or `python -m bgfn.train --profile {profile} "
             f"--dataset {dataset} --method {method} --seed {int(seed)}`)")
     return path
+
+
+def energy_dataset(profile: str, train_cfg: dict, method: str = "bgfn") -> str | None:
+    """The first of ``train.datasets`` where some seed's ``method`` network improved on its initial network
+    (``best_epoch >= 1`` in its card), so that one dataset the networks could not learn does not stop the estimate;
+    the first dataset when none has such a card (its network is then refused), None without datasets."""
+    datasets = list(train_cfg.get("datasets") or [])
+    for dataset in datasets:
+        for seed in train_cfg.get("seeds") or [0]:
+            card = card_path(checkpoint_path(profile, dataset, method, int(seed), create=False))
+            if card.is_file() and int(json.loads(card.read_text()).get("best_epoch", 1)) >= 1:
+                return dataset
+    return datasets[0] if datasets else None
 
 
 def median_seed(profile: str, dataset: str, seeds, method: str = "bgfn") -> int:

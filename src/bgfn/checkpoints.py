@@ -48,11 +48,14 @@ def models_dir(profile: str, dataset: str, fold: int | None = None, create: bool
     from bgfn.data.names import dataset_id
 
     d = results_dir(profile, create=create) / "models" / dataset_id(dataset)
-    if fold is not None:
-        d = d / f"fold{int(fold)}"
+    return _made(d / f"fold{int(fold)}" if fold is not None else d, create)
+
+
+def _made(folder: Path, create: bool) -> Path:
+    """``folder``, created (with its parents) when ``create``."""
     if create:
-        d.mkdir(parents=True, exist_ok=True)
-    return d
+        folder.mkdir(parents=True, exist_ok=True)
+    return folder
 
 
 #: Folder of ``results/<profile>/models/`` that holds the variants' networks (:func:`variant_models_dir`).
@@ -62,10 +65,7 @@ VARIANTS_DIR = "variants"
 def variant_models_dir(profile: str, variant: str, dataset: str, create: bool = True) -> Path:
     """``results/<profile>/models/variants/<variant>/<dataset>/`` (a variant's networks), created unless
     ``create`` is False."""
-    d = results_dir(profile, create=create) / "models" / VARIANTS_DIR / variant / dataset
-    if create:
-        d.mkdir(parents=True, exist_ok=True)
-    return d
+    return _made(results_dir(profile, create=create) / "models" / VARIANTS_DIR / variant / dataset, create)
 
 
 #: Folder of ``results/<profile>/models/`` that holds the runs trained again on all windows (:mod:`bgfn.train.recheck`).
@@ -77,10 +77,7 @@ def all_windows_models_dir(profile: str, dataset: str, create: bool = True) -> P
     created unless ``create`` is False."""
     from bgfn.data.names import dataset_id
 
-    d = results_dir(profile, create=create) / "models" / ALL_WINDOWS_DIR / dataset_id(dataset)
-    if create:
-        d.mkdir(parents=True, exist_ok=True)
-    return d
+    return _made(results_dir(profile, create=create) / "models" / ALL_WINDOWS_DIR / dataset_id(dataset), create)
 
 
 def checkpoint_path(profile: str, dataset: str, method: str, seed: int, fold: int | None = None,

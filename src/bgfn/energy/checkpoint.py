@@ -63,10 +63,9 @@ def energy_dataset(profile: str, train_cfg: dict, method: str = "bgfn") -> str |
     the first dataset when none has such a card (its network is then refused), None without datasets."""
     datasets = list(train_cfg.get("datasets") or [])
     for dataset in datasets:
-        for seed in train_cfg.get("seeds") or [0]:
-            card = card_path(checkpoint_path(profile, dataset, method, int(seed), create=False))
-            if card.is_file() and int(json.loads(card.read_text()).get("best_epoch", 1)) >= 1:
-                return dataset
+        cards = (_card(profile, dataset, method, seed) for seed in train_cfg.get("seeds") or [0])
+        if any(c is not None and int(c.get("best_epoch", 1)) >= 1 for c in cards):
+            return dataset
     return datasets[0] if datasets else None
 
 
@@ -76,14 +75,19 @@ def median_seed(profile: str, dataset: str, seeds, method: str = "bgfn") -> int:
     among all cards when none is; the first seed when no card is there yet."""
     scored, trained = [], []
     for seed in seeds:
-        card = card_path(checkpoint_path(profile, dataset, method, int(seed), create=False))
-        if card.is_file():
-            c = json.loads(card.read_text())
+        c = _card(profile, dataset, method, seed)
+        if c is not None:
             scored.append((float(c.get("val_rmse_m", float("inf"))), int(seed)))
             if int(c.get("best_epoch", 1)) >= 1:
                 trained.append(scored[-1])
     pool = sorted(trained or scored)
     return pool[(len(pool) - 1) // 2][1] if pool else int(list(seeds)[0])
+
+
+def _card(profile: str, dataset: str, method: str, seed) -> dict | None:
+    """The training card of ``method``'s network of ``dataset`` and ``seed``; None when it is not there."""
+    card = card_path(checkpoint_path(profile, dataset, method, int(seed), create=False))
+    return json.loads(card.read_text()) if card.is_file() else None
 
 
 def check_trained(card: dict, card_file: str | Path, allow_untrained: bool = False) -> None:
@@ -100,8 +104,7 @@ def check_trained(card: dict, card_file: str | Path, allow_untrained: bool = Fal
     if not allow_untrained and int(card.get("best_epoch", 1)) < 1:
         raise DataError(card_file, "best_epoch", "a network that training improved on its initial weights (best epoch >= 1; "
                         "epoch 0 is the initial network) "
-                        "-- its firing rates decide the energy, and no seed of this dataset improved on its initial weights; "
-                        "train longer (train.optimizer.epochs, patience), set energy.dataset to a dataset whose BGFN "
+                        "-- its firing rates decide the energy; train longer (train.optimizer.epochs, patience), set energy.dataset to a dataset whose BGFN "
                         "learned, energy.seed to a trained seed, or energy.allow_untrained: true", "0")
 
 

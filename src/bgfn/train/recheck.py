@@ -11,8 +11,6 @@ reported networks are not touched). The table
 
 from __future__ import annotations
 
-from typing import Any, Callable
-
 import pandas as pd
 
 from bgfn import checkpoints
@@ -44,8 +42,7 @@ def capped_runs(cards: list[dict], prepared: dict, train_cfgs: dict[str, dict]) 
 
 
 def recheck_all_windows(plan, cards: list[dict], prepared: dict, train_cfgs: dict[str, dict],
-                        device: str | None = None, progress: bool = False,
-                        echo: Callable[[str], Any] | None = None) -> list[dict]:
+                        device: str | None = None, progress: bool = False) -> list[dict]:
     """Train every run of :func:`capped_runs` again on all training windows when the plan's profile sets
     ``train.recheck_all_windows`` (else nothing); return pairs ``{'capped': card, 'all': new card}`` (a completed
     network is not trained again).
@@ -70,9 +67,6 @@ def recheck_all_windows(plan, cards: list[dict], prepared: dict, train_cfgs: dic
                           device=device, progress=progress,
                           extra_card={"dataset": dataset, "profile": plan.profile, "size": tc.get("size")})
         pairs.append({"capped": card, "all": new})
-        if echo is not None:
-            echo(f"  {dataset} {method} seed {seed}: {card['n_train']} -> {new['n_train']} training windows, "
-                 f"best epoch {card['best_epoch']} -> {new['best_epoch']}")
     return pairs
 
 

@@ -26,7 +26,7 @@ import torch
 from bgfn.config import load_profile
 from bgfn.io import update_json
 from bgfn.models import METHODS, build_model, count_parameters
-from bgfn.speed import bench_file, median_time, training_step_profile, training_throughput
+from bgfn.speed import bench_file, median_time, training_step_profile, training_throughput, twin_ratios
 
 SIZES = ("quick", "paper")
 #: (training steps, inference calls) measured per size, after one warm-up each.
@@ -75,22 +75,17 @@ def main(sizes=SIZES, methods=METHODS) -> dict:
             info["problem"][size] = prob
             print(f"{m:>12} {size:>6}: {rate:9.1f} train windows/s, {ms:8.2f} ms/window inference, "
                   f"{n_params} parameters", flush=True)
-    # BGFN's training throughput over its ANN twin's, both measured in this run (issue: at least 1/3)
-    ratio = {size: train_rate["bgfn"][size] / train_rate["transformer"][size] for size in sizes
-             if "bgfn" in train_rate and "transformer" in train_rate}
-    profiles: dict = {m: {} for m in ("bgfn", "transformer") if m in methods}
-    ceiling: dict = {}
-    for size in sizes:
-        for m in profiles:
-            profiles[m][size] = step_profile(m, size)
-        if len(profiles) == 2:
-            ceiling[size] = profiles["transformer"][size]["step_s"] / profiles["bgfn"][size]["matmul_s"]
+    # BGFN's training throughput over its ANN twin's, both measured in this run (issue: at least 1/3), and the
+    # ceiling its matrix products set
+    profiles = {m: {size: step_profile(m, size) for size in sizes} for m in ("bgfn", "transformer") if m in methods}
+    ratios = twin_ratios(train_rate, profiles)
+    ratio, ceiling = ratios["train_ratio_bgfn_over_twin"], ratios["train_ratio_ceiling"]
     for size, r in ratio.items():
         print(f"BGFN / Transformer training throughput, {size}: {r:.2f} (ceiling: twin's step / BGFN's matrix "
               f"products alone {ceiling.get(size, float('nan')):.2f})", flush=True)
     update_json(bench_file(),
                 {"train_windows_per_s": train_rate, "infer_ms": infer_ms, "models_bench": info,
-                 "train_ratio_bgfn_over_twin": ratio, "train_step_profile": profiles, "train_ratio_ceiling": ceiling})
+                 "train_step_profile": profiles, **ratios})
     return {"train_windows_per_s": train_rate, "infer_ms": infer_ms, "train_ratio_bgfn_over_twin": ratio}
 
 

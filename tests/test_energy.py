@@ -389,3 +389,14 @@ def test_matmul_share_of_a_training_step_counts_only_dense_products():
     assert speed.training_step_profile(Scale(), window=5, batch=4)["matmul_s"] == 0.0
     p = speed.training_step_profile(build_model("mlp", {"hidden": 64}), window=5, batch=16)
     assert 0.0 < p["matmul_s"] < p["step_s"]
+
+
+def test_twin_ratios_divide_bgfn_by_its_twin_per_size_measured_for_both():
+    from bgfn.speed import twin_ratios
+
+    rates = {"bgfn": {"quick": 600.0, "paper": 6.0}, "transformer": {"quick": 750.0, "paper": 30.0}}
+    profiles = {"bgfn": {"paper": {"matmul_s": 0.8, "step_s": 1.3}}, "transformer": {"paper": {"step_s": 0.24}}}
+    out = twin_ratios(rates, profiles)
+    assert out["train_ratio_bgfn_over_twin"] == pytest.approx({"quick": 0.8, "paper": 0.2})    # 600/750, 6/30
+    assert out["train_ratio_ceiling"] == pytest.approx({"paper": 0.3})                         # 0.24 / 0.8
+    assert twin_ratios({"bgfn": {"quick": 1.0}}, {}) == {"train_ratio_bgfn_over_twin": {}, "train_ratio_ceiling": {}}

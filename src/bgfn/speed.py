@@ -163,6 +163,29 @@ def training_step_profile(model: nn.Module, window: int, batch: int, in_channels
     return {"step_s": total, "matmul_s": dense}
 
 
+def twin_ratios(rates: dict, profiles: dict) -> dict[str, dict[str, float]]:
+    """BGFN against its ANN twin per size, as ``make bench`` records them.
+
+    Parameters
+    ----------
+    rates : dict
+        ``train_windows_per_s``: method -> size -> training windows per second.
+    profiles : dict
+        ``train_step_profile``: method -> size -> :func:`training_step_profile`.
+
+    Returns
+    -------
+    dict
+        ``train_ratio_bgfn_over_twin``: size -> BGFN's throughput over the twin's; ``train_ratio_ceiling``: size ->
+        the twin's profiled step over BGFN's matrix products alone (the ratio if nothing else cost time). A size
+        is left out where a measurement is missing.
+    """
+    b, t = rates.get("bgfn") or {}, rates.get("transformer") or {}
+    pb, pt = profiles.get("bgfn") or {}, profiles.get("transformer") or {}
+    return {"train_ratio_bgfn_over_twin": {size: b[size] / t[size] for size in b if size in t},
+            "train_ratio_ceiling": {size: pt[size]["step_s"] / pb[size]["matmul_s"] for size in pb if size in pt}}
+
+
 def realtime_flags(latency_ms_value: float, imu_rate_hz: float = IMU_RATE_HZ,
                    gnss_rate_hz: float = GNSS_RATE_HZ) -> dict[str, bool]:
     """Whether a batch-1 latency (ms) keeps up with the IMU and the GNSS rates.

@@ -53,7 +53,7 @@ def measure_paper_step(paper_cfg: dict, repeats: int = 2) -> dict:
     import torch
 
     from bgfn.models import build_model
-    from bgfn.speed import training_step_profile, training_throughput
+    from bgfn.speed import training_step_profile, training_throughput, twin_ratios
 
     tc = paper_cfg["train"]
     window, batch = int(tc["window"]), int(tc["optimizer"]["batch_size"])
@@ -64,13 +64,8 @@ def measure_paper_step(paper_cfg: dict, repeats: int = 2) -> dict:
         rates[method] = {"paper": training_throughput(model, window, batch, repeats=repeats)}
         if method in ("bgfn", "transformer"):
             profiles[method] = {"paper": training_step_profile(model, window, batch)}
-    out = {"train_windows_per_s": rates, "measured_by": "bgfn.train.estimate.measure_paper_step",
-           "train_step_profile": profiles}
-    if {"bgfn", "transformer"} <= set(rates):
-        out["train_ratio_bgfn_over_twin"] = {"paper": rates["bgfn"]["paper"] / rates["transformer"]["paper"]}
-        out["train_ratio_ceiling"] = {"paper": profiles["transformer"]["paper"]["step_s"]
-                                      / profiles["bgfn"]["paper"]["matmul_s"]}
-    return out
+    return {"train_windows_per_s": rates, "measured_by": "bgfn.train.estimate.measure_paper_step",
+            "train_step_profile": profiles, **twin_ratios(rates, profiles)}
 
 
 def speed_lines(bench: dict | None, paper_cfg: dict | None = None) -> list[str]:

@@ -101,7 +101,9 @@ def test_same_size_builder_changes_only_the_time_steps():
 
 
 # ----------------------------------------------------------------------------------------------- which networks
-def test_load_measured_reads_dataset_seed_and_cards(tmp_path, monkeypatch):
+def _measured_checkpoints(tmp_path, monkeypatch, dataset: str, seed: int):
+    """Empty checkpoints of BGFN and its twin under ``results/smoke/models/<dataset>/`` (tmp), each loaded as a
+    tiny network with T_s = 3; the folder, for the test's cards."""
     from bgfn import config
     from bgfn.energy import checkpoint
 
@@ -109,11 +111,16 @@ def test_load_measured_reads_dataset_seed_and_cards(tmp_path, monkeypatch):
     monkeypatch.setattr(checkpoint, "load_trained",
                         lambda p, device=None: TrainedModel("x", build_model("mlp", {"hidden": 4}), None, {},
                                                             {**TINY, "time_steps": 3}))
-    cfg = {"energy": {"dataset": "drive-b", "seed": 2}, "train": {"datasets": ["drive-a"], "seeds": [0]}}
-    folder = tmp_path / "smoke" / "models" / "drive-b"
+    folder = tmp_path / "smoke" / "models" / dataset
     folder.mkdir(parents=True)
     for m in energy.MEASURED:
-        (folder / f"{m}_seed2.pt").write_bytes(b"")
+        (folder / f"{m}_seed{seed}.pt").write_bytes(b"")
+    return folder
+
+
+def test_load_measured_reads_dataset_seed_and_cards(tmp_path, monkeypatch):
+    cfg = {"energy": {"dataset": "drive-b", "seed": 2}, "train": {"datasets": ["drive-a"], "seeds": [0]}}
+    folder = _measured_checkpoints(tmp_path, monkeypatch, "drive-b", 2)
     (folder / "bgfn_seed2.json").write_text(json.dumps({"best_epoch": 7, "val_rmse_m": 1.25}))
     measured = energy.load_measured("smoke", cfg)
     assert (measured.dataset, measured.seed, measured.time_steps) == ("drive-b", 2, 3)
@@ -232,19 +239,10 @@ def test_the_energy_network_is_the_median_seed_and_must_be_trained(tmp_path, mon
 def test_only_the_spiking_network_must_have_learned(tmp_path, monkeypatch):
     """BGFN's firing rates depend on training, the twin's MAC count does not: an untrained twin is accepted, an
     untrained BGFN refused."""
-    from bgfn import config
-    from bgfn.energy import checkpoint
     from bgfn.errors import DataError
 
-    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)
-    monkeypatch.setattr(checkpoint, "load_trained",
-                        lambda p, device=None: TrainedModel("x", build_model("mlp", {"hidden": 4}), None, {},
-                                                            {**TINY, "time_steps": 3}))
     cfg = {"energy": {"dataset": "d", "seed": 0}, "train": {"datasets": ["d"], "seeds": [0]}}
-    folder = tmp_path / "smoke" / "models" / "d"
-    folder.mkdir(parents=True)
-    for m in energy.MEASURED:
-        (folder / f"{m}_seed0.pt").write_bytes(b"")
+    folder = _measured_checkpoints(tmp_path, monkeypatch, "d", 0)
     (folder / "transformer_seed0.json").write_text(json.dumps({"best_epoch": 0}))
     (folder / "bgfn_seed0.json").write_text(json.dumps({"best_epoch": 4}))
     assert energy.load_measured("smoke", cfg).cards["transformer"]["best_epoch"] == 0

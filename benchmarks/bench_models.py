@@ -8,7 +8,7 @@ Adds to ``results/bench.json``:
 - ``train_ratio_bgfn_over_twin.<size>``: BGFN's training throughput divided by its ANN twin's (Transformer),
   both measured in the same run;
 - ``train_step_profile.<model>.<size>``: one training step of BGFN and its twin under ``torch.profiler``: all
-  operators and the dense matrix products alone, s (:func:`bgfn.speed.training_step_profile`);
+  operators and the dense matrix products alone, s (:func:`bgfn.train.speed.training_step_profile`);
   ``train_ratio_ceiling.<size>``: the twin's profiled step over BGFN's matrix products alone, the ratio BGFN
   would reach if everything but its matrix arithmetic (LIF, BatchNorm, copies) cost nothing;
 - ``models_bench``: what ran (threads, device, batch, window, parameter counts, repeats).
@@ -23,10 +23,10 @@ import sys
 
 import torch
 
-from bgfn.config import load_profile
+from bgfn.profile_schema import load_profile
 from bgfn.io import update_json
 from bgfn.models import METHODS, build_model, count_parameters
-from bgfn.speed import bench_file, median_time, training_step_profile, training_throughput, twin_ratios
+from bgfn.train.speed import bench_file, median_time, training_step_profile, training_throughput, twin_ratios
 
 SIZES = ("quick", "paper")
 #: (training steps, inference calls) measured per size, after one warm-up each.

@@ -28,7 +28,7 @@ import pandas as pd
 from bgfn.io import update_json
 from bgfn.nav.baseline import filter_setup, nav_config
 from bgfn.nav.filter import run_filter
-from bgfn.speed import bench_file
+from bgfn.train.speed import bench_file
 
 DATASET = "turin-sim-ekinox"
 

@@ -24,10 +24,10 @@ import sys
 
 import torch
 
-from bgfn.config import load_profile
+from bgfn.profile_schema import load_profile
 from bgfn.io import update_json
 from bgfn.models import METHODS, build_model
-from bgfn.speed import GNSS_RATE_HZ, IMU_RATE_HZ, bench_file, latency_ms, realtime_flags, throughput
+from bgfn.train.speed import GNSS_RATE_HZ, IMU_RATE_HZ, bench_file, latency_ms, realtime_flags, throughput
 
 SIZES = ("quick", "paper")
 BATCH = 64

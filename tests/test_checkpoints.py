@@ -1,10 +1,10 @@
-"""Checkpoint names are built and read back by one module (bgfn.checkpoints)."""
+"""Checkpoint names are built and read back by one module (bgfn.train.checkpoints)."""
 
 from __future__ import annotations
 
 import pytest
 
-from bgfn import checkpoints as ck
+from bgfn.train import checkpoints as ck
 from bgfn import config
 
 

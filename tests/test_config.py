@@ -12,6 +12,7 @@ import yaml
 
 from bgfn import config
 from bgfn.errors import DataError
+from bgfn.profile_schema import load_profile, with_overrides
 
 
 def _section_keys(cfg: dict) -> dict[str, set[str]]:
@@ -35,7 +36,7 @@ def test_project_root_is_independent_of_cwd(tmp_path):
 
 @pytest.mark.parametrize("profile", config.PROFILES)
 def test_shipped_profiles_load(profile):
-    cfg = config.load_profile(profile)
+    cfg = load_profile(profile)
     assert cfg["profile"] == profile
     assert isinstance(cfg["seed"], int)
     assert cfg["description"].strip()
@@ -44,7 +45,7 @@ def test_shipped_profiles_load(profile):
 
 
 def test_profiles_define_the_same_keys():
-    cfgs = {p: config.load_profile(p) for p in config.PROFILES}
+    cfgs = {p: load_profile(p) for p in config.PROFILES}
     top = {p: set(c) for p, c in cfgs.items()}
     assert len({frozenset(k) for k in top.values()}) == 1, f"top-level keys differ: {top}"
     # A notebook reads the same keys whatever the profile: sections must agree one level down, too.
@@ -59,7 +60,7 @@ def test_profiles_define_the_same_keys():
 
 def test_unknown_profile_names_the_file():
     with pytest.raises(DataError) as err:
-        config.load_profile("no_such_profile")
+        load_profile("no_such_profile")
     msg = str(err.value)
     assert str(config.PARAMS_DIR / "no_such_profile.yaml") in msg
     assert "unknown profile" in msg
@@ -70,7 +71,7 @@ def test_unknown_profile_names_the_file():
 @pytest.mark.parametrize("bad", ["../quick", "", "a/b", ".hidden", "quick.yaml"])
 def test_profile_names_cannot_escape_params(bad):
     with pytest.raises(DataError):
-        config.load_profile(bad)
+        load_profile(bad)
     with pytest.raises(DataError):
         config.results_dir(bad, create=False)
 
@@ -92,18 +93,18 @@ def test_missing_required_key_names_file_and_key(tmp_path, monkeypatch):
     del cfg["train"]
     path = _write_profile(tmp_path, monkeypatch, "mine", cfg)
     with pytest.raises(DataError) as err:
-        config.load_profile("mine")
+        load_profile("mine")
     assert err.value.source == str(path)
     assert err.value.field == "train"
 
 
 def test_empty_section_reads_as_mapping(tmp_path, monkeypatch):
     _write_profile(tmp_path, monkeypatch, "mine", _complete("mine"))
-    cfg = config.load_profile("mine")
+    cfg = load_profile("mine")
     assert cfg["data"] == {}
     assert cfg["train"] == {"window": 2}
     cfg["train"]["window"] = 99  # a caller's edit must not leak into the next load
-    assert config.load_profile("mine")["train"]["window"] == 2
+    assert load_profile("mine")["train"]["window"] == 2
 
 
 @pytest.mark.parametrize("field,value", [("seed", "7"), ("seed", -1), ("seed", True), ("nav", [1, 2]),
@@ -115,7 +116,7 @@ def test_bad_values_are_rejected(tmp_path, monkeypatch, field, value):
     cfg[field] = value
     _write_profile(tmp_path, monkeypatch, "mine", cfg)
     with pytest.raises(DataError) as err:
-        config.load_profile("mine")
+        load_profile("mine")
     assert err.value.field.split("[")[0] == field
 
 
@@ -129,14 +130,14 @@ def test_a_moved_outage_key_names_the_new_one(tmp_path, monkeypatch, section, ke
     path = _write_profile(tmp_path, monkeypatch, "variant", {"profile": "variant", "base": "mine",
                                                              "description": "v", section: {key: value}})
     with pytest.raises(DataError, match="top-level key 'outage_windows'") as err:
-        config.load_profile("variant")
+        load_profile("variant")
     assert err.value.source == str(path) and err.value.field == f"{section}.{key}"
 
 
 def test_invalid_yaml_names_the_file(tmp_path, monkeypatch):
     path = _write_profile(tmp_path, monkeypatch, "mine", "profile: [unclosed\n")
     with pytest.raises(DataError) as err:
-        config.load_profile("mine")
+        load_profile("mine")
     assert str(path) in str(err.value)
 
 
@@ -160,7 +161,7 @@ def test_run_metadata_is_deterministic_and_complete():
     b = config.run_metadata("smoke")
     assert a == b
     assert a["profile"] == "smoke"
-    assert a["seed"] == config.load_profile("smoke")["seed"]
+    assert a["seed"] == load_profile("smoke")["seed"]
     assert a["params_file"] == "params/smoke.yaml"
     assert len(a["params_sha256"]) == 64
     assert a["packages"]["numpy"] is not None
@@ -179,12 +180,12 @@ def test_a_variant_profile_holds_only_its_changes(tmp_path, monkeypatch):
     _write_profile(tmp_path, monkeypatch, "variant", {"profile": "variant", "base": "mine", "description": "v",
                                                       "data": None, "train": {"lr": {"mlp": 3e-3},
                                                                               "extra_channels": []}})
-    cfg = config.load_profile("variant")
+    cfg = load_profile("variant")
     assert cfg["profile"] == "variant" and cfg["description"] == "v" and cfg["seed"] == 1 and "base" not in cfg
     # mappings merge key by key, lists and scalars replace, an empty section changes nothing
     assert cfg["train"] == {"window": 2, "lr": {"bgfn": 1e-3, "mlp": 3e-3}, "extra_channels": []}
     assert cfg["data"] == {"seed": 5}
-    assert config.load_profile("mine")["train"]["lr"]["mlp"] == 1e-3            # the base is untouched
+    assert load_profile("mine")["train"]["lr"]["mlp"] == 1e-3            # the base is untouched
     assert [p.name for p in config.profile_chain("variant")] == ["variant.yaml", "mine.yaml"]
 
 
@@ -192,25 +193,25 @@ def test_a_variant_never_inherits_its_description_and_needs_a_real_base(tmp_path
     _write_profile(tmp_path, monkeypatch, "mine", _complete("mine"))
     # a derived profile without a description says what it is (the base's own text would describe the base)
     _write_profile(tmp_path, monkeypatch, "nodesc", {"profile": "nodesc", "base": "mine"})
-    assert config.load_profile("nodesc")["description"] == "profile 'nodesc': 'mine' with its own settings"
+    assert load_profile("nodesc")["description"] == "profile 'nodesc': 'mine' with its own settings"
     # a profile without a base must describe itself
     path = _write_profile(tmp_path, monkeypatch, "bare", {k: v for k, v in _complete("bare").items()
                                                             if k != "description"})
     with pytest.raises(DataError) as err:
-        config.load_profile("bare")
+        load_profile("bare")
     assert err.value.source == str(path) and err.value.field == "description"
     _write_profile(tmp_path, monkeypatch, "orphan", {"profile": "orphan", "base": "nosuch", "description": "o"})
     with pytest.raises(DataError, match="nosuch") as err:
-        config.load_profile("orphan")
+        load_profile("orphan")
     assert err.value.field == "base"
     _write_profile(tmp_path, monkeypatch, "a", {"profile": "a", "base": "b", "description": "a"})
     _write_profile(tmp_path, monkeypatch, "b", {"profile": "b", "base": "a", "description": "b"})
     with pytest.raises(DataError, match="a -> b -> a"):
-        config.load_profile("a")
+        load_profile("a")
 
 
 def test_quick_heading_differs_from_quick_only_where_it_says():
-    quick, variant = config.load_profile("quick"), config.load_profile("quick-heading")
+    quick, variant = load_profile("quick"), load_profile("quick-heading")
     changed = {k for k in quick["train"] if quick["train"][k] != variant["train"][k]}
     assert changed == {"yaw_encoding", "target_frame", "extra_channels", "sizes"}
     for section in ("outage_windows", "data", "nav", "evaluate", "energy"):

@@ -14,6 +14,7 @@ from bgfn.data.imu_errors import OPTIONAL_VECTOR_KEYS, VECTOR_KEYS
 from bgfn.errors import ChecksumError, DataError
 from bgfn.nav.sim import imu_from_trajectory
 from conftest import REQUIRED
+from bgfn.profile_schema import load_profile, with_overrides
 
 pytestmark = pytest.mark.usefixtures("repo_untouched")
 
@@ -203,7 +204,7 @@ def test_profile_data_section_sets_the_parameters(env, tmp_path, monkeypatch):
     from bgfn import config
 
     d = load_drive("turin-sim-mpu6000", profile="smoke", cache=False, **env)
-    smoke = config.load_profile("smoke")["data"]
+    smoke = load_profile("smoke")["data"]
     assert d.meta["params"]["seed"] == smoke["seed"]
     assert d.reference["time"].iloc[0] == smoke["t_start"] and d.reference["time"].iloc[-1] == smoke["t_end"]
     assert d.meta["params"]["gnss_correlated_tau_s"] == smoke["turin-sim-mpu6000"]["gnss_correlated_tau_s"]

@@ -18,7 +18,7 @@ def test_notebook_01_is_stored_clean_with_a_parameters_cell():
     src = "".join(first["source"])
     assert 'profile = "quick"' in src
     assert "outage_windows(cfg, d, name)" in "".join("".join(c["source"]) for c in code)    # the profile's one key
-    assert "from bgfn.config import load_profile, results_dir" in "".join(code[1]["source"])
+    assert "from bgfn.profile_schema import load_profile" in "".join(code[1]["source"])   # checked at the edge
     body = "".join("".join(c["source"]) for c in code)
     for name in ("trajectory_3d.png", "trajectory_map.png", "imu_channels.png", "dataset_{name}.csv"):
         assert name in body

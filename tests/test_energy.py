@@ -345,7 +345,7 @@ def test_missing_checkpoint_names_the_file(tmp_path, monkeypatch):
 
 # ----------------------------------------------------------------------------------------------- speed helpers
 def test_realtime_flags_use_the_sample_periods():
-    from bgfn.speed import realtime_flags
+    from bgfn.train.speed import realtime_flags
 
     assert realtime_flags(9.9) == {"imu": True, "gnss": True}          # 100 Hz IMU: 10 ms per sample
     assert realtime_flags(10.0) == {"imu": True, "gnss": True}
@@ -357,7 +357,7 @@ def test_realtime_flags_use_the_sample_periods():
 
 
 def test_timing_helpers_restore_threads_and_count_calls():
-    from bgfn import speed
+    from bgfn.train import speed
 
     calls = []
     t = speed.median_time(lambda: calls.append(1), repeats=3, warmup=2)
@@ -372,7 +372,7 @@ def test_timing_helpers_restore_threads_and_count_calls():
 def test_matmul_share_of_a_training_step_counts_only_dense_products():
     from types import SimpleNamespace
 
-    from bgfn import speed
+    from bgfn.train import speed
 
     ev = [SimpleNamespace(key=k, self_cpu_time_total=us) for k, us in
           [("aten::mm", 3e5), ("aten::addmm", 1e5), ("aten::add_", 5e5), ("aten::bmm", 1e5)]]
@@ -392,7 +392,7 @@ def test_matmul_share_of_a_training_step_counts_only_dense_products():
 
 
 def test_twin_ratios_divide_bgfn_by_its_twin_per_size_measured_for_both():
-    from bgfn.speed import twin_ratios
+    from bgfn.train.speed import twin_ratios
 
     rates = {"bgfn": {"quick": 600.0, "paper": 6.0}, "transformer": {"quick": 750.0, "paper": 30.0}}
     profiles = {"bgfn": {"paper": {"matmul_s": 0.8, "step_s": 1.3}}, "transformer": {"paper": {"step_s": 0.24}}}

@@ -12,7 +12,7 @@ import torch
 
 from bgfn import energy
 from bgfn.config import PROJECT_ROOT
-from bgfn.energy.summary import REPORTED_KEYS
+from bgfn.energy.record import REPORTED_KEYS
 from bgfn.learning import WindowSet
 from bgfn.models import build_model
 from bgfn.train import TrainedModel
@@ -200,7 +200,7 @@ def test_the_energy_network_is_the_median_seed_and_must_be_trained(tmp_path, mon
     import json
 
     from bgfn import config
-    from bgfn.checkpoints import card_path, checkpoint_path
+    from bgfn.train.checkpoints import card_path, checkpoint_path
     from bgfn.energy.checkpoint import check_trained, energy_checkpoint, median_seed
     from bgfn.errors import DataError
 

@@ -15,7 +15,8 @@ from bgfn import evaluate as ev
 from bgfn import paper
 from bgfn import learning as L
 from bgfn import stats
-from bgfn.config import PROFILES, load_profile
+from bgfn.config import PROFILES
+from bgfn.profile_schema import load_profile
 from bgfn.data import Drive
 from bgfn.data.gnss import fix_errors
 from bgfn.errors import DataError
@@ -23,6 +24,7 @@ from bgfn.nav import earth, metrics
 from bgfn.nav.filter import run_filter, run_outage
 from bgfn.nav.outages import OutageWindow, TablePseudoGps
 from synthetic_drive import demo_drive
+from bgfn.profile_schema import load_profile, with_overrides
 
 WINDOWS = [(60.0, 20.0), (110.0, 20.0)]
 NAV = {"init": {"position_std_m": 1.0, "height_std_m": 2.0, "velocity_std_mps": 0.1, "level_std_deg": 0.2,
@@ -122,7 +124,7 @@ def test_constrained_runs_equal_the_filters_with_the_same_constraints(ctx5):
     con = ctx5.constraints
     assert con is not None and np.count_nonzero(con.aid) > 0
     run = ev.run_outages(ctx5, [(s, d)], None, "INS+NHC", None, constraints=con)[0]
-    ref = run_outage(ctx5.drive.imu, ctx5.state_at(s), OutageWindow(s, d), ctx5.noise, ctx5.lever, constraints=con)
+    ref = run_outage(ctx5.drive.imu, ctx5.state_at(s), OutageWindow(s, d), ctx5.noise, ctx5.lever, aid=con)
     np.testing.assert_allclose(run.trajectory[["lat", "lon"]].to_numpy(), ref.trajectory[["lat", "lon"]].to_numpy(),
                                rtol=0, atol=1e-12)
     np.testing.assert_allclose(run.trajectory[["v_n", "v_e", "yaw"]].to_numpy(),
@@ -134,7 +136,7 @@ def test_constrained_runs_equal_the_filters_with_the_same_constraints(ctx5):
     fx = hyb.pseudo.rename(columns={"std_m": "std_n"}).assign(std_e=lambda x: x["std_n"], std_d=np.nan)
     ref = run_filter(ctx5.drive.imu, ctx5.state_at(s), ctx5.noise, None, ctx5.lever, [(s, d)],
                      pseudo_gps=TablePseudoGps(fx), t_end=s + d, pseudo_rate_hz=1.0,
-                     constraints=con.frozen(ctx5.state_at(s).time))
+                     aid=con.frozen(ctx5.state_at(s).time))
     np.testing.assert_allclose(hyb.trajectory[["lat", "lon", "h"]].to_numpy(),
                                ref.trajectory[["lat", "lon", "h"]].to_numpy(), rtol=0, atol=1e-11)
     np.testing.assert_allclose(hyb.trajectory[["v_n", "v_e", "roll", "yaw"]].to_numpy(),
@@ -532,7 +534,7 @@ def test_evaluation_setup_applies_the_notebook_parameters_over_the_profile(monke
     cfg = load_profile("smoke")
     section = cfg["evaluate"]
     before = repr(section)
-    setup = ev.evaluation_setup(cfg, seeds=[3, 4], sweep_datasets=[])
+    setup = ev.evaluation_setup(with_overrides(cfg, {"evaluate.seeds": [3, 4], "evaluate.sweep.datasets": []}))
     assert setup.config["seeds"] == [3, 4] and setup.config["sweep"]["datasets"] == []
     assert setup.config["sweep"]["n_starts"] == section["sweep"]["n_starts"]       # the other sweep keys stay
     assert setup.config["methods"] == section["methods"] and setup.datasets == section["datasets"]
@@ -543,10 +545,11 @@ def test_evaluation_setup_applies_the_notebook_parameters_over_the_profile(monke
     # the recorded drive's outages come from the profile's rule, said beside the default list
     assert lines[3].endswith("; rtklib-drive0708: rule cruise_and_manoeuvre (picked from the drive)")
     with pytest.raises(DataError):
-        ev.evaluation_setup(cfg, methods=["no_such_network"])
+        with_overrides(cfg, {"evaluate.methods": ["no_such_network"]})
     # real_imu: one line per note, the tables' and the sweep's, said once
     monkeypatch.setattr(acquire, "resolve", lambda name, **kw: acquire.Resolved(name, None, "missing", None, "t"))
-    real = ev.evaluation_setup(cfg, real_imu=True, sweep_datasets=["turin-sim-mpu6000"])
+    real = ev.evaluation_setup(with_overrides(cfg, {"evaluate.real_imu": True,
+                                                 "evaluate.sweep.datasets": ["turin-sim-mpu6000"]}))
     assert real.datasets == section["datasets"] and len(real.notes) == 2 and real.sweep_notes == real.notes[1:]
     assert [ln for ln in real.describe() if ln.startswith("real_imu:")] == [f"real_imu: {n}" for n in real.notes]
 
@@ -656,7 +659,7 @@ def test_evaluation_record_is_what_notebook_06_reads(tmp_path):
     from bgfn import report
 
     cfg = load_profile("smoke")
-    setup = ev.evaluation_setup(cfg, sweep_datasets=[])
+    setup = ev.evaluation_setup(with_overrides(cfg, {"evaluate.sweep.datasets": []}))
     results = {"turin-sim-ekinox": _table_result("turin-sim-ekinox"),
                "turin-sim-mpu6000": _table_result("turin-sim-mpu6000")}
     reductions = {n: ev.reduction_table(r) for n, r in results.items()}

@@ -1,4 +1,4 @@
-"""bgfn.figures: the LIF illustration is a real LIF neuron, the diagrams read the configuration they are given."""
+"""bgfn.report.diagrams: the LIF illustration is a real LIF neuron, the diagrams read the configuration they are given."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 import torch  # noqa: E402
 
-from bgfn import figures  # noqa: E402
+from bgfn.report import diagrams as figures  # noqa: E402
 from bgfn.models import build_model  # noqa: E402
 from bgfn.models.lif import beta_from_tau, lif_reference  # noqa: E402
 

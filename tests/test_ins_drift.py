@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from bgfn import evaluate as ev
-from bgfn.config import load_profile, with_overrides
+from bgfn.profile_schema import load_profile, with_overrides
 from bgfn.data import Drive
 from synthetic_drive import demo_drive
 

@@ -178,7 +178,7 @@ def test_nhc_bounds_the_cross_track_drift_of_a_lateral_tilt(bias):
     init, noise = _start(ref)
     con = cn.build_constraints(imu, EKINOX, _body_frame())
     ins = _cross_along(run_filter(imu, init, noise), ref)[0]
-    aided = _cross_along(run_filter(imu, init, noise, constraints=con), ref)[0]
+    aided = _cross_along(run_filter(imu, init, noise, aid=con), ref)[0]
     assert np.abs(ins).max() > 15.0 and abs(ins[-1]) > 15.0
     assert np.abs(aided).max() < 2.0
 
@@ -193,7 +193,7 @@ def test_nhc_turns_the_velocity_with_a_heading_drift():
     init, noise = _start(ref)
     con = cn.build_constraints(imu, EKINOX, _body_frame())
     cross_ins, _, e_ins = _cross_along(run_filter(imu, init, noise), ref)
-    cross_nhc, _, e_nhc = _cross_along(run_filter(imu, init, noise, constraints=con), ref)
+    cross_nhc, _, e_nhc = _cross_along(run_filter(imu, init, noise, aid=con), ref)
     assert np.abs(cross_ins).max() < 0.5
     assert abs(e_ins["yaw"].iloc[-1]) == pytest.approx(b * t_end, rel=0.05)       # the INS heading drifts, too
     assert abs(cross_nhc[-1]) == pytest.approx(v * b * t_end ** 2 / 2, rel=0.15)
@@ -215,7 +215,7 @@ def test_zupt_holds_the_position_at_a_stop_where_the_ins_drifts():
     assert (con.aid[standing[1:]] == cn.AID_ZUPT).sum() == 39     # one per second, 22 s .. 60 s
     drift = {}
     for name, c in (("INS", None), ("ZUPT", con)):
-        res = run_filter(imu, init, noise, constraints=c)
+        res = run_filter(imu, init, noise, aid=c)
         p = res.trajectory[["lat", "lon"]].to_numpy()[standing]
         ned = np.column_stack([(p[:, 0] - p[0, 0]) * 6.37e6, (p[:, 1] - p[0, 1]) * 6.37e6 * np.cos(p[0, 0])])
         drift[name] = np.hypot(*ned.T).max()
@@ -233,10 +233,10 @@ def test_zupt_is_refused_at_speed():
     init, noise = _start(ref)
     con = cn.build_constraints(imu, EKINOX, _body_frame())
     assert con.still[300:].all()                                  # the detector is fooled
-    _, along, _ = _cross_along(run_filter(imu, init, noise, constraints=con), ref)
+    _, along, _ = _cross_along(run_filter(imu, init, noise, aid=con), ref)
     assert np.abs(along).max() < 5.0                              # no ZUPT: no stop forced on a moving car
     ungated = cn.build_constraints(imu, EKINOX, _body_frame(zupt_max_speed_mps=100.0))
-    _, along_bad, _ = _cross_along(run_filter(imu, init, noise, constraints=ungated), ref)
+    _, along_bad, _ = _cross_along(run_filter(imu, init, noise, aid=ungated), ref)
     assert np.abs(along_bad).max() > 100.0
 
 
@@ -250,11 +250,11 @@ def test_constraints_without_epochs_change_nothing():
     con = cn.build_constraints(imu, EKINOX, _body_frame())
     idle = cn.Constraints(con.config, con.imu_time, np.zeros_like(con.aid), con.still, con.mount_time, con.mount)
     a = run_filter(imu, init, noise, gnss, outage_windows=[(20.0, 20.0)])
-    b = run_filter(imu, init, noise, gnss, outage_windows=[(20.0, 20.0)], constraints=idle)
+    b = run_filter(imu, init, noise, gnss, outage_windows=[(20.0, 20.0)], aid=idle)
     for x, y in ((a.trajectory, b.trajectory), (a.bias, b.bias), (a.sd, b.sd), (a.updates, b.updates)):
         pd.testing.assert_frame_equal(x, y, check_exact=True)
     np.testing.assert_array_equal(a.P_updates, b.P_updates)
-    c = run_filter(imu, init, noise, gnss, outage_windows=[(20.0, 20.0)], constraints=con)
+    c = run_filter(imu, init, noise, gnss, outage_windows=[(20.0, 20.0)], aid=con)
     assert not np.allclose(c.trajectory["lat"], a.trajectory["lat"], rtol=0, atol=1e-12)
     # the bias table follows the constraints' updates too: it changes at the aid epochs
     jumps = np.flatnonzero(np.any(np.diff(c.bias.iloc[:, 1:].to_numpy(), axis=0) != 0, axis=1)) + 1
@@ -289,7 +289,7 @@ def test_baseline_has_the_ins_nhc_row_beside_the_ins_row():
     assert list(b.outage_table["method"]) == ["INS", "INS", "INS+NHC", "INS+NHC"]
     con = baseline.outage_constraints(drive, cfg, b.full.trajectory)
     again = run_outage(drive.imu, b.states["outage_2"], windows[1], b.noise, drive.meta["lever_arm_m"],
-                       constraints=con)
+                       aid=con)
     e = b.outage_errors["outage_2"]
     np.testing.assert_array_equal(e.loc[e["method"] == "INS+NHC", "north"].to_numpy(),
                                   metrics.navigation_errors(again.trajectory, drive.reference)["north"].to_numpy())

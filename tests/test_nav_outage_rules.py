@@ -12,6 +12,7 @@ import pytest
 from bgfn.errors import DataError
 from bgfn.nav import outage_rules as R
 from bgfn.nav import outages, sim
+from bgfn.profile_schema import load_profile, with_overrides
 
 RULE = {"rule": "cruise_and_manoeuvre", "duration_s": 30.0, "step_s": 1.0, "warmup_s": 60.0, "min_speed_mps": 2.0,
         "cruise_max_yaw_rate_dps": 3.0, "manoeuvre_min_yaw_rate_dps": 5.0, "gap_s": 30.0, "min_training_s": 120.0}
@@ -160,7 +161,7 @@ def test_a_rule_in_a_profile_file_is_checked_with_the_schema(params):
     assert set(OUTAGE_RULE.fields) == {"rule", *R.RULE_DEFAULTS["cruise_and_manoeuvre"]}
     def load(text):
         (params / "mine.yaml").write_text(f"profile: mine\nbase: smoke\ndescription: v\n{text}\n")
-        return config.load_profile("mine")
+        return load_profile("mine")
 
     cfg = load("outage_windows: {sim: {rule: cruise_and_manoeuvre, gap_s: 10.0}}")      # merged over smoke's
     assert cfg["outage_windows"]["sim"]["gap_s"] == 10.0 and "default" in cfg["outage_windows"]
@@ -180,15 +181,14 @@ def test_a_rule_in_a_profile_file_is_checked_with_the_schema(params):
     # a mapping without a default must name every dataset of the profile
     (params / "quick.yaml").write_text((params / "quick.yaml").read_text().replace("  default: [[", "  turin: [["))
     with pytest.raises(DataError, match="none for turin-sim-ekinox"):
-        config.load_profile("smoke")                             # smoke takes its outages from quick
+        load_profile("smoke")                             # smoke takes its outages from quick
 
 
 def test_check_with_drives_applies_the_rule_to_each_drive(params, monkeypatch):
-    import bgfn.data
-    from bgfn import config
+    from bgfn import config, profile_schema
     from bgfn.profile_schema import check_with_drives
 
-    monkeypatch.setattr(bgfn.data, "load_drive", lambda name, profile=None: SimpleNamespace(
+    monkeypatch.setattr(profile_schema, "load_drive", lambda name, profile=None: SimpleNamespace(
         name=name, reference=drive_reference(), imu=drive_reference()[["time"]], meta={"imu_rate_hz": 10.0}))
     path = params / "mine.yaml"
     head = ("profile: mine\nbase: smoke\ndescription: v\ndata: {t_start: null, t_end: null}\n"
@@ -212,13 +212,13 @@ def test_check_with_drives_applies_the_rule_to_each_drive(params, monkeypatch):
 def test_training_and_evaluation_take_each_datasets_outages():
     from bgfn import evaluate as ev
     from bgfn import train as T
-    from bgfn.config import load_profile, with_overrides
+    from bgfn.profile_schema import load_profile, with_overrides
 
-    smoke = T.TrainingPlan.of("smoke")                     # the shipped mapping: every Turin dataset the default
+    smoke = T.TrainingPlan.of(load_profile("smoke"))                   # the shipped mapping: every Turin dataset the default
     default = outages.default_windows(smoke.cfg)
     assert smoke.per_dataset and smoke.outage_windows == default == [(138906.0, 30.0), (139170.0, 30.0)]
     assert smoke.windows_of("turin-sim-mpu6000") == default
-    fixed = T.TrainingPlan.of("smoke", outage_windows=[(1.0, 2.0)])
+    fixed = T.TrainingPlan.of(load_profile("smoke"), outage_windows=[(1.0, 2.0)])
     assert not fixed.per_dataset and fixed.windows_of("rtklib-drive0708") == [(1.0, 2.0)]
     cfg = {"profile": "p", "description": "d", "train": {"margin_s": 30.0},
            "outage_windows": {"default": [[1100.0, 30.0]], "sim": dict(RULE)}}
@@ -230,7 +230,7 @@ def test_training_and_evaluation_take_each_datasets_outages():
     # notebook 04's setup: the default list, and a line for each dataset with its own entry
     prof = with_overrides(load_profile("smoke"), {"evaluate.datasets": ["turin-sim-ekinox", "sim", "other"]})
     prof["outage_windows"] = {**prof["outage_windows"], "sim": dict(RULE), "other": [[138800.0, 10.0]]}
-    setup = ev.evaluation_setup(prof, sweep_datasets=[])
+    setup = ev.evaluation_setup(with_overrides(prof, {"evaluate.sweep.datasets": []}))
     assert setup.windows == default
     assert setup.describe()[3] == (f"outages (start, duration) s: {[list(w) for w in default]}; sim: rule "
                                    "cruise_and_manoeuvre (picked from the drive); other: [[138800.0, 10.0]]")

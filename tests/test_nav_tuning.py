@@ -93,7 +93,7 @@ def test_auto_finds_the_true_noise_factor_and_makes_the_nis_consistent(quiet_dri
     b = baseline.run_baseline(quiet_drive, cfg, [(150.0, 20.0)])
     s = consistency.nis_summary(b.full.updates)
     assert s["verdict"] == "consistent" and s["mean_nis"] == pytest.approx(t.mean_nis)
-    rec = baseline.save_baseline(b, tmp_path)
+    rec = baseline.save_baseline(b, tmp_path, "sim")
     assert rec["noise_scale"] == t.scale and rec["noise_tuning"]["mean_nis_at_one"] == t.mean_nis_at_one
     assert rec["alignment"] is None and rec["start_time"] == quiet_drive.reference["time"].iloc[0]
     # the gate comparison reuses the factor found instead of searching again

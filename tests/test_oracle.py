@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 
 from bgfn import evaluate as ev
-from bgfn.config import load_profile
+from bgfn.profile_schema import load_profile
 from bgfn.data import Drive
 from bgfn.errors import DataError
 from bgfn.evaluate import oracle as orc

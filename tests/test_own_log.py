@@ -22,6 +22,7 @@ from bgfn.data.names import dataset_folder, dataset_id, unique_ids
 from bgfn.data.regrid import GAP_SAMPLES, interpolate_reference
 from bgfn.errors import DataError
 from bgfn.nav import earth, sim
+from bgfn.profile_schema import load_profile, with_overrides
 
 pytestmark = pytest.mark.usefixtures("repo_untouched")
 
@@ -105,7 +106,7 @@ def test_a_csv_log_named_by_its_path_runs_notebooks_01_to_04(tmp_path, monkeypat
     monkeypatch.setattr(config, "RESULTS_ROOT", results)
     monkeypatch.chdir(tmp_path)
 
-    cfg = config.load_profile("mine")
+    cfg = load_profile("mine")
     assert cfg["profile"] == "mine"                               # the file's name
     assert cfg["description"] == "profile 'mine': 'quick' with its own settings"     # none written
     from bgfn.profile_schema import check_with_drives
@@ -129,11 +130,11 @@ def test_a_csv_log_named_by_its_path_runs_notebooks_01_to_04(tmp_path, monkeypat
     # notebook 02
     windows = outage_windows(cfg)
     b = baseline.run_baseline(drive, baseline.nav_config(cfg["nav"]), windows)
-    rec = baseline.save_baseline(b, out)
+    rec = baseline.save_baseline(b, out, did)
     assert rec["states_file"] == f"nav_states_{did}.npz"
     assert b.rms.loc["horizontal", "rms"] < 2.0                   # GPS-aided: near the 0.5 m fixes
     # notebook 03
-    plan = train.TrainingPlan.of("mine")
+    plan = train.TrainingPlan.of(load_profile("mine"))
     prepared = train.prepare_datasets(plan)
     cards = [c for n, d in prepared.items() for c in train.train_dataset(plan, n, d.data)]
     assert {c["method"] for c in cards} == {"bgfn", "mlp"}
@@ -351,8 +352,8 @@ def test_top_level_datasets_reach_every_notebook_and_a_section_still_wins(tmp_pa
     (params / "mine.yaml").write_text("base: quick\ndescription: d\ndatasets: [a/b]\n")
     (params / "again.yaml").write_text("base: mine\ndescription: e\nnav: {datasets: [c]}\n")
     (params / "bad.yaml").write_text("base: quick\ndescription: d\ndatasets: []\n")
-    mine, again = config.load_profile("mine"), config.load_profile("again")
-    quick = config.load_profile("quick")
+    mine, again = load_profile("mine"), load_profile("again")
+    quick = load_profile("quick")
     for section in ("data", "nav", "train", "evaluate"):
         assert mine[section]["datasets"] == ["a/b"]
     assert mine["evaluate"]["sweep"]["datasets"] == ["a/b"] and mine["profile"] == "mine"
@@ -360,5 +361,5 @@ def test_top_level_datasets_reach_every_notebook_and_a_section_still_wins(tmp_pa
     assert {k: v for k, v in mine["train"].items() if k != "datasets"} == {
         k: v for k, v in quick["train"].items() if k != "datasets"}
     with pytest.raises(DataError) as err:
-        config.load_profile("bad")
+        load_profile("bad")
     assert err.value.field == "datasets" and err.value.source == str(params / "bad.yaml")

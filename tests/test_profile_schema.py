@@ -7,7 +7,7 @@ import pytest
 
 from bgfn import config
 from bgfn.errors import DataError
-from bgfn.profile_schema import SCHEMA
+from bgfn.profile_schema import SCHEMA, load_profile, with_overrides
 
 pytestmark = pytest.mark.usefixtures("repo_untouched")
 
@@ -58,7 +58,7 @@ def test_a_bad_variant_names_its_file_the_key_and_the_value(params, case):
     path = params / "mine.yaml"
     path.write_text(f"profile: mine\nbase: smoke\ndescription: a variant\n{text}\n")
     with pytest.raises(DataError) as err:
-        config.load_profile("mine")
+        load_profile("mine")
     assert err.value.source == str(path), str(err.value)
     assert err.value.field == key and words in str(err.value), str(err.value)
 
@@ -66,9 +66,9 @@ def test_a_bad_variant_names_its_file_the_key_and_the_value(params, case):
 def test_noise_scale_auto_and_alignment_options_are_accepted(params):
     (params / "mine.yaml").write_text("profile: mine\nbase: smoke\ndescription: v\n"
                                       "nav: {noise_scale: auto, alignment: {mode: gnss, heading_time_s: 5.0}}\n")
-    nav = config.load_profile("mine")["nav"]
+    nav = load_profile("mine")["nav"]
     assert nav["noise_scale"] == "auto" and nav["alignment"]["mode"] == "gnss"
-    assert nav["alignment"]["speed_threshold_mps"] == config.load_profile("smoke")["nav"]["alignment"][
+    assert nav["alignment"]["speed_threshold_mps"] == load_profile("smoke")["nav"]["alignment"][
         "speed_threshold_mps"]                                   # sections merge key by key
 
 
@@ -77,7 +77,7 @@ def test_an_error_in_the_base_names_the_base_file(params):
     quick.write_text(quick.read_text().replace("  margin_s: 30.0", "  margin_s: -1.0"))
     (params / "mine.yaml").write_text("profile: mine\nbase: smoke\ndescription: v\ntrain: {window: 40}\n")
     with pytest.raises(DataError) as err:
-        config.load_profile("mine")
+        load_profile("mine")
     assert err.value.source == str(quick) and err.value.field == "train.margin_s"
 
 
@@ -89,7 +89,7 @@ def test_every_shipped_profile_uses_only_schema_keys():
     from bgfn.train import LR_SEARCH_DEFAULTS, OPTIMIZER_DEFAULTS
 
     for name in config.available_profiles():
-        config.load_profile(name)
+        load_profile(name)
     f = SCHEMA.fields
     assert set(NAV_DEFAULTS) <= set(f["nav"].fields)
     assert set(EVALUATE_DEFAULTS) <= set(f["evaluate"].fields)
@@ -100,12 +100,12 @@ def test_every_shipped_profile_uses_only_schema_keys():
 
 
 def test_notebook_parameters_are_checked_like_the_profile():
-    cfg = config.load_profile("smoke")
-    out = config.with_overrides(cfg, {"train.methods": ["mlp"], "train.seeds": None, "evaluate.sweep.datasets": []})
+    cfg = load_profile("smoke")
+    out = with_overrides(cfg, {"train.methods": ["mlp"], "train.seeds": None, "evaluate.sweep.datasets": []})
     assert out["train"]["methods"] == ["mlp"] and out["train"]["seeds"] == cfg["train"]["seeds"]
     assert out["evaluate"]["sweep"]["datasets"] == [] and cfg["train"]["methods"] != ["mlp"]   # a copy
     with pytest.raises(DataError) as err:
-        config.with_overrides(cfg, {"train.methods": ["lstm"]})
+        with_overrides(cfg, {"train.methods": ["lstm"]})
     assert err.value.source == "notebook parameters" and err.value.field == "train.methods"
     with pytest.raises(DataError, match="evaluate.real_imu"):
-        config.with_overrides(cfg, {"evaluate.real_imu": "yes"})
+        with_overrides(cfg, {"evaluate.real_imu": "yes"})

@@ -542,7 +542,7 @@ def test_figure_sections_show_a_file_or_say_it_is_missing(tmp_path):
 
 
 def test_draw_diagrams_writes_the_papers_figures_made_by_notebook_06(tmp_path):
-    from bgfn.config import load_profile
+    from bgfn.profile_schema import load_profile
 
     written = report.draw_diagrams(load_profile("smoke"), None, tmp_path)
     assert [p.name for p in written] == [e["file"] for e in report.PAPER_FIGURES if e["by"].startswith("notebook 06")]

@@ -15,6 +15,7 @@ from bgfn import learning as L
 from bgfn import train as T
 from bgfn.errors import DataError
 from bgfn.train import loop, lr_search
+from bgfn.profile_schema import load_profile, with_overrides
 
 torch.set_num_threads(1)
 
@@ -156,7 +157,8 @@ def test_heading_frame_predictions_come_back_in_ned(tmp_path):
 
 
 def test_profile_train_sections_are_complete_and_consistent():
-    from bgfn.config import PROFILES, load_profile
+    from bgfn.config import PROFILES
+    from bgfn.profile_schema import load_profile
     from bgfn.models import METHODS, build_model
 
     sections = {p: load_profile(p)["train"] for p in PROFILES}
@@ -301,7 +303,7 @@ def _toy_plan(datasets=("toy",), methods=("mlp",), seeds=(0,), **train):
 @pytest.fixture
 def models_in_tmp(tmp_path, monkeypatch):
     """``results/<profile>/models/<dataset>/`` under ``tmp_path``."""
-    from bgfn import checkpoints
+    from bgfn.train import checkpoints
 
     monkeypatch.setattr(checkpoints, "models_dir", lambda profile, dataset, fold=None, create=True:
                         tmp_path / profile / dataset)
@@ -309,16 +311,16 @@ def models_in_tmp(tmp_path, monkeypatch):
 
 
 def test_training_plan_takes_the_profile_unless_told():
-    from bgfn.config import load_profile
+    from bgfn.profile_schema import load_profile
     from bgfn.nav.outages import outage_windows
 
     cfg = load_profile("smoke")
-    plan = T.TrainingPlan.of("smoke")
+    plan = T.TrainingPlan.of(cfg)
     tc = cfg["train"]
     assert (plan.datasets, plan.methods, plan.seeds) == (tc["datasets"], tc["methods"], tc["seeds"])
     assert plan.outage_windows == outage_windows(cfg) and plan.train_cfg == tc
-    mine = T.TrainingPlan.of("smoke", datasets=["turin-sim-mpu6000"], methods=["mlp"], seeds=[np.int64(3)],
-                             outage_windows=[(1.0, 2.0)])
+    mine = T.TrainingPlan.of(with_overrides(cfg, {"train.datasets": ["turin-sim-mpu6000"], "train.methods": ["mlp"],
+                                                  "train.seeds": [np.int64(3)]}), outage_windows=[(1.0, 2.0)])
     assert (mine.datasets, mine.methods, mine.seeds, mine.outage_windows) == (["turin-sim-mpu6000"], ["mlp"], [3],
                                                                              [(1.0, 2.0)])
     assert type(mine.seeds[0]) is int                      # the card and file name take a plain int
@@ -404,7 +406,8 @@ def test_training_metrics_gather_what_training_json_holds():
     cards = [{"dataset": "a", "method": "mlp", "seed": 0, "params": 10, "epochs_run": 3, "best_epoch": 2,
               "wall_time_s": 1.5, "val_rmse_m": 0.5, "val_rmse_zero_m": 1.0, "val_rmse_last_m": 0.2}]
     runs, summary = T.cards_table(cards), T.summary_table(cards)
-    plan = T.TrainingPlan.of("smoke", datasets=["a"], outage_windows=[(1100.0, 10.0)])
+    plan = T.TrainingPlan.of(with_overrides(load_profile("smoke"), {"train.datasets": ["a"]}),
+                             outage_windows=[(1100.0, 10.0)])
     m = T.training_metrics(plan, prepared, runs, summary, T.windows_table(prepared))
     assert list(m) == ["runs", "summary", "windows", "learning_options", "outage_windows", "meta"]
     assert m["runs"][0]["wall_time_s"] == 1.5                     # training.json keeps the times

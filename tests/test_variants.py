@@ -16,7 +16,8 @@ from bgfn import evaluate as ev
 from bgfn import learning as L
 from bgfn import train as T
 from bgfn.errors import DataError
-from bgfn.profile_schema import MAIN_VARIANT, variant_config
+from bgfn.config import MAIN_VARIANT, variant_config
+from bgfn.profile_schema import load_profile, with_overrides
 
 torch.set_num_threads(1)
 
@@ -95,7 +96,7 @@ def test_variants_merge_into_the_profile_as_profiles_merge(params):
     (params / "mine.yaml").write_text(
         "profile: mine\nbase: smoke\ndescription: v\n"
         "variants: {wide: {train: {optimizer: {epochs: 7}, sizes: {mlp: {smoke: {hidden: 8}}}}}}\n")
-    cfg = config.load_profile("mine")
+    cfg = load_profile("mine")
     merged = variant_config(cfg, "wide")
     # key by key, as a base: chain: the variant's keys replace, everything it does not name is the profile's
     assert merged["train"]["optimizer"] == {**cfg["train"]["optimizer"], "epochs": 7}
@@ -112,23 +113,23 @@ def test_variants_merge_into_the_profile_as_profiles_merge(params):
 def test_the_velocity_variant_is_quick_headings_learning_problem():
     own = yaml.safe_load((config.PARAMS_DIR / "quick-heading.yaml").read_text())["train"]
     for profile in config.PROFILES:
-        cfg = config.load_profile(profile)
+        cfg = load_profile(profile)
         assert cfg["variants"]["velocity"]["train"] == own, profile
         assert cfg["variants"]["velocity-leaky"]["train"] == {**own, "protocol": "leaky"}, profile
         assert cfg["variants"]["leaky"]["train"] == {"protocol": "leaky"}, profile
-    quick = config.load_profile("quick")
-    heading = config.load_profile("quick-heading")
+    quick = load_profile("quick")
+    heading = load_profile("quick-heading")
     assert variant_config(quick, "velocity")["train"] == {k: v for k, v in heading["train"].items()}
 
 
 def test_variant_plan_takes_variant_runs_and_describes_each_variant():
-    plan = T.TrainingPlan.of("quick", methods=["mlp", "bgfn"])
+    plan = T.TrainingPlan.of(with_overrides(load_profile("quick"), {"train.methods": ["mlp", "bgfn"]}))
     vplan = T.VariantPlan.of(plan)
     assert vplan.names == ["velocity", "leaky", "velocity-leaky"]
     # variant_runs' own order (quick: bgfn, at_lstm, mlp), cut to the plan's methods
     assert vplan.methods == ["bgfn", "mlp"] and vplan.seeds == [0] and vplan.datasets == plan.datasets
     # variant_runs' own lists are cut to what notebook 03 trains (its parameters may narrow train:)
-    smoke = T.VariantPlan.of(T.TrainingPlan.of("smoke", methods=["mlp", "at_lstm"]))
+    smoke = T.VariantPlan.of(T.TrainingPlan.of(with_overrides(load_profile("smoke"), {"train.methods": ["mlp", "at_lstm"]})))
     assert (smoke.methods, smoke.datasets) == (["mlp"], ["turin-sim-mpu6000"])
     assert T.describe_options(vplan.train_section(MAIN_VARIANT)) == {"inputs": "eq21", "protocol": "honest"}
     velocity = "eq21+v_along+v_cross; yaw relative; heading frame"
@@ -247,19 +248,18 @@ def test_a_capped_search_is_the_prefix_of_the_full_budget(data):
 
 
 def test_the_command_line_trains_the_variants_only_when_asked(monkeypatch, tmp_path):
-    import bgfn.train.profile as P
-    import bgfn.train.variants as V
-    from bgfn.train.cli import main
+    import bgfn.train.runs as R
+    from bgfn.__main__ import main
 
     monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)                  # no search ran: train.lr
-    monkeypatch.setattr(P, "prepare_datasets", lambda plan: {d: T.TrainingDataset(d, None, None, f"data {d}")
+    monkeypatch.setattr(R, "prepare_datasets", lambda plan: {d: T.TrainingDataset(d, None, None, f"data {d}")
                                                              for d in plan.datasets})
-    monkeypatch.setattr(P, "train_dataset", lambda plan, d, data, tc, **kw: [{"dataset": d, "data": data}])
+    monkeypatch.setattr(R, "train_dataset", lambda plan, d, data, tc, **kw: [{"dataset": d, "data": data}])
     calls = []
-    monkeypatch.setattr(V, "train_variants", lambda vplan, prepared, cfgs, **kw: calls.append(
+    monkeypatch.setattr(R, "train_variants", lambda vplan, prepared, cfgs, **kw: calls.append(
         (vplan.names, vplan.datasets, sorted(prepared), sorted(cfgs))) or [])
-    main(["--profile", "smoke", "--dataset", "turin-sim-mpu6000"])
+    assert main(["train", "--profile", "smoke", "--dataset", "turin-sim-mpu6000"]) == 0
     assert calls == []
-    main(["--profile", "smoke", "--dataset", "turin-sim-mpu6000", "--variants"])
-    smoke = config.load_profile("smoke")
+    main(["train", "--profile", "smoke", "--dataset", "turin-sim-mpu6000", "--variants"])
+    smoke = load_profile("smoke")
     assert calls == [(list(smoke["variants"]), ["turin-sim-mpu6000"], ["turin-sim-mpu6000"], ["turin-sim-mpu6000"])]

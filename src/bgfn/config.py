@@ -4,12 +4,17 @@ A *profile* fixes the size of a run: ``smoke`` (CI, a minute), ``quick`` (defaul
 ``paper`` (the paper's settings). Every notebook starts with a ``parameters`` cell (``profile = "quick"``)
 that papermill overrides, then::
 
-    from bgfn.config import load_profile, results_dir, run_metadata
+    from bgfn.config import results_dir, run_metadata
+    from bgfn.profile_schema import load_profile
     cfg = load_profile(profile)          # dict: profile, description, seed, data, nav, train, evaluate, energy
     out = results_dir(profile)           # results/<profile>/ with tables/ figures/ notebooks/ models/
 
 Outputs go to ``out / "tables" / "<name>.csv"``, ``out / "figures" / "<name>.png"`` and
 ``out / "<name>.json"`` (metrics), always through :mod:`bgfn.io` (atomic writes).
+
+This module only finds and merges profiles (:func:`read_profile`, the ``base:`` chain) and knows paths: it is a
+core fact and imports nothing of the package above it. The check of every key against the schema is the edge's
+(:mod:`bgfn.profile_schema`, whose ``load_profile`` reads with :func:`read_profile`, then validates).
 """
 
 from __future__ import annotations
@@ -23,6 +28,8 @@ import sys
 from importlib import metadata
 from pathlib import Path
 from typing import Any
+
+import yaml
 
 from bgfn.errors import DataError
 
@@ -97,6 +104,11 @@ MOVED_KEYS: dict[str, str] = {
     "train.outage_windows": "outage_windows",
     "evaluate.outage_windows": "outage_windows",
 }
+#: A profile's ``variants:``: named overrides of the profile (each checked as a whole profile). Their names, the
+#: name of the profile's own networks among them, and the keys that ``variant_runs:`` alone sets.
+VARIANT_NAME = r"^[A-Za-z0-9][A-Za-z0-9_-]*$"
+MAIN_VARIANT = "main"
+VARIANT_RUN_KEYS = ("datasets", "methods", "seeds")
 #: Subfolders of ``results/<profile>/``.
 RESULT_SUBDIRS: tuple[str, ...] = ("tables", "figures", "notebooks", "models")
 
@@ -138,8 +150,6 @@ def merge_sections(base: dict, override: dict) -> dict:
 
 
 def _read_profile_file(path: Path) -> dict:
-    import yaml
-
     try:
         cfg = yaml.safe_load(path.read_text(encoding="utf-8"))
     except yaml.YAMLError as exc:
@@ -176,8 +186,9 @@ def profile_chain(profile: str) -> list[Path]:
     return [path for path, _ in _read_chain(profile)]
 
 
-def load_profile(profile: str) -> dict[str, Any]:
-    """Read and validate ``params/<profile>.yaml``.
+def read_profile(profile: str) -> dict[str, Any]:
+    """Read ``params/<profile>.yaml`` and merge its ``base:`` chain; the structure is checked, not the keys' values
+    (:func:`bgfn.profile_schema.load_profile` adds that check: call it where a checked profile is needed).
 
     A profile may name another one as ``base:``; it then holds only what differs: its sections are laid
     over the base's key by key (:func:`merge_sections`), so ``params/quick-heading.yaml`` lists only the
@@ -207,8 +218,8 @@ def load_profile(profile: str) -> dict[str, Any]:
     Raises
     ------
     bgfn.errors.DataError
-        Unknown profile (missing file), unreadable YAML, a missing required key or a wrong type, a key that
-        moved (:data:`MOVED_KEYS`, the message names the new one), a ``base:`` that does not exist or leads
+        Unknown profile (missing file), unreadable YAML, a missing required top-level key or a wrong type of
+        one, a key that moved (:data:`MOVED_KEYS`, the message names the new one), a ``base:`` that does not exist or leads
         back to the profile. The message names the file.
     """
     chain = _read_chain(profile)
@@ -243,13 +254,14 @@ def load_profile(profile: str) -> dict[str, Any]:
             cfg[key] = {}
         if not isinstance(cfg[key], dict):
             raise DataError(path, key, "a mapping (section of keys)", type(cfg[key]).__name__)
-    from bgfn.profile_schema import ProfileError, validate
-
-    try:
-        validate(cfg)
-    except ProfileError as exc:
-        raise DataError(_file_setting(chain, exc.path), exc.path, exc.expected, exc.found) from None
     return copy.deepcopy(cfg)
+
+
+def variant_config(cfg: dict, name: str) -> dict:
+    """The profile ``cfg`` with variant ``name``'s overrides merged over it (:func:`merge_sections`, as a ``base:``
+    chain merges), without the ``variants`` and ``variant_runs`` keys; not checked."""
+    own = {k: v for k, v in cfg.items() if k not in ("variants", "variant_runs")}
+    return merge_sections(own, (cfg.get("variants") or {})[name] or {})
 
 
 def _spread_datasets(datasets) -> dict:
@@ -267,28 +279,10 @@ def _spread_datasets(datasets) -> dict:
     return out
 
 
-def with_overrides(cfg: dict, overrides: dict[str, Any], source: str = "notebook parameters") -> dict:
-    """``cfg`` with the non-None ``overrides`` set, checked against the profile schema like the file itself.
-
-    The notebooks' papermill parameters (``datasets = None`` ... in their ``parameters`` cell) reach the
-    profile through this one function, so a bad parameter fails like a bad profile key.
-
-    Parameters
-    ----------
-    cfg : dict
-        A loaded profile (:func:`load_profile`); not modified.
-    overrides : dict
-        ``{"section.key": value}`` (dotted paths); None values are skipped (None = keep the profile's).
-    source : str
-        Named in the error message instead of a file.
-
-    Raises
-    ------
-    bgfn.errors.DataError
-        ``source``, the key path and the value, as for a profile file.
-    """
-    from bgfn.profile_schema import ProfileError, validate
-
+def set_keys(cfg: dict, overrides: dict[str, Any]) -> dict:
+    """A copy of ``cfg`` with the non-None ``overrides`` (``{"section.key": value}``, dotted paths) set, as YAML would
+    give them (tuples as lists, numpy scalars as numbers); not checked (:func:`bgfn.profile_schema.with_overrides`
+    checks them)."""
     out = copy.deepcopy(cfg)
     for path, value in overrides.items():
         if value is None:
@@ -298,10 +292,6 @@ def with_overrides(cfg: dict, overrides: dict[str, Any], source: str = "notebook
         for k in parents:
             node = node.setdefault(k, {})
         node[key] = _plain(value)
-    try:
-        validate(out)
-    except ProfileError as exc:
-        raise DataError(source, exc.path, exc.expected, exc.found) from None
     return out
 
 
@@ -316,9 +306,10 @@ def _plain(value: Any) -> Any:
     return copy.deepcopy(value)
 
 
-def _file_setting(chain: list[tuple[Path, dict]], path: str) -> Path:
+def file_setting(profile: str, path: str) -> Path:
     """The file of a profile chain that sets ``path`` (a dotted key, ``[i]`` list items ignored): the profile's
     own file when it holds the key, else the nearest base that does; the profile's file when none does."""
+    chain = _read_chain(profile)
     keys = [k for k in path.split("[")[0].split(".") if k]
     for depth in range(len(keys), 0, -1):
         for file, own in chain:
@@ -384,7 +375,7 @@ def run_metadata(profile: str) -> dict[str, Any]:
         without git), ``python`` (``major.minor.micro``) and ``packages`` (name -> version, ``None`` if
         not installed).
     """
-    cfg = load_profile(profile)
+    cfg = read_profile(profile)
     path = profile_path(profile)
     commit = _git("rev-parse", "HEAD")
     status = _git("status", "--porcelain", "--untracked-files=no") if commit else None

@@ -24,6 +24,7 @@ from typing import Sequence
 
 import numpy as np
 import pandas as pd
+import yaml
 
 from bgfn.config import DATA_DIR
 
@@ -134,7 +135,6 @@ def published_values(test: str) -> pd.DataFrame:
 
 def claims() -> dict:
     """``data/paper/claims.yaml``: the percentages and settings the paper states in its text."""
-    import yaml
 
     return yaml.safe_load(CLAIMS_FILE.read_text(encoding="utf-8"))
 

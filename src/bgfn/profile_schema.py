@@ -1,7 +1,9 @@
 """The schema of a profile (``params/<profile>.yaml``): every key, its type and range, checked before anything runs.
 
-:func:`bgfn.config.load_profile` checks the merged profile (a ``base:`` chain included) against
-:data:`SCHEMA` and the cross-field facts of :func:`cross_check`, so every notebook's parameters handling and
+This module is the package's edge, the top of its layers: it may import everything it checks, and nothing of the
+package imports it. :func:`load_profile` reads the merged profile (:func:`bgfn.config.read_profile`, a ``base:``
+chain included) and checks it against :data:`SCHEMA` and the cross-field facts of :func:`cross_check`;
+:func:`with_overrides` does the same for a notebook's parameters. So every notebook's first cell and
 ``make reproduce`` (its ``check-profile`` step, ``python -m bgfn.profile_schema <profile>``) refuse a bad
 profile at once, with one message naming the YAML file that set the key, the key path and the value. Keys
 may be left out (the module that reads a section fills its defaults: ``bgfn.nav.baseline.NAV_DEFAULTS``,
@@ -15,10 +17,24 @@ data are fetched.
 
 from __future__ import annotations
 
+import argparse
 import difflib
 import math
+import re
+import sys
 from dataclasses import dataclass, field
 from typing import Any
+
+from bgfn.config import (MAIN_VARIANT, VARIANT_NAME, VARIANT_RUN_KEYS, file_setting, profile_chain, read_profile,
+                         set_keys, variant_config)
+from bgfn.data import load_drive
+from bgfn.data.names import unique_ids
+from bgfn.errors import DataError
+from bgfn.evaluate import EVALUATE_DEFAULTS, evaluate_config, sweep_plan
+from bgfn.learning import learning_options
+from bgfn.nav.baseline import filter_start
+from bgfn.nav.outages import DEFAULT_KEY, check_windows, is_rule, outage_entry, picked_outages
+from bgfn.paper import METHOD_LABELS
 
 
 class ProfileError(ValueError):
@@ -132,11 +148,9 @@ OUTAGE_WINDOWS = either(OUTAGE_LIST, mapping(either(OUTAGE_LIST, OUTAGE_RULE)))
 VARIANT = section(train=Spec("section", fields=TRAIN.fields))
 VARIANT_RUNS = section(datasets=seq(text(), min_len=1, null=True), methods=seq(text(), min_len=1, null=True),
                        seeds=seq(_SEED, min_len=1))
-#: Variant names: a folder name of ``models/variants/`` (``main`` is the profile itself).
-VARIANT_NAME = r"^[A-Za-z0-9][A-Za-z0-9_-]*$"
-MAIN_VARIANT = "main"
-#: Keys a variant may not set: which networks it trains is ``variant_runs``'s.
-VARIANT_RUN_KEYS = ("datasets", "methods", "seeds")
+# Variant names (a folder name of ``models/variants/``; ``main`` is the profile itself) and the keys a variant may
+# not set (which networks it trains is ``variant_runs``'s): :data:`bgfn.config.VARIANT_NAME`, ``MAIN_VARIANT``,
+# ``VARIANT_RUN_KEYS``.
 
 #: The whole profile.
 SCHEMA = section(
@@ -319,8 +333,6 @@ def _check_outage_entries(cfg: dict) -> None:
                 raise ProfileError(f"{path}.rule", "the name of the rule that picks the windows", "missing")
         else:
             _check_window_list(path, entry, t0, t1)
-    from bgfn.nav.outages import DEFAULT_KEY
-
     spec = cfg.get("outage_windows")
     if isinstance(spec, dict) and DEFAULT_KEY not in spec:      # every dataset a notebook loads needs its outages
         uncovered = [d for d in _profile_datasets(cfg) if d not in spec]
@@ -354,8 +366,6 @@ def cross_check(cfg: dict) -> None:
     if vp is not None and not (vp in ("start", "middle", "end") or (isinstance(vp, (int, float))
                                                                       and not isinstance(vp, bool) and 0 <= vp <= 1)):
         raise ProfileError("train.val_position", "'start', 'middle', 'end' or a fraction in [0, 1]", _fmt(vp))
-    from bgfn.paper import METHOD_LABELS
-
     for key, methods in (("train.methods", tr.get("methods")), ("evaluate.methods", ev.get("methods"))):
         bad = [m for m in methods or [] if m not in METHOD_LABELS]
         if bad:
@@ -372,8 +382,6 @@ def cross_check(cfg: dict) -> None:
     if "folds" in sw and "n_starts" in sw and sw["folds"] > sw["n_starts"]:
         raise ProfileError("evaluate.sweep.folds", f"at most evaluate.sweep.n_starts = {sw['n_starts']}",
                            _fmt(sw["folds"]))
-    from bgfn.evaluate.config import EVALUATE_DEFAULTS
-
     # the oracle runs at the sweep's starts (defaults filled in, as bgfn.evaluate.evaluate_config does)
     o_dur = (ev.get("oracle") or {}).get("durations_s", EVALUATE_DEFAULTS["oracle"]["durations_s"])
     s_dur = sw.get("durations_s") or EVALUATE_DEFAULTS["sweep"]["durations_s"]
@@ -389,21 +397,10 @@ def cross_check(cfg: dict) -> None:
     _check_variants(cfg)          # last: the profile itself passed, so an error here is the variant's
 
 
-def variant_config(cfg: dict, name: str) -> dict:
-    """The profile ``cfg`` with variant ``name``'s overrides merged over it (:func:`bgfn.config.merge_sections`,
-    as a ``base:`` chain merges), without the ``variants`` and ``variant_runs`` keys; not checked."""
-    from bgfn.config import merge_sections
-
-    own = {k: v for k, v in cfg.items() if k not in ("variants", "variant_runs")}
-    return merge_sections(own, (cfg.get("variants") or {})[name] or {})
-
-
 def _check_variants(cfg: dict) -> None:
     """Every variant's name, and the profile it makes checked as a whole profile (:func:`validate`): an error
     is named ``variants.<name>.<key>``; ``variant_runs.methods`` are method ids (notebook 03 trains those of them
     that ``train:`` trains: :meth:`bgfn.train.variants.VariantPlan.of`)."""
-    import re
-
     for name, own in (cfg.get("variants") or {}).items():
         where = f"variants.{name}"
         if not re.match(VARIANT_NAME, str(name)) or name == MAIN_VARIANT:
@@ -417,8 +414,6 @@ def _check_variants(cfg: dict) -> None:
             validate(variant_config(cfg, name))
         except ProfileError as exc:
             raise ProfileError(f"{where}.{exc.path}", exc.expected, exc.found) from None
-    from bgfn.paper import METHOD_LABELS
-
     bad = [m for m in (cfg.get("variant_runs") or {}).get("methods") or [] if m not in METHOD_LABELS]
     if bad:
         raise ProfileError("variant_runs.methods", f"method ids among {', '.join(METHOD_LABELS)}", _fmt(bad))
@@ -428,6 +423,59 @@ def validate(cfg: dict) -> None:
     """:func:`check` the whole profile against :data:`SCHEMA`, then :func:`cross_check`."""
     check(cfg, SCHEMA, "")
     cross_check(cfg)
+
+
+def load_profile(profile: str, overrides: dict[str, Any] | None = None,
+                 source: str = "notebook parameters") -> dict[str, Any]:
+    """``params/<profile>.yaml`` read and merged (:func:`bgfn.config.read_profile`), then checked against the schema;
+    with ``overrides`` (a notebook's parameters, ``{"section.key": value}``, None values skipped) set over it
+    (:func:`with_overrides`, errors naming ``source``).
+
+    Returns
+    -------
+    dict
+        As :func:`bgfn.config.read_profile`: a fresh copy on every call.
+
+    Raises
+    ------
+    bgfn.errors.DataError
+        As :func:`bgfn.config.read_profile`, and a value that breaks the schema or a cross-field fact: the message
+        names the YAML file that set the key (the profile's own or a base), the key path and the value.
+    """
+    cfg = read_profile(profile)
+    try:
+        validate(cfg)
+    except ProfileError as exc:
+        raise DataError(file_setting(profile, exc.path), exc.path, exc.expected, exc.found) from None
+    return with_overrides(cfg, overrides, source) if overrides else cfg
+
+
+def with_overrides(cfg: dict, overrides: dict[str, Any], source: str = "notebook parameters") -> dict:
+    """``cfg`` with the non-None ``overrides`` set (:func:`bgfn.config.set_keys`), checked like the file itself.
+
+    The notebooks' papermill parameters (``datasets = None`` ... in their ``parameters`` cell) reach the
+    profile through this one function, so a bad parameter fails like a bad profile key.
+
+    Parameters
+    ----------
+    cfg : dict
+        A loaded profile (:func:`load_profile`); not modified.
+    overrides : dict
+        ``{"section.key": value}`` (dotted paths); None values are skipped (None = keep the profile's).
+    source : str
+        Named in the error message instead of a file.
+
+    Raises
+    ------
+    bgfn.errors.DataError
+        ``source``, the key path and the value, as for a profile file.
+    """
+    out = set_keys(cfg, overrides)
+    try:
+        validate(out)
+    except ProfileError as exc:
+        raise DataError(source, exc.path, exc.expected, exc.found) from None
+    return out
 
 
 def check_with_drives(profile: str) -> list[str]:
@@ -446,14 +494,6 @@ def check_with_drives(profile: str) -> list[str]:
     bgfn.errors.DataError
         Naming the profile's file and the key.
     """
-    from bgfn.config import load_profile, profile_chain
-    from bgfn.data import load_drive
-    from bgfn.data.names import unique_ids
-    from bgfn.errors import DataError
-    from bgfn.learning import learning_options
-    from bgfn.nav.baseline import filter_start
-    from bgfn.nav.outages import DEFAULT_KEY, check_windows, is_rule, outage_entry, picked_outages
-
     cfg = load_profile(profile)
     path = profile_chain(profile)[0]
     tr, ev = cfg["train"], cfg["evaluate"]
@@ -491,8 +531,6 @@ def check_with_drives(profile: str) -> list[str]:
         how = "picked by the rule" if rule else "inside"
         lines.append(f"{name}: {t0:.2f}..{t1:.2f} s, outages {how} {[list(w) for w in windows]}, "
                      f"window {window_s:g} s")
-    from bgfn.evaluate import evaluate_config, sweep_plan
-
     sw = evaluate_config(ev, tr)["sweep"]
     for name in sw["datasets"]:
         drive = load_drive(name, profile=profile)
@@ -507,11 +545,6 @@ def check_with_drives(profile: str) -> list[str]:
 
 def main(argv=None) -> int:
     """``python -m bgfn.profile_schema <profile>``: check a profile, with its data, before anything runs."""
-    import argparse
-    import sys
-
-    from bgfn.errors import DataError
-
     parser = argparse.ArgumentParser(description=main.__doc__)
     parser.add_argument("profile")
     args = parser.parse_args(argv)

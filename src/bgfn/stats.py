@@ -14,6 +14,7 @@ from __future__ import annotations
 from typing import Callable
 
 import numpy as np
+from scipy.stats import wilcoxon
 
 from bgfn.errors import DataError
 
@@ -75,7 +76,6 @@ def wilcoxon_p(diff) -> float:
 
     Zero differences are dropped (Wilcox's convention); NaN when fewer than one non-zero difference.
     """
-    from scipy.stats import wilcoxon
 
     d = np.asarray(diff, dtype=float)
     d = d[np.isfinite(d)]

@@ -27,13 +27,17 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import yaml
 
 from bgfn.data.csv_meta import META_FILE, read_meta
 from bgfn.data.drive import Drive
+from bgfn.data.imu_errors import OPTIONAL_VECTOR_KEYS, SCALAR_KEYS, VECTOR_KEYS
+from bgfn.data.names import safe_id
 from bgfn.data.navego import check_time
 from bgfn.data.physics import check_drive
 from bgfn.data.regrid import check_gaps, imu_on_grid, interpolate_reference, median_rate_hz
 from bgfn.errors import DataError
+from bgfn.io import atomic_write_csv, atomic_write_text
 from bgfn.schema import GNSS_COLUMNS, GNSS_FIX_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS
 
 #: Reference attitude columns: all three or none.
@@ -144,7 +148,6 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_st
     DataError
         Naming the file and the column (or ``meta.yaml`` and the key).
     """
-    from bgfn.data.names import safe_id
 
     folder = Path(folder)
     if not folder.is_dir():
@@ -201,22 +204,18 @@ def write_csv_drive(drive: Drive, folder: str | Path) -> Path:
     Path
         The folder.
     """
-    import yaml
 
-    from bgfn.io import atomic_write_csv, atomic_write_text
 
     folder = Path(folder)
     ref_cols = [c for c in REFERENCE_COLUMNS if drive.has_attitude or c not in ATTITUDE_COLUMNS]
     atomic_write_csv(folder / "imu.csv", drive.imu[list(IMU_COLUMNS)], float_format="%.17g")
     atomic_write_csv(folder / "gnss.csv", drive.gnss[list(GNSS_COLUMNS)], float_format="%.17g")
     atomic_write_csv(folder / "reference.csv", drive.reference[ref_cols], float_format="%.17g")
-    from bgfn.data.names import safe_id
 
     meta = {"name": safe_id(drive.name), "lever_arm_m": [float(x) for x in drive.meta.get("lever_arm_m", [0, 0, 0])],
             "source": str(drive.meta.get("source", ""))}
     errs = drive.meta.get("imu_errors")
     if errs:
-        from bgfn.data.imu_errors import OPTIONAL_VECTOR_KEYS, SCALAR_KEYS, VECTOR_KEYS
 
         meta["imu_errors"] = {k: errs[k] for k in VECTOR_KEYS + OPTIONAL_VECTOR_KEYS + SCALAR_KEYS + ("model",) if k in errs}
     atomic_write_text(folder / META_FILE, yaml.safe_dump(meta, sort_keys=True))

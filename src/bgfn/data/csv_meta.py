@@ -27,15 +27,20 @@ the key and the closest valid key: a misspelt noise density never silently becom
 from __future__ import annotations
 
 import difflib
+import re
 from pathlib import Path
 
 import numpy as np
+import yaml
 
 from bgfn.data.imu_errors import OPTIONAL_VECTOR_KEYS, PROFILES, SCALAR_KEYS, VECTOR_KEYS, error_params
 from bgfn.errors import DataError
 
 #: The file name inside a CSV drive's folder.
 META_FILE = "meta.yaml"
+#: A dataset id (a meta file's ``name``, and every id :func:`bgfn.data.names.dataset_id` gives): letters, digits,
+#: ``_``, ``-`` and ``.``, starting with a letter or digit.
+ID_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 #: Error profile of :mod:`bgfn.data.imu_errors` used when ``meta.yaml`` gives no ``imu_errors`` (or no ``base``).
 DEFAULT_IMU_PROFILE = "mpu6000"
 #: Top-level keys of ``meta.yaml``.
@@ -54,7 +59,6 @@ def _unknown_key(path: Path, key, valid, prefix: str = "") -> DataError:
 
 def _load(path: Path) -> dict:
     """The parsed YAML mapping of ``path`` ({} for an empty file)."""
-    import yaml
 
     try:
         meta = yaml.safe_load(path.read_text(encoding="utf-8"))
@@ -71,7 +75,6 @@ def _load(path: Path) -> dict:
 
 
 def _checked_name(path: Path, meta: dict) -> str | None:
-    from bgfn.data.names import ID_PATTERN
 
     name = meta.get("name")
     if name is None:

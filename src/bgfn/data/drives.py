@@ -36,7 +36,9 @@ from typing import Callable
 
 import numpy as np
 import pandas as pd
+from scipy.interpolate import CubicSpline
 
+from bgfn.config import PROJECT_ROOT, profile_path, read_profile
 from bgfn.data import acquire
 from bgfn.data.csv_drive import CSV_FILES, TABLE_OF, load_csv_drive
 from bgfn.data.drive import Drive, load_cached, prune_stale, save_drive
@@ -44,50 +46,23 @@ from bgfn.data.gnss import decimate, degrade_fixes, fix_errors, imu_position, si
 from bgfn.data.imu_errors import MPU6000, apply_imu_errors, error_params
 from bgfn.data.names import dataset_folder
 from bgfn.data.navego import read_gnss, read_imu, read_reference, resample_imu
-from bgfn.data.rtklib import LEVER_ARM_M as RTKLIB_LEVER_ARM_M
-from bgfn.data.rtklib import IMU_TIME_OFFSET_S, Q_FIX, quality_spans, read_imu_csv, read_pos, read_tag
+from bgfn.data.registry import COMMON_PARAMS, DATASETS, DEFAULT_DATASET
+from bgfn.data.rtklib import LEVER_ARM_M as RTKLIB_LEVER_ARM_M, Q_FIX, quality_spans, read_imu_csv, read_pos, read_tag
 from bgfn.data.trajectory import smooth_reference
 from bgfn.errors import DataError
 from bgfn.nav.earth import curvature_radii
 from bgfn.nav.metrics import REFERENCE_EXCLUDED_KEY
+from bgfn.nav.sim import imu_from_trajectory
 from bgfn.schema import ATTITUDE_COLUMNS, REFERENCE_COLUMNS
 
 log = logging.getLogger(__name__)
 
-#: Default dataset (the paper's dataset test).
-DEFAULT_DATASET = "turin-sim-ekinox"
-#: Antenna lever arm NaveGo uses with the MPU-6000 (body frame, m).
-MPU_LEVER_ARM_M = [-0.369, 0.0, -0.219]
-
-_COMMON = {
-    "seed": 0,                     # seed of every random draw
-    "imu_rate_hz": 100.0,          # IMU / truth rate, Hz
-    "smoothing_degree": 5,         # truth spline degree
-    "position_sigma_m": 0.05,      # truth smoothing of north/east/up, m (s = n sigma^2)
-    "attitude_sigma_rad": 0.002,   # truth smoothing of roll/pitch/yaw, rad
-    "t_start": None,               # crop, s (GPS time of week); applied after the cache
-    "t_end": None,
-}
-
-#: The simulated u-blox-like receiver (turin-sim-mpu6000), also the degraded copy of the RTK solution.
-_UBLOX = {"gnss_rate_hz": 1.0, "gnss_white_std_m": [0.3, 0.3, 0.6], "gnss_correlated_std_m": [1.0, 1.0, 2.0],
-          "gnss_correlated_tau_s": 60.0}
-
-#: Parameters of each dataset (defaults). ``imu_errors`` holds overrides of the error profile's keys.
-DATASETS: dict[str, dict] = {
-    "turin-sim-ekinox": {**_COMMON, "gnss_rate_hz": 5.0, "imu_errors": {}},
-    "turin-sim-mpu6000": {**_COMMON, **_UBLOX, "imu_errors": {}, "lever_arm_m": MPU_LEVER_ARM_M},
-    "navego-ekinox": {**_COMMON, "gnss_rate_hz": 5.0},
-    "navego-mpu6000": {**_COMMON, "gnss_rate_hz": 5.0, "lever_arm_m": MPU_LEVER_ARM_M},
-    "rtklib-drive0708": {"seed": 0, "imu_rate_hz": 100.0, **_UBLOX, "imu_errors": {},
-                         "imu_time_offset_s": IMU_TIME_OFFSET_S, "t_start": None, "t_end": None},
-}
 #: Datasets with a clock of their own: the ``data:`` section's common ``t_start``/``t_end`` (the Turin drive's
 #: GPS time of week) do not crop them; their own section may.
 OWN_CLOCK = ("rtklib-drive0708",)
 _NOT_IN_KEY = ("t_start", "t_end")
 #: Modules whose source is hashed into the cache key.
-_KEY_MODULES = ("acquire", "navego", "rtklib", "trajectory", "imu_errors", "gnss", "drive", "drives")
+_KEY_MODULES = ("acquire", "navego", "rtklib", "trajectory", "imu_errors", "gnss", "drive", "drives", "registry")
 
 
 def substream_seed(seed: int, stream: int) -> int:
@@ -124,13 +99,12 @@ def profile_overrides(name: str, profile: str) -> dict:
     dict
         Overrides for :func:`dataset_params` (unknown per-dataset keys raise there).
     """
-    from bgfn.config import load_profile, profile_path
 
-    cfg = load_profile(profile)
+    cfg = read_profile(profile)
     data = cfg["data"]
     out = {"seed": data.get("seed", cfg["seed"])}
     own = DATASETS.get(name, {})
-    out.update({k: data[k] for k in _COMMON if k in data and k != "seed" and k in own
+    out.update({k: data[k] for k in COMMON_PARAMS if k in data and k != "seed" and k in own
                 and not (k in _NOT_IN_KEY and name in OWN_CLOCK)})
     section = data.get(name) or {}
     if not isinstance(section, dict):
@@ -181,7 +155,6 @@ def _speed(truth: pd.DataFrame) -> np.ndarray:
 
 
 def _build_sim(name: str, p: dict, paths: dict) -> Drive:
-    from bgfn.nav.sim import imu_from_trajectory
 
     ref = read_reference(paths["ref.mat"])
     truth, fit = _truth(ref, p)
@@ -256,7 +229,6 @@ def _rtk_reference(fixed: pd.DataFrame, grid: np.ndarray) -> pd.DataFrame:
     positions (its std is ``sqrt(2)`` times the position std over 0.25 s, and it matches the positions' central
     difference 0.125 s earlier), i.e. the mean velocity of the past interval, late by half an epoch.
     """
-    from scipy.interpolate import CubicSpline
 
     t = fixed["time"].to_numpy(float)
     splines = {c: CubicSpline(t, fixed[c].to_numpy(float)) for c in ("lat", "lon", "h")}
@@ -354,9 +326,8 @@ def _load_folder(folder: Path, profile: str | None, overrides: dict) -> Drive:
         raise DataError(folder, extra[0], f"a parameter of a CSV drive: {', '.join(CSV_PARAMS)}", "unknown parameter")
     params = {}
     if profile is not None:
-        from bgfn.config import load_profile
 
-        data = load_profile(profile)["data"]
+        data = read_profile(profile)["data"]
         params = {k: data[k] for k in CSV_PARAMS if data.get(k) is not None}
     params.update({k: v for k, v in overrides.items() if v is not None})
     files = {TABLE_OF[f]: str(folder / f) for f in CSV_FILES}
@@ -408,7 +379,6 @@ def load_drive(name: str | Path = DEFAULT_DATASET, *, profile: str | None = None
     if folder is not None:
         return _load_folder(folder, profile, overrides)
     if name not in DATASETS:
-        from bgfn.config import PROJECT_ROOT
 
         if isinstance(name, Path) or "/" in str(name) or "\\" in str(name):
             raise DataError(name, "folder", f"a folder with {', '.join(CSV_FILES)} (a relative path is taken from "

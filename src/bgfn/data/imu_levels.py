@@ -25,6 +25,7 @@ accelerometers with gravity (:func:`rest_biases`).
 
 from __future__ import annotations
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 from scipy import signal
@@ -272,7 +273,6 @@ def plot_imu_psd(psds: dict):
     psds : dict
         ``{label: imu_psd(...)}``.
     """
-    import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.6), constrained_layout=True)
     for ax, (sensor, cols) in zip(axes, SENSORS.items()):

@@ -25,18 +25,18 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from bgfn.config import PROJECT_ROOT
+from bgfn.data.csv_meta import ID_PATTERN, META_FILE, read_meta_name
+from bgfn.data.registry import DATASETS
 from bgfn.errors import DataError
 
-#: A dataset id: letters, digits, ``_``, ``-`` and ``.``, starting with a letter or digit.
-ID_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 _UNSAFE = re.compile(r"[^A-Za-z0-9_.-]+")
 #: The id of a folder whose name has no safe character at all.
 FALLBACK_ID = "drive"
 
 
 def registered(name) -> bool:
-    """True when ``name`` is a dataset of :data:`bgfn.data.drives.DATASETS`."""
-    from bgfn.data.drives import DATASETS
+    """True when ``name`` is a dataset of :data:`bgfn.data.registry.DATASETS`."""
 
     return isinstance(name, str) and name in DATASETS
 
@@ -52,7 +52,6 @@ def dataset_folder(name: str | Path) -> Path | None:
     path = Path(str(name)).expanduser()
     if path.is_absolute():
         return path if path.is_dir() else None
-    from bgfn.config import PROJECT_ROOT
 
     for base in (PROJECT_ROOT, Path.cwd()):
         if (base / path).is_dir():
@@ -89,7 +88,6 @@ def dataset_id(name: str | Path) -> str:
         return str(name)
     folder = dataset_folder(name)
     if folder is not None:
-        from bgfn.data.csv_meta import META_FILE, read_meta_name
 
         meta_name = read_meta_name(folder / META_FILE)
         return meta_name if meta_name is not None else safe_id(folder.name)

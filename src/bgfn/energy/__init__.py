@@ -20,37 +20,32 @@ builds on) uses. Per prediction (one window)::
 
 Modules, one concept each (every public name is also importable from ``bgfn.energy``):
 
-* :mod:`~bgfn.energy.costs` -- energy per MAC and per SOP (Horowitz 2014), ``E`` from the counts;
-* :mod:`~bgfn.energy.passes` -- forward passes over the windows with hooks; spikes vs real values;
-* :mod:`~bgfn.energy.rates` -- firing rates of the LIF layers;
-* :mod:`~bgfn.energy.rules` -- the counting rule of every block kind (encoder, embedding, SSA, MLP, head, twin);
-* :mod:`~bgfn.energy.residual` -- the spike trains merged by the residual stream;
-* :mod:`~bgfn.energy.counts` -- :class:`LayerCount` and :func:`layer_counts`, MACs/SOPs per layer;
-* :mod:`~bgfn.energy.tables` -- energy per layer, totals, reduction against the twin;
-* :mod:`~bgfn.energy.sweeps` -- reduction vs firing rate and vs ``T_s``;
-* :mod:`~bgfn.energy.folding` -- BatchNorm folding;
+* :mod:`~bgfn.energy.passes` -- forward passes over the windows in inference form (BatchNorm folded); spikes vs
+  real values;
+* :mod:`~bgfn.energy.rules` -- the 45 nm costs (energy per MAC and per AC, Horowitz 2014), the residual stream of
+  the spiking blocks, the counting rule of every block kind (encoder, embedding, SSA, MLP, head, twin);
+* :mod:`~bgfn.energy.counts` -- counting operations: :class:`LayerCount` and :func:`layer_counts` (MACs/SOPs per
+  layer), the firing rates of the LIF layers, the reduction vs firing rate and vs ``T_s``;
+* :mod:`~bgfn.energy.checkpoint` -- the audit of what is measured: which trained networks, on which windows;
 * :mod:`~bgfn.energy.crosscheck` -- SpikingJelly 2.0's operation counter on the same spikes;
-* :mod:`~bgfn.energy.checkpoint`, :mod:`~bgfn.energy.windows` -- which trained networks, on which windows;
-* :mod:`~bgfn.energy.plots`, :mod:`~bgfn.energy.bench`, :mod:`~bgfn.energy.summary` -- notebook 05's
-  figures, speed table and ``energy.json``.
+* :mod:`~bgfn.energy.tables` -- energy per layer, totals, reduction against the twin, the measured CPU speed beside
+  them;
+* :mod:`~bgfn.energy.record` -- ``energy.json``, what notebook 05 hands to the results page;
+* :mod:`~bgfn.energy.plots` -- notebook 05's figures.
 """
 
-from bgfn.energy.bench import speed_notes, speed_table
-from bgfn.energy.checkpoint import MEASURED, MeasuredModels, energy_checkpoint, load_measured
-from bgfn.energy.costs import E_AC_PJ, E_MAC_PJ, energy_uj
-from bgfn.energy.counts import LayerCount, layer_counts, mean_rate, with_rates
+from bgfn.energy.checkpoint import (MEASURED, EvaluationWindows, MeasuredModels, energy_checkpoint, evaluation_windows,
+                                    load_measured, window_indices)
+from bgfn.energy.counts import (LayerCount, break_even_note, layer_counts, mean_rate, measure_firing_rates, rates_table,
+                                reduction_vs_rate, reduction_vs_time_steps, same_size_builder, with_rates)
 from bgfn.energy.crosscheck import Crosscheck, compare_with_spikingjelly, spikingjelly_counts
-from bgfn.energy.folding import fold_batchnorm
-from bgfn.energy.passes import is_spike_count
+from bgfn.energy.passes import fold_batchnorm, is_spike_count
 from bgfn.energy.plots import plot_energy_per_layer, plot_firing_rates, plot_sweeps
-from bgfn.energy.rates import measure_firing_rates, rates_table
-from bgfn.energy.rules import softmax_attention_macs, ssa_dense_ops, ssa_sops
-from bgfn.energy.summary import energy_summary, result_markdown
-from bgfn.energy.sweeps import break_even_note, reduction_vs_rate, reduction_vs_time_steps, same_size_builder
-from bgfn.energy.tables import (COLUMNS, EnergyTotals, attention_energy_uj, energy_table, energy_totals,
-                                model_name, reduction_pct, stack_tables, table_from_counts, total_energy_uj,
-                                with_input_trains)
-from bgfn.energy.windows import EvaluationWindows, evaluation_windows, window_indices
+from bgfn.energy.record import energy_summary, result_markdown
+from bgfn.energy.rules import E_AC_PJ, E_MAC_PJ, energy_uj, softmax_attention_macs, ssa_dense_ops, ssa_sops
+from bgfn.energy.tables import (COLUMNS, EnergyTotals, attention_energy_uj, energy_table, energy_totals, model_name,
+                                reduction_pct, speed_notes, speed_table, stack_tables, table_from_counts,
+                                total_energy_uj, with_input_trains)
 
 __all__ = [
     "E_AC_PJ", "E_MAC_PJ", "COLUMNS", "MEASURED",

@@ -1,14 +1,5 @@
-"""Which trained networks the energy estimate measures: BGFN and its Transformer twin of one dataset and seed.
-
-The firing rates, hence the SOPs, are those of a *trained* BGFN; the twin's MACs do not depend on its weights,
-but loading its checkpoint of the same run proves it was trained on the same windows. The dataset is the
-profile's ``energy.dataset`` (default: the first of ``train.datasets`` whose BGFN improved on its initial
-network for at least one seed, :func:`energy_dataset`); the seed is ``energy.seed`` or, by
-default, the seed whose BGFN has the median validation error among the seeds of ``train.seeds`` whose training
-improved on the initial network (a representative trained network, not the luckiest or the first; among all
-seeds when none did). A BGFN whose best epoch is 0 -- epoch 0 is the initial network, so training never
-improved on it and its firing rates are those of an untrained network -- is refused unless the profile says
-``energy.allow_untrained: true`` (the smoke profile, whose numbers mean nothing).
+"""The checkpoint audit: which trained networks the energy estimate measures (BGFN and its Transformer twin of
+one dataset and seed) and on which evaluation windows (BGFN's validation windows, evenly subsampled).
 """
 
 from __future__ import annotations
@@ -17,21 +8,29 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 from torch import nn
 
-from bgfn.checkpoints import card_path, checkpoint_path, parse_checkpoint
-from bgfn.config import PROJECT_ROOT, load_profile
-from bgfn.train import TrainedModel, load_trained
+from bgfn.config import PROJECT_ROOT, read_profile
+from bgfn.errors import DataError
+from bgfn.learning import WindowSet
+from bgfn.train import TrainedModel, even_subset, load_trained, prepare_learning_data
+from bgfn.train.checkpoints import card_path, checkpoint_path, parse_checkpoint
 
+# ---------------------------------------------------------------------------------------------------
+# Which trained networks the energy estimate measures: BGFN and its Transformer twin of one dataset and seed.
+# ---------------------------------------------------------------------------------------------------
 #: The networks compared: the SNN and its ANN twin (method ids of :data:`bgfn.models.MODELS`).
 MEASURED = ("bgfn", "transformer")
+
+
 #: The networks whose energy depends on training (their firing rates): refused untrained (:func:`check_trained`).
 SPIKING: tuple[str, ...] = ("bgfn",)
 
 
 def energy_checkpoint(profile: str, method: str, cfg: dict | None = None, dataset: str | None = None,
                       seed: int | None = None, must_exist: bool = True) -> Path:
-    """The checkpoint of the energy estimate (:func:`bgfn.checkpoints.checkpoint_path`).
+    """The checkpoint of the energy estimate (:func:`bgfn.train.checkpoints.checkpoint_path`).
 
     ``dataset``/``seed`` default to the profile's ``energy.dataset``/``energy.seed`` and, when those are
     null, to :func:`energy_dataset` and to :func:`median_seed` over ``train.seeds``.
@@ -41,7 +40,7 @@ def energy_checkpoint(profile: str, method: str, cfg: dict | None = None, datase
     FileNotFoundError
         The checkpoint is missing (``must_exist``); the message names the file and the notebook that writes it.
     """
-    cfg = cfg if cfg is not None else load_profile(profile)
+    cfg = cfg if cfg is not None else read_profile(profile)
     ecfg, tcfg = cfg.get("energy") or {}, cfg.get("train") or {}
     dataset = dataset or ecfg.get("dataset") or energy_dataset(profile, tcfg)
     if dataset is None:
@@ -52,7 +51,7 @@ def energy_checkpoint(profile: str, method: str, cfg: dict | None = None, datase
     if must_exist and not path.is_file():
         raise FileNotFoundError(
             f"trained {method} model not found: {path} -- notebook 03_bgfn_training.ipynb writes it "
-            f"(run `make reproduce PROFILE={profile}`, or `python -m bgfn.train --profile {profile} "
+            f"(run `make reproduce PROFILE={profile}`, or `python -m bgfn train --profile {profile} "
             f"--dataset {dataset} --method {method} --seed {int(seed)}`)")
     return path
 
@@ -99,7 +98,6 @@ def check_trained(card: dict, card_file: str | Path, allow_untrained: bool = Fal
     bgfn.errors.DataError
         Naming the card, unless ``allow_untrained`` (``energy.allow_untrained`` of the profile).
     """
-    from bgfn.errors import DataError
 
     if not allow_untrained and int(card.get("best_epoch", 1)) < 1:
         raise DataError(card_file, "best_epoch", "a network that training improved on its initial weights (best epoch >= 1; "
@@ -116,7 +114,7 @@ class MeasuredModels:
     ----------
     profile, dataset : str
     seed : int
-        Training seed, read back from the checkpoint name (:func:`bgfn.checkpoints.parse_checkpoint`).
+        Training seed, read back from the checkpoint name (:func:`bgfn.train.checkpoints.parse_checkpoint`).
     paths : dict
         Method -> best checkpoint.
     trained : dict
@@ -175,10 +173,65 @@ def load_measured(profile: str, cfg: dict | None = None, methods=MEASURED) -> Me
     for t in trained.values():
         t.model.eval()
     cards = {m: json.loads(card_path(p).read_text()) if card_path(p).exists() else {} for m, p in paths.items()}
-    cfg = cfg if cfg is not None else load_profile(profile)
+    cfg = cfg if cfg is not None else read_profile(profile)
     allow = bool((cfg.get("energy") or {}).get("allow_untrained", False))
     for m in methods:
         if m in SPIKING:        # firing rates depend on the weights; the twin's MAC count does not
             check_trained(cards[m], card_path(paths[m]), allow)
     first = paths[methods[0]]
     return MeasuredModels(profile, first.parent.name, parse_checkpoint(first).seed, paths, trained, cards)
+
+
+# ---------------------------------------------------------------------------------------------------
+# The evaluation windows that give the firing rates: BGFN's validation windows, evenly subsampled.
+# ---------------------------------------------------------------------------------------------------
+def window_indices(n_windows: int, max_windows: int | None) -> np.ndarray:
+    """Indices of the evaluation windows among ``n_windows``: ``max_windows`` evenly spaced ones, all when
+    ``max_windows`` is null or 0 (``energy.max_windows``)."""
+    return even_subset(n_windows, int(max_windows) if max_windows else None)
+
+
+@dataclass
+class EvaluationWindows:
+    """The windows measured, raw and as each network reads them.
+
+    Attributes
+    ----------
+    windows : WindowSet
+        The selected validation windows (raw units).
+    x : dict
+        Method -> normalized windows, float32 [M, N, C].
+    n_validation : int
+        Validation windows before the subsampling.
+    """
+
+    windows: WindowSet
+    x: dict[str, np.ndarray]
+    n_validation: int
+
+    def line(self, dataset: str, time_steps: int) -> str:
+        """How many windows, of what shape, from when."""
+        ws = self.windows
+        return (f"{dataset}: {len(ws)} of {self.n_validation} validation windows, {ws.x.shape[1]} IMU samples x "
+                f"{ws.x.shape[2]} channels, t = {ws.t_end.min():.0f} .. {ws.t_end.max():.0f} s (GPS time of "
+                f"week); T_s = {time_steps}")
+
+
+def evaluation_windows(cfg: dict, measured: MeasuredModels) -> EvaluationWindows:
+    """The validation windows of ``measured.dataset``, subsampled and normalized per network.
+
+    Raises
+    ------
+    DataError
+        A network was trained with other learning options than the profile's (retrain with notebook 03).
+    """
+    data = prepare_learning_data(cfg, measured.dataset)
+    for m, tm in measured.trained.items():
+        if dict(tm.options) != dict(data.options):
+            raise DataError(measured.paths[m], "options",
+                            f"the learning options of params/{measured.profile}.yaml {data.options}",
+                            f"{tm.options} (retrain with notebook 03)")
+    n_val = len(data.val)
+    ws = data.val.subset(window_indices(n_val, (cfg.get("energy") or {}).get("max_windows")))
+    x = {m: tm.norm.x(ws.x).astype(np.float32) for m, tm in measured.trained.items()}
+    return EvaluationWindows(ws, x, n_val)

@@ -1,25 +1,28 @@
-"""MACs and SOPs of every counted layer, per prediction: :class:`LayerCount` and :func:`layer_counts`.
-
-:func:`layer_counts` runs a model over the evaluation windows with the hooks of :mod:`bgfn.energy.rules` (one
-rule per block kind) and turns their sums into one :class:`LayerCount` per layer. :func:`with_rates` puts the
-measured rates of one model on the shapes of another (the analytic sweeps), :func:`mean_rate` summarizes
-them.
+"""Counting operations: MACs and SOPs of every counted layer per prediction (:class:`LayerCount`), the firing
+rates of the LIF layers on the evaluation windows, and the analytic sweeps over the mean rate and T_s.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Callable
 
+import numpy as np
+import pandas as pd
 import torch
 from torch import nn
 
-from bgfn.energy.passes import is_spiking_model, run_batches
-from bgfn.energy.rules import (COUNTED, LayerSums, Tally, check_supported, count_linear_or_conv,
+from bgfn.energy.passes import SPIKE_MODULES, is_spiking_model, run_batches
+from bgfn.energy.rules import (COUNTED, E_AC_PJ, E_MAC_PJ, LayerSums, Tally, check_supported, count_linear_or_conv,
                                count_softmax_attention, count_spiking_self_attention, ssa_dense_ops, ssa_sops)
+from bgfn.models import build_model
 from bgfn.models.baselines import TwinBlock
 from bgfn.models.bgfn import SSA, Block
 
 
+# ---------------------------------------------------------------------------------------------------
+# MACs and SOPs of every counted layer, per prediction: :class:`LayerCount` and :func:`layer_counts`.
+# ---------------------------------------------------------------------------------------------------
 @dataclass
 class LayerCount:
     """Operations of one layer, per prediction (one window).
@@ -170,3 +173,138 @@ def mean_rate(counts: list[LayerCount]) -> float:
     """Effective mean input rate of the spike-driven layers: ``sum(sops) / sum(trains * dense)``."""
     dense = sum(c.trains * c.dense for c in counts if c.spiking)
     return sum(c.sops for c in counts if c.spiking) / dense if dense else float("nan")
+
+
+# ---------------------------------------------------------------------------------------------------
+# Firing rates of BGFN's spiking (LIF) layers on the evaluation windows.
+# ---------------------------------------------------------------------------------------------------
+@torch.no_grad()
+def measure_firing_rates(model: nn.Module, windows, batch_size: int = 32) -> dict[str, float]:
+    """Firing rate of every spiking (LIF) layer: fraction of ones of its output over all windows.
+
+    Parameters
+    ----------
+    model : nn.Module
+        A spiking model (its LIF layers are SpikingJelly ``BaseNode`` subclasses); evaluated in eval mode.
+    windows : array [M, N, C] or WindowSet-like (``.x``)
+        Normalized input windows (the evaluation windows).
+    batch_size : int
+        Windows per forward pass; membrane potentials are reset between batches.
+
+    Returns
+    -------
+    dict
+        Module path (``'blocks.0.attn.q.lif'``) -> rate in [0, 1] = spikes / (T * B * neurons), pooled over
+        all windows, in execution order.
+    """
+    sums: dict[str, float] = {}
+    counts: dict[str, int] = {}
+
+    def hook(name):
+        def fn(_mod, _inp, out):                 # out: spikes [T, B, ...]
+            out = out.detach()
+            sums[name] = sums.get(name, 0.0) + float(out.double().sum())
+            counts[name] = counts.get(name, 0) + out.numel()
+        return fn
+
+    hooks = [mod.register_forward_hook(hook(name)) for name, mod in model.named_modules()
+             if isinstance(mod, SPIKE_MODULES)]
+    if not hooks:
+        raise ValueError(f"{type(model).__name__} has no spiking (SpikingJelly neuron) layer")
+    run_batches(model, windows, batch_size, hooks)
+    return {k: sums[k] / counts[k] for k in sums}
+
+
+def rates_table(rates: dict[str, float]) -> pd.DataFrame:
+    """:func:`measure_firing_rates` as a one-column table ``firing_rate`` indexed by ``LIF layer``."""
+    return pd.Series(rates, name="firing_rate").rename_axis("LIF layer").to_frame()
+
+
+# ---------------------------------------------------------------------------------------------------
+# Analytic sweeps around the trained model: the reduction against the twin as a function of the mean firing
+# ---------------------------------------------------------------------------------------------------
+def _energy_pj(counts: list[LayerCount], e_mac: float, e_ac: float) -> float:
+    """Energy per prediction, pJ: the per-layer energies summed."""
+    return sum(e_mac * c.macs + e_ac * c.sops for c in counts)
+
+
+def reduction_vs_rate(snn_counts: list[LayerCount], ann_counts: list[LayerCount], rates,
+                      e_mac: float = E_MAC_PJ, e_ac: float = E_AC_PJ) -> pd.DataFrame:
+    """Reduction (%) if every spike rate of the SNN were scaled so that the mean rate is ``r`` (analytic).
+
+    ``E_snn(r) = e_mac * MACs + e_ac * r * sum(trains * dense)`` (all SOP terms, the SSA's included, are
+    linear in a common rate scale). Returns ``mean_firing_rate, energy_uj, reduction_pct``; ``break_even_rate`` (the
+    rate at which the SNN costs as much as the ANN) is in ``.attrs``.
+    """
+    macs = sum(c.macs for c in snn_counts)
+    dense = sum(c.trains * c.dense for c in snn_counts if c.spiking)
+    e_ann = _energy_pj(ann_counts, e_mac, e_ac)
+    r = np.asarray(rates, float)
+    e = e_mac * macs + e_ac * r * dense
+    df = pd.DataFrame({"mean_firing_rate": r, "energy_uj": e * 1e-6, "reduction_pct": 100.0 * (1.0 - e / e_ann)})
+    df.attrs["break_even_rate"] = (e_ann - e_mac * macs) / (e_ac * dense) if dense else float("nan")
+    return df
+
+
+def break_even_note(rate: float) -> str:
+    """One sentence on the break-even mean firing rate of :func:`reduction_vs_rate`."""
+    return (f"break-even mean firing rate: {rate:.3f} "
+            + ("(above 1: BGFN stays cheaper at any firing rate)" if rate > 1
+               else "(BGFN costs more than the twin above it)"))
+
+
+def same_size_builder(size_cfgs: dict[str, dict], in_channels: int, seed: int = 0,
+                      methods: tuple[str, str] = ("bgfn", "transformer")
+                      ) -> Callable[[int], tuple[nn.Module, nn.Module]]:
+    """``build(T_s) -> (snn, ann)``: untrained models of the trained sizes with ``T_s`` time steps.
+
+    Parameters
+    ----------
+    size_cfgs : dict
+        Method -> size configuration of the trained model (``TrainedModel.size_cfg``).
+    in_channels : int
+        Input channels per IMU sample.
+    seed : int
+        Torch seed set before building (the weights do not matter for the counts, only the shapes).
+    methods : (str, str)
+        The SNN and the ANN method ids.
+    """
+    def build(ts: int):
+        torch.manual_seed(seed)
+        return tuple(build_model(m, {**size_cfgs[m], "time_steps": ts}, in_channels=in_channels) for m in methods)
+
+    return build
+
+
+def reduction_vs_time_steps(build: Callable[[int], tuple[nn.Module, nn.Module]], windows,
+                            rates_from: list[LayerCount], time_steps, e_mac: float = E_MAC_PJ,
+                            e_ac: float = E_AC_PJ) -> pd.DataFrame:
+    """Reduction (%) as a function of ``T_s``, with the trained model's per-layer spike rates held fixed.
+
+    Parameters
+    ----------
+    build : callable
+        ``build(T_s) -> (snn, ann)``: untrained models of the same size with ``T_s`` time steps (only their
+        shapes are used; :func:`same_size_builder`).
+    windows : array [M, N, C]
+        A few windows (shapes only; one is enough).
+    rates_from : list of LayerCount
+        :func:`bgfn.energy.counts.layer_counts` of the trained SNN (its input rates, by layer name).
+    time_steps : iterable of int
+    e_mac, e_ac : float
+        Energy per MAC and per accumulate, pJ.
+
+    Returns
+    -------
+    DataFrame
+        ``time_steps, snn_energy_uj, ann_energy_uj, reduction_pct``.
+    """
+    out = []
+    for ts in time_steps:
+        snn, ann = build(int(ts))
+        s = with_rates(layer_counts(snn, windows), rates_from)
+        a = layer_counts(ann, windows)
+        es, ea = _energy_pj(s, e_mac, e_ac), _energy_pj(a, e_mac, e_ac)
+        out.append({"time_steps": int(ts), "snn_energy_uj": es * 1e-6, "ann_energy_uj": ea * 1e-6,
+                    "reduction_pct": 100.0 * (1.0 - es / ea)})
+    return pd.DataFrame(out)

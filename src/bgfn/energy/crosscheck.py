@@ -3,7 +3,7 @@
 SpikingJelly's counters intercept every aten matmul/convolution of a forward pass (compute only: no memory
 term; its ``ACCounter`` is not used because it also counts the additions of LIF updates and residuals, which
 the convention of :mod:`bgfn.energy.rules` leaves out). Both models are counted with their BatchNorms folded
-(:mod:`bgfn.energy.folding`) and the twin's attention on PyTorch's math kernel so that its matmuls are visible.
+(:mod:`bgfn.energy.passes`) and the twin's attention on PyTorch's math kernel so that its matmuls are visible.
 SpikingJelly counts an operand as spikes only when it is binary; :func:`_sj_rules` extends it to spike counts
 (the residual stream) through its ``extra_rules``. Its count of the SSA products is exact (nonzero products)
 where Spikformer's formula uses the sparser operand's rate: :func:`compare_with_spikingjelly` reports both
@@ -21,10 +21,9 @@ from spikingjelly.activation_based.op_counter import DispatchCounterMode, MACCou
 from torch import nn
 from torch.nn.attention import SDPBackend, sdpa_kernel
 
-from bgfn.energy.costs import E_AC_PJ, E_MAC_PJ, energy_uj
 from bgfn.energy.counts import layer_counts
-from bgfn.energy.folding import fold_batchnorm
-from bgfn.energy.passes import is_binary, is_spike_count, is_spiking_model, run_batches
+from bgfn.energy.passes import fold_batchnorm, is_binary, is_spike_count, is_spiking_model, run_batches
+from bgfn.energy.rules import E_AC_PJ, E_MAC_PJ, energy_uj
 from bgfn.energy.tables import reduction_pct, table_from_counts, total_energy_uj
 
 

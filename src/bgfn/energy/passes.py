@@ -1,20 +1,48 @@
-"""Forward passes over the evaluation windows, as every energy measurement runs them.
-
-Firing rates (:mod:`bgfn.energy.rates`), operation counts (:mod:`bgfn.energy.counts`) and the SpikingJelly
-cross-check (:mod:`bgfn.energy.crosscheck`) all read a model through hooks while it runs over the windows in
-batches; this module is that loop (eval mode, membranes reset between batches, hooks removed afterwards) and
-the test that tells spikes from real values.
+"""Forward passes over the evaluation windows in the network's inference form (BatchNorm folded), as every
+energy measurement runs them; the spike predicates the counting rules test.
 """
 
 from __future__ import annotations
 
+import copy
 from typing import Callable, Iterable
 
 import numpy as np
 import torch
 from spikingjelly.activation_based import functional, neuron
 from torch import nn
+from torch.nn.utils.fusion import fuse_conv_bn_eval, fuse_linear_bn_eval
 
+
+# ---------------------------------------------------------------------------------------------------
+# BatchNorm folding: the inference form of a network, in which BatchNorm costs nothing.
+# ---------------------------------------------------------------------------------------------------
+def fold_batchnorm(model: nn.Module) -> nn.Module:
+    """A copy of ``model`` (eval mode) with every BatchNorm folded into the Linear/Conv registered just before it.
+
+    ``W' = W * g / sqrt(var + eps)``, ``b' = (b - mean) * g / sqrt(var + eps) + beta`` (exact at inference);
+    the BatchNorm is replaced by ``nn.Identity``. A BatchNorm without such a predecessor is left in place.
+    """
+    m = copy.deepcopy(model).eval()
+    for parent in m.modules():
+        names = list(parent._modules)
+        for prev, cur in zip(names[:-1], names[1:]):
+            a, b = parent._modules[prev], parent._modules[cur]
+            if not isinstance(b, nn.modules.batchnorm._BatchNorm) or not b.track_running_stats:
+                continue
+            if isinstance(a, nn.Linear) and a.out_features == b.num_features:
+                parent._modules[prev] = fuse_linear_bn_eval(a, b)
+            elif isinstance(a, (nn.Conv1d, nn.Conv2d, nn.Conv3d)) and a.out_channels == b.num_features:
+                parent._modules[prev] = fuse_conv_bn_eval(a, b)
+            else:
+                continue
+            parent._modules[cur] = nn.Identity()
+    return m
+
+
+# ---------------------------------------------------------------------------------------------------
+# Forward passes over the evaluation windows, as every energy measurement runs them.
+# ---------------------------------------------------------------------------------------------------
 #: Module types whose output is spikes: SpikingJelly's neurons (BGFN's LIF layers, :mod:`bgfn.models.lif`).
 SPIKE_MODULES: tuple[type, ...] = (neuron.BaseNode,)
 

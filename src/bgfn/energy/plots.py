@@ -5,20 +5,20 @@ Each function returns the figure; the notebook saves it (``results/<profile>/fig
 
 from __future__ import annotations
 
+import matplotlib.pyplot as plt
 import pandas as pd
 
 from bgfn.energy.tables import total_energy_uj
 
 
 def plot_firing_rates(rates: dict[str, float], title: str = ""):
-    """Horizontal bars: firing rate of every LIF layer (:func:`bgfn.energy.rates.measure_firing_rates`),
+    """Horizontal bars: firing rate of every LIF layer (:func:`bgfn.energy.counts.measure_firing_rates`),
     in execution order from the top.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(8, 0.28 * len(rates) + 1.2))
     ax.barh(range(len(rates)), list(rates.values()), color="tab:blue")
@@ -42,7 +42,6 @@ def plot_energy_per_layer(tables: dict[str, pd.DataFrame], methods=("bgfn", "tra
     -------
     matplotlib.figure.Figure
     """
-    import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, len(methods), figsize=(12, 0.25 * len(tables[methods[0]]) + 1.5))
     for ax, m in zip(axes, methods):
@@ -64,7 +63,7 @@ def plot_sweeps(sweep_t: pd.DataFrame, sweep_r: pd.DataFrame, time_steps: int, r
     Parameters
     ----------
     sweep_t, sweep_r : DataFrame
-        :func:`bgfn.energy.sweeps.reduction_vs_time_steps` and :func:`~bgfn.energy.sweeps.reduction_vs_rate`.
+        :func:`bgfn.energy.counts.reduction_vs_time_steps` and :func:`~bgfn.energy.counts.reduction_vs_rate`.
     time_steps, reduction, mean_rate : int, float, float
         The trained model (a star on both panels): its ``T_s``, reduction (%) and mean input rate.
     paper_reduction : float
@@ -74,7 +73,6 @@ def plot_sweeps(sweep_t: pd.DataFrame, sweep_r: pd.DataFrame, time_steps: int, r
     -------
     matplotlib.figure.Figure
     """
-    import matplotlib.pyplot as plt
 
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 3.8))
     a1.plot(sweep_t["time_steps"], sweep_t["reduction_pct"], "o-", label="this reproduction (rates fixed)")

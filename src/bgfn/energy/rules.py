@@ -1,41 +1,6 @@
-"""How each block of BGFN and of its Transformer twin is counted (Spikformer / syops convention, paper Sec. 4.2).
-
-The paper gives no counting rule; the one of Spikformer (Zhou et al. 2023) and of the syops counter of SeqSNN
-(Lv et al. 2024, the code BGFN builds on) is used. A Linear/Conv layer is counted by what it reads: real
-values cost one multiply-accumulate per weight use (MAC), spikes one accumulate per input spike and fan-out
-(SOP, ``r * T * FLOPs``).
-
-Every block kind and its rule, per prediction (one window), with ``T = T_s`` steps, ``N`` tokens, width
-``D``, ``H`` heads of width ``d_h``, ``C`` input channels with ``K`` encoder neurons each, encoder kernel ``k``,
-``r`` the measured input spike rate and FLOPs the multiply-accumulates of one step with every input active
-(module paths of BGFN, then of the twin)::
-
-    spike encoder, Eq. eq:spike_input      spike_encoder.conv          reads real IMU samples
-        -> MACs, N * (C K T_s) * k (grouped convolution)                               count_linear_or_conv
-    spiking embedding, Eq. eq:spiking_embedding   embedding.layer.linear   reads the encoder's spikes
-        -> SOPs, r T FLOPs                                                             count_linear_or_conv
-    SSA: Q, K, V                           blocks.l.attn.{q,k,v}.linear   read the residual stream
-        -> SOPs, n r T FLOPs with n = 1 + 2l merged trains                             count_linear_or_conv
-    SSA: products Q K^T V (no softmax)     blocks.l.attn.qkv_matmul    read the Q, K, V spikes
-        -> SOPs, (min(r_k, r_v) + r_q) T H N d_h^2 (Spikformer; d_h < N)               count_spiking_self_attention
-    SSA: projection                        blocks.l.attn.proj.linear   reads the attention LIF's spikes
-        -> SOPs, r T FLOPs                                                             count_linear_or_conv
-    spiking MLP                            blocks.l.mlp.fc1.linear     reads the residual stream
-        -> SOPs, n r T FLOPs with n = 2 + 2l;  mlp.fc2.linear (fc1's spikes): r T FLOPs  count_linear_or_conv
-    readout                                head                        reads the mean of the spikes (real)
-        -> MACs, 2 D                                                                   count_linear_or_conv
-    twin: every Linear/Conv                conv, embed, qkv, proj, ffn, head    read real values
-        -> MACs, FLOPs                                                                 count_linear_or_conv
-    twin: attention products Q K^T, A V    blocks.l.attention
-        -> MACs, 2 N^2 D                                                               count_softmax_attention
-
-The number of merged trains ``n`` comes from :class:`bgfn.energy.residual.ResidualStream`. Not counted, for
-either model (Spikformer's convention: only synaptic operations / matmuls): biases, BatchNorm (folded into the
-preceding layer at inference, :mod:`bgfn.energy.folding`), LIF membrane updates, residual additions,
-LayerNorm, softmax, GELU and memory traffic.
-
-Each rule registers forward hooks that add the operations of one batch to a :class:`Tally`;
-:func:`bgfn.energy.counts.layer_counts` turns the sums into per-prediction counts.
+"""How each operation of BGFN and of its Transformer twin is counted, and what it costs on 45 nm CMOS (paper
+Sec. 4.2): the energy of one MAC and one AC (Horowitz 2014), the residual stream of the spiking blocks, the rule
+of every block kind (Spikformer / syops convention).
 """
 
 from __future__ import annotations
@@ -47,12 +12,123 @@ import numpy as np
 import torch
 from torch import nn
 
-from bgfn.energy.passes import SPIKE_MODULES, is_spike_count
-from bgfn.energy.residual import ResidualStream
+from bgfn.energy.passes import SPIKE_MODULES, is_binary, is_spike_count
 from bgfn.models.bgfn import SSA
 
+# ---------------------------------------------------------------------------------------------------
+# Energy of one operation on 45 nm CMOS (Horowitz 2014), the paper's hardware assumption (Sec. 4.2).
+# ---------------------------------------------------------------------------------------------------
+#: Horowitz (2014), 45 nm, 32-bit float: multiply 3.7 pJ + add 0.9 pJ (pJ per MAC).
+E_MAC_PJ = 4.6
+
+
+#: Horowitz (2014), 45 nm, 32-bit float add (pJ per accumulate / synaptic operation).
+E_AC_PJ = 0.9
+
+
+def energy_uj(macs: float, sops: float, e_mac: float = E_MAC_PJ, e_ac: float = E_AC_PJ) -> float:
+    """``E = E_MAC * MACs + E_AC * SOPs``, converted from pJ to µJ.
+
+    Parameters
+    ----------
+    macs, sops : float
+        Multiply-accumulates and synaptic operations (ops, per prediction).
+    e_mac, e_ac : float
+        Energy per MAC and per accumulate, pJ.
+
+    Returns
+    -------
+    float
+        Energy, µJ (per prediction when the counts are).
+    """
+    return (e_mac * macs + e_ac * sops) * 1e-6
+
+
+# ---------------------------------------------------------------------------------------------------
+# The residual stream of BGFN's spiking blocks: how many spike trains the layers that read it merge.
+# ---------------------------------------------------------------------------------------------------
+def _total(t: torch.Tensor) -> float:
+    return float(t.detach().double().sum())
+
+
+class ResidualStream:
+    """The tensor the spiking blocks pass on, and the number ``n`` of binary spike trains it sums.
+
+    Attributes
+    ----------
+    n : int
+        Spike trains merged into the stream so far (0 before the first block of a forward pass).
+    total : float
+        Its spike total (checked against every block input and output).
+    tensor : torch.Tensor or None
+        The stream tensor [T, B, N, D] a layer may read right now (the object, compared by identity).
+    """
+
+    def __init__(self):
+        self.reset()
+
+    def reset(self) -> None:
+        """Start of a forward pass: no stream yet."""
+        self.n, self.total, self.tensor = 0, 0.0, None
+
+    def trains_of(self, x: torch.Tensor) -> int | None:
+        """``n`` if ``x`` is the stream tensor (a layer reading it merges ``n`` trains), else None."""
+        return self.n if x is self.tensor else None
+
+    def follow(self, name: str, block: nn.Module) -> list:
+        """Hooks on a spiking :class:`~bgfn.models.bgfn.Block` (``attn``, ``mlp``) that follow the stream.
+
+        Returns
+        -------
+        list of RemovableHandle
+        """
+
+        def block_input(_m, inputs):
+            x = inputs[0]                                    # [T, B, N, D]
+            if self.n == 0:                                  # first block: the stream is the embedding's spikes
+                if not is_binary(x):
+                    raise ValueError(f"{name}: the input of the first block is not binary spikes")
+                self.n, self.total = 1, _total(x)
+            elif _total(x) != self.total:
+                raise ValueError(f"{name}: block input is not the residual sum tracked so far; "
+                                 "bgfn.energy must follow the changed block wiring")
+            self.tensor = x
+
+        def added(part):
+            def fn(_m, _inp, out):                           # SSA or MLP output, added to the stream
+                if not is_binary(out):
+                    raise ValueError(f"{name}.{part}: output added to the residual stream is not binary spikes")
+                self.n += 1
+                self.total += _total(out)
+                self.tensor = None
+            return fn
+
+        def mlp_input(_m, inputs):
+            if _total(inputs[0]) != self.total:
+                raise ValueError(f"{name}.mlp: MLP input is not x + attn(x); bgfn.energy must follow the block "
+                                 "wiring")
+            self.tensor = inputs[0]
+
+        def block_output(_m, _inp, out):
+            if _total(out) != self.total:
+                raise ValueError(f"{name}: block output is not x + attn(x) + mlp(.); "
+                                 "bgfn.energy must follow the block wiring")
+            self.tensor = None
+
+        return [block.register_forward_pre_hook(block_input),
+                block.attn.register_forward_hook(added("attn")),
+                block.mlp.register_forward_pre_hook(mlp_input),
+                block.mlp.register_forward_hook(added("mlp")),
+                block.register_forward_hook(block_output)]
+
+
+# ---------------------------------------------------------------------------------------------------
+# How each block of BGFN and of its Transformer twin is counted (Spikformer / syops convention, paper Sec. 4.2).
+# ---------------------------------------------------------------------------------------------------
 #: Layers with weights that are counted (:func:`count_linear_or_conv`).
 COUNTED = (nn.Linear, nn.Conv1d, nn.Conv2d, nn.Conv3d)
+
+
 #: Layers with parameters that cost nothing under the convention (BatchNorm: folded) or only group others.
 FREE = (nn.modules.batchnorm._BatchNorm, nn.LayerNorm, nn.Identity, nn.Dropout, nn.GELU, nn.ReLU, nn.Tanh,
         nn.Sequential, nn.ModuleList)

@@ -1,8 +1,5 @@
-"""Energy tables: energy per layer and per prediction, the totals, and the reduction against the twin.
-
-``E = E_MAC * MACs + E_AC * SOPs`` per prediction (one window), reported in µJ (:mod:`bgfn.energy.costs`).
-The per-layer table (:func:`energy_table`, columns :data:`COLUMNS`) is ``results/<profile>/tables/energy.csv``;
-:func:`energy_totals` gathers what notebook 05 reports beside the paper's reduction.
+"""Energy tables and the record of notebook 05: energy per layer and per prediction, the totals, the reduction
+against the twin, and the measured CPU speed beside them (``make bench``).
 """
 
 from __future__ import annotations
@@ -13,12 +10,17 @@ import numpy as np
 import pandas as pd
 from torch import nn
 
-from bgfn.energy.costs import E_AC_PJ, E_MAC_PJ, energy_uj
 from bgfn.energy.counts import LayerCount, layer_counts, mean_rate
+from bgfn.energy.rules import E_AC_PJ, E_MAC_PJ, energy_uj
 from bgfn.models import MODELS
 
+# ---------------------------------------------------------------------------------------------------
+# Energy tables: energy per layer and per prediction, the totals, and the reduction against the twin.
+# ---------------------------------------------------------------------------------------------------
 #: Columns of :func:`energy_table` (and of ``results/<profile>/tables/energy.csv``).
 COLUMNS = ("model", "layer", "firing_rate", "macs", "sops", "energy_uj")
+
+
 #: Suffixes of the attention-product rows: BGFN's spiking (``qkv_matmul``) and the twin's softmax attention.
 ATTENTION_ROWS = (".attention", ".qkv_matmul")
 
@@ -201,3 +203,57 @@ def energy_totals(tables: dict[str, pd.DataFrame], bgfn_counts: list[LayerCount]
         mean_rate=mean_rate(bgfn_counts), macs=float(tb.loc["total", "macs"]), sops=float(tb.loc["total", "sops"]),
         mac_share=e_mac * tb.loc["total", "macs"] * 1e-6 / e_bgfn, attention_uj=attn,
         reduction_without_attention_pct=reduction_pct(e_bgfn - attn["bgfn"], e_twin - attn["transformer"]))
+
+
+# ---------------------------------------------------------------------------------------------------
+# Measured CPU speed beside the energy estimate: the figures of ``results/bench.json`` (``make bench``).
+# ---------------------------------------------------------------------------------------------------
+#: Keys of ``bench.json`` (method -> size -> value) shown in the table.
+SPEED_KEYS = ("infer_ms", "throughput_windows_per_s", "realtime_imu_100hz", "realtime_gnss_1hz")
+
+
+#: Columns of :func:`speed_table` after ``model`` and ``size``, by ``bench.json`` key.
+SPEED_COLUMNS = {"throughput_windows_per_s": "throughput (windows/s, batch 64)",
+                 "realtime_imu_100hz": "keeps up with 100 Hz IMU",
+                 "realtime_gnss_1hz": "keeps up with 1 Hz GNSS"}
+
+
+def speed_table(bench: dict, methods=("bgfn", "transformer", "at_lstm", "mlp"),
+                sizes=("quick", "paper")) -> pd.DataFrame:
+    """One row per method and size that has a speed figure in ``bench`` (the parsed ``bench.json``).
+
+    The latency is ``infer_ms`` (bench_models.py), else bench_speed.py's own ``speed_bench.latency_ms``.
+
+    Returns
+    -------
+    DataFrame
+        ``model, size, latency (ms, batch 1), throughput (windows/s, batch 64), keeps up with 100 Hz IMU,
+        keeps up with 1 Hz GNSS`` (None where not measured); empty when ``bench`` has no speed figure.
+    """
+    if not any(k in bench for k in SPEED_KEYS):
+        return pd.DataFrame()
+    fallback = (bench.get("speed_bench") or {}).get("latency_ms") or {}
+    recs = []
+    for m in methods:
+        for size in sizes:
+            def get(key):
+                return (bench.get(key) or {}).get(m, {}).get(size)
+            lat = get("infer_ms") if get("infer_ms") is not None else fallback.get(m, {}).get(size)
+            rec = {"model": m, "size": size, "latency (ms, batch 1)": lat,
+                   **{col: get(key) for key, col in SPEED_COLUMNS.items()}}
+            if any(v is not None for k, v in rec.items() if k not in ("model", "size")):
+                recs.append(rec)
+    return pd.DataFrame(recs)
+
+
+def speed_notes(bench: dict, path: str = "results/bench.json") -> list[str]:
+    """What the table cannot say: no figures yet, the settings they were recorded with, missing keys."""
+    if not any(k in bench for k in SPEED_KEYS):
+        return [f"{path} has no speed figures yet: `make bench` produces them."]
+    info = bench.get("speed_bench") or bench.get("models_bench") or {}
+    settings = {k: info.get(k) for k in ("threads", "threads_infer", "batch", "device", "torch") if k in info}
+    notes = [f"recorded with: {settings}"]
+    missing = [k for k in SPEED_KEYS if k not in bench]
+    if missing:
+        notes.append(f"missing in {path}: {', '.join(missing)} -- run `make bench`")
+    return notes

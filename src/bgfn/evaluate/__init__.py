@@ -68,32 +68,30 @@ Everything public is re-exported here: ``from bgfn import evaluate as ev; ev.eva
 """
 
 from bgfn.evaluate.claims import REDUCTION_COLUMNS, claim_lines, ours_above_paper, paper_table_title, reduction_table
-from bgfn.evaluate.config import (COLORS, EVALUATE_DEFAULTS, FIGURE_METHODS, METRIC_COLUMNS,
-                                  REAL_IMU_DATASETS, SWEEP_COLUMNS, TABLE_COLUMNS, TABLE_FILES,
-                                  TABLE_METHODS, EvaluationSetup, choose_datasets, evaluate_config,
-                                  evaluation_setup)
-from bgfn.evaluate.hybrid import (NavContext, OutageRun, gps_run, navigation_context, pseudo_gps_positions,
-                                  run_outages, window_metrics)
-from bgfn.evaluate.networks import ensure_models, load_model
+from bgfn.evaluate.config import (COLORS, EVALUATE_DEFAULTS, FIGURE_METHODS, METRIC_COLUMNS, REAL_IMU_DATASETS,
+                                  SWEEP_COLUMNS, TABLE_COLUMNS, TABLE_FILES, TABLE_METHODS, EvaluationSetup,
+                                  choose_datasets, evaluate_config, evaluation_setup)
+from bgfn.evaluate.hybrid import (NavContext, OutageRun, gps_run, navigation_context, pseudo_gps_positions, run_outages,
+                                  window_metrics)
 from bgfn.evaluate.increments import AntennaTruth, increment_errors, increment_rmse
 from bgfn.evaluate.ins_drift import (DRIFT_COLUMNS, DRIFT_RUN_COLUMNS, drift_sentences, drift_starts, drift_summary,
                                      ins_drift_runs, plot_ins_drift)
+from bgfn.evaluate.networks import ensure_models, load_model
 from bgfn.evaluate.oracle import (BREAKEVEN_COLUMNS, ORACLE_COLUMNS, OracleIncrements, OracleResult, breakeven_table,
                                   crossing_sigma, curve_at, describe_oracle, method_levels, oracle_interval_table,
-                                  oracle_runs, oracle_table, oracle_windows, run_oracle)
-from bgfn.evaluate.plots import outage_figures, plot_gps_row, plot_oracle, plot_outage, plot_sweep_boxes
+                                  oracle_runs, oracle_table, oracle_windows, plot_oracle, run_oracle)
+from bgfn.evaluate.plots import outage_figures, plot_gps_row, plot_outage, plot_sweep_boxes
 from bgfn.evaluate.record import RECORD_FILE, evaluation_record, write_evaluation_record
-from bgfn.evaluate.sensitivity import (SENSITIVITY_COLUMNS, Sensitivity, pseudo_std_sensitivity,
-                                       save_sensitivity, sensitivity_table)
+from bgfn.evaluate.sensitivity import (SENSITIVITY_COLUMNS, Sensitivity, pseudo_std_sensitivity, save_sensitivity,
+                                       sensitivity_table)
 from bgfn.evaluate.sweep import (describe_sweep, describe_sweep_setup, describe_sweep_size, profile_sweep_plan,
                                  run_sweep, run_sweeps, sweep_comparisons, sweep_interval_table, sweep_plan,
                                  sweep_summary, sweep_train_config)
 from bgfn.evaluate.tables import (TableResult, aggregate_seeds, describe_tables, error_reduction, error_series,
-                                  evaluate_dataset, fix_error_table,
-                                  representative_seeds, run_tables, save_table_result, table_file,
-                                  table_paths)
-from bgfn.evaluate.variants import (NO_VARIANT, VARIANT_COLUMNS, VARIANT_METRICS, load_variant_network,
-                                    variant_pivot, variant_runs, variant_table)
+                                  evaluate_dataset, fix_error_table, representative_seeds, run_tables,
+                                  save_table_result, table_file, table_paths)
+from bgfn.evaluate.variants import (NO_VARIANT, VARIANT_COLUMNS, VARIANT_METRICS, load_variant_network, variant_pivot,
+                                    variant_runs, variant_table)
 
 __all__ = [
     "DRIFT_COLUMNS", "DRIFT_RUN_COLUMNS", "drift_sentences", "drift_starts", "drift_summary", "ins_drift_runs",

@@ -7,7 +7,9 @@ import copy
 from dataclasses import dataclass, field
 from typing import Any, Sequence
 
+from bgfn.data import acquire
 from bgfn.errors import DataError
+from bgfn.nav import outages
 from bgfn.paper import METHOD_LABELS, TESTS, nhc_label
 
 #: The standalone INS and the networks, each also with the vehicle constraints (``+NHC``, bgfn.nav.constraints).
@@ -116,7 +118,6 @@ def choose_datasets(datasets: Sequence[str], real_imu: bool) -> tuple[list[str],
             names.append(d)
             continue
         real, fname = REAL_IMU_DATASETS[d]
-        from bgfn.data import acquire
 
         res = acquire.resolve(fname, download=False)
         if res.path is not None:
@@ -182,30 +183,25 @@ class EvaluationSetup:
         return lines
 
 
-def evaluation_setup(cfg: dict, real_imu: bool | None = None, datasets: Sequence[str] | None = None,
-                     methods: Sequence[str] | None = None, seeds: Sequence[int] | None = None,
-                     sweep_datasets: Sequence[str] | None = None) -> EvaluationSetup:
-    """Notebook 04's parameters over a profile: the checked configuration, the datasets, the outages.
+#: Notebook 04's parameters and the profile keys they set (:func:`bgfn.profile_schema.with_overrides`, in the
+#: notebook's first cell; ``sweep_datasets`` ``[]`` skips the sweep).
+PARAMETER_KEYS = {"real_imu": "evaluate.real_imu", "datasets": "evaluate.datasets", "methods": "evaluate.methods",
+                  "seeds": "evaluate.seeds", "sweep_datasets": "evaluate.sweep.datasets"}
+
+
+def evaluation_setup(cfg: dict) -> EvaluationSetup:
+    """Notebook 04's configuration over a profile: the evaluate section with its defaults, the datasets, the outages.
 
     Parameters
     ----------
     cfg : dict
-        The profile (:func:`bgfn.config.load_profile`).
-    real_imu, datasets, methods, seeds, sweep_datasets
-        The notebook's parameters, set through :func:`bgfn.config.with_overrides` (checked against the profile
-        schema; ``sweep_datasets`` replaces ``evaluate.sweep.datasets``, ``[]`` skips the sweep); None keeps
-        the profile's value.
+        The checked profile (:func:`bgfn.profile_schema.load_profile`), the notebook's parameters set over it
+        (:data:`PARAMETER_KEYS`).
 
     Returns
     -------
     EvaluationSetup
     """
-    from bgfn.config import with_overrides
-    from bgfn.nav import outages
-
-    cfg = with_overrides(cfg, {"evaluate.real_imu": real_imu, "evaluate.datasets": datasets,
-                               "evaluate.methods": methods, "evaluate.seeds": seeds,
-                               "evaluate.sweep.datasets": sweep_datasets})
     ecfg = evaluate_config(cfg.get("evaluate"), cfg.get("train"))
     names, notes = choose_datasets(ecfg["datasets"], ecfg["real_imu"])
     sweep_names, sweep_notes = choose_datasets(ecfg["sweep"]["datasets"], ecfg["real_imu"])

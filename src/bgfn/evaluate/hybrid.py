@@ -12,8 +12,13 @@ import pandas as pd
 
 from bgfn.errors import DataError
 from bgfn.evaluate.config import EVALUATE_DEFAULTS, merge_checked
-from bgfn.learning import (ANGULAR_RATE_CHANNELS, ATTITUDE_CHANNELS, CHANNELS, EXTRA_START, IMU_CHANNELS,
-                           SPECIFIC_FORCE_CHANNELS, YAW_CHANNEL)
+from bgfn.learning import (ANGULAR_RATE_CHANNELS, ATTITUDE_CHANNELS, CHANNELS, DERIVED_CHANNELS, EXTRA_START,
+                           IMU_CHANNELS, SPECIFIC_FORCE_CHANNELS, YAW_CHANNEL, WindowSet, encode_yaw, heading_velocity,
+                           with_derived_channels)
+from bgfn.nav import baseline, earth, error_model as em, metrics, navego_setup, transform
+from bgfn.nav.filter import noise_arrays, propagate, run_filter, update_position
+from bgfn.nav.outages import epochs_before
+from bgfn.nav.strapdown import trajectory_frame
 
 
 # ----------------------------------------------------------------------------------------------- Eq. pred-gps
@@ -33,7 +38,6 @@ def pseudo_gps_positions(p0, increments) -> np.ndarray:
         ``[lat, lon, h]`` of the pseudo-GPS positions after each increment; the sums are north/east offsets
         from ``P_GPS0`` in its local level frame (exact through ECEF), the height stays ``h0``.
     """
-    from bgfn.nav import earth
 
     inc = np.asarray(increments, dtype=float).reshape(-1, 2)
     cum = np.cumsum(inc, axis=0)                                     # [K, 2]
@@ -116,10 +120,6 @@ def navigation_context(drive, nav_section: dict | None, starts: Sequence[float])
     starts : sequence of float
         Outage starts, s.
     """
-    from bgfn.learning import DERIVED_CHANNELS, with_derived_channels
-    from bgfn.nav import baseline, navego_setup
-    from bgfn.nav.filter import run_filter
-    from bgfn.nav.outages import epochs_before
 
     cfg = baseline.nav_config(nav_section)
     initial, noise = baseline.filter_setup(drive, cfg)
@@ -134,7 +134,7 @@ def navigation_context(drive, nav_section: dict | None, starts: Sequence[float])
     snaps = {f"start_{i}": float(t) for i, t in enumerate(epochs_before(imu_time, starts, drive.name))}
     full = run_filter(filter_imu, initial, noise, drive.gnss, lever, snapshots=snaps,
                       gate_probability=cfg["innovation_gate"], source=drive.name,
-                      constraints=baseline.gps_constraints(drive, cfg, initial, noise))
+                      aid=baseline.gps_constraints(drive, cfg, initial, noise))
     states = {s: full.states[f"start_{i}"] for i, s in enumerate(starts)}
     imu = drive.imu[list(CHANNELS[IMU_CHANNELS])].to_numpy(float)          # [M, 6] in the input layout
     tr = full.trajectory
@@ -210,14 +210,12 @@ class _Run:
     the network inputs at a pseudo epoch need the attitude the run itself computed up to that epoch, and one
     ``run_filter`` call per epoch costs ~2 ms of pandas overhead (the sweep has ~10^5 epochs).
     ``tests/test_evaluate.py`` checks that the result equals ``run_filter`` / ``run_outage`` fed the same fixes.
-    With ``constraints`` the prediction applies their NHC/ZUPT updates at their epochs
-    (:func:`bgfn.nav.constraints.propagate_aided`), the vehicle frame held at its estimate at the start.
+    With ``constraints`` (an aid of the engine, :class:`bgfn.nav.filter.Aid`) the prediction fuses their
+    updates at their epochs (:func:`bgfn.nav.filter.propagate`), the vehicle frame held at its estimate at the start.
     """
 
     def __init__(self, ctx: NavContext, start: float, duration: float, n_window: int, extra: tuple,
                  constraints=None):
-        from bgfn.nav import error_model as em
-        from bgfn.nav.filter import noise_arrays
 
         self.start, self.duration, self.end = float(start), float(duration), float(start) + float(duration)
         s = ctx.state_at(start)
@@ -239,10 +237,9 @@ class _Run:
         self.out_c, self.out_sd = np.empty((n, 3, 3)), np.empty((n, em.N_STATES))
         self.out_pos[0], self.out_v[0], self.out_c[0] = self.pos, self.v, self.c
         self.row = 0
-        self.constraints = constraints
+        self.schedule = None
         if constraints is not None:
-            self.aid, self.mount = constraints.frozen(s.time).steps(self.time, ctx.drive.name)
-            self.out_bias = np.zeros((n, 6))
+            self.schedule = constraints.schedule(self.time, ctx.drive.name, hold_at=s.time)
         self.lever = ctx.lever
         self.p0 = s.antenna_position(ctx.lever)                     # P_GPS0 of Eq. (pred-gps)
         # Input features [roll, pitch, yaw, f, w, extra]: N samples up to the start from the GPS-aided run,
@@ -274,8 +271,6 @@ class _Run:
 
     def _fill(self, r0: int, r1: int) -> None:
         """Features of output rows r0..r1 (inclusive, >= 1) from the current solution."""
-        from bgfn.learning import DERIVED_CHANNELS, heading_velocity
-        from bgfn.nav import transform
 
         if r1 < r0:
             return
@@ -293,23 +288,15 @@ class _Run:
 
     def propagate_to(self, r: int) -> None:
         """Prediction (strapdown + covariance, Eq. eq3) up to output row ``r``."""
-        from bgfn.nav.constraints import propagate_aided
-        from bgfn.nav.filter import propagate_steps
-
         r = min(int(r), len(self.times) - 1)
         if r > self.row:
-            args = (self.row, r, self.dt, self.gyro, self.accel, self.pos, self.v, self.c, self.ba, self.bg, self.P,
-                    *self.q, self.out_pos, self.out_v, self.out_c, self.out_sd)
-            if self.constraints is None:
-                propagate_steps(*args)
-            else:
-                propagate_aided(*args, self.aid, self.mount, *self.constraints.config.kernel_args(), self.out_bias)
+            propagate(self.row, r, self.dt, self.gyro, self.accel, (self.pos, self.v, self.c, self.ba, self.bg, self.P),
+                      self.q, (self.out_pos, self.out_v, self.out_c, self.out_sd), self.schedule)
             self._fill(self.row + 1, r)
             self.row = r
 
     def update(self, t_m: float, fix: np.ndarray, std: np.ndarray) -> None:
         """Eq. (eq4) position update with a pseudo fix of time ``t_m`` at the current row, then feedback."""
-        from bgfn.nav.filter import update_position
 
         innov = np.empty(3)
         update_position(self.pos, self.v, self.c, self.ba, self.bg, self.P, self.lever, np.asarray(fix, float),
@@ -328,7 +315,6 @@ class _Run:
         return x, float(self.t_feat[last]), float(x[-1, YAW_CHANNEL])
 
     def trajectory(self) -> pd.DataFrame:
-        from bgfn.nav.strapdown import trajectory_frame
 
         return trajectory_frame(self.times, self.out_pos, self.out_v, self.out_c)
 
@@ -371,8 +357,6 @@ def run_outages(ctx: NavContext, windows, predictor=None, method: str = "INS", s
     list of OutageRun
         One per window, same order.
     """
-    from bgfn.learning import WindowSet, encode_yaw
-    from bgfn.nav import metrics
 
     pcfg = merge_checked(EVALUATE_DEFAULTS["pseudo_gps"], pseudo or {}, "evaluate.pseudo_gps")
     windows = [(float(s), float(d)) for s, d in windows]
@@ -450,7 +434,6 @@ def run_outages(ctx: NavContext, windows, predictor=None, method: str = "INS", s
 
 def gps_run(ctx: NavContext, start: float, duration: float, errors: bool = True) -> OutageRun:
     """The GPS-available solution over the outage window (the lower bound row ``GPS``)."""
-    from bgfn.nav import metrics
 
     tr = ctx.full.trajectory
     t = tr["time"].to_numpy(float)

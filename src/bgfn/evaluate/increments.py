@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from bgfn.data.gnss import antenna_position
 from bgfn.errors import DataError
 from bgfn.learning.targets import position_increment
 
@@ -38,7 +39,6 @@ class AntennaTruth:
     """
 
     def __init__(self, reference: pd.DataFrame, lever_arm_m, source: str = "reference"):
-        from bgfn.data.gnss import antenna_position
 
         self.source = source
         self.time = reference["time"].to_numpy(float)

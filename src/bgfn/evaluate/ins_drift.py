@@ -17,8 +17,14 @@ from __future__ import annotations
 
 from typing import Callable
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
+
+from bgfn.evaluate.config import evaluate_config
+from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
+from bgfn.evaluate.sweep import profile_sweep_plan
+from bgfn.paper import nhc_label, test_of
 
 #: Columns of the per-run rows (``tables/kf_ins_drift_runs.csv``).
 DRIFT_RUN_COLUMNS: tuple[str, ...] = ("dataset", "test", "start_s", "duration_s", "method", "max_h_m", "final_h_m")
@@ -29,8 +35,6 @@ DRIFT_COLUMNS: tuple[str, ...] = ("dataset", "test", "duration_s", "method", "n_
 
 def drift_starts(cfg: dict, drive) -> list[float]:
     """The sweep's starts on ``drive`` (``evaluate.sweep`` of the profile; after the filter's start), s."""
-    from bgfn.evaluate.config import evaluate_config
-    from bgfn.evaluate.sweep import profile_sweep_plan
 
     plan = profile_sweep_plan(cfg, drive, evaluate_config(cfg.get("evaluate"), cfg.get("train"))["sweep"])
     return [float(s) for s in plan["start_s"]]
@@ -57,9 +61,6 @@ def ins_drift_runs(cfg: dict, drives: list, durations=None, nhc: bool = True,
     DataFrame
         :data:`DRIFT_RUN_COLUMNS`, one row per drive, start, duration and method.
     """
-    from bgfn.evaluate.config import evaluate_config
-    from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
-    from bgfn.paper import nhc_label, test_of
 
     ecfg = evaluate_config(cfg.get("evaluate"), cfg.get("train"))
     durations = sorted(float(d) for d in (durations or ecfg["sweep"]["durations_s"]))
@@ -117,7 +118,6 @@ def drift_sentences(summary: pd.DataFrame, stand_in: str = "turin-sim-mpu6000",
 
 def plot_ins_drift(runs: pd.DataFrame, title: str = ""):
     """Max horizontal error of every start against the outage duration, one panel per method, a box per drive."""
-    import matplotlib.pyplot as plt
 
     methods = list(dict.fromkeys(runs["method"]))
     names = list(dict.fromkeys(runs["dataset"]))

@@ -1,23 +1,23 @@
-"""The trained networks of the evaluation: loading notebook 03's checkpoints (:mod:`bgfn.checkpoints`), and
+"""The trained networks of the evaluation: loading notebook 03's checkpoints (:mod:`bgfn.train.checkpoints`), and
 training the missing ones."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
 
-from bgfn.checkpoints import card_path, checkpoint_path
+from bgfn import train
 from bgfn.errors import DataError
 from bgfn.evaluate.hybrid import NavContext
+from bgfn.train.checkpoints import card_path, checkpoint_path
 
 
 def load_model(path: str | Path):
     """A checkpoint of :mod:`bgfn.train` on the CPU, with ``val_rmse_m`` (validation RMSE of one increment,
     m, from its JSON card; NaN without a card) attached."""
-    import json
 
-    from bgfn import train
 
     model = train.load_trained(path, device="cpu")
     card = card_path(path)
@@ -35,7 +35,6 @@ def ensure_models(cfg: dict, profile: str, dataset: str, ctx: NavContext, method
     dict
         ``{(method, seed): TrainedModel}``.
     """
-    from bgfn import train
 
     models, data = {}, None
     tc = train.tuned_train_config(cfg, profile, dataset)      # notebook 03's selected learning rates

@@ -34,15 +34,24 @@ from __future__ import annotations
 import time
 import zlib
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Callable
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from bgfn.config import SHARED_TABLES
+from bgfn.data import load_drive
 from bgfn.errors import DataError
+from bgfn.evaluate.config import COLORS
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.evaluate.increments import AntennaTruth, increment_rmse
+from bgfn.evaluate.sweep import profile_sweep_plan
+from bgfn.io import atomic_write_csv, save_figure
+from bgfn.nav.outages import outage_windows
 from bgfn.paper import METHOD_LABELS, test_of
+from bgfn.stats import bootstrap_ci
 
 #: Method label of the oracle runs.
 ORACLE_METHOD = "oracle"
@@ -124,7 +133,6 @@ def oracle_windows(cfg: dict, drive, ecfg: dict, windows) -> tuple[list[tuple[st
     notes : list of str
         Why a drive has no sweep starts.
     """
-    from bgfn.evaluate.sweep import profile_sweep_plan
 
     out = [(str(k + 1), float(s), float(d)) for k, (s, d) in enumerate(windows)]
     sw, durations = ecfg["sweep"], ecfg["oracle"]["durations_s"]
@@ -208,7 +216,6 @@ def oracle_table(runs: pd.DataFrame, increment_s: dict, n_boot: int = 2000, leve
     DataFrame
         :data:`ORACLE_COLUMNS`, INS first in each group, then sigma increasing.
     """
-    from bgfn.stats import bootstrap_ci
 
     rows = []
     keys = ["dataset", "test", "outage", "duration_s", "method", "sigma_m"]
@@ -453,6 +460,75 @@ class OracleResult:
         return list(self.notes) + describe_oracle(self.breakeven)
 
 
+def plot_oracle(table: pd.DataFrame, levels: pd.DataFrame, breakeven: pd.DataFrame, dataset: str):
+    """The oracle rows of one dataset (:mod:`bgfn.evaluate.oracle`): aided error against the increment noise.
+
+    One panel per windows and duration (the sweep's durations, then the paper's outages): the oracle's median max
+    horizontal error with its interval against sigma (log axis; sigma = 0 at the left edge), the learning-free
+    baselines as horizontal lines (INS, and INS+NHC or any other ``INS...`` row when present), the break-even
+    sigma on each, and every network at (its increment RMSE per axis, its own aided error).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+
+    d = table[table["dataset"] == dataset]
+    groups = [k for k, _ in d.groupby(["outage", "duration_s"], sort=False)]
+    groups.sort(key=lambda k: (k[0] != SWEEP_OUTAGE, k[0], k[1]))
+    ncol = min(2, max(1, len(groups)))
+    nrow = max(1, -(-len(groups) // ncol))
+    fig, axes = plt.subplots(nrow, ncol, figsize=(5.2 * ncol, 4.2 * nrow), squeeze=False)
+    for ax in axes.ravel()[len(groups):]:
+        ax.set_visible(False)
+    for ax, (o, du) in zip(axes.ravel(), groups):
+        g = d[(d["outage"] == o) & (d["duration_s"] == du)]
+        curve = g[g["method"] == ORACLE_METHOD].sort_values("sigma_m")
+        lv = levels[(levels["dataset"] == dataset) & (levels["outage"] == o) & np.isclose(levels["duration_s"], du)]
+        nets = lv[lv["method"].map(is_network).astype(bool)]
+        sig = curve["sigma_m"].to_numpy(float)
+        pos = np.concatenate([sig[sig > 0], nets["increment_rmse_m"].dropna().to_numpy(float)])
+        zero_x = (pos.min() if len(pos) else 1.0) / 3.0           # where sigma = 0 is drawn (log axis)
+        x = np.where(sig > 0, sig, zero_x)
+        ax.fill_between(x, curve["ci_lo_m"], curve["ci_hi_m"], color="0.6", alpha=0.3, lw=0)
+        ax.plot(x, curve["median_m"], "o-", color="0.2", ms=4, label="oracle (true increments + noise)")
+        ins = g[g["method"] == "INS"]
+        bases = ([("INS", float(ins["median_m"].iloc[0]))] if len(ins) else [])
+        bases += [(m, float(v)) for m, v in zip(lv["method"], lv["median_m"])
+                  if not is_network(m) and m not in ("INS", "GPS")]
+        for k, (m, v) in enumerate(bases):
+            ax.axhline(v, color=COLORS.get(m, f"C{k + 4}"), ls="-" if m == "INS" else "--", lw=1.2, label=m)
+            be = breakeven[(breakeven["dataset"] == dataset) & (breakeven["outage"] == o)
+                           & np.isclose(breakeven["duration_s"], du) & (breakeven["baseline"] == m)]
+            if len(be) and be["crossing"].iloc[0] == CROSSED:
+                s = float(be["breakeven_sigma_m"].iloc[0])
+                ax.axvline(s, color=COLORS.get(m, f"C{k + 4}"), ls=":", lw=1.0)
+                ax.plot([s], [v], "D", color=COLORS.get(m, f"C{k + 4}"), ms=6,
+                        label=f"break-even vs {m}: {s:.2g} m")
+        for n in nets.itertuples(index=False):
+            if not np.isfinite(n.increment_rmse_m):
+                continue
+            c = COLORS.get(n.method, COLORS.get(n.method.split("+")[0], "0.4"))
+            ax.plot([n.increment_rmse_m], [n.median_m], "^" if "+" in n.method else "o", color=c, ms=7,
+                    mec="white", label=f"{n.method} (own increments)")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ticks = [zero_x] + [s for s in sig if s > 0]
+        ax.set_xticks(ticks)
+        ax.set_xticklabels(["0"] + [f"{s:g}" for s in sig if s > 0], fontsize=8)
+        ax.minorticks_off()
+        ax.set_xlim(zero_x / 1.6, max(ticks + list(pos)) * 1.6)
+        ax.set_xlabel("increment error per axis, sigma or network RMSE (m)")
+        ax.set_ylabel("max horizontal error (m)")
+        n_starts = int(curve["n_starts"].max()) if len(curve) else 0
+        ax.set_title(f"{dataset}: " + (f"sweep, {du:g} s outages ({n_starts} starts)" if o == SWEEP_OUTAGE
+                                       else f"outage {o} ({du:g} s)"), fontsize=9)
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+    return fig
+
+
 def run_oracle(cfg: dict, profile: str, setup, out=None, results: dict | None = None,
                sweep: pd.DataFrame | None = None, figures: bool = True,
                report: Callable[[str], None] | None = None) -> OracleResult:
@@ -477,11 +553,6 @@ def run_oracle(cfg: dict, profile: str, setup, out=None, results: dict | None = 
     report : callable, optional
         Called with a line per dataset when it is done.
     """
-    from bgfn.config import SHARED_TABLES
-    from bgfn.data import load_drive
-    from bgfn.evaluate.plots import plot_oracle
-    from bgfn.nav.outages import outage_windows
-    from bgfn.io import atomic_write_csv, save_figure
 
     ecfg = setup.config
     oc, sw = ecfg["oracle"], ecfg["sweep"]
@@ -515,7 +586,6 @@ def run_oracle(cfg: dict, profile: str, setup, out=None, results: dict | None = 
     if figures:
         result.figures = {name: plot_oracle(table, lv, be, name) for name in names}
     if out is not None:
-        from pathlib import Path
 
         tables = Path(out) / "tables"
         atomic_write_csv(tables / SHARED_TABLES["oracle"], table, float_format="%.4f")

@@ -3,11 +3,14 @@ sweep's box plots."""
 
 from __future__ import annotations
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
+from matplotlib.patches import Patch
 
 from bgfn.evaluate.config import COLORS, FIGURE_METHODS, TABLE_METHODS
 from bgfn.evaluate.tables import TableResult, representative_seeds
+from bgfn.nav import earth
 from bgfn.paper import NHC_SUFFIX, base_label, nhc_label
 
 
@@ -17,7 +20,6 @@ def _style(method: str) -> str:
 
 
 def _ned_from_start(traj: pd.DataFrame, ref0) -> np.ndarray:
-    from bgfn.nav import earth
 
     return earth.lla_to_ned(traj["lat"].to_numpy(), traj["lon"].to_numpy(), traj["h"].to_numpy(),
                             float(ref0["lat"]), float(ref0["lon"]), float(ref0["h"]))
@@ -34,7 +36,6 @@ def plot_outage(result: TableResult, outage: int, reference: pd.DataFrame, metho
     -------
     matplotlib.figure.Figure
     """
-    import matplotlib.pyplot as plt
 
     rep = representative_seeds(result.per_seed)
     start = float(result.per_seed.loc[result.per_seed["outage"] == outage, "start_s"].iloc[0])
@@ -101,7 +102,6 @@ def plot_gps_row(result: TableResult, outage: int, title: str = ""):
     -------
     matplotlib.figure.Figure
     """
-    import matplotlib.pyplot as plt
 
     start = float(result.per_seed.loc[result.per_seed["outage"] == outage, "start_s"].iloc[0])
     runs = {r.method: r for r in result.runs if r.seed is None and abs(r.start - start) < 1e-6}
@@ -128,8 +128,6 @@ def plot_gps_row(result: TableResult, outage: int, title: str = ""):
 
 def plot_sweep_boxes(sweep: pd.DataFrame, dataset: str, methods=TABLE_METHODS):
     """Box plots of the max horizontal error per duration and method (log scale; ``+NHC`` rows hatched)."""
-    import matplotlib.pyplot as plt
-    from matplotlib.patches import Patch
 
     d = sweep[sweep["dataset"] == dataset]
     durations = sorted(d["duration_s"].unique())
@@ -159,77 +157,5 @@ def plot_sweep_boxes(sweep: pd.DataFrame, dataset: str, methods=TABLE_METHODS):
     ax.set_title(f"{dataset}: outage sweep")
     ax.grid(alpha=0.3, axis="y")
     ax.legend(handles=handles, fontsize=8, ncol=3)
-    fig.tight_layout()
-    return fig
-
-
-def plot_oracle(table: pd.DataFrame, levels: pd.DataFrame, breakeven: pd.DataFrame, dataset: str):
-    """The oracle rows of one dataset (:mod:`bgfn.evaluate.oracle`): aided error against the increment noise.
-
-    One panel per windows and duration (the sweep's durations, then the paper's outages): the oracle's median max
-    horizontal error with its interval against sigma (log axis; sigma = 0 at the left edge), the learning-free
-    baselines as horizontal lines (INS, and INS+NHC or any other ``INS...`` row when present), the break-even
-    sigma on each, and every network at (its increment RMSE per axis, its own aided error).
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-    """
-    import matplotlib.pyplot as plt
-
-    from bgfn.evaluate.oracle import CROSSED, ORACLE_METHOD, SWEEP_OUTAGE, is_network
-
-    d = table[table["dataset"] == dataset]
-    groups = [k for k, _ in d.groupby(["outage", "duration_s"], sort=False)]
-    groups.sort(key=lambda k: (k[0] != SWEEP_OUTAGE, k[0], k[1]))
-    ncol = min(2, max(1, len(groups)))
-    nrow = max(1, -(-len(groups) // ncol))
-    fig, axes = plt.subplots(nrow, ncol, figsize=(5.2 * ncol, 4.2 * nrow), squeeze=False)
-    for ax in axes.ravel()[len(groups):]:
-        ax.set_visible(False)
-    for ax, (o, du) in zip(axes.ravel(), groups):
-        g = d[(d["outage"] == o) & (d["duration_s"] == du)]
-        curve = g[g["method"] == ORACLE_METHOD].sort_values("sigma_m")
-        lv = levels[(levels["dataset"] == dataset) & (levels["outage"] == o) & np.isclose(levels["duration_s"], du)]
-        nets = lv[lv["method"].map(is_network).astype(bool)]
-        sig = curve["sigma_m"].to_numpy(float)
-        pos = np.concatenate([sig[sig > 0], nets["increment_rmse_m"].dropna().to_numpy(float)])
-        zero_x = (pos.min() if len(pos) else 1.0) / 3.0           # where sigma = 0 is drawn (log axis)
-        x = np.where(sig > 0, sig, zero_x)
-        ax.fill_between(x, curve["ci_lo_m"], curve["ci_hi_m"], color="0.6", alpha=0.3, lw=0)
-        ax.plot(x, curve["median_m"], "o-", color="0.2", ms=4, label="oracle (true increments + noise)")
-        ins = g[g["method"] == "INS"]
-        bases = ([("INS", float(ins["median_m"].iloc[0]))] if len(ins) else [])
-        bases += [(m, float(v)) for m, v in zip(lv["method"], lv["median_m"])
-                  if not is_network(m) and m not in ("INS", "GPS")]
-        for k, (m, v) in enumerate(bases):
-            ax.axhline(v, color=COLORS.get(m, f"C{k + 4}"), ls="-" if m == "INS" else "--", lw=1.2, label=m)
-            be = breakeven[(breakeven["dataset"] == dataset) & (breakeven["outage"] == o)
-                           & np.isclose(breakeven["duration_s"], du) & (breakeven["baseline"] == m)]
-            if len(be) and be["crossing"].iloc[0] == CROSSED:
-                s = float(be["breakeven_sigma_m"].iloc[0])
-                ax.axvline(s, color=COLORS.get(m, f"C{k + 4}"), ls=":", lw=1.0)
-                ax.plot([s], [v], "D", color=COLORS.get(m, f"C{k + 4}"), ms=6,
-                        label=f"break-even vs {m}: {s:.2g} m")
-        for n in nets.itertuples(index=False):
-            if not np.isfinite(n.increment_rmse_m):
-                continue
-            c = COLORS.get(n.method, COLORS.get(n.method.split("+")[0], "0.4"))
-            ax.plot([n.increment_rmse_m], [n.median_m], "^" if "+" in n.method else "o", color=c, ms=7,
-                    mec="white", label=f"{n.method} (own increments)")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ticks = [zero_x] + [s for s in sig if s > 0]
-        ax.set_xticks(ticks)
-        ax.set_xticklabels(["0"] + [f"{s:g}" for s in sig if s > 0], fontsize=8)
-        ax.minorticks_off()
-        ax.set_xlim(zero_x / 1.6, max(ticks + list(pos)) * 1.6)
-        ax.set_xlabel("increment error per axis, sigma or network RMSE (m)")
-        ax.set_ylabel("max horizontal error (m)")
-        n_starts = int(curve["n_starts"].max()) if len(curve) else 0
-        ax.set_title(f"{dataset}: " + (f"sweep, {du:g} s outages ({n_starts} starts)" if o == SWEEP_OUTAGE
-                                       else f"outage {o} ({du:g} s)"), fontsize=9)
-        ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=7, loc="upper left")
     fig.tight_layout()
     return fig

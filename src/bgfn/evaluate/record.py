@@ -11,9 +11,10 @@ from typing import Mapping
 import pandas as pd
 
 from bgfn import paper
-from bgfn.config import RUN_RECORDS
+from bgfn.config import RUN_RECORDS, run_metadata
 from bgfn.evaluate.config import EvaluationSetup
 from bgfn.evaluate.tables import TableResult
+from bgfn.io import atomic_write_json
 
 #: File name under ``results/<profile>/``.
 RECORD_FILE = RUN_RECORDS["evaluation"]
@@ -68,8 +69,6 @@ def write_evaluation_record(out, setup: EvaluationSetup, results: Mapping[str, T
                             timings: dict) -> Path:
     """Write :func:`evaluation_record` plus ``meta`` (:func:`bgfn.config.run_metadata`) to
     ``<out>/outage_evaluation.json`` atomically; returns the path."""
-    from bgfn.config import run_metadata
-    from bgfn.io import atomic_write_json
 
     record = {**evaluation_record(setup, results, reductions, sweep_rows, sweep_info, timings),
               "meta": run_metadata(setup.profile)}

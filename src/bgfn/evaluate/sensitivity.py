@@ -16,6 +16,7 @@ from pathlib import Path
 import pandas as pd
 
 from bgfn.evaluate.tables import TableResult, aggregate_seeds, evaluate_dataset, table_file
+from bgfn.io import atomic_write_csv
 
 #: Columns of :attr:`Sensitivity.table`: max errors (m) with the tables' pseudo std, then with the validation std.
 SENSITIVITY_COLUMNS: tuple[str, ...] = ("outage", "method", "max_east_m", "max_north_m",
@@ -82,7 +83,6 @@ def pseudo_std_sensitivity(cfg: dict, profile: str, result: TableResult, ecfg: d
 def save_sensitivity(out, sensitivity: Sensitivity) -> Path:
     """Write the sensitivity run's seed aggregate (``TABLE_COLUMNS``) to
     ``<out>/tables/outage_<test>_std_validation.csv``, atomically; returns the path."""
-    from bgfn.io import atomic_write_csv
 
     stem = table_file(sensitivity.alternative.test)[: -len(".csv")]
     path = Path(out) / "tables" / f"{stem}_std_validation.csv"

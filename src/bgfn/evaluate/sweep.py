@@ -4,19 +4,25 @@ tested on (k-fold), bootstrap intervals and paired tests, and the lines and tabl
 from __future__ import annotations
 
 import copy
+import time
 from typing import Callable
 
 import numpy as np
 import pandas as pd
+from tqdm import tqdm
 
-from bgfn.checkpoints import checkpoint_path
+from bgfn import train
+from bgfn.data import load_drive
 from bgfn.errors import DataError
 from bgfn.evaluate.config import SEEDLESS_METHODS, SWEEP_COLUMNS, TABLE_METHODS, evaluate_config
 from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
 from bgfn.evaluate.increments import AntennaTruth, increment_rmse
 from bgfn.evaluate.networks import load_model
+from bgfn.learning import build_learning_data, learning_options
 from bgfn.nav.baseline import filter_start
 from bgfn.paper import METHOD_LABELS, NHC_SUFFIX, label, nhc_label
+from bgfn.stats import bootstrap_ci, paired_comparison, wilcoxon_p
+from bgfn.train.checkpoints import checkpoint_path
 
 
 def sweep_plan(drive, sweep: dict, window_samples: int = 200, t_first: float | None = None) -> pd.DataFrame:
@@ -53,7 +59,6 @@ def sweep_plan(drive, sweep: dict, window_samples: int = 200, t_first: float | N
 def profile_sweep_plan(cfg: dict, drive, sweep: dict) -> pd.DataFrame:
     """:func:`sweep_plan` of ``drive`` under a profile: the input window of the sweep's networks (``train:`` with
     ``sweep.train``'s overrides) and the filter's start (``nav:``; a self-aligned filter starts late)."""
-    from bgfn.learning import learning_options
 
     n_window = int(learning_options(sweep_train_config(cfg.get("train") or {}, sweep))["window"])
     return sweep_plan(drive, sweep, n_window, t_first=filter_start(drive, cfg.get("nav")))
@@ -83,17 +88,12 @@ def run_sweep(cfg: dict, profile: str, dataset: str, drive=None, ecfg: dict | No
     info : dict
         Sizes, training and evaluation wall times, fold windows.
     """
-    import time
 
-    from tqdm import tqdm
 
-    from bgfn import train
-    from bgfn.learning import build_learning_data, learning_options
 
     ecfg = ecfg or evaluate_config(cfg.get("evaluate"), cfg.get("train"))
     sw = ecfg["sweep"]
     if drive is None:
-        from bgfn.data import load_drive
 
         drive = load_drive(dataset, profile=profile)
     # the sweep's budget, with the learning rates notebook 03 selected for this dataset (same for every fold)
@@ -178,7 +178,6 @@ def sweep_summary(sweep: pd.DataFrame, n_boot: int = 2000, level: float = 0.95, 
     DataFrame
         ``dataset``, ``duration_s``, ``method``, ``n`` (runs), ``n_starts``, ``median_m``, ``ci_lo_m``, ``ci_hi_m``.
     """
-    from bgfn.stats import bootstrap_ci
 
     rows = []
     order = {m: i for i, m in enumerate(TABLE_METHODS)}
@@ -207,7 +206,6 @@ def sweep_comparisons(sweep: pd.DataFrame, method: str = "BGFN", metric: str = "
         ``dataset``, ``duration_s``, ``method``, ``baseline``, ``n``, ``wins``, ``ties``, ``win_rate``,
         ``median_diff_m`` (method - baseline), ``median_ratio``, ``p_value``, ``n_starts``, ``p_value_by_start``.
     """
-    from bgfn.stats import paired_comparison, wilcoxon_p
 
     rows = []
     aided = nhc_label(method)
@@ -285,7 +283,6 @@ def run_sweeps(cfg: dict, profile: str, datasets, ecfg: dict, progress: bool = T
     timings : dict
         ``{"sweep_<dataset>_s": wall time, s}``.
     """
-    import time
 
     parts, info, timings = [], {}, {}
     for name in datasets:

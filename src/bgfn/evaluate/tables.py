@@ -4,6 +4,7 @@ ours are :mod:`bgfn.evaluate.claims`."""
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
@@ -11,11 +12,14 @@ from typing import Any, Callable
 import numpy as np
 import pandas as pd
 
+from bgfn.data import load_drive
 from bgfn.data.gnss import fix_errors
 from bgfn.data.names import dataset_id
 from bgfn.evaluate.config import METRIC_COLUMNS, TABLE_COLUMNS, TABLE_FILES, TABLE_METHODS, evaluate_config
 from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
 from bgfn.evaluate.networks import ensure_models
+from bgfn.io import atomic_write_csv
+from bgfn.nav import outages
 from bgfn.paper import METHOD_LABELS, nhc_label, test_of
 
 
@@ -110,11 +114,9 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
         Also run ``INS+NHC`` and every network with the vehicle constraints (``<METHOD>+NHC``); None:
         ``ecfg['nhc_rows']``.
     """
-    from bgfn.nav import outages
 
     ecfg = ecfg or evaluate_config(cfg.get("evaluate"), cfg.get("train"))
     if drive is None:
-        from bgfn.data import load_drive
 
         drive = load_drive(dataset, profile=profile)
     windows = outages.outage_windows(cfg, drive, dataset)
@@ -167,7 +169,6 @@ def run_tables(cfg: dict, profile: str, datasets, ecfg: dict, out,
     timings : dict
         ``{"tables_<dataset>_s": wall time of loading, evaluating and writing, s}``.
     """
-    import time
 
     results, timings = {}, {}
     for name in datasets:
@@ -209,7 +210,6 @@ def save_table_result(out, result: TableResult, series_rate_hz: float = 10.0) ->
     dict
         ``{kind: path}``.
     """
-    from bgfn.io import atomic_write_csv
 
     paths = table_paths(out, result.test)
     gnss = paths.pop("gnss")

@@ -11,14 +11,22 @@ outage (variant ``-``, ``n_runs`` 0).
 
 from __future__ import annotations
 
+import time
+from pathlib import Path
+
 import pandas as pd
 
+from bgfn.config import MAIN_VARIANT
+from bgfn.data import load_drive
 from bgfn.data.names import dataset_id
 from bgfn.errors import DataError
 from bgfn.evaluate.config import evaluate_config
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.evaluate.networks import load_model
+from bgfn.nav import outages
 from bgfn.paper import METHOD_LABELS, test_of
+from bgfn.train.checkpoints import checkpoint_name
+from bgfn.train.variants import describe_options
 
 #: Columns of ``tables/outage_variants.csv``.
 VARIANT_COLUMNS: tuple[str, ...] = ("dataset", "test", "outage", "start_s", "variant", "inputs", "protocol",
@@ -32,7 +40,6 @@ NO_VARIANT = "-"
 def load_variant_network(path):
     """The network at ``path`` (:func:`bgfn.evaluate.networks.load_model`); DataError when notebook 03 has not
     trained it."""
-    from pathlib import Path
 
     if not Path(path).exists():
         raise DataError(path, "checkpoint", "a variant's network (notebook 03 trains it: train_variants)", "missing")
@@ -60,12 +67,7 @@ def variant_runs(vplan, drives: dict | None = None, loader=load_variant_network,
         ``dataset, test, outage, start_s, variant, inputs, protocol, method, seed`` and
         :func:`bgfn.evaluate.hybrid.window_metrics`'s metrics.
     """
-    import time
 
-    from bgfn.checkpoints import checkpoint_name
-    from bgfn.nav import outages
-    from bgfn.profile_schema import MAIN_VARIANT
-    from bgfn.train.variants import describe_options
 
     cfg = vplan.cfg
     ecfg = evaluate_config(cfg.get("evaluate"), cfg.get("train"))
@@ -74,7 +76,6 @@ def variant_runs(vplan, drives: dict | None = None, loader=load_variant_network,
         t0 = time.perf_counter()
         drive = (drives or {}).get(dataset)
         if drive is None:
-            from bgfn.data import load_drive
 
             drive = load_drive(dataset, profile=vplan.profile)
         windows = outages.outage_windows(cfg, drive, dataset)         # each drive its own

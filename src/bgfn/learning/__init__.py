@@ -53,8 +53,8 @@ Modules, one concept each (every public name is re-exported here):
 - :mod:`bgfn.learning.synthetic`: a toy drive for tests and examples.
 """
 
-from bgfn.learning.coverage import (VAL_POSITIONS, motion_in_windows, motion_of_windows, motion_sets,
-                                    unseen_fraction, val_position_coverage)
+from bgfn.learning.coverage import (VAL_POSITIONS, motion_in_windows, motion_of_windows, motion_sets, unseen_fraction,
+                                    val_position_coverage)
 from bgfn.learning.data import (LEARNING_DEFAULTS, LearningData, all_windows, build_learning_data, inner_split,
                                 learning_options, split_summary)
 from bgfn.learning.inputs import (ANGULAR_RATE_CHANNELS, ATTITUDE_CHANNELS, CHANNELS, DERIVED_CHANNELS, EXTRA_START,

@@ -13,10 +13,11 @@ from bgfn.learning.references import reference_columns, reference_rmse
 from bgfn.learning.split import block_label, split_windows
 from bgfn.learning.targets import TARGET_FRAMES
 from bgfn.learning.windows import WindowSet, make_windows
+from bgfn.nav.outages import DEFAULT_MARGIN_S
 
 #: Defaults of the learning-problem keys of a profile's ``train:`` section.
 LEARNING_DEFAULTS = {"window": 200, "alignment": "ending", "yaw_encoding": "unwrap", "target_frame": "ned",
-                     "extra_channels": [], "epoch_stride": 1, "margin_s": 30.0, "val_fraction": 0.2,
+                     "extra_channels": [], "epoch_stride": 1, "margin_s": DEFAULT_MARGIN_S, "val_fraction": 0.2,
                      "val_position": "middle", "target_screen_sigma": None, "protocol": "honest"}
 
 

@@ -29,10 +29,11 @@ Modules (pyins style, one concept each; SI units, radians, NED, tables as in CON
   ``PseudoGpsContext``, ``IncrementPseudoGps`` = Eq. pred-gps, ``TablePseudoGps``).
 - :mod:`~bgfn.nav.outage_rules` -- ``pick_windows(rule, reference, margin_s)``: a drive's outages picked by a
   rule (``cruise_and_manoeuvre``: one cruising, one manoeuvring, as the paper's field test).
-- :mod:`~bgfn.nav.constraints` -- the vehicle constraints of the ``+NHC`` rows: NHC and ZUPT velocity updates
-  (``nhc_measurement``, ``zupt_measurement``, ``propagate_aided``), the stillness detector ``stillness``, the
-  vehicle frame ``mounting_track``; ``build_constraints(imu, imu_errors, config, trajectory) -> Constraints``,
-  which ``run_filter`` / ``run_outage`` take as ``constraints``.
+- :mod:`~bgfn.nav.constraints` -- the vehicle constraints of the ``+NHC`` rows, an aid of the filter engine
+  (``Aid``: it answers the engine's "which measurement after this step?"): NHC and ZUPT velocity updates
+  (``nhc_measurement``, ``zupt_measurement``), the stillness detector ``stillness``, the vehicle frame
+  ``mounting_track``; ``build_constraints(imu, imu_errors, config, trajectory) -> Constraints``, which
+  ``run_filter`` / ``run_outage`` take as ``aid``.
 - :mod:`~bgfn.nav.outages` -- ``OutageWindow``, ``check_windows``, ``outage_windows(profile, drive)`` (the profile's one key),
   the pseudo-GPS hook (``PseudoFix``, ``PseudoGpsContext``, ``IncrementPseudoGps`` = Eq. pred-gps,
   ``TablePseudoGps``).
@@ -52,14 +53,3 @@ Modules (pyins style, one concept each; SI units, radians, NED, tables as in CON
 - :mod:`~bgfn.nav.ins_setups` -- the standalone-INS row under each setup beside the paper's:
   ``ins_tuning_table(drive, cfg, windows)``, ``layout``, ``gap_explained``, ``sentences``, ``save_table``.
 """
-
-__all__ = ["run_drive"]
-
-
-def __getattr__(name):
-    # Lazy: importing bgfn.nav.earth must not load numba, pandas plotting or the filter.
-    if name == "run_drive":
-        from .baseline import run_drive
-
-        return run_drive
-    raise AttributeError(f"module 'bgfn.nav' has no attribute {name!r}")

@@ -27,19 +27,20 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from .. import paper
 from ..errors import DataError
-from . import metrics, navego_setup
+from ..io import atomic_write_csv
+from . import constraints as cn, metrics, navego_setup
 from .alignment import ALIGNMENT_DEFAULTS, MODES, Alignment, align
 from .consistency import nis_line, nis_summary
-from . import constraints as cn
 from .filter import FilterResult, gate_thresholds, run_filter, run_outage
 from .outages import check_windows, epochs_before
-from .state import FilterNoise, FilterState, initial_covariance, initial_state, noise_from_imu_errors
+from .state import FilterNoise, FilterState, initial_covariance, initial_state, noise_from_imu_errors, save_states
 from .tuning import NOISE_SEARCH_DEFAULTS, NoiseTuning, search_noise_scale
 
 #: Defaults of the ``nav:`` profile section.
@@ -145,7 +146,7 @@ def run_drive(drive, section: dict | None = None, snapshots: dict | None = None)
     initial, noise = filter_setup(drive, cfg)
     return run_filter(filter_imu(drive, cfg), initial, noise, drive.gnss, _lever(drive), snapshots=snapshots,
                       gate_probability=cfg["innovation_gate"], source=drive.name,
-                      constraints=gps_constraints(drive, cfg, initial, noise))
+                      aid=gps_constraints(drive, cfg, initial, noise))
 
 
 @dataclass
@@ -384,14 +385,14 @@ def run_baseline(drive, cfg: dict, windows) -> Baseline:
     starts = epochs_before(drive.imu["time"], [w.start for w in windows], drive.name)
     full = run_filter(imu, initial, noise, drive.gnss, lever, snapshots=dict(zip(names, starts)),
                       gate_probability=cfg["innovation_gate"], source=drive.name,
-                      constraints=gps_constraints(drive, cfg, initial, noise))
+                      aid=gps_constraints(drive, cfg, initial, noise))
     errors = metrics.navigation_errors(full.trajectory, drive.reference, drive.meta)
     aids = outage_constraints(drive, cfg, full.trajectory)
     rows, outage_errors = [], {}
     for n, w in zip(names, windows):
         parts = []
         for method, con in (("INS", None), (INS_NHC, aids)):
-            res = run_outage(imu, full.states[n], w, noise, lever, source=drive.name, constraints=con)
+            res = run_outage(imu, full.states[n], w, noise, lever, source=drive.name, aid=con)
             e = metrics.navigation_errors(res.trajectory, drive.reference, drive.meta)
             e.insert(1, "t_rel", e["time"] - w.start)
             e.insert(0, "method", method)
@@ -445,7 +446,7 @@ def ins_max_error_file(outage_table: pd.DataFrame) -> pd.DataFrame:
                             for m in methods for _, axis in paper.AXES}})
 
 
-def save_baseline(b: Baseline, out, lat=None) -> dict:
+def save_baseline(b: Baseline, out, file_id: str, lat=None) -> dict:
     """Write one drive's baseline under ``out`` (``results/<profile>``) atomically.
 
     Files (``<d>`` = the dataset's id, :func:`bgfn.data.names.dataset_id`, never a folder path):
@@ -464,14 +465,10 @@ def save_baseline(b: Baseline, out, lat=None) -> dict:
         JSON-ready summary (RMS, outage metrics, mean NIS, the filter's start and noise factor
         (:meth:`FilterSetup.record`), the constraints' facts) for ``kf_baseline.json``.
     """
-    from pathlib import Path
 
-    from ..data.names import dataset_id
-    from ..io import atomic_write_csv
-    from .state import save_states
 
     out = Path(out)
-    d = dataset_id(b.drive_name)
+    d = file_id
     save_states(out / f"nav_states_{d}.npz", b.states)
     atomic_write_csv(out / "tables" / f"kf_rms_{d}.csv", b.rms.reset_index(), float_format="%.6g")
     atomic_write_csv(out / "tables" / f"kf_outage_max_errors_{d}.csv", ins_max_error_file(b.outage_table))

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+from scipy.stats import chi2
 
 #: A mean NIS within a factor NIS_BAND of its degrees of freedom reads as consistent. The bound is deliberately
 #: loose: real GNSS errors are time-correlated and no 15-state filter models them, so a mean of 4-5 for 3 axes is
@@ -42,7 +43,6 @@ def nis_summary(updates: pd.DataFrame, kind: str = "gnss") -> dict:
         (fraction of fixes above the 95 % quantile of chi-square with their dof; 0.05 when consistent) and
         ``verdict`` (:func:`verdict`).
     """
-    from scipy.stats import chi2
 
     u = updates[updates["kind"] == kind] if len(updates) else updates
     if not len(u):

@@ -1,8 +1,9 @@
 """Learning-free outage aids of a road vehicle: non-holonomic constraints (NHC) and zero-velocity updates (ZUPT).
 
 Beyond the paper (issue 17, the classic aids a learned one must beat or add to). Both are velocity measurements
-of the 15-state filter (:mod:`bgfn.nav.filter`), fused with the same sequential Joseph update and closed-loop
-feedback as a position fix, at the *aid epochs*: the first IMU row at or after every multiple of
+of the 15-state filter, an *aid* of the engine :mod:`bgfn.nav.filter` (:class:`Constraints` is its
+:class:`~bgfn.nav.filter.Aid`): the engine asks after each IMU step of the schedule which measurement to fuse,
+and fuses it with the same sequential Joseph update and closed-loop feedback as a position fix, at the *aid epochs*: the first IMU row at or after every multiple of
 ``1 / nhc_rate_hz`` of the time of week (the same epochs in every run of a drive).
 
 - **NHC**: a car neither slides sideways nor leaves the road, so its velocity in the *vehicle* frame has
@@ -49,7 +50,8 @@ import pandas as pd
 from ..errors import DataError
 from ..schema import ACCEL_COLUMNS, GYRO_COLUMNS
 from . import error_model as em
-from .filter import feedback, propagate_steps, sequential_update
+from .filter import AidMeasurement
+from .transform import dcm_from_euler
 
 #: What happens at an IMU step (the aid schedule, one code per step).
 AID_NONE, AID_NHC, AID_ZUPT = 0, 1, 2
@@ -111,10 +113,6 @@ class ConstraintConfig:
                 raise DataError("params nav.nhc/nav.zupt", name, "a number >= 0", repr(value))
         if self.mounting not in MOUNTINGS:
             raise DataError("params nav.nhc", "mounting", f"one of {MOUNTINGS}", repr(self.mounting))
-
-    def kernel_args(self) -> tuple[float, float, float]:
-        """``(nhc_std, zupt_std, zupt_max_speed)`` in the order :func:`propagate_aided` takes them."""
-        return self.nhc_std_mps, self.zupt_std_mps, self.zupt_max_speed_mps
 
 
 def constraint_config(nav_cfg: dict) -> ConstraintConfig:
@@ -215,8 +213,6 @@ def vehicle_velocity_ratios(trajectory: pd.DataFrame) -> tuple[np.ndarray, np.nd
     forward : ndarray [T]
         ``v^b_x``, m/s.
     """
-    from .transform import dcm_from_euler
-
     c = dcm_from_euler(trajectory["roll"].to_numpy(float), trajectory["pitch"].to_numpy(float),
                        trajectory["yaw"].to_numpy(float))                                    # [T, 3, 3]
     vb = np.einsum("tji,tj->ti", c, trajectory[["v_n", "v_e", "v_d"]].to_numpy(float))      # C^T v, [T, 3]
@@ -315,6 +311,14 @@ class Constraints:
                             "an epoch it does not have")
         return np.ascontiguousarray(self.aid[i]), np.ascontiguousarray(self.mounting_at(time))
 
+    def schedule(self, time, source: str = "imu", hold_at: float | None = None) -> "VehicleSchedule":
+        """The :class:`~bgfn.nav.filter.AidSchedule` of the IMU steps ending at ``time`` (s): NHC or ZUPT at each
+        aid epoch, the vehicle frame held at its value at ``hold_at`` (an outage) when given."""
+        con = self if hold_at is None else self.frozen(hold_at if self.freeze_at is None
+                                                       else min(hold_at, self.freeze_at))
+        aid, mount = con.steps(time, source)
+        return VehicleSchedule(np.flatnonzero(aid != AID_NONE), aid, mount, self.config)
+
     def summary(self) -> dict:
         """JSON-ready facts: aid epochs, ZUPT epochs, the share of still IMU rows, the final mounting angles (deg)."""
         yaw, pitch = np.degrees(np.arctan(self.mount[-1])) if self.mount.size else (0.0, 0.0)
@@ -389,60 +393,45 @@ def zupt_measurement(v, dz, H):
         H[j, em.DV_NED[j]] = 1.0
 
 
-@numba.njit(cache=True)
-def apply_aid(kind, pos, v, c, ba, bg, P, tan_yaw, tan_pitch, nhc_std, zupt_std, zupt_max_speed):
-    """One NHC (``kind == AID_NHC``) or ZUPT (``AID_ZUPT``, while the speed is at most ``zupt_max_speed``)
-    update with feedback (:func:`bgfn.nav.filter.feedback`). Returns the code of the update applied."""
-    n = P.shape[0]
-    x = np.zeros(n)
-    if kind == AID_ZUPT and np.sqrt(v @ v) > zupt_max_speed:
-        kind = AID_NHC
-    if kind == AID_ZUPT:
-        dz = np.empty(3)
-        H = np.empty((3, n))
-        zupt_measurement(v, dz, H)
-        std = np.full(3, zupt_std)
-    else:
-        dz = np.empty(2)
-        H = np.empty((2, n))
-        r_vb = np.empty((3, 3))
-        vehicle_rotation_nb(tan_yaw, tan_pitch, r_vb)
+@dataclass(frozen=True)
+class VehicleSchedule:
+    """The vehicle constraints bound to one run's IMU steps: what the filter engine asks after each aided step.
+
+    Attributes
+    ----------
+    rows : ndarray of int
+        Steps with an aid epoch (:class:`~bgfn.nav.filter.AidSchedule`).
+    aid : ndarray of int8 [n]
+        ``AID_NHC`` / ``AID_ZUPT`` / ``AID_NONE`` per step.
+    mount : ndarray [n, 2]
+        Mounting tangents in force at each step.
+    config : ConstraintConfig
+    """
+
+    rows: np.ndarray
+    aid: np.ndarray
+    mount: np.ndarray
+    config: ConstraintConfig
+
+    def measurement(self, k: int, pos, v, c) -> AidMeasurement | None:
+        """NHC (the vehicle-frame lateral and vertical velocity are zero) or, at a still epoch while the speed is
+        at most ``zupt_max_speed_mps``, ZUPT (the NED velocity is zero)."""
+        kind = self.aid[k]
+        if kind == AID_NONE:
+            return None
+        if kind == AID_ZUPT and np.sqrt(v @ v) > self.config.zupt_max_speed_mps:
+            kind = AID_NHC              # a vibration-free IMU at constant speed reads as still: no ZUPT at speed
+        n = em.N_STATES
+        if kind == AID_ZUPT:
+            dz, H = np.empty(3), np.empty((3, n))
+            zupt_measurement(v, dz, H)
+            return AidMeasurement(dz, H, np.full(3, self.config.zupt_std_mps))
+        dz, H, r_vb = np.empty(2), np.empty((2, n)), np.empty((3, 3))
+        vehicle_rotation_nb(self.mount[k, 0], self.mount[k, 1], r_vb)
         nhc_measurement(v, c, r_vb, dz, H)
-        std = np.full(2, nhc_std)
-    innov = np.empty(dz.size)
-    sequential_update(P, H, dz, std, x, innov)
-    feedback(pos, v, c, ba, bg, x)
-    return kind
-
-
-@numba.njit(cache=True)
-def propagate_aided(i0, i1, dt, gyro, accel, pos, v, c, ba, bg, P, q_g, q_a, q_bg, q_ba, inv_tau_a, inv_tau_g,
-                    out_pos, out_v, out_c, out_sd, aid, mount, nhc_std, zupt_std, zupt_max_speed, out_bias):
-    """:func:`bgfn.nav.filter.propagate_steps` over steps ``i0..i1-1`` with the aid of ``aid[k]`` applied after
-    step ``k``; an aided output row ``k + 1`` holds the state after the update, and ``out_bias[k + 1]`` its
-    bias estimates (accelerometer then gyro)."""
-    n = P.shape[0]
-    k = i0
-    while k < i1:
-        j = k
-        while j < i1 and aid[j] == AID_NONE:
-            j += 1
-        end = min(j + 1, i1)
-        propagate_steps(k, end, dt, gyro, accel, pos, v, c, ba, bg, P, q_g, q_a, q_bg, q_ba, inv_tau_a, inv_tau_g,
-                        out_pos, out_v, out_c, out_sd)
-        if j < i1:
-            apply_aid(aid[j], pos, v, c, ba, bg, P, mount[j, 0], mount[j, 1], nhc_std, zupt_std, zupt_max_speed)
-            out_pos[j + 1] = pos
-            out_v[j + 1] = v
-            out_c[j + 1] = c
-            for r in range(n):
-                out_sd[j + 1, r] = np.sqrt(max(P[r, r], 0.0))
-            for a in range(3):
-                out_bias[j + 1, a] = ba[a]
-                out_bias[j + 1, 3 + a] = bg[a]
-        k = end
+        return AidMeasurement(dz, H, np.full(2, self.config.nhc_std_mps))
 
 
 __all__ = ["AID_NHC", "AID_NONE", "AID_ZUPT", "ConstraintConfig", "Constraints", "NHC_DEFAULTS", "ZUPT_DEFAULTS",
            "aid_epochs", "build_constraints", "constraint_config", "mounting_track", "nhc_measurement",
-           "propagate_aided", "rest_noise", "stillness", "vehicle_rotation", "zupt_measurement"]
+           "rest_noise", "stillness", "vehicle_rotation", "VehicleSchedule", "zupt_measurement"]

@@ -33,8 +33,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from .strapdown import gravity_nb, radii_nb
 from .earth import E2, GAMMA_E, K_SOMIGLIANA, OMEGA_IE
+from .strapdown import gravity_nb, radii_nb
 
 # Eq. (eq13), the paper's order.
 PHI_E, PHI_N, PHI_D = 0, 1, 2

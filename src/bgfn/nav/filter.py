@@ -14,17 +14,22 @@ time (exactly the batch update for the diagonal R), with the Joseph form for ``P
 fed back: position, velocity, ``C_bn <- exp([phi]) C_bn``, bias estimates ``+= (nabla, eps)``, ``x = 0``.
 
 Outage windows remove GNSS updates; inside them a pseudo-GPS source may supply fixes
-(:mod:`bgfn.nav.outages`, Eq. pred-gps). Beyond the paper, the vehicle constraints of
-:mod:`bgfn.nav.constraints` (NHC, ZUPT) may add velocity updates at their epochs (``constraints``; default none).
+(:mod:`bgfn.nav.outages`, Eq. pred-gps). Beyond the paper, an *aid* may add measurements at its own epochs
+(``aid``; default none). The filter is the engine and knows no aid: it asks the aid's schedule "which
+measurement after this IMU step?" (:class:`AidSchedule`) and fuses the answer (:class:`AidMeasurement`: an
+innovation, its Jacobian and its std) with the same sequential update and feedback as a fix. The vehicle
+constraints (NHC, ZUPT) are one such aid (:mod:`bgfn.nav.constraints`); a new aid is a new module.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numba
 import numpy as np
 import pandas as pd
+from scipy.stats import chi2
 
 from ..errors import DataError
 from ..schema import GNSS_FIX_COLUMNS
@@ -199,6 +204,77 @@ def update_position(pos, v, c, ba, bg, P, lever, fix, std, lag, innov, gate):
 
 
 # ---------------------------------------------------------------------------------------------------
+# the aid interface: an aid answers, after the IMU steps it names, with a measurement the engine fuses
+# ---------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class AidMeasurement:
+    """One aid measurement for :func:`sequential_update`: ``dz`` [m] (computed minus measured), ``H`` [m, 15] its
+    Jacobian with respect to the error states (:mod:`bgfn.nav.error_model` order), ``std`` [m] the measurement
+    noise per row (a row with a non-positive or non-finite std is left out)."""
+
+    dz: np.ndarray
+    H: np.ndarray
+    std: np.ndarray
+
+
+class AidSchedule(Protocol):
+    """An aid bound to the IMU steps of one run (what :meth:`Aid.schedule` returns).
+
+    ``rows``: the sorted step indices ``k`` (0-based, into the run's IMU steps) after which the engine asks;
+    ``measurement(k, pos, v, c)`` answers with the measurement at that epoch from the current solution
+    (``pos`` [lat, lon, h] rad/rad/m, ``v`` NED m/s, ``c`` C_bn), or None for no update.
+    """
+
+    rows: np.ndarray
+
+    def measurement(self, k: int, pos: np.ndarray, v: np.ndarray, c: np.ndarray) -> AidMeasurement | None: ...
+
+
+class Aid(Protocol):
+    """A measurement source beyond the GNSS fixes (NHC/ZUPT, a learned odometer ...), built once per drive."""
+
+    def schedule(self, time: np.ndarray, source: str = "imu", hold_at: float | None = None) -> AidSchedule:
+        """Bind to the IMU steps ending at ``time`` (s). ``hold_at``: no GNSS fix comes after this time (an
+        outage), so whatever the aid estimates from the GPS-aided solution is held at its value then."""
+        ...
+
+
+def propagate(r0: int, r1: int, dt, gyro, accel, nav: tuple, q: tuple, out: tuple,
+              schedule: AidSchedule | None = None, out_bias: np.ndarray | None = None,
+              aided_rows: list | None = None) -> None:
+    """Prediction over output rows ``r0..r1`` (steps ``r0..r1-1``, Eq. eq3) with the aid's updates at its epochs.
+
+    ``nav`` = ``(pos, v, c, ba, bg, P)`` and ``out`` = ``(out_pos, out_v, out_c, out_sd)`` are updated in place,
+    as :func:`propagate_steps` does. After each step ``k`` of ``schedule.rows`` the aid's measurement is fused
+    (:func:`sequential_update`, then :func:`feedback`); the output row ``k + 1`` then holds the corrected state,
+    ``out_bias[k + 1]`` its bias estimates (accelerometer then gyro) and ``k + 1`` is appended to ``aided_rows``.
+    """
+    pos, v, c, ba, bg, P = nav
+    out_pos, out_v, out_c, out_sd = out
+    k = r0
+    if schedule is not None:
+        rows = schedule.rows
+        for j in rows[np.searchsorted(rows, r0):np.searchsorted(rows, r1)]:
+            j = int(j)
+            propagate_steps(k, j + 1, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd)
+            k = j + 1
+            m = schedule.measurement(j, pos, v, c)
+            if m is None:
+                continue
+            x = np.zeros(P.shape[0])
+            sequential_update(P, m.H, m.dz, m.std, x, np.empty(m.dz.size))
+            feedback(pos, v, c, ba, bg, x)
+            out_pos[k], out_v[k], out_c[k] = pos, v, c
+            out_sd[k] = np.sqrt(np.maximum(np.diag(P), 0.0))
+            if out_bias is not None:
+                out_bias[k, :3], out_bias[k, 3:] = ba, bg
+            if aided_rows is not None:
+                aided_rows.append(k)
+    if k < r1:
+        propagate_steps(k, r1, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd)
+
+
+# ---------------------------------------------------------------------------------------------------
 # results
 # ---------------------------------------------------------------------------------------------------
 @dataclass
@@ -253,8 +329,6 @@ def gate_thresholds(probability: float | None, source: str = "nav") -> np.ndarra
         p = float("nan")
     if not 0.0 < p < 1.0:
         raise DataError(source, "innovation_gate", "a probability in (0, 1), or null for no gate", repr(probability))
-    from scipy.stats import chi2
-
     return np.array([0.0] + [float(chi2.ppf(p, k)) for k in (1, 2, 3)])
 
 
@@ -270,7 +344,7 @@ def _check_gnss(gnss, source):
 def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss: pd.DataFrame | None = None,
                lever_arm=(0.0, 0.0, 0.0), outage_windows=(), pseudo_gps=None, t_end: float | None = None,
                snapshots: dict | None = None, pseudo_rate_hz: float = PSEUDO_RATE_HZ,
-               gate_probability: float | None = None, source: str = "drive", constraints=None) -> FilterResult:
+               gate_probability: float | None = None, source: str = "drive", aid: Aid | None = None) -> FilterResult:
     """Run the closed-loop GPS/INS filter from ``initial`` over the IMU rows after ``initial.time``.
 
     Parameters
@@ -302,10 +376,10 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
         fused (the paper's filter). Pseudo fixes are never gated.
     source : str
         Name used in error messages.
-    constraints : bgfn.nav.constraints.Constraints, optional
-        Vehicle constraints (NHC, and ZUPT where the stillness detector fires) applied at their aid epochs;
-        built for this ``imu`` (:func:`bgfn.nav.constraints.build_constraints`). None: none (the paper's filter).
-        Their updates are not rows of ``updates``.
+    aid : Aid, optional
+        A measurement source fused at its own epochs (module docstring), e.g. the vehicle constraints of
+        :func:`bgfn.nav.constraints.build_constraints` (NHC, and ZUPT where the stillness detector fires), built
+        for this ``imu``. None: none (the paper's filter). Its updates are not rows of ``updates``.
 
     Returns
     -------
@@ -321,9 +395,7 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
         time, gyro, accel, dt = time[keep], gyro[keep], accel[keep], dt[keep]
     times = np.concatenate([[t0], time])  # output rows
     n_rows = times.size
-    aid = mount = None
-    if constraints is not None:
-        aid, mount = constraints.steps(time, source + ":imu")
+    schedule = aid.schedule(time, source + ":imu") if aid is not None else None
     windows = check_windows(outage_windows, t0, times[-1], source + ":outage_windows")
     lever = np.asarray(lever_arm, dtype=float).reshape(3)
 
@@ -364,24 +436,19 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
     q = noise_arrays(noise)
     out_pos, out_v = np.empty((n_rows, 3)), np.empty((n_rows, 3))
     out_c, out_sd = np.empty((n_rows, 3, 3)), np.empty((n_rows, em.N_STATES))
-    out_bias = np.empty((n_rows, 6))
     out_pos[0], out_v[0], out_c[0] = pos, v, c
     out_sd[0] = np.sqrt(np.clip(np.diag(P), 0, None))
     bias_rows, bias_vals = [0], [np.concatenate([ba, bg])]
     upd, P_upd = [], []
     states, window_start = {}, {}
     innov = np.empty(3)
-    out_bias_aid = np.zeros((n_rows, 6)) if aid is not None else None
+    out_bias_aid = np.zeros((n_rows, 6)) if schedule is not None else None
+    aided_rows: list[int] = []
 
     def advance(r0, r1):
-        """Prediction over output rows r0..r1 (with the constraints' updates at their epochs)."""
-        if aid is None:
-            propagate_steps(r0, r1, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd)
-        else:
-            from .constraints import propagate_aided
-
-            propagate_aided(r0, r1, dt, gyro, accel, pos, v, c, ba, bg, P, *q, out_pos, out_v, out_c, out_sd, aid,
-                            mount, *constraints.config.kernel_args(), out_bias_aid)
+        """Prediction over output rows r0..r1 (with the aid's updates at its epochs)."""
+        propagate(r0, r1, dt, gyro, accel, (pos, v, c, ba, bg, P), q, (out_pos, out_v, out_c, out_sd), schedule,
+                  out_bias_aid, aided_rows)
 
     def current(row):
         return FilterState(float(times[row]), pos.copy(), v.copy(), c.copy(), ba.copy(), bg.copy(), P.copy())
@@ -419,9 +486,9 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
     if row < n_rows - 1:
         advance(row, n_rows - 1)
 
-    if aid is not None:
-        # the constraints' updates also move the bias estimates; at a row with both, the fix comes after
-        aided = np.flatnonzero(aid) + 1
+    if schedule is not None:
+        # the aid's updates also move the bias estimates; at a row with both, the fix comes after
+        aided = np.array(aided_rows, dtype=int)
         order = np.lexsort((np.r_[np.zeros(aided.size), np.ones(len(bias_rows))], np.r_[aided, bias_rows]))
         bias_rows = list(np.r_[aided, bias_rows][order])
         bias_vals = list(np.concatenate([out_bias_aid[aided], np.array(bias_vals)])[order])
@@ -446,7 +513,7 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
 
 def run_outage(imu: pd.DataFrame, start_state: FilterState, window, noise: FilterNoise,
                lever_arm=(0.0, 0.0, 0.0), pseudo_gps=None, pseudo_rate_hz: float = PSEUDO_RATE_HZ,
-               source: str = "drive", constraints=None) -> FilterResult:
+               source: str = "drive", aid: Aid | None = None) -> FilterResult:
     """One outage from a saved filter state: only the window's own IMU rows are processed.
 
     Without ``pseudo_gps`` this is the standalone INS (prediction only, biases held at their last
@@ -466,8 +533,9 @@ def run_outage(imu: pd.DataFrame, start_state: FilterState, window, noise: Filte
         See :func:`run_filter`.
     pseudo_rate_hz : float
     source : str
-    constraints : bgfn.nav.constraints.Constraints, optional
-        See :func:`run_filter`; the vehicle frame is held at its estimate at the start (no fix inside).
+    aid : Aid, optional
+        See :func:`run_filter`; what it estimates from the GPS-aided solution (the vehicle frame of the
+        constraints) is held at its value at the start (no fix inside: ``hold_at``).
 
     Returns
     -------
@@ -477,11 +545,22 @@ def run_outage(imu: pd.DataFrame, start_state: FilterState, window, noise: Filte
     w = window if isinstance(window, OutageWindow) else OutageWindow(*map(float, window))
     if abs(start_state.time - w.start) > 0.5:
         raise DataError(source, "start_state.time", f"the outage start {w.start} s", str(start_state.time))
-    if constraints is not None:
-        constraints = constraints.frozen(start_state.time)
+    if aid is not None:
+        aid = _Held(aid, start_state.time)
     return run_filter(imu, start_state, noise, None, lever_arm, [(start_state.time, w.end - start_state.time)],
-                      pseudo_gps, t_end=w.end, pseudo_rate_hz=pseudo_rate_hz, source=source,
-                      constraints=constraints)
+                      pseudo_gps, t_end=w.end, pseudo_rate_hz=pseudo_rate_hz, source=source, aid=aid)
 
 
-__all__ = ["FilterResult", "run_filter", "run_outage", "gate_thresholds"]
+@dataclass(frozen=True)
+class _Held:
+    """An aid whose schedule is always bound with ``hold_at`` (an outage run: no fix after ``t``)."""
+
+    aid: Aid
+    t: float
+
+    def schedule(self, time, source: str = "imu", hold_at: float | None = None) -> AidSchedule:
+        return self.aid.schedule(time, source, self.t if hold_at is None else min(hold_at, self.t))
+
+
+__all__ = ["Aid", "AidMeasurement", "AidSchedule", "FilterResult", "gate_thresholds", "propagate", "run_filter",
+           "run_outage"]

@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import DataError
-from . import earth
+from . import earth, outage_rules
 
 #: Two window edges closer than this are the same time (float times of week), s.
 TIME_TOL = 1e-6
@@ -114,6 +114,9 @@ def epochs_before(imu_time, starts, source: str = "outage_windows") -> np.ndarra
 
 #: Key of a per-dataset ``outage_windows`` mapping that answers for every dataset it does not name.
 DEFAULT_KEY = "default"
+#: Default of ``train.margin_s``: how far (s) training and validation data stay from an evaluation outage, and
+#: how much training data a rule's outages must leave (read here and by :data:`bgfn.learning.LEARNING_DEFAULTS`).
+DEFAULT_MARGIN_S = 30.0
 
 
 def outage_entry(profile: dict, dataset: str | None = None):
@@ -205,14 +208,11 @@ def outage_windows(profile: dict, drive=None, dataset: str | None = None) -> lis
 def picked_outages(profile: dict, drive, dataset: str | None = None):
     """What the profile's rule for ``dataset`` picks on ``drive`` (:class:`bgfn.nav.outage_rules.PickedOutages`),
     or None when its entry is a list. The training margin of the rule's check is ``train.margin_s``."""
-    from bgfn.learning import learning_options
-    from bgfn.nav import outage_rules
-
     name = dataset if dataset is not None else getattr(drive, "name", None)
     entry = outage_entry(profile, name)
     if not is_rule(entry):
         return None
-    margin = float(learning_options(profile.get("train"))["margin_s"])
+    margin = float((profile.get("train") or {}).get("margin_s", DEFAULT_MARGIN_S))
     return outage_rules.pick_windows(entry, drive.reference, margin, f"{name}: profile outage_windows")
 
 

@@ -45,6 +45,7 @@ def feedback_filter(init: FilterState, noise: FilterNoise, imu: pd.DataFrame, gn
     callable
         ``run() -> DataFrame`` in the reference schema (radians, ``yaw`` from pyins' heading).
     """
+    # here, not at the top: pyins is optional (the test extra), used by the cross-check alone
     from pyins import filters, inertial_sensor, measurements, strapdown
 
     row = init.as_row()

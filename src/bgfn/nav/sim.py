@@ -20,8 +20,8 @@ import numpy as np
 import pandas as pd
 
 from ..errors import DataError
-from . import earth, transform
 from ..schema import REFERENCE_COLUMNS
+from . import earth, transform
 from .strapdown import position_step_nb
 
 

@@ -25,7 +25,7 @@ import pandas as pd
 from ..errors import DataError
 from ..schema import ACCEL_COLUMNS, GYRO_COLUMNS, IMU_COLUMNS
 from . import transform
-from .earth import A, E2, F, GAMMA_E, K_SOMIGLIANA, M_RATIO, OMEGA_IE
+from .earth import E2, GAMMA_E, K_SOMIGLIANA, M_RATIO, OMEGA_IE, A, F
 
 #: An IMU step longer than this many nominal (median) steps is a gap, not a sample.
 MAX_GAP_SAMPLES = 5

@@ -31,8 +31,8 @@ Everything public is re-exported here: ``from bgfn import report; report.outage_
 from bgfn.report.figures import (EXTRA_FIGURES, PAPER_FIGURES, draw_diagrams, extra_figure_section, figure_list,
                                  paper_figure_section)
 from bgfn.report.glance import RUN_FILES, findings_markdown, glance_lines, run_header
-from bgfn.report.provenance import (cards_line, meta_line, model_cards, outage_datasets, outage_provenance,
-                                    provenance, run_meta, short_source)
+from bgfn.report.provenance import (cards_line, meta_line, model_cards, outage_datasets, outage_provenance, provenance,
+                                    run_meta, short_source)
 from bgfn.report.reading import ProfileResults, missing_note, read_csv, read_json, read_results, rel
 from bgfn.report.sections import (OutageSection, energy_section, header_section, kf_section, outage_section,
                                   shown_tests, sweep_section, training_section)
@@ -41,9 +41,9 @@ from bgfn.report.sentences import (BASELINES, EXTRA_METHODS, EXTRA_TAGS, bullets
 from bgfn.report.tables import (REFERENCE_LABELS, TABLE_STYLES, TRAINING_COLUMNS, best_mask, compact, energy_table,
                                 fmt_num, kf_table, reduction_comparison, reductions, style_layout, sweep_table,
                                 training_table)
-from bgfn.report.verdict import Verdict, VerdictInputs, verdict_of, verdict_table
 from bgfn.report.variants import (compared_profiles, profile_tables, reference_sentences, variant_outage_table,
                                   variant_sentences, variant_sweep_table, variant_training_table, variants_section)
+from bgfn.report.verdict import Verdict, VerdictInputs, verdict_of, verdict_table
 
 __all__ = [
     "BASELINES", "EXTRA_METHODS", "EXTRA_TAGS", "PAPER_FIGURES",

@@ -7,15 +7,15 @@ import json
 from pathlib import Path
 from typing import Any, Sequence
 
-from bgfn import checkpoints
+from bgfn.config import RESULTS_ROOT
+from bgfn.data.names import dataset_id
 from bgfn.paper import TESTS, test_of
 from bgfn.report.reading import rel
+from bgfn.train import checkpoints
 
 
 def model_cards(profile: str, dataset: str, results_root: str | Path | None = None) -> list[dict]:
     """The model cards ``results/<profile>/models/<dataset id>/<method>_seed<k>.json`` (fold models excluded)."""
-    from bgfn.config import RESULTS_ROOT
-    from bgfn.data.names import dataset_id
 
     d = Path(results_root or RESULTS_ROOT) / profile / "models" / dataset_id(dataset)
     cards = []

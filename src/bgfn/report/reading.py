@@ -13,7 +13,7 @@ from pathlib import Path
 import pandas as pd
 
 from bgfn import paper
-from bgfn.config import PROJECT_ROOT, RUN_RECORDS, SHARED_TABLES, load_profile, results_dir, run_metadata
+from bgfn.config import PROJECT_ROOT, RUN_RECORDS, SHARED_TABLES, read_profile, results_dir, run_metadata
 
 
 def rel(path: str | Path) -> str:
@@ -102,7 +102,7 @@ def read_results(profile: str, out: str | Path | None = None) -> ProfileResults:
         ``params/<profile>.yaml`` is missing or invalid (the page needs the profile; a missing *result* is
         ``None``).
     """
-    cfg = load_profile(profile)
+    cfg = read_profile(profile)
     out = Path(out) if out is not None else results_dir(profile)
     tables = out / "tables"
     return ProfileResults(

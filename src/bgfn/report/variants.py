@@ -13,7 +13,7 @@ from typing import Sequence
 import numpy as np
 import pandas as pd
 
-from bgfn.config import SHARED_TABLES
+from bgfn.config import RESULTS_ROOT, SHARED_TABLES, profile_chain
 from bgfn.evaluate import describe_sweep
 from bgfn.paper import TESTS, label
 from bgfn.report.provenance import short_source
@@ -34,7 +34,6 @@ def compared_profiles(profile: str, variants: Sequence[str],
     missing : list of str
         The others, ``profile`` itself left out.
     """
-    from bgfn.config import RESULTS_ROOT, profile_chain
 
     base = [p.stem for p in profile_chain(profile)[1:2]]
     names = list(dict.fromkeys([profile, *variants, *base]))
@@ -45,7 +44,6 @@ def compared_profiles(profile: str, variants: Sequence[str],
 
 def profile_tables(profiles: Sequence[str], file: str, results_root: str | Path | None = None) -> dict:
     """``{profile: results/<profile>/tables/<file>}`` (None where it is missing)."""
-    from bgfn.config import RESULTS_ROOT
 
     root = Path(results_root or RESULTS_ROOT)
     return {p: read_csv(root / p / "tables" / file) for p in profiles}
@@ -143,7 +141,6 @@ def variants_section(profile: str, variants: Sequence[str], results_root: str | 
         has, the validation RMSE per profile with its sentences, each outage test's table per profile, the
         sweep per profile with each variant's paired comparisons, and a source line.
     """
-    from bgfn.config import RESULTS_ROOT
 
     root = Path(results_root or RESULTS_ROOT)
     shown, missing = compared_profiles(profile, variants, root)

@@ -23,7 +23,10 @@ import numpy as np
 import pandas as pd
 
 from bgfn import paper
-from bgfn.config import SHARED_TABLES
+from bgfn.config import MAIN_VARIANT, SHARED_TABLES
+from bgfn.data.names import dataset_id
+from bgfn.evaluate.tables import table_paths
+from bgfn.nav.ins_setups import gap_explained
 from bgfn.report.reading import read_csv
 
 #: Rows of the verdict table, in order: (label, method label in the tables). The oracle row is built apart.
@@ -60,8 +63,6 @@ class VerdictInputs:
     @classmethod
     def read(cls, out: str | Path, dataset: str) -> "VerdictInputs":
         """The tables of ``dataset`` under ``out`` (``results/<profile>``), each restricted to that dataset."""
-        from bgfn.data.names import dataset_id
-        from bgfn.evaluate.tables import table_paths
 
         out = Path(out)
         test = paper.test_of(dataset) or dataset_id(dataset)
@@ -130,7 +131,6 @@ def _oracle_value(breakeven: pd.DataFrame | None, outage: str, duration: float |
 def _main_inputs(variants: pd.DataFrame | None) -> str:
     """The main networks' inputs as the variants table describes them (its ``main`` rows), ``Eq. (eq21)`` for
     the paper's; the paper's when there is no variants table."""
-    from bgfn.profile_schema import MAIN_VARIANT
 
     if variants is not None and len(variants) and "inputs" in variants.columns:
         rows = variants[variants["variant"] == MAIN_VARIANT]
@@ -358,7 +358,6 @@ def answer_ins_tuning(inp: VerdictInputs) -> str:
     """Question 5: the INS row under NaveGo v1.4's bias modelling beside ours and the paper's."""
     if inp.ins_tuning is None or not len(inp.ins_tuning):
         return "Is the INS row comparable? Not measured: notebook 02's INS-setup table has not run."
-    from bgfn.nav.ins_setups import gap_explained
 
     gap = gap_explained(inp.ins_tuning)
     g = gap[gap["setup"] == "navego"]

@@ -11,6 +11,7 @@ Modules, one concept each (every public name is re-exported here):
 - :mod:`bgfn.train.lr_search`: the learning rate of every method from one grid on a tuning split;
 - :mod:`bgfn.train.profile`: a profile's runs (:class:`TrainingPlan`), its drives and windows, the INS attitude
   input, the training over datasets x methods x seeds;
+- :mod:`bgfn.train.runs`: :func:`train_profile`, a whole profile (main networks, then variants) from one call;
 - :mod:`bgfn.train.variants`: the profile's input and protocol variants (:class:`VariantPlan`), trained beside the
   main networks with their learning rates;
 - :mod:`bgfn.train.recheck`: the runs that never improved on their initial network, trained again on all their
@@ -18,11 +19,13 @@ Modules, one concept each (every public name is re-exported here):
 - :mod:`bgfn.train.tables`: the run and summary tables, the windows table, ``training.json``;
 - :mod:`bgfn.train.plots`: the figures of notebook 03;
 - :mod:`bgfn.train.estimate`: how long the paper profile would train here, from ``make bench``;
-- :mod:`bgfn.train.cli`: ``python -m bgfn.train --profile ...``.
+- :mod:`bgfn.train.speed`: CPU timing (latency, throughput, the profiled training step) for ``make bench``;
+- :mod:`bgfn.train.checkpoints`: where trained networks live (names of checkpoints and cards).
+
+The command line ``python -m bgfn train --profile ...`` is the package's edge (:mod:`bgfn.__main__`).
 """
 
 from bgfn.learning import REFERENCES, VAL_POSITIONS
-from bgfn.train.cli import main
 from bgfn.train.estimate import estimate_lines, measure_paper_step, paper_training_estimate, speed_lines
 from bgfn.train.loop import set_seed, train_model
 from bgfn.train.lr_search import (LR_SEARCH_COLUMNS, LR_SEARCH_DEFAULTS, LR_SEARCH_FILE, chosen_learning_rates,
@@ -33,8 +36,9 @@ from bgfn.train.options import (OPTIMIZER_DEFAULTS, even_subset, method_lr, opti
                                 train_subsection)
 from bgfn.train.plots import plot_motion_coverage, plot_training_curves, plot_val_predictions
 from bgfn.train.profile import (TrainingDataset, TrainingPlan, ins_attitude, prepare_datasets, prepare_learning_data,
-                                train_dataset, train_profile, val_position_table, val_position_tables)
+                                train_dataset, val_position_table, val_position_tables)
 from bgfn.train.recheck import RECHECK_COLUMNS, capped_runs, recheck_all_windows, recheck_lines, recheck_table
+from bgfn.train.runs import train_profile
 from bgfn.train.tables import (TIMING_COLUMNS, card_line, cards_table, learning_check, summary_table, timing_table,
                                training_metrics, windows_table, without_timing)
 from bgfn.train.trained import TrainedModel, checkpoint_predictions, load_trained, pick_device, predict_normalized
@@ -65,6 +69,4 @@ __all__ = [
     # input and protocol variants
     "VARIANT_RUN_DEFAULTS", "VariantPlan", "describe_options", "variant_train_section", "variant_learning_data",
     "train_variants", "variant_cards_table", "wall_time_by_variant",
-    # command line
-    "main",
 ]

@@ -11,6 +11,10 @@ upper bound (early stopping may end a run sooner) without the learning-rate sear
 from __future__ import annotations
 
 import pandas as pd
+import torch
+
+from bgfn.models import build_model
+from bgfn.train.speed import training_step_profile, training_throughput, twin_ratios
 
 
 def paper_training_estimate(n_train: dict[str, int], paper_cfg: dict, bench: dict | None) -> pd.DataFrame | None:
@@ -23,7 +27,7 @@ def paper_training_estimate(n_train: dict[str, int], paper_cfg: dict, bench: dic
     paper_cfg : dict
         The ``paper`` profile (:func:`bgfn.config.load_profile`): its methods, seeds and epochs.
     bench : dict or None
-        ``results/bench.json`` (:func:`bgfn.speed.read_bench`); without a paper-size rate the result is None.
+        ``results/bench.json`` (:func:`bgfn.train.speed.read_bench`); without a paper-size rate the result is None.
 
     Returns
     -------
@@ -50,10 +54,7 @@ def measure_paper_step(paper_cfg: dict, repeats: int = 2) -> dict:
     """The paper-size training throughput of every method, measured now (a few seconds per method), in the
     form of ``results/bench.json`` (``{"train_windows_per_s": {method: {"paper": windows/s}}}``), for when
     ``make bench`` has not run on this machine."""
-    import torch
 
-    from bgfn.models import build_model
-    from bgfn.speed import training_step_profile, training_throughput, twin_ratios
 
     tc = paper_cfg["train"]
     window, batch = int(tc["window"]), int(tc["optimizer"]["batch_size"])

@@ -31,13 +31,15 @@ from typing import Any
 
 import numpy as np
 import torch
+from spikingjelly.activation_based import functional
 from torch import nn
+from tqdm import tqdm
 
-from bgfn import checkpoints
 from bgfn.errors import DataError
 from bgfn.io import atomic_path, atomic_write_json
 from bgfn.learning import LearningData, from_target_frame, reference_columns, reference_rmse, rmse, to_target_frame
 from bgfn.models import build_model, count_parameters, is_spiking
+from bgfn.train import checkpoints
 from bgfn.train.options import even_subset, method_lr, optimizer_options
 from bgfn.train.trained import pick_device, predict_normalized
 
@@ -118,8 +120,6 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
         ``val_rmse_m``, the references of :func:`bgfn.learning.reference_rmse` on the same windows
         (``val_rmse_zero_m``, ``val_rmse_last_m``, ``val_rmse_ins_m``), ``wall_time_s``, ``device``, ``history``, ...
     """
-    from spikingjelly.activation_based import functional
-    from tqdm import tqdm
 
     size_cfg = dict(size_cfg or {})
     o = optimizer_options(train_cfg)

@@ -17,10 +17,10 @@ from typing import Any
 
 import pandas as pd
 
-from bgfn import checkpoints
 from bgfn.config import results_dir
 from bgfn.errors import DataError
 from bgfn.learning import LearningData, inner_split
+from bgfn.train import checkpoints
 from bgfn.train.loop import train_model
 from bgfn.train.options import method_lr, size_config, train_subsection
 

@@ -1,4 +1,4 @@
-"""A profile's training: what notebook 03 and ``python -m bgfn.train`` train, and the data they train it on.
+"""A profile's training: what notebook 03 and ``python -m bgfn train`` train, and the data they train it on.
 
 :class:`TrainingPlan` names the ``(dataset, method, seed)`` runs of a profile's ``train:`` section and the
 evaluation outages kept out of training; :func:`prepare_datasets` loads each drive, runs the GPS/INS filter for
@@ -13,13 +13,14 @@ from typing import Any, Callable
 
 import pandas as pd
 
-from bgfn import checkpoints
+from bgfn.data import load_drive
 from bgfn.errors import DataError
 from bgfn.learning import (VAL_POSITIONS, LearningData, all_windows, build_learning_data, learning_options,
                            motion_in_windows, val_position_coverage)
 from bgfn.nav import outages
+from bgfn.nav.baseline import run_drive
+from bgfn.train import checkpoints
 from bgfn.train.loop import train_model
-from bgfn.train.lr_search import tuned_train_config
 from bgfn.train.options import optimizer_options, size_config
 from bgfn.train.tables import card_line
 
@@ -59,21 +60,17 @@ class TrainingPlan:
     per_dataset: bool = False
 
     @classmethod
-    def of(cls, profile: str, datasets=None, methods=None, seeds=None, outage_windows=None) -> "TrainingPlan":
-        """The plan of ``profile``; ``datasets``, ``methods`` and ``seeds`` default (None) to the profile's
-        (``train.datasets``, ``train.methods``, ``train.seeds``) and are checked against the profile schema like
-        the file (:func:`bgfn.config.with_overrides`); ``outage_windows`` given: the outages of every dataset,
+    def of(cls, cfg: dict, outage_windows=None) -> "TrainingPlan":
+        """The plan of a checked profile ``cfg`` (:func:`bgfn.profile_schema.load_profile`, with a notebook's
+        ``train.datasets`` / ``train.methods`` / ``train.seeds`` set through
+        :func:`bgfn.profile_schema.with_overrides`); ``outage_windows`` given: the outages of every dataset,
         else each dataset's own from the top-level ``outage_windows`` (:meth:`windows_of`)."""
-        from bgfn.config import load_profile, with_overrides
-
-        cfg = with_overrides(load_profile(profile), {"train.datasets": datasets, "train.methods": methods,
-                                                     "train.seeds": seeds})
         tc = cfg["train"]
         if outage_windows is not None:
             windows, per_dataset = [(float(s), float(d)) for s, d in outage_windows], False
         else:
             windows, per_dataset = outages.default_windows(cfg), True
-        return cls(profile, cfg, list(tc["datasets"]), list(tc["methods"]), [int(s) for s in tc["seeds"]],
+        return cls(cfg["profile"], cfg, list(tc["datasets"]), list(tc["methods"]), [int(s) for s in tc["seeds"]],
                    windows, per_dataset)
 
     def windows_of(self, dataset: str, drive=None) -> list:
@@ -105,6 +102,10 @@ class TrainingPlan:
         ])
 
 
+    def dataset_windows(self, name: str, prepared: "TrainingDataset") -> list:
+        """The evaluation outages kept out of a prepared dataset: its own (``prepared.windows``), else the plan's."""
+        return prepared.windows if prepared.windows is not None else self.windows_of(name, prepared.drive)
+
     def _windows_text(self) -> str:
         """The outages per dataset where the profile gives them per dataset, else the one list."""
         if not self.per_dataset:
@@ -132,7 +133,6 @@ class TrainingDataset:
 def prepare_datasets(plan: TrainingPlan) -> dict[str, TrainingDataset]:
     """``{dataset: TrainingDataset}`` for every dataset of ``plan``, in its order (:func:`prepare_learning_data`
     with the :func:`ins_attitude` of each drive)."""
-    from bgfn.data import load_drive
 
     prepared = {}
     for name in plan.datasets:
@@ -160,7 +160,6 @@ def prepare_learning_data(cfg: dict, dataset: str, attitude=None, drive=None, ou
     outage_windows : sequence of (start, duration), optional
         Evaluation outages; default: the profile's for ``dataset`` (:func:`bgfn.nav.outages.outage_windows`).
     """
-    from bgfn.data import load_drive
 
     if drive is None:
         drive = load_drive(dataset, profile=cfg["profile"])
@@ -192,7 +191,6 @@ def ins_attitude(drive, cfg: dict):
         return drive.reference.copy()
     if src != "kf":
         raise DataError("train", "attitude_source", "'kf' or 'reference'", repr(src))
-    from bgfn.nav import run_drive
 
     traj = run_drive(drive, cfg.get("nav") or {}).trajectory
     return pd.DataFrame(traj).reset_index(drop=True)
@@ -212,15 +210,10 @@ def val_position_table(cfg: dict, drive, attitude=None, outage_windows=None, pos
 def val_position_tables(plan: TrainingPlan, prepared: dict[str, TrainingDataset]) -> pd.DataFrame:
     """:func:`val_position_table` of every prepared dataset in one table, ``dataset`` first."""
     positions = pd.concat([val_position_table(plan.cfg, d.drive, attitude=d.attitude,
-                                              outage_windows=dataset_windows(plan, name, d),
+                                              outage_windows=plan.dataset_windows(name, d),
                                               dataset=name).assign(dataset=name)
                            for name, d in prepared.items()], ignore_index=True)
     return positions[["dataset"] + [col for col in positions.columns if col != "dataset"]]
-
-
-def dataset_windows(plan: TrainingPlan, name: str, prepared: TrainingDataset) -> list:
-    """The evaluation outages kept out of a prepared dataset: its own (``prepared.windows``), else the plan's."""
-    return prepared.windows if prepared.windows is not None else plan.windows_of(name, prepared.drive)
 
 
 def train_dataset(plan: TrainingPlan, dataset: str, data: LearningData, train_cfg: dict | None = None,
@@ -252,28 +245,4 @@ def train_dataset(plan: TrainingPlan, dataset: str, data: LearningData, train_cf
             cards.append(card)
             if echo is not None:
                 echo(card_line(card))
-    return cards
-
-
-def train_profile(profile: str, datasets=None, methods=None, seeds=None, device: str | None = None,
-                  progress: bool = True, outage_windows=None, echo: Callable[[str], Any] | None = None,
-                  variants: bool = False) -> list[dict]:
-    """Train every ``(dataset, method, seed)`` of a profile's ``train:`` section; return the cards.
-
-    The learning rates are those notebook 03 selected (:func:`bgfn.train.lr_search.tuned_train_config`) when its
-    search has run. ``variants``: also the profile's input and protocol variants (``variants:`` and
-    ``variant_runs:``, :func:`bgfn.train.variants.train_variants`), as notebook 03 trains them.
-    """
-    from bgfn.train.variants import VariantPlan, train_variants
-
-    plan = TrainingPlan.of(profile, datasets, methods, seeds, outage_windows)
-    prepared = prepare_datasets(plan)       # each dataset's own outages unless outage_windows is given
-    train_cfgs = {name: tuned_train_config(plan.cfg, profile, name) for name in plan.datasets}
-    cards = []
-    for name in plan.datasets:
-        cards += train_dataset(plan, name, prepared[name].data, train_cfgs[name], device=device, progress=progress,
-                               echo=echo)
-    if variants:
-        cards += train_variants(VariantPlan.of(plan), prepared, train_cfgs, device=device, progress=progress,
-                                echo=echo)
     return cards

@@ -4,7 +4,7 @@ A profile may cap the training windows of a run (``train.optimizer.max_train_win
 spaced in time, deviations row 63), so a run whose validation loss never beats its initial network
 (``best_epoch`` 0) might have learned from more. With ``train.recheck_all_windows: true``, every such run whose
 cap left windows out is trained once more, the same method, seed, learning rate and budget, on all of them,
-into ``results/<profile>/models/all_windows/<dataset>/`` (:func:`bgfn.checkpoints.all_windows_models_dir`; the
+into ``results/<profile>/models/all_windows/<dataset>/`` (:func:`bgfn.train.checkpoints.all_windows_models_dir`; the
 reported networks are not touched). The table
 (:func:`recheck_table`) and the lines of notebook 03 (:func:`recheck_lines`) say whether it then improved.
 """
@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from bgfn import checkpoints
+from bgfn.train import checkpoints
 from bgfn.train.loop import train_model
 from bgfn.train.options import optimizer_options, size_config
 from bgfn.train.tables import initial_val_rmse, lowest_train_loss

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import pandas as pd
 
+from bgfn.config import run_metadata
 from bgfn.learning import REFERENCES, split_summary
 
 
@@ -117,8 +118,6 @@ def training_metrics(plan, prepared: dict, runs: pd.DataFrame, summary: pd.DataF
     runs, summary, windows : DataFrame
         :func:`cards_table`, :func:`summary_table`, :func:`windows_table`.
     """
-    from bgfn.config import run_metadata
-    from bgfn.train.profile import dataset_windows
 
     return {
         "runs": runs.to_dict(orient="records"),
@@ -126,7 +125,7 @@ def training_metrics(plan, prepared: dict, runs: pd.DataFrame, summary: pd.DataF
         "windows": windows.to_dict(orient="records"),
         "learning_options": {name: d.data.options for name, d in prepared.items()},
         # per dataset, the outages its learning data were built without (a rule's differ from drive to drive)
-        "outage_windows": {name: d.data.info.get("outage_windows", dataset_windows(plan, name, d))
+        "outage_windows": {name: d.data.info.get("outage_windows", plan.dataset_windows(name, d))
                            for name, d in prepared.items()},
         "meta": run_metadata(plan.profile),
     }

@@ -13,11 +13,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import torch
+from spikingjelly.activation_based import functional
 from torch import nn
 
-from bgfn import checkpoints
 from bgfn.learning import Normalizer, WindowSet, from_target_frame, prediction_windows
 from bgfn.models import build_model, is_spiking
+from bgfn.train import checkpoints
 
 
 def pick_device(device: str | None = None) -> torch.device:
@@ -31,7 +32,6 @@ def pick_device(device: str | None = None) -> torch.device:
 def predict_normalized(model: nn.Module, x: np.ndarray | torch.Tensor, batch_size: int = 64,
                        device: torch.device | str = "cpu") -> np.ndarray:
     """Model outputs [M, 2] (normalized units) for normalized inputs ``x`` [M, N, C]; eval mode."""
-    from spikingjelly.activation_based import functional
 
     model.eval()
     xt = torch.as_tensor(x, dtype=torch.float32)

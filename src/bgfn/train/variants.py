@@ -13,7 +13,7 @@ and the result is checked as a whole profile when the profile loads (a misspelt 
 same budget and **the learning rates the main search selected** for each dataset and method
 (:mod:`bgfn.train.lr_search`; the variants are not searched again, so a variant is compared at the rate its
 main network uses). They are stored under ``results/<profile>/models/variants/<variant>/<dataset>/``
-(:func:`bgfn.checkpoints.variant_models_dir`); :mod:`bgfn.evaluate.variants` evaluates them in the outages.
+(:func:`bgfn.train.checkpoints.variant_models_dir`); :mod:`bgfn.evaluate.variants` evaluates them in the outages.
 """
 
 from __future__ import annotations
@@ -21,13 +21,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Callable
 
-from bgfn import checkpoints
-from bgfn.config import merge_sections
+from bgfn.config import MAIN_VARIANT, merge_sections, variant_config
 from bgfn.learning import LEARNING_DEFAULTS, LearningData, build_learning_data, learning_options
-from bgfn.profile_schema import MAIN_VARIANT, variant_config
+from bgfn.train import checkpoints
 from bgfn.train.loop import train_model
 from bgfn.train.options import size_config
-from bgfn.train.tables import card_line
+from bgfn.train.tables import card_line, cards_table
 
 #: Defaults of ``variant_runs`` (null datasets / methods: the ``train:`` section's).
 VARIANT_RUN_DEFAULTS: dict[str, Any] = {"datasets": None, "methods": None, "seeds": [0]}
@@ -94,7 +93,7 @@ class VariantPlan:
         return list(self.variants)
 
     def profile_of(self, name: str) -> dict:
-        """The profile with variant ``name`` merged over it (:func:`bgfn.profile_schema.variant_config`);
+        """The profile with variant ``name`` merged over it (:func:`bgfn.config.variant_config`);
         ``main``: the profile itself."""
         return self.cfg if name == MAIN_VARIANT else variant_config(self.cfg, name)
 
@@ -171,7 +170,6 @@ def train_variants(vplan: VariantPlan, prepared: dict, train_cfgs: dict[str, dic
 def variant_cards_table(cards: list[dict]):
     """:func:`bgfn.train.tables.cards_table` of variant cards, with ``variant``, ``inputs`` and ``protocol``
     first and the training windows that touch an outage (``n_outage_in_train``: 0 when honest)."""
-    from bgfn.train.tables import cards_table
 
     table = cards_table(cards)
     for i, col in enumerate(("variant", "inputs", "protocol")):

@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import NamedTuple
 
 from bgfn.config import results_dir
+from bgfn.data.names import dataset_id
 
 #: Suffixes of the three files of one network.
 BEST_SUFFIX, CARD_SUFFIX, LAST_SUFFIX = ".pt", ".json", ".last.pt"
@@ -45,7 +46,6 @@ def checkpoint_name(method: str, seed: int, suffix: str = BEST_SUFFIX) -> str:
 def models_dir(profile: str, dataset: str, fold: int | None = None, create: bool = True) -> Path:
     """``results/<profile>/models/<dataset id>/`` (``.../fold<k>/`` for a sweep fold), created unless ``create``
     is False; ``dataset`` may be a registered name, a CSV folder path or an id (:func:`bgfn.data.names.dataset_id`)."""
-    from bgfn.data.names import dataset_id
 
     d = results_dir(profile, create=create) / "models" / dataset_id(dataset)
     return _made(d / f"fold{int(fold)}" if fold is not None else d, create)
@@ -75,7 +75,6 @@ ALL_WINDOWS_DIR = "all_windows"
 def all_windows_models_dir(profile: str, dataset: str, create: bool = True) -> Path:
     """``results/<profile>/models/all_windows/<dataset id>/`` (runs trained again on all their training windows),
     created unless ``create`` is False."""
-    from bgfn.data.names import dataset_id
 
     return _made(results_dir(profile, create=create) / "models" / ALL_WINDOWS_DIR / dataset_id(dataset), create)
 

@@ -24,6 +24,8 @@ from typing import Callable, Iterator
 import torch
 from torch import nn
 
+from bgfn.config import RESULTS_ROOT
+
 #: IMU rate of the Turin drive, Hz.
 IMU_RATE_HZ = 100.0
 #: GNSS rate of the low-cost receiver (and of the pseudo-GNSS predictions during an outage), Hz.
@@ -32,7 +34,6 @@ GNSS_RATE_HZ = 1.0
 
 def bench_file() -> Path:
     """``results/bench.json``: what ``make bench`` measured on this machine (every benchmark merges into it)."""
-    from bgfn.config import RESULTS_ROOT
 
     return RESULTS_ROOT / "bench.json"
 
@@ -153,6 +154,7 @@ def training_step_profile(model: nn.Module, window: int, batch: int, in_channels
     Returns ``{'step_s', 'matmul_s'}``: profiled time of all operators and of the dense matrix products alone,
     s. Their ratio says how much of a step is arithmetic that no change of the other layers can remove.
     """
+    # here, not at the top: the profiler loads its own native library, needed by `make bench` alone
     from torch.profiler import ProfilerActivity, profile
 
     step = _training_step(model, window, batch, in_channels, seed)

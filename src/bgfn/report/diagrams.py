@@ -23,8 +23,13 @@ from typing import Any, Sequence
 
 import matplotlib.pyplot as plt
 import numpy as np
+import torch
 from matplotlib.lines import Line2D
 from matplotlib.patches import FancyArrowPatch, FancyBboxPatch
+
+from bgfn.models import count_parameters
+from bgfn.models.lif import DEFAULT_TAU, DEFAULT_THRESHOLD, beta_from_tau, lif_modules, make_lif
+from bgfn.nav.error_model import N_STATES
 
 #: Colours of the diagrams: sensors, navigation, learning, prediction-mode path.
 SENSOR_FC = "#e8f1fb"
@@ -106,7 +111,6 @@ def plot_loosely_coupled(imu_rate_hz: float = 100.0, gnss_rates_hz: dict[str, fl
         Bias states' model (profile ``nav.bias_model``), shown in the KF box.
     """
     if n_states is None:
-        from bgfn.nav.error_model import N_STATES
 
         n_states = N_STATES
     fig, ax = _canvas(13.0, 6.3, (10.0, 4.85))
@@ -154,9 +158,7 @@ def simulate_lif(current: Sequence[float], tau: float | None = None, v_threshold
         the value compared with the threshold), ``v`` SpikingJelly's stored potential after the reset,
         ``spikes`` S(t) in {0, 1} (the node's output), ``tau``, ``beta``, ``v_threshold``, ``v_reset``.
     """
-    import torch
 
-    from bgfn.models.lif import DEFAULT_TAU, DEFAULT_THRESHOLD, beta_from_tau, make_lif
 
     tau = DEFAULT_TAU if tau is None else float(tau)
     v_threshold = DEFAULT_THRESHOLD if v_threshold is None else float(v_threshold)
@@ -210,7 +212,6 @@ def plot_lif(trace: dict, title: str | None = None):
 
 def lif_settings(model) -> dict:
     """``tau`` and ``v_threshold`` of the first LIF layer of ``model`` (the settings BGFN's neurons use)."""
-    from bgfn.models.lif import lif_modules
 
     mods = lif_modules(model)
     if not mods:
@@ -229,7 +230,6 @@ def architecture_spec(model, window: int) -> dict:
         ``depth`` L, ``heads``, ``head_dim``, ``attn_scale``, ``out_dim``, ``readout``, ``tau``,
         ``v_threshold``, ``attn_threshold``, ``params``.
     """
-    from bgfn.models import count_parameters
 
     enc = model.spike_encoder
     emb = model.embedding.layer.linear

@@ -1,18 +1,12 @@
-"""``results/<profile>/energy.json``: what notebook 05 hands to the results page, and its one-paragraph result.
-
-:mod:`bgfn.report` and notebook 06 read ``energy_uj_per_prediction``, ``macs``, ``sops``, ``reduction_pct``,
-``reduction_pct_without_attention``, ``e_mac_pj``, ``e_ac_pj``, ``time_steps``, ``dataset``, ``seed``,
-``checkpoints``, ``windows.n_windows`` and ``metadata`` (:data:`REPORTED_KEYS`); the rest documents the run.
-"""
+"""``results/<profile>/energy.json``: what notebook 05 hands to the results page, and its one-paragraph result."""
 
 from __future__ import annotations
 
 import pandas as pd
 
-from bgfn.energy.checkpoint import MeasuredModels
+from bgfn.energy.checkpoint import EvaluationWindows, MeasuredModels
 from bgfn.energy.crosscheck import Crosscheck
 from bgfn.energy.tables import EnergyTotals
-from bgfn.energy.windows import EvaluationWindows
 
 #: Top-level keys of ``energy.json`` that the results page reads.
 REPORTED_KEYS = ("energy_uj_per_prediction", "macs", "sops", "reduction_pct", "reduction_pct_without_attention",
@@ -29,7 +23,7 @@ def energy_summary(measured: MeasuredModels, windows: EvaluationWindows, tables:
     ----------
     measured, windows
         The networks and windows measured (:func:`bgfn.energy.checkpoint.load_measured`,
-        :func:`bgfn.energy.windows.evaluation_windows`).
+        :func:`bgfn.energy.checkpoint.evaluation_windows`).
     tables : dict
         Method -> per-layer energy table with its ``total`` row.
     totals : EnergyTotals

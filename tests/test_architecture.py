@@ -1,0 +1,96 @@
+"""The package reads as layers (pyproject.toml, ``[tool.importlinter]``): the import contract holds, and it fails on
+an upward import and on a cycle, function-level imports included (a copy of the package with one planted module)."""
+
+from __future__ import annotations
+
+import ast
+import re
+import shutil
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "src" / "bgfn"
+LINT = Path(sys.executable).with_name("lint-imports")
+#: Imports inside functions that are genuinely optional or heavy (each with a comment saying why at its place).
+ALLOWED_FUNCTION_IMPORTS = {("bgfn.nav.pyins_bridge", "pyins"), ("bgfn.train.speed", "torch.profiler")}
+
+
+def _lint(src: Path, tmp: Path) -> subprocess.CompletedProcess:
+    """``lint-imports`` over the package found under ``src``, with the project's contracts, no cache in the repo."""
+    env = {"PYTHONPATH": str(src), "PATH": str(LINT.parent), "HOME": str(tmp)}
+    return subprocess.run([str(LINT), "--no-cache", "--no-logo", str(ROOT / "pyproject.toml")], cwd=tmp, env=env,
+                          capture_output=True, text=True, timeout=300)
+
+
+def _copy(tmp: Path) -> Path:
+    src = tmp / "src"
+    shutil.copytree(PACKAGE, src / "bgfn", ignore=shutil.ignore_patterns("__pycache__"))
+    return src
+
+
+@pytest.fixture(scope="module")
+def contracts() -> dict:
+    return tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["importlinter"]
+
+
+def test_the_package_keeps_its_contracts(tmp_path):
+    res = _lint(PACKAGE.parent, tmp_path)
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert "0 broken" in res.stdout
+
+
+@pytest.mark.parametrize("planted, broken", [
+    # a lower layer reaching up to the report, at module level
+    ({"nav/planted.py": "from bgfn.report import verdict\n"}, "Layers"),
+    # the same hidden inside a function (the import graph counts it)
+    ({"nav/planted.py": "def f():\n    from bgfn.train import loop\n    return loop\n"}, "Layers"),
+    # two modules of one package importing each other
+    ({"nav/planted_a.py": "from bgfn.nav import planted_b\n",
+      "nav/planted_b.py": "def f():\n    from bgfn.nav import planted_a\n    return planted_a\n"}, "No import cycle"),
+    # the filter engine importing an aid
+    ({"nav/filter.py": "+from bgfn.nav import constraints\n"}, "The filter engine imports no aid"),
+])
+def test_the_check_fails_on_a_planted_import(tmp_path, planted, broken):
+    src = _copy(tmp_path)
+    for where, body in planted.items():
+        path = src / "bgfn" / where
+        if body.startswith("+"):                      # appended to an existing module
+            body = path.read_text(encoding="utf-8") + body[1:]
+        path.write_text(body, encoding="utf-8")
+    res = _lint(src, tmp_path)
+    assert res.returncode != 0, res.stdout
+    verdicts = " ".join(res.stdout.split("Broken contracts")[0].split())     # contract names are wrapped
+    verdict = re.search(re.escape(broken) + r".*?\b(KEPT|BROKEN)\b", verdicts)
+    assert verdict is not None and verdict.group(1) == "BROKEN", res.stdout
+
+
+def test_every_module_of_the_top_level_is_in_a_layer(contracts):
+    """A new top-level module or package must take its place in the layers (no module escapes the check)."""
+    named = set()
+    for layer in next(c for c in contracts["contracts"] if c["id"] == "layers")["layers"]:
+        named |= {m.strip() for part in layer.split("|") for m in part.split(":")}
+    present = {f"bgfn.{p.stem}" for p in PACKAGE.glob("*.py") if p.stem != "__init__"}
+    present |= {f"bgfn.{p.name}" for p in PACKAGE.iterdir() if (p / "__init__.py").is_file()}
+    assert present == named
+
+
+def test_imports_inside_functions_are_the_few_optional_ones():
+    """Imports live at the top of their module, where a reader sees the graph; inside a function only an optional
+    or heavy one (ALLOWED_FUNCTION_IMPORTS), with a comment saying why on the line before."""
+    found = set()
+    for path in PACKAGE.rglob("*.py"):
+        module = ".".join(path.relative_to(PACKAGE.parent).with_suffix("").parts).removesuffix(".__init__")
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        lines = path.read_text(encoding="utf-8").splitlines()
+        for fn in (n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))):
+            for node in (n for n in ast.walk(fn) if isinstance(n, (ast.Import, ast.ImportFrom))):
+                name = node.module if isinstance(node, ast.ImportFrom) else node.names[0].name
+                found.add((module, name.split(".")[0] if name.startswith("pyins") else name))
+                assert lines[node.lineno - 2].strip().startswith("#"), f"{path}:{node.lineno}: say why it is here"
+    assert found <= ALLOWED_FUNCTION_IMPORTS, sorted(found - ALLOWED_FUNCTION_IMPORTS)
+    assert len(found) < 10

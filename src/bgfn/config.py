@@ -219,8 +219,8 @@ def read_profile(profile: str) -> dict[str, Any]:
     ------
     bgfn.errors.DataError
         Unknown profile (missing file), unreadable YAML, a missing required top-level key or a wrong type of
-        one, a key that moved (:data:`MOVED_KEYS`, the message names the new one), a ``base:`` that does not exist or leads
-        back to the profile. The message names the file.
+        one, a key that moved (:data:`MOVED_KEYS`, the message names the new one), a ``base:`` that does not
+        exist or leads back to the profile. The message names the file.
     """
     chain = _read_chain(profile)
     path = chain[0][0]

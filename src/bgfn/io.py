@@ -70,7 +70,6 @@ def save_figure(fig, path: str | Path, dpi: int = 150) -> Path:
 
 
 def _json_default(obj: Any) -> Any:
-
     if isinstance(obj, np.generic):
         return obj.item()
     if isinstance(obj, np.ndarray):

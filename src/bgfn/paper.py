@@ -135,7 +135,6 @@ def published_values(test: str) -> pd.DataFrame:
 
 def claims() -> dict:
     """``data/paper/claims.yaml``: the percentages and settings the paper states in its text."""
-
     return yaml.safe_load(CLAIMS_FILE.read_text(encoding="utf-8"))
 
 

@@ -76,7 +76,6 @@ def wilcoxon_p(diff) -> float:
 
     Zero differences are dropped (Wilcox's convention); NaN when fewer than one non-zero difference.
     """
-
     d = np.asarray(diff, dtype=float)
     d = d[np.isfinite(d)]
     d = d[d != 0.0]

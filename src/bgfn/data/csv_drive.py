@@ -148,7 +148,6 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_st
     DataError
         Naming the file and the column (or ``meta.yaml`` and the key).
     """
-
     folder = Path(folder)
     if not folder.is_dir():
         raise DataError(folder, "folder", "a folder with imu.csv, gnss.csv, reference.csv", "no such folder")
@@ -204,19 +203,15 @@ def write_csv_drive(drive: Drive, folder: str | Path) -> Path:
     Path
         The folder.
     """
-
-
     folder = Path(folder)
     ref_cols = [c for c in REFERENCE_COLUMNS if drive.has_attitude or c not in ATTITUDE_COLUMNS]
     atomic_write_csv(folder / "imu.csv", drive.imu[list(IMU_COLUMNS)], float_format="%.17g")
     atomic_write_csv(folder / "gnss.csv", drive.gnss[list(GNSS_COLUMNS)], float_format="%.17g")
     atomic_write_csv(folder / "reference.csv", drive.reference[ref_cols], float_format="%.17g")
-
     meta = {"name": safe_id(drive.name), "lever_arm_m": [float(x) for x in drive.meta.get("lever_arm_m", [0, 0, 0])],
             "source": str(drive.meta.get("source", ""))}
     errs = drive.meta.get("imu_errors")
     if errs:
-
         meta["imu_errors"] = {k: errs[k] for k in VECTOR_KEYS + OPTIONAL_VECTOR_KEYS + SCALAR_KEYS + ("model",) if k in errs}
     atomic_write_text(folder / META_FILE, yaml.safe_dump(meta, sort_keys=True))
     return folder

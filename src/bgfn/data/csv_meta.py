@@ -59,7 +59,6 @@ def _unknown_key(path: Path, key, valid, prefix: str = "") -> DataError:
 
 def _load(path: Path) -> dict:
     """The parsed YAML mapping of ``path`` ({} for an empty file)."""
-
     try:
         meta = yaml.safe_load(path.read_text(encoding="utf-8"))
     except (yaml.YAMLError, UnicodeDecodeError) as exc:
@@ -75,7 +74,6 @@ def _load(path: Path) -> dict:
 
 
 def _checked_name(path: Path, meta: dict) -> str | None:
-
     name = meta.get("name")
     if name is None:
         return None

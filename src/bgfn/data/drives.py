@@ -99,7 +99,6 @@ def profile_overrides(name: str, profile: str) -> dict:
     dict
         Overrides for :func:`dataset_params` (unknown per-dataset keys raise there).
     """
-
     cfg = read_profile(profile)
     data = cfg["data"]
     out = {"seed": data.get("seed", cfg["seed"])}
@@ -155,7 +154,6 @@ def _speed(truth: pd.DataFrame) -> np.ndarray:
 
 
 def _build_sim(name: str, p: dict, paths: dict) -> Drive:
-
     ref = read_reference(paths["ref.mat"])
     truth, fit = _truth(ref, p)
     imu_true = imu_from_trajectory(truth, source=f"{name} truth")
@@ -229,7 +227,6 @@ def _rtk_reference(fixed: pd.DataFrame, grid: np.ndarray) -> pd.DataFrame:
     positions (its std is ``sqrt(2)`` times the position std over 0.25 s, and it matches the positions' central
     difference 0.125 s earlier), i.e. the mean velocity of the past interval, late by half an epoch.
     """
-
     t = fixed["time"].to_numpy(float)
     splines = {c: CubicSpline(t, fixed[c].to_numpy(float)) for c in ("lat", "lon", "h")}
     out = {"time": grid, **{c: s(grid) for c, s in splines.items()}}
@@ -326,7 +323,6 @@ def _load_folder(folder: Path, profile: str | None, overrides: dict) -> Drive:
         raise DataError(folder, extra[0], f"a parameter of a CSV drive: {', '.join(CSV_PARAMS)}", "unknown parameter")
     params = {}
     if profile is not None:
-
         data = read_profile(profile)["data"]
         params = {k: data[k] for k in CSV_PARAMS if data.get(k) is not None}
     params.update({k: v for k, v in overrides.items() if v is not None})
@@ -379,7 +375,6 @@ def load_drive(name: str | Path = DEFAULT_DATASET, *, profile: str | None = None
     if folder is not None:
         return _load_folder(folder, profile, overrides)
     if name not in DATASETS:
-
         if isinstance(name, Path) or "/" in str(name) or "\\" in str(name):
             raise DataError(name, "folder", f"a folder with {', '.join(CSV_FILES)} (a relative path is taken from "
                             f"{PROJECT_ROOT}, else from the current directory)", "no such folder")

@@ -273,7 +273,6 @@ def plot_imu_psd(psds: dict):
     psds : dict
         ``{label: imu_psd(...)}``.
     """
-
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.6), constrained_layout=True)
     for ax, (sensor, cols) in zip(axes, SENSORS.items()):
         for name, psd in psds.items():

@@ -52,7 +52,6 @@ def dataset_folder(name: str | Path) -> Path | None:
     path = Path(str(name)).expanduser()
     if path.is_absolute():
         return path if path.is_dir() else None
-
     for base in (PROJECT_ROOT, Path.cwd()):
         if (base / path).is_dir():
             return (base / path).resolve()
@@ -88,7 +87,6 @@ def dataset_id(name: str | Path) -> str:
         return str(name)
     folder = dataset_folder(name)
     if folder is not None:
-
         meta_name = read_meta_name(folder / META_FILE)
         return meta_name if meta_name is not None else safe_id(folder.name)
     text = str(name)

@@ -98,7 +98,6 @@ def check_trained(card: dict, card_file: str | Path, allow_untrained: bool = Fal
     bgfn.errors.DataError
         Naming the card, unless ``allow_untrained`` (``energy.allow_untrained`` of the profile).
     """
-
     if not allow_untrained and int(card.get("best_epoch", 1)) < 1:
         raise DataError(card_file, "best_epoch", "a network that training improved on its initial weights (best epoch >= 1; "
                         "epoch 0 is the initial network) "

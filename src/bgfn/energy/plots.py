@@ -19,7 +19,6 @@ def plot_firing_rates(rates: dict[str, float], title: str = ""):
     -------
     matplotlib.figure.Figure
     """
-
     fig, ax = plt.subplots(figsize=(8, 0.28 * len(rates) + 1.2))
     ax.barh(range(len(rates)), list(rates.values()), color="tab:blue")
     ax.set_yticks(range(len(rates)), list(rates.keys()), fontsize=8)
@@ -42,7 +41,6 @@ def plot_energy_per_layer(tables: dict[str, pd.DataFrame], methods=("bgfn", "tra
     -------
     matplotlib.figure.Figure
     """
-
     fig, axes = plt.subplots(1, len(methods), figsize=(12, 0.25 * len(tables[methods[0]]) + 1.5))
     for ax, m in zip(axes, methods):
         t = tables[m][tables[m]["layer"] != "total"]
@@ -73,7 +71,6 @@ def plot_sweeps(sweep_t: pd.DataFrame, sweep_r: pd.DataFrame, time_steps: int, r
     -------
     matplotlib.figure.Figure
     """
-
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 3.8))
     a1.plot(sweep_t["time_steps"], sweep_t["reduction_pct"], "o-", label="this reproduction (rates fixed)")
     a1.plot([time_steps], [reduction], "k*", ms=12, label=f"trained model, T_s = {time_steps}")

@@ -118,7 +118,6 @@ def choose_datasets(datasets: Sequence[str], real_imu: bool) -> tuple[list[str],
             names.append(d)
             continue
         real, fname = REAL_IMU_DATASETS[d]
-
         res = acquire.resolve(fname, download=False)
         if res.path is not None:
             names.append(real)

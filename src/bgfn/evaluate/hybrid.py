@@ -38,7 +38,6 @@ def pseudo_gps_positions(p0, increments) -> np.ndarray:
         ``[lat, lon, h]`` of the pseudo-GPS positions after each increment; the sums are north/east offsets
         from ``P_GPS0`` in its local level frame (exact through ECEF), the height stays ``h0``.
     """
-
     inc = np.asarray(increments, dtype=float).reshape(-1, 2)
     cum = np.cumsum(inc, axis=0)                                     # [K, 2]
     ned = np.column_stack([cum, np.zeros(len(cum))])                 # [K, 3]
@@ -120,7 +119,6 @@ def navigation_context(drive, nav_section: dict | None, starts: Sequence[float])
     starts : sequence of float
         Outage starts, s.
     """
-
     cfg = baseline.nav_config(nav_section)
     initial, noise = baseline.filter_setup(drive, cfg)
     filter_imu = baseline.filter_imu(drive, cfg)     # drive.imu, or without NaveGo's static biases
@@ -216,7 +214,6 @@ class _Run:
 
     def __init__(self, ctx: NavContext, start: float, duration: float, n_window: int, extra: tuple,
                  constraints=None):
-
         self.start, self.duration, self.end = float(start), float(duration), float(start) + float(duration)
         s = ctx.state_at(start)
         self.state0 = s
@@ -271,7 +268,6 @@ class _Run:
 
     def _fill(self, r0: int, r1: int) -> None:
         """Features of output rows r0..r1 (inclusive, >= 1) from the current solution."""
-
         if r1 < r0:
             return
         roll, pitch, yaw = transform.euler_from_dcm(self.out_c[r0:r1 + 1])
@@ -297,7 +293,6 @@ class _Run:
 
     def update(self, t_m: float, fix: np.ndarray, std: np.ndarray) -> None:
         """Eq. (eq4) position update with a pseudo fix of time ``t_m`` at the current row, then feedback."""
-
         innov = np.empty(3)
         update_position(self.pos, self.v, self.c, self.ba, self.bg, self.P, self.lever, np.asarray(fix, float),
                         np.asarray(std, float), float(self.times[self.row] - t_m), innov, 0.0)   # never gated
@@ -315,7 +310,6 @@ class _Run:
         return x, float(self.t_feat[last]), float(x[-1, YAW_CHANNEL])
 
     def trajectory(self) -> pd.DataFrame:
-
         return trajectory_frame(self.times, self.out_pos, self.out_v, self.out_c)
 
 
@@ -357,7 +351,6 @@ def run_outages(ctx: NavContext, windows, predictor=None, method: str = "INS", s
     list of OutageRun
         One per window, same order.
     """
-
     pcfg = merge_checked(EVALUATE_DEFAULTS["pseudo_gps"], pseudo or {}, "evaluate.pseudo_gps")
     windows = [(float(s), float(d)) for s, d in windows]
     opts = dict(getattr(predictor, "options", {}) or {}) if predictor is not None else {}
@@ -434,7 +427,6 @@ def run_outages(ctx: NavContext, windows, predictor=None, method: str = "INS", s
 
 def gps_run(ctx: NavContext, start: float, duration: float, errors: bool = True) -> OutageRun:
     """The GPS-available solution over the outage window (the lower bound row ``GPS``)."""
-
     tr = ctx.full.trajectory
     t = tr["time"].to_numpy(float)
     s0 = ctx.state_at(start).time

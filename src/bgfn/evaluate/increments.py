@@ -39,7 +39,6 @@ class AntennaTruth:
     """
 
     def __init__(self, reference: pd.DataFrame, lever_arm_m, source: str = "reference"):
-
         self.source = source
         self.time = reference["time"].to_numpy(float)
         self.lat, self.lon, self.h = antenna_position(reference, lever_arm_m)   # [n] each: rad, rad, m

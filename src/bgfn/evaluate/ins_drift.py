@@ -35,7 +35,6 @@ DRIFT_COLUMNS: tuple[str, ...] = ("dataset", "test", "duration_s", "method", "n_
 
 def drift_starts(cfg: dict, drive) -> list[float]:
     """The sweep's starts on ``drive`` (``evaluate.sweep`` of the profile; after the filter's start), s."""
-
     plan = profile_sweep_plan(cfg, drive, evaluate_config(cfg.get("evaluate"), cfg.get("train"))["sweep"])
     return [float(s) for s in plan["start_s"]]
 
@@ -61,7 +60,6 @@ def ins_drift_runs(cfg: dict, drives: list, durations=None, nhc: bool = True,
     DataFrame
         :data:`DRIFT_RUN_COLUMNS`, one row per drive, start, duration and method.
     """
-
     ecfg = evaluate_config(cfg.get("evaluate"), cfg.get("train"))
     durations = sorted(float(d) for d in (durations or ecfg["sweep"]["durations_s"]))
     rows = []
@@ -118,7 +116,6 @@ def drift_sentences(summary: pd.DataFrame, stand_in: str = "turin-sim-mpu6000",
 
 def plot_ins_drift(runs: pd.DataFrame, title: str = ""):
     """Max horizontal error of every start against the outage duration, one panel per method, a box per drive."""
-
     methods = list(dict.fromkeys(runs["method"]))
     names = list(dict.fromkeys(runs["dataset"]))
     durations = sorted(runs["duration_s"].unique())

@@ -17,8 +17,6 @@ from bgfn.train.checkpoints import card_path, checkpoint_path
 def load_model(path: str | Path):
     """A checkpoint of :mod:`bgfn.train` on the CPU, with ``val_rmse_m`` (validation RMSE of one increment,
     m, from its JSON card; NaN without a card) attached."""
-
-
     model = train.load_trained(path, device="cpu")
     card = card_path(path)
     model.val_rmse_m = float(json.loads(card.read_text()).get("val_rmse_m", np.nan)) if card.exists() else np.nan
@@ -35,7 +33,6 @@ def ensure_models(cfg: dict, profile: str, dataset: str, ctx: NavContext, method
     dict
         ``{(method, seed): TrainedModel}``.
     """
-
     models, data = {}, None
     tc = train.tuned_train_config(cfg, profile, dataset)      # notebook 03's selected learning rates
     for method in methods:

@@ -133,7 +133,6 @@ def oracle_windows(cfg: dict, drive, ecfg: dict, windows) -> tuple[list[tuple[st
     notes : list of str
         Why a drive has no sweep starts.
     """
-
     out = [(str(k + 1), float(s), float(d)) for k, (s, d) in enumerate(windows)]
     sw, durations = ecfg["sweep"], ecfg["oracle"]["durations_s"]
     if not durations:
@@ -216,7 +215,6 @@ def oracle_table(runs: pd.DataFrame, increment_s: dict, n_boot: int = 2000, leve
     DataFrame
         :data:`ORACLE_COLUMNS`, INS first in each group, then sigma increasing.
     """
-
     rows = []
     keys = ["dataset", "test", "outage", "duration_s", "method", "sigma_m"]
     for k, g in runs.groupby(keys, dropna=False, sort=False):
@@ -553,7 +551,6 @@ def run_oracle(cfg: dict, profile: str, setup, out=None, results: dict | None = 
     report : callable, optional
         Called with a line per dataset when it is done.
     """
-
     ecfg = setup.config
     oc, sw = ecfg["oracle"], ecfg["sweep"]
     results = results or {}
@@ -586,7 +583,6 @@ def run_oracle(cfg: dict, profile: str, setup, out=None, results: dict | None = 
     if figures:
         result.figures = {name: plot_oracle(table, lv, be, name) for name in names}
     if out is not None:
-
         tables = Path(out) / "tables"
         atomic_write_csv(tables / SHARED_TABLES["oracle"], table, float_format="%.4f")
         atomic_write_csv(tables / SHARED_TABLES["oracle_breakeven"], be, float_format="%.4f")

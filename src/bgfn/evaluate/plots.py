@@ -20,7 +20,6 @@ def _style(method: str) -> str:
 
 
 def _ned_from_start(traj: pd.DataFrame, ref0) -> np.ndarray:
-
     return earth.lla_to_ned(traj["lat"].to_numpy(), traj["lon"].to_numpy(), traj["h"].to_numpy(),
                             float(ref0["lat"]), float(ref0["lon"]), float(ref0["h"]))
 
@@ -36,7 +35,6 @@ def plot_outage(result: TableResult, outage: int, reference: pd.DataFrame, metho
     -------
     matplotlib.figure.Figure
     """
-
     rep = representative_seeds(result.per_seed)
     start = float(result.per_seed.loc[result.per_seed["outage"] == outage, "start_s"].iloc[0])
     fig = plt.figure(figsize=(12, 4.2))
@@ -102,7 +100,6 @@ def plot_gps_row(result: TableResult, outage: int, title: str = ""):
     -------
     matplotlib.figure.Figure
     """
-
     start = float(result.per_seed.loc[result.per_seed["outage"] == outage, "start_s"].iloc[0])
     runs = {r.method: r for r in result.runs if r.seed is None and abs(r.start - start) < 1e-6}
     dur = runs["GPS"].duration
@@ -128,7 +125,6 @@ def plot_gps_row(result: TableResult, outage: int, title: str = ""):
 
 def plot_sweep_boxes(sweep: pd.DataFrame, dataset: str, methods=TABLE_METHODS):
     """Box plots of the max horizontal error per duration and method (log scale; ``+NHC`` rows hatched)."""
-
     d = sweep[sweep["dataset"] == dataset]
     durations = sorted(d["duration_s"].unique())
     methods = [m for m in methods if m in set(d["method"])]

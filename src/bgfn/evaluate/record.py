@@ -69,7 +69,6 @@ def write_evaluation_record(out, setup: EvaluationSetup, results: Mapping[str, T
                             timings: dict) -> Path:
     """Write :func:`evaluation_record` plus ``meta`` (:func:`bgfn.config.run_metadata`) to
     ``<out>/outage_evaluation.json`` atomically; returns the path."""
-
     record = {**evaluation_record(setup, results, reductions, sweep_rows, sweep_info, timings),
               "meta": run_metadata(setup.profile)}
     return atomic_write_json(Path(out) / RECORD_FILE, record)

@@ -83,7 +83,6 @@ def pseudo_std_sensitivity(cfg: dict, profile: str, result: TableResult, ecfg: d
 def save_sensitivity(out, sensitivity: Sensitivity) -> Path:
     """Write the sensitivity run's seed aggregate (``TABLE_COLUMNS``) to
     ``<out>/tables/outage_<test>_std_validation.csv``, atomically; returns the path."""
-
     stem = table_file(sensitivity.alternative.test)[: -len(".csv")]
     path = Path(out) / "tables" / f"{stem}_std_validation.csv"
     atomic_write_csv(path, sensitivity.alternative.table, float_format="%.4f")

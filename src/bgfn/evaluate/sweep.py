@@ -59,7 +59,6 @@ def sweep_plan(drive, sweep: dict, window_samples: int = 200, t_first: float | N
 def profile_sweep_plan(cfg: dict, drive, sweep: dict) -> pd.DataFrame:
     """:func:`sweep_plan` of ``drive`` under a profile: the input window of the sweep's networks (``train:`` with
     ``sweep.train``'s overrides) and the filter's start (``nav:``; a self-aligned filter starts late)."""
-
     n_window = int(learning_options(sweep_train_config(cfg.get("train") or {}, sweep))["window"])
     return sweep_plan(drive, sweep, n_window, t_first=filter_start(drive, cfg.get("nav")))
 
@@ -88,13 +87,9 @@ def run_sweep(cfg: dict, profile: str, dataset: str, drive=None, ecfg: dict | No
     info : dict
         Sizes, training and evaluation wall times, fold windows.
     """
-
-
-
     ecfg = ecfg or evaluate_config(cfg.get("evaluate"), cfg.get("train"))
     sw = ecfg["sweep"]
     if drive is None:
-
         drive = load_drive(dataset, profile=profile)
     # the sweep's budget, with the learning rates notebook 03 selected for this dataset (same for every fold)
     tc = sweep_train_config(train.tuned_train_config(cfg, profile, dataset), sw)
@@ -178,7 +173,6 @@ def sweep_summary(sweep: pd.DataFrame, n_boot: int = 2000, level: float = 0.95, 
     DataFrame
         ``dataset``, ``duration_s``, ``method``, ``n`` (runs), ``n_starts``, ``median_m``, ``ci_lo_m``, ``ci_hi_m``.
     """
-
     rows = []
     order = {m: i for i, m in enumerate(TABLE_METHODS)}
     for (ds, du, m), g in sweep.groupby(["dataset", "duration_s", "method"]):
@@ -206,7 +200,6 @@ def sweep_comparisons(sweep: pd.DataFrame, method: str = "BGFN", metric: str = "
         ``dataset``, ``duration_s``, ``method``, ``baseline``, ``n``, ``wins``, ``ties``, ``win_rate``,
         ``median_diff_m`` (method - baseline), ``median_ratio``, ``p_value``, ``n_starts``, ``p_value_by_start``.
     """
-
     rows = []
     aided = nhc_label(method)
     for (ds, du), g in sweep.groupby(["dataset", "duration_s"]):
@@ -283,7 +276,6 @@ def run_sweeps(cfg: dict, profile: str, datasets, ecfg: dict, progress: bool = T
     timings : dict
         ``{"sweep_<dataset>_s": wall time, s}``.
     """
-
     parts, info, timings = [], {}, {}
     for name in datasets:
         t0 = time.perf_counter()

@@ -114,10 +114,8 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
         Also run ``INS+NHC`` and every network with the vehicle constraints (``<METHOD>+NHC``); None:
         ``ecfg['nhc_rows']``.
     """
-
     ecfg = ecfg or evaluate_config(cfg.get("evaluate"), cfg.get("train"))
     if drive is None:
-
         drive = load_drive(dataset, profile=profile)
     windows = outages.outage_windows(cfg, drive, dataset)
     ctx = navigation_context(drive, cfg.get("nav"), [s for s, _ in windows])
@@ -169,7 +167,6 @@ def run_tables(cfg: dict, profile: str, datasets, ecfg: dict, out,
     timings : dict
         ``{"tables_<dataset>_s": wall time of loading, evaluating and writing, s}``.
     """
-
     results, timings = {}, {}
     for name in datasets:
         t0 = time.perf_counter()
@@ -210,7 +207,6 @@ def save_table_result(out, result: TableResult, series_rate_hz: float = 10.0) ->
     dict
         ``{kind: path}``.
     """
-
     paths = table_paths(out, result.test)
     gnss = paths.pop("gnss")
     atomic_write_csv(paths["table"], result.table[list(TABLE_COLUMNS)], float_format="%.4f")

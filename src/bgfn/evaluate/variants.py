@@ -40,7 +40,6 @@ NO_VARIANT = "-"
 def load_variant_network(path):
     """The network at ``path`` (:func:`bgfn.evaluate.networks.load_model`); DataError when notebook 03 has not
     trained it."""
-
     if not Path(path).exists():
         raise DataError(path, "checkpoint", "a variant's network (notebook 03 trains it: train_variants)", "missing")
     return load_model(path)
@@ -67,8 +66,6 @@ def variant_runs(vplan, drives: dict | None = None, loader=load_variant_network,
         ``dataset, test, outage, start_s, variant, inputs, protocol, method, seed`` and
         :func:`bgfn.evaluate.hybrid.window_metrics`'s metrics.
     """
-
-
     cfg = vplan.cfg
     ecfg = evaluate_config(cfg.get("evaluate"), cfg.get("train"))
     rows = []
@@ -76,7 +73,6 @@ def variant_runs(vplan, drives: dict | None = None, loader=load_variant_network,
         t0 = time.perf_counter()
         drive = (drives or {}).get(dataset)
         if drive is None:
-
             drive = load_drive(dataset, profile=vplan.profile)
         windows = outages.outage_windows(cfg, drive, dataset)         # each drive its own
         ctx = navigation_context(drive, cfg.get("nav"), [s for s, _ in windows])

@@ -465,8 +465,6 @@ def save_baseline(b: Baseline, out, file_id: str, lat=None) -> dict:
         JSON-ready summary (RMS, outage metrics, mean NIS, the filter's start and noise factor
         (:meth:`FilterSetup.record`), the constraints' facts) for ``kf_baseline.json``.
     """
-
-
     out = Path(out)
     d = file_id
     save_states(out / f"nav_states_{d}.npz", b.states)

@@ -43,7 +43,6 @@ def nis_summary(updates: pd.DataFrame, kind: str = "gnss") -> dict:
         (fraction of fixes above the 95 % quantile of chi-square with their dof; 0.05 when consistent) and
         ``verdict`` (:func:`verdict`).
     """
-
     u = updates[updates["kind"] == kind] if len(updates) else updates
     if not len(u):
         return {"fixes": 0, "dof": float("nan"), "mean_nis": float("nan"), "median_nis": float("nan"),

@@ -2,9 +2,10 @@
 
 Beyond the paper (issue 17, the classic aids a learned one must beat or add to). Both are velocity measurements
 of the 15-state filter, an *aid* of the engine :mod:`bgfn.nav.filter` (:class:`Constraints` is its
-:class:`~bgfn.nav.filter.Aid`): the engine asks after each IMU step of the schedule which measurement to fuse,
-and fuses it with the same sequential Joseph update and closed-loop feedback as a position fix, at the *aid epochs*: the first IMU row at or after every multiple of
-``1 / nhc_rate_hz`` of the time of week (the same epochs in every run of a drive).
+:class:`~bgfn.nav.filter.Aid`): after each aided IMU step the engine asks which measurement to fuse, and fuses it
+with the same sequential Joseph update and closed-loop feedback as a position fix. The *aid epochs* are the first
+IMU row at or after every multiple of ``1 / nhc_rate_hz`` of the time of week (the same epochs in every run of a
+drive).
 
 - **NHC**: a car neither slides sideways nor leaves the road, so its velocity in the *vehicle* frame has
   zero lateral and vertical components: ``z = [v^v_y, v^v_z] = 0 + w``, ``w ~ N(0, nhc_std^2)``. With

@@ -16,7 +16,6 @@ from bgfn.train import checkpoints
 
 def model_cards(profile: str, dataset: str, results_root: str | Path | None = None) -> list[dict]:
     """The model cards ``results/<profile>/models/<dataset id>/<method>_seed<k>.json`` (fold models excluded)."""
-
     d = Path(results_root or RESULTS_ROOT) / profile / "models" / dataset_id(dataset)
     cards = []
     for p in checkpoints.cards(d):

@@ -34,7 +34,6 @@ def compared_profiles(profile: str, variants: Sequence[str],
     missing : list of str
         The others, ``profile`` itself left out.
     """
-
     base = [p.stem for p in profile_chain(profile)[1:2]]
     names = list(dict.fromkeys([profile, *variants, *base]))
     root = Path(results_root or RESULTS_ROOT)
@@ -44,7 +43,6 @@ def compared_profiles(profile: str, variants: Sequence[str],
 
 def profile_tables(profiles: Sequence[str], file: str, results_root: str | Path | None = None) -> dict:
     """``{profile: results/<profile>/tables/<file>}`` (None where it is missing)."""
-
     root = Path(results_root or RESULTS_ROOT)
     return {p: read_csv(root / p / "tables" / file) for p in profiles}
 
@@ -141,7 +139,6 @@ def variants_section(profile: str, variants: Sequence[str], results_root: str | 
         has, the validation RMSE per profile with its sentences, each outage test's table per profile, the
         sweep per profile with each variant's paired comparisons, and a source line.
     """
-
     root = Path(results_root or RESULTS_ROOT)
     shown, missing = compared_profiles(profile, variants, root)
     pieces: list = [missing_note(root / v / "tables" / SHARED_TABLES["training_summary"], f"the variant `{v}`",

@@ -63,7 +63,6 @@ class VerdictInputs:
     @classmethod
     def read(cls, out: str | Path, dataset: str) -> "VerdictInputs":
         """The tables of ``dataset`` under ``out`` (``results/<profile>``), each restricted to that dataset."""
-
         out = Path(out)
         test = paper.test_of(dataset) or dataset_id(dataset)
         tables = out / "tables"
@@ -131,7 +130,6 @@ def _oracle_value(breakeven: pd.DataFrame | None, outage: str, duration: float |
 def _main_inputs(variants: pd.DataFrame | None) -> str:
     """The main networks' inputs as the variants table describes them (its ``main`` rows), ``Eq. (eq21)`` for
     the paper's; the paper's when there is no variants table."""
-
     if variants is not None and len(variants) and "inputs" in variants.columns:
         rows = variants[variants["variant"] == MAIN_VARIANT]
         if len(rows) and str(rows["inputs"].iloc[0]) != EQ21_INPUTS:
@@ -358,7 +356,6 @@ def answer_ins_tuning(inp: VerdictInputs) -> str:
     """Question 5: the INS row under NaveGo v1.4's bias modelling beside ours and the paper's."""
     if inp.ins_tuning is None or not len(inp.ins_tuning):
         return "Is the INS row comparable? Not measured: notebook 02's INS-setup table has not run."
-
     gap = gap_explained(inp.ins_tuning)
     g = gap[gap["setup"] == "navego"]
     if not len(g):

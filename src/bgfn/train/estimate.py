@@ -54,8 +54,6 @@ def measure_paper_step(paper_cfg: dict, repeats: int = 2) -> dict:
     """The paper-size training throughput of every method, measured now (a few seconds per method), in the
     form of ``results/bench.json`` (``{"train_windows_per_s": {method: {"paper": windows/s}}}``), for when
     ``make bench`` has not run on this machine."""
-
-
     tc = paper_cfg["train"]
     window, batch = int(tc["window"]), int(tc["optimizer"]["batch_size"])
     rates, profiles = {}, {}

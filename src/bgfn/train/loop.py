@@ -120,7 +120,6 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
         ``val_rmse_m``, the references of :func:`bgfn.learning.reference_rmse` on the same windows
         (``val_rmse_zero_m``, ``val_rmse_last_m``, ``val_rmse_ins_m``), ``wall_time_s``, ``device``, ``history``, ...
     """
-
     size_cfg = dict(size_cfg or {})
     o = optimizer_options(train_cfg)
     lr = method_lr(train_cfg, method)

@@ -12,7 +12,6 @@ from bgfn.learning import LearningData
 def plot_training_curves(cards: list[dict], title: str = ""):
     """Training (dashed) and validation (solid) loss per epoch, one panel per method, one line per seed; epoch 0
     is the initial network (validation only), the dot each run's best epoch."""
-
     methods = list(dict.fromkeys(c["method"] for c in cards))
     fig, axes = plt.subplots(1, len(methods), figsize=(3.6 * len(methods), 3.2), squeeze=False, sharey=True)
     for ax, m in zip(axes[0], methods):
@@ -44,7 +43,6 @@ def plot_val_predictions(data: LearningData, predictions: dict, title: str = "",
     predictions : dict
         ``{method: [M, 2] array}`` (north, east, m) for ``data.val``.
     """
-
     val = data.val
     t = val.t_to
     seg = np.flatnonzero(t <= t[0] + segment_s)
@@ -83,7 +81,6 @@ def plot_motion_coverage(sets: dict, title: str = ""):
     """Heading and speed histograms of the windows a network trains on, is validated on and meets in the
     outages. ``sets``: ``{label: DataFrame with heading_deg, speed_mps}`` (:func:`bgfn.learning.motion_of_windows`,
     :func:`bgfn.learning.motion_in_windows`)."""
-
     fig, axes = plt.subplots(1, 2, figsize=(11, 3.4))
     for i, (label, df) in enumerate(sets.items()):
         axes[0].hist(df["heading_deg"], bins=np.arange(0, 361, 15), density=True, histtype="step", lw=1.5,

@@ -133,7 +133,6 @@ class TrainingDataset:
 def prepare_datasets(plan: TrainingPlan) -> dict[str, TrainingDataset]:
     """``{dataset: TrainingDataset}`` for every dataset of ``plan``, in its order (:func:`prepare_learning_data`
     with the :func:`ins_attitude` of each drive)."""
-
     prepared = {}
     for name in plan.datasets:
         drive = load_drive(name, profile=plan.profile)
@@ -160,7 +159,6 @@ def prepare_learning_data(cfg: dict, dataset: str, attitude=None, drive=None, ou
     outage_windows : sequence of (start, duration), optional
         Evaluation outages; default: the profile's for ``dataset`` (:func:`bgfn.nav.outages.outage_windows`).
     """
-
     if drive is None:
         drive = load_drive(dataset, profile=cfg["profile"])
     attitude, outage_windows, opts = _learning_inputs(cfg, drive, attitude, outage_windows, dataset)
@@ -191,7 +189,6 @@ def ins_attitude(drive, cfg: dict):
         return drive.reference.copy()
     if src != "kf":
         raise DataError("train", "attitude_source", "'kf' or 'reference'", repr(src))
-
     traj = run_drive(drive, cfg.get("nav") or {}).trajectory
     return pd.DataFrame(traj).reset_index(drop=True)
 

@@ -118,7 +118,6 @@ def training_metrics(plan, prepared: dict, runs: pd.DataFrame, summary: pd.DataF
     runs, summary, windows : DataFrame
         :func:`cards_table`, :func:`summary_table`, :func:`windows_table`.
     """
-
     return {
         "runs": runs.to_dict(orient="records"),
         "summary": summary.to_dict(orient="records"),

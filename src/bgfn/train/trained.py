@@ -32,7 +32,6 @@ def pick_device(device: str | None = None) -> torch.device:
 def predict_normalized(model: nn.Module, x: np.ndarray | torch.Tensor, batch_size: int = 64,
                        device: torch.device | str = "cpu") -> np.ndarray:
     """Model outputs [M, 2] (normalized units) for normalized inputs ``x`` [M, N, C]; eval mode."""
-
     model.eval()
     xt = torch.as_tensor(x, dtype=torch.float32)
     out = []

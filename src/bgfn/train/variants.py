@@ -170,7 +170,6 @@ def train_variants(vplan: VariantPlan, prepared: dict, train_cfgs: dict[str, dic
 def variant_cards_table(cards: list[dict]):
     """:func:`bgfn.train.tables.cards_table` of variant cards, with ``variant``, ``inputs`` and ``protocol``
     first and the training windows that touch an outage (``n_outage_in_train``: 0 when honest)."""
-
     table = cards_table(cards)
     for i, col in enumerate(("variant", "inputs", "protocol")):
         table.insert(i, col, [c.get(col) for c in cards])

@@ -1,6 +1,7 @@
 # BGFN artifact -- environment, tests, notebooks -> results/<profile>/, HTML book.
 #
 #   make reproduce [PROFILE=smoke|quick|paper]   environment + data + notebooks + book (default PROFILE=quick)
+#                  [JOBS=n] [DASK_SCHEDULER=tcp://host:8786]   runs at a time here / on a Dask cluster
 #   make test                                    pytest (fails when no test ran)
 #   make book [PROFILE=...]                      rebuild the book from already executed notebooks
 #   make bench | make strip | make clean | make distclean | make lock | make help
@@ -42,6 +43,11 @@ DATA_FETCH ?= $(PY) -m bgfn.data fetch
 # Extra papermill options; in CI (CI=true) cell output is streamed to the log.
 PAPERMILL_FLAGS ?= $(if $(filter true 1,$(CI)),--log-output,)
 PYTEST_ARGS ?=
+# Independent runs (training runs, sweep networks, oracle points) at a time (bgfn.parallel.Runner): empty = the
+# profile's `parallel.jobs` (null: the cores here); DASK_SCHEDULER: run them on that Dask cluster instead. Neither
+# changes a result, so neither makes a notebook stale.
+JOBS ?=
+DASK_SCHEDULER ?=
 # pip lines that are noise on a mirror-backed machine (kept: errors and real warnings)
 PIP_NOISE := is ignored: it is neither a file nor a directory\|^Requirement already satisfied
 
@@ -74,6 +80,10 @@ export JUPYTER_PATH := $(VENV_ABS)/share/jupyter
 export MPLBACKEND := Agg
 export PYDEVD_DISABLE_FILE_VALIDATION := 1
 export PYTHONHASHSEED := 0
+export BGFN_JOBS := $(JOBS)
+export DASK_SCHEDULER
+# the venv's IPython kernel configuration (tools/ipython_kernel_config.py, installed by `make venv`)
+KERNEL_CONFIG := $(VENV)/etc/ipython/ipython_kernel_config.py
 
 .PHONY: help reproduce notebooks book test bench clean clean-debris distclean venv data lock strip
 
@@ -92,7 +102,7 @@ help:
 	@sed -n '3,6p' Makefile | sed 's/^# \{0,1\}//'
 
 # ---------------------------------------------------------------- environment
-venv: $(STAMP)
+venv: $(STAMP) $(KERNEL_CONFIG)
 
 $(STAMP): requirements.lock
 	@echo "==> environment $(VENV) from requirements.lock ($(LOCK_HASH))"
@@ -117,6 +127,9 @@ $(STAMP): requirements.lock
 	@rm -f $(VENV)/.installed-*
 	@touch $@
 
+$(KERNEL_CONFIG): tools/ipython_kernel_config.py | $(STAMP)
+	@mkdir -p $(@D) && cp $< $@
+
 # Rewrite requirements.lock from the current venv (keeps the comment header).
 lock:
 	@{ grep '^#' requirements.lock; $(PIP) freeze --exclude-editable | grep -vi '^spikingjelly==' ; } > requirements.lock.tmp
@@ -130,16 +143,20 @@ data: $(STAMP)
 
 # ---------------------------------------------------------------- notebooks
 # papermill writes to a temporary name; only a complete run is renamed to the target, so a failed run leaves
-# no executed notebook behind (and Make redoes it next time).
-$(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(PARAMS) $(SRC) $(STAMP) | data
-	@mkdir -p $(@D)
+# no executed notebook behind (and Make redoes it next time). The notebook's runner (bgfn.parallel) writes one
+# line per finished run to $(RES)/logs/<notebook>.log (BGFN_PROGRESS_LOG); `tail` shows them here as they come
+# and stops after this recipe's shell ($$$$) has ended, having shown the last ones.
+$(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(PARAMS) $(SRC) $(STAMP) | data $(KERNEL_CONFIG)
+	@mkdir -p $(@D) $(RES)/logs
 	@$(MAKE) clean-debris
 	@echo "==> [$(PROFILE)] papermill $<"
-	@tmp="$(@D)/.$*.running-$$$$.ipynb"; \
-	if $(VENV_ABS)/bin/papermill "$<" "$$tmp" -p profile $(PROFILE) --cwd "$(CURDIR)" -k python3 \
-	     --progress-bar $(PAPERMILL_FLAGS); then \
+	@tmp="$(@D)/.$*.running-$$$$.ipynb"; log="$(RES)/logs/$*.log"; : > "$$log"; \
+	tail --pid=$$$$ -s 0.5 -n +1 -f "$$log" 2>/dev/null | sed -u 's/^/    /' & \
+	if BGFN_PROGRESS_LOG="$(CURDIR)/$$log" $(VENV_ABS)/bin/papermill "$<" "$$tmp" -p profile $(PROFILE) \
+	     --cwd "$(CURDIR)" -k python3 --progress-bar $(PAPERMILL_FLAGS); then \
 	  mv -f "$$tmp" "$@"; \
-	else rm -f "$$tmp"; echo "error: $< failed under PROFILE=$(PROFILE); nothing written to $@" >&2; exit 1; fi
+	else rm -f "$$tmp"; echo "error: $< failed under PROFILE=$(PROFILE); nothing written to $@ (log: $$log)" >&2; \
+	  exit 1; fi
 
 # The profile is checked before the first notebook runs: its schema (every notebook's load_profile checks that
 # too) and the facts that need the data (outages inside the drives, window, outage sweep). A bad profile fails

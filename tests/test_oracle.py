@@ -279,17 +279,18 @@ def test_sweep_rows_carry_each_networks_increment_error(drive, monkeypatch, tmp_
     stand_in = {"mlp": orc.OracleIncrements(truth, 0.2, 0.0, noise, t0),
                 "bgfn": orc.OracleIncrements(truth, 0.2, 0.5, noise, t0)}
 
-    def fake_train(method, data, size_cfg, tc, seed=0, extra_card=None, **kw):
-        return {"method": method, "seed": seed, "fold": extra_card["fold"], "epochs_run": 1, "val_rmse_m": 1.0}
+    def fake_train(run):
+        return {"method": run.method, "seed": run.seed, "fold": run.extra_card["fold"], "epochs_run": 1,
+                "best_val_loss": 1.0, "best_epoch": 1, "val_rmse_m": 1.0}
 
-    monkeypatch.setattr(train, "train_model", fake_train)
+    monkeypatch.setattr(train, "train_run", fake_train)
     monkeypatch.setattr(sweep_module, "load_model", lambda path: stand_in[path.name.split("_seed")[0]])
     cfg = load_profile("smoke")
     cfg = {**cfg, "nav": NAV, "train": {**cfg["train"], "window": 20, "margin_s": 5.0}}
     ecfg = ev.evaluate_config({"methods": ["bgfn", "mlp"], "sweep": {
         "n_starts": 2, "folds": 2, "durations_s": [10.0, 30.0], "warmup_s": 30.0, "seeds": [0]},
         "oracle": _oracle([0.0], durations=[30.0])}, cfg["train"])
-    rows, _ = ev.run_sweep(cfg, "t", "synthetic", drive=drive, ecfg=ecfg, progress=False)
+    rows, _ = ev.run_sweep(cfg, "t", "synthetic", drive=drive, ecfg=ecfg)
     assert list(rows.columns) == list(ev.SWEEP_COLUMNS)
     inc = rows.groupby(["method", "duration_s"])["increment_rmse_m"]
     assert rows.loc[rows["method"].isin(["INS", "GPS"]), "increment_rmse_m"].isna().all()

@@ -337,9 +337,12 @@ def test_train_dataset_trains_every_method_and_seed_into_the_models_folder(data,
     folder = models_in_tmp / "toyprofile" / "toy"
     assert sorted(p.name for p in folder.glob("*.pt")) == ["at_lstm_seed0.pt", "at_lstm_seed1.pt", "mlp_seed0.pt",
                                                            "mlp_seed1.pt"]
-    assert lines == [T.card_line(c) for c in cards]
-    assert lines[0].split()[:4] == ["toy", "mlp", "seed", "0:"]
-    assert f"val RMSE {cards[0]['val_rmse_m']:.3f} m" in lines[0]
+    # one progress line per finished run: which run, what it reports, the runs left
+    assert [line.split(" | ")[0] for line in lines] == [f"[training toy] toy {m} seed {s}" for m, s in
+                                                       [("mlp", 0), ("mlp", 1), ("at_lstm", 0), ("at_lstm", 1)]]
+    assert f"val RMSE {cards[0]['val_rmse_m']:.3f} m" in lines[0] and f"{cards[0]['epochs_run']} epochs" in lines[0]
+    assert [line.split(" | ")[3] for line in lines[:3]] == ["3 left", "2 left", "1 left"]
+    assert lines[3].split(" | ")[-1].startswith("all 4 in ")
     # the figure of the validation block reads the same checkpoints back: the cards' validation error
     preds = T.checkpoint_predictions(folder, data.val, ["mlp", "at_lstm"], seed=1)
     assert list(preds) == ["mlp", "at_lstm"]

@@ -254,7 +254,8 @@ def test_the_command_line_trains_the_variants_only_when_asked(monkeypatch, tmp_p
     monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)                  # no search ran: train.lr
     monkeypatch.setattr(R, "prepare_datasets", lambda plan: {d: T.TrainingDataset(d, None, None, f"data {d}")
                                                              for d in plan.datasets})
-    monkeypatch.setattr(R, "train_dataset", lambda plan, d, data, tc, **kw: [{"dataset": d, "data": data}])
+    monkeypatch.setattr(R, "train_datasets", lambda plan, learning, cfgs, *a, **kw: [
+        {"dataset": d, "data": data} for d, data in learning.items()])
     calls = []
     monkeypatch.setattr(R, "train_variants", lambda vplan, prepared, cfgs, **kw: calls.append(
         (vplan.names, vplan.datasets, sorted(prepared), sorted(cfgs))) or [])

@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import difflib
 import math
+import os
 import re
 import sys
 from dataclasses import dataclass, field
@@ -35,6 +36,7 @@ from bgfn.learning import learning_options
 from bgfn.nav.baseline import filter_start
 from bgfn.nav.outages import DEFAULT_KEY, check_windows, is_rule, outage_entry, picked_outages
 from bgfn.paper import METHOD_LABELS
+from bgfn.parallel import BACKENDS, SCHEDULER_ENV
 
 
 class ProfileError(ValueError):
@@ -157,6 +159,8 @@ SCHEMA = section(
     profile=text(), description=text(), seed=_SEED, base=text(), datasets=_NAMES,
     outage_windows=OUTAGE_WINDOWS,
     variants=mapping(VARIANT), variant_runs=VARIANT_RUNS,
+    # where the independent runs go (bgfn.parallel.Runner): jobs null = the cores here; backend dask: scheduler
+    parallel=section(jobs=integer(1, null=True), backend=text(*BACKENDS), scheduler=text(null=True)),
     data=section(
         datasets=_NAMES, seed=_SEED, imu_rate_hz=_POS, smoothing_degree=integer(1, 5),
         position_sigma_m=_POS, attitude_sigma_rad=_POS, t_start=number(null=True), t_end=number(null=True),
@@ -344,6 +348,10 @@ def _check_outage_entries(cfg: dict) -> None:
 def cross_check(cfg: dict) -> None:
     """The facts that tie keys together and need no data; :class:`ProfileError` naming the key."""
     _check_outage_entries(cfg)
+    par = cfg.get("parallel") or {}
+    if par.get("backend") == "dask" and not par.get("scheduler") and not os.environ.get(SCHEDULER_ENV):
+        raise ProfileError("parallel.scheduler", f"a Dask scheduler address (tcp://host:8786) with backend dask, or "
+                           f"{SCHEDULER_ENV}= on the make command line", _fmt(par.get("scheduler")))
     data, tr, ev = cfg.get("data") or {}, cfg.get("train") or {}, cfg.get("evaluate") or {}
     nav = cfg.get("nav") or {}
     ns = nav.get("noise_scale")

@@ -11,6 +11,7 @@ from bgfn.data import acquire
 from bgfn.errors import DataError
 from bgfn.nav import outages
 from bgfn.paper import METHOD_LABELS, TESTS, nhc_label
+from bgfn.parallel import Runner
 
 #: The standalone INS and the networks, each also with the vehicle constraints (``+NHC``, bgfn.nav.constraints).
 _AIDED: tuple[str, ...] = ("INS", "MLP", "AT-LSTM", "BGFN", "Transformer")
@@ -153,6 +154,8 @@ class EvaluationSetup:
         :class:`~bgfn.evaluate.tables.TableResult` (``windows``).
     outage_lines : list of str
         Per dataset of the tables whose entry differs from ``windows``: its list, or the rule that picks them.
+    runner : bgfn.parallel.Runner
+        Where the independent runs of the sweep and the oracle go (the profile's ``parallel:`` section).
     """
 
     profile: str
@@ -164,6 +167,7 @@ class EvaluationSetup:
     sweep_notes: list[str]
     windows: list = field(default_factory=list)
     outage_lines: list = field(default_factory=list)
+    runner: Runner = field(default_factory=Runner)
 
     def describe(self) -> list[str]:
         """Lines saying what is evaluated: profile, IMUs, datasets, methods, seeds, outages, pseudo-GPS."""
@@ -179,6 +183,7 @@ class EvaluationSetup:
         lines.append(f"outages (start, duration) s: {[list(w) for w in self.windows]}"
                      + "".join(f"; {line}" for line in self.outage_lines))
         lines.append(f"pseudo-GPS: {ecfg['pseudo_gps']}")
+        lines.append(f"independent runs: {self.runner.describe()}")
         return lines
 
 
@@ -213,4 +218,4 @@ def evaluation_setup(cfg: dict) -> EvaluationSetup:
         elif outages.outage_windows(cfg, dataset=name) != default:
             lines.append(f"{name}: {[list(w) for w in outages.outage_windows(cfg, dataset=name)]}")
     return EvaluationSetup(cfg.get("profile", ""), cfg.get("description", ""), ecfg, names, notes, sweep_names,
-                           sweep_notes, default, lines)
+                           sweep_notes, default, lines, Runner.of(cfg))

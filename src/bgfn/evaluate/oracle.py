@@ -51,6 +51,7 @@ from bgfn.evaluate.sweep import profile_sweep_plan
 from bgfn.io import atomic_write_csv, save_figure
 from bgfn.nav.outages import outage_windows
 from bgfn.paper import METHOD_LABELS, test_of
+from bgfn.parallel import Runner
 from bgfn.stats import bootstrap_ci
 
 #: Method label of the oracle runs.
@@ -148,7 +149,8 @@ def oracle_windows(cfg: dict, drive, ecfg: dict, windows) -> tuple[list[tuple[st
     return out + [(SWEEP_OUTAGE, float(s), float(max(durations))) for s in plan["start_s"]], []
 
 
-def oracle_runs(ctx, windows, oracle: dict, pseudo: dict | None = None) -> pd.DataFrame:
+def oracle_runs(ctx, windows, oracle: dict, pseudo: dict | None = None,
+                runner: Runner | None = None) -> pd.DataFrame:
     """INS and the oracle at every sigma and seed in ``windows`` of one drive.
 
     Parameters
@@ -161,6 +163,8 @@ def oracle_runs(ctx, windows, oracle: dict, pseudo: dict | None = None) -> pd.Da
         ``sigmas_m``, ``seeds``, ``durations_s`` (the ``evaluate.oracle`` section).
     pseudo : dict, optional
         ``evaluate.pseudo_gps``: the oracle's fixes are fused like a network's.
+    runner : bgfn.parallel.Runner, optional
+        Where the ``(sigma, seed)`` points run (default: one after the other).
 
     Returns
     -------
@@ -187,12 +191,22 @@ def oracle_runs(ctx, windows, oracle: dict, pseudo: dict | None = None) -> pd.Da
                              **{k: m[k] for k in ("max_h_m", "rmse_h_m", "final_h_m")}, "increment_rmse_m": inc})
 
     add(run_outages(ctx, pairs, None, "INS", None, pseudo), np.nan, np.nan)
-    for sigma in sigmas:
-        for seed in ([None] if sigma == 0.0 else [int(s) for s in oracle["seeds"]]):
-            noise = oracle_noise(name, 0 if seed is None else seed, n_intervals)
-            pred = OracleIncrements(truth, interval, sigma, noise, t0)
-            add(run_outages(ctx, pairs, pred, ORACLE_METHOD, seed, pseudo), sigma, np.nan if seed is None else seed)
+    points = [(sigma, seed) for sigma in sigmas for seed in ([None] if sigma == 0.0 else
+                                                               [int(s) for s in oracle["seeds"]])]
+    tasks = [(ctx, pairs, OracleIncrements(truth, interval, sigma, oracle_noise(name, 0 if seed is None else seed,
+                                                                                n_intervals), t0), seed, pseudo)
+             for sigma, seed in points]
+    done = (runner or Runner()).map(oracle_point, tasks, labels=[f"{name} sigma {sigma:g} m seed {seed}"
+                                                                 for sigma, seed in points],
+                                    desc=f"oracle {name}", bar=len(tasks) > 1)
+    for (sigma, seed), runs in zip(points, done):
+        add(runs, sigma, np.nan if seed is None else seed)
     return pd.DataFrame(rows, columns=list(RUN_COLUMNS))
+
+
+def oracle_point(ctx, pairs, pred: OracleIncrements, seed: int | None, pseudo: dict | None) -> list:
+    """The oracle's outage runs at one sigma and seed (an independent run of :func:`oracle_runs`)."""
+    return run_outages(ctx, pairs, pred, ORACLE_METHOD, seed, pseudo)
 
 
 # ----------------------------------------------------------------------------------------------- tables
@@ -529,7 +543,7 @@ def plot_oracle(table: pd.DataFrame, levels: pd.DataFrame, breakeven: pd.DataFra
 
 def run_oracle(cfg: dict, profile: str, setup, out=None, results: dict | None = None,
                sweep: pd.DataFrame | None = None, figures: bool = True,
-               report: Callable[[str], None] | None = None) -> OracleResult:
+               report: Callable[[str], None] | None = None, runner: Runner | None = None) -> OracleResult:
     """The oracle rows of every dataset of notebook 04 (module docstring), their tables and figures.
 
     Parameters
@@ -550,6 +564,8 @@ def run_oracle(cfg: dict, profile: str, setup, out=None, results: dict | None = 
         Draw :func:`bgfn.evaluate.plot_oracle` per dataset.
     report : callable, optional
         Called with a line per dataset when it is done.
+    runner : bgfn.parallel.Runner, optional
+        Where the grid points of each dataset run (:func:`oracle_runs`).
     """
     ecfg = setup.config
     oc, sw = ecfg["oracle"], ecfg["sweep"]
@@ -568,7 +584,7 @@ def run_oracle(cfg: dict, profile: str, setup, out=None, results: dict | None = 
         notes += why
         ctx = navigation_context(drive, cfg.get("nav"), [s for _, s, _ in wins])
         interval[name] = float(ctx.gnss_interval_s)
-        runs = oracle_runs(ctx, wins, oc, ecfg["pseudo_gps"])
+        runs = oracle_runs(ctx, wins, oc, ecfg["pseudo_gps"], runner)
         parts.append(runs)
         levels.append(method_levels(name, sweep, res, AntennaTruth.of(ctx), ctx.gnss_interval_s, oc["durations_s"]))
         timings[f"oracle_{name}_s"] = time.perf_counter() - t0

@@ -5,24 +5,26 @@ from __future__ import annotations
 
 import copy
 import time
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Callable
 
 import numpy as np
 import pandas as pd
-from tqdm import tqdm
 
 from bgfn import train
 from bgfn.data import load_drive
 from bgfn.errors import DataError
 from bgfn.evaluate.config import SEEDLESS_METHODS, SWEEP_COLUMNS, TABLE_METHODS, evaluate_config
-from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
+from bgfn.evaluate.hybrid import NavContext, gps_run, navigation_context, run_outages, window_metrics
 from bgfn.evaluate.increments import AntennaTruth, increment_rmse
 from bgfn.evaluate.networks import load_model
 from bgfn.learning import build_learning_data, learning_options
 from bgfn.nav.baseline import filter_start
 from bgfn.paper import METHOD_LABELS, NHC_SUFFIX, label, nhc_label
+from bgfn.parallel import Runner
 from bgfn.stats import bootstrap_ci, paired_comparison, wilcoxon_p
-from bgfn.train.checkpoints import checkpoint_path
+from bgfn.train.checkpoints import checkpoint_name, checkpoint_path
 
 
 def sweep_plan(drive, sweep: dict, window_samples: int = 200, t_first: float | None = None) -> pd.DataFrame:
@@ -74,9 +76,129 @@ def sweep_train_config(train_section: dict, sweep: dict) -> dict:
     return tc
 
 
+@dataclass(frozen=True)
+class SweepRun:
+    """One network of the sweep, an independent run: trained without fold ``k``'s outages (``training``), then
+    run in them (``windows``, ``(start, longest duration)``), alone and (``nhc``) with the vehicle constraints."""
+
+    label: str
+    ctx: NavContext
+    fold: int
+    windows: list
+    training: train.TrainingRun
+    method: str
+    seed: int
+    pseudo_gps: dict
+    nhc: bool
+
+
+def sweep_run(run: SweepRun) -> tuple[dict, list, float, float]:
+    """Train one sweep network and run it in its fold's outages: ``(card, outage runs, training s, evaluation
+    s)``; the runs of ``<METHOD>`` first, then ``<METHOD>+NHC``."""
+    ta = time.perf_counter()
+    card = train.train_run(run.training)
+    model = load_model(Path(run.training.out_dir) / checkpoint_name(run.method, run.seed))
+    tb = time.perf_counter()
+    runs = list(run_outages(run.ctx, run.windows, model, METHOD_LABELS[run.method], run.seed, run.pseudo_gps))
+    if run.nhc:
+        runs += run_outages(run.ctx, run.windows, model, nhc_label(run.method), run.seed, run.pseudo_gps,
+                            constraints=run.ctx.constraints)
+    return card, runs, tb - ta, time.perf_counter() - tb
+
+
+def _sweep_summary(result: tuple) -> str:
+    """The progress line's part of a finished sweep run."""
+    card, runs = result[0], result[1]
+    return f"{train.run_summary(card)}, {len(runs)} outage runs"
+
+
+class _Sweep:
+    """One dataset's sweep while it runs: its plan, the learning-free rows (computed at once) and the networks'
+    runs (:class:`SweepRun`, handed to a runner), then its rows and info (:meth:`finish`)."""
+
+    def __init__(self, cfg: dict, profile: str, dataset: str, drive, ecfg: dict):
+        self.dataset, self.sw = dataset, ecfg["sweep"]
+        if drive is None:
+            drive = load_drive(dataset, profile=profile)
+        # the sweep's budget, with the learning rates notebook 03 selected for this dataset (same for every fold)
+        self.tc = tc = sweep_train_config(train.tuned_train_config(cfg, profile, dataset), self.sw)
+        self.opts = opts = learning_options(tc)
+        self.plan = plan = sweep_plan(drive, self.sw, int(opts["window"]), t_first=filter_start(drive, cfg.get("nav")))
+        self.durations = sorted(float(d) for d in self.sw["durations_s"])
+        dmax = self.durations[-1]
+        self.seeds = [int(s) for s in self.sw["seeds"]]
+        self.methods = list(ecfg["methods"])
+        t0 = time.perf_counter()
+        self.ctx = ctx = navigation_context(drive, cfg.get("nav"), plan["start_s"])
+        self.rows: list[dict] = []
+        self.truth = AntennaTruth.of(ctx)
+        self.fold_of = dict(zip(plan["start_s"], plan["fold"]))
+        windows_all = [(s, dmax) for s in plan["start_s"]]
+        self.aids = aids = ctx.constraints if ecfg.get("nhc_rows", True) else None
+        for r in run_outages(ctx, windows_all, None, "INS", None, ecfg["pseudo_gps"]):
+            self.add(r, self.fold_of[r.start])
+        if aids is not None:
+            for r in run_outages(ctx, windows_all, None, nhc_label("INS"), None, ecfg["pseudo_gps"], constraints=aids):
+                self.add(r, self.fold_of[r.start])
+        for s in plan["start_s"]:
+            self.add(gps_run(ctx, s, dmax), self.fold_of[s])
+        self.t_nav = time.perf_counter() - t0
+        attitude = ctx.attitude_table()
+        self.runs = []
+        for k in sorted(plan["fold"].unique()):
+            fw = [(s, dmax) for s in plan.loc[plan["fold"] == k, "start_s"]]
+            data = build_learning_data(drive.imu, attitude, drive.gnss, fw, **opts)
+            for method in self.methods:
+                for seed in self.seeds:
+                    out = checkpoint_path(profile, dataset, method, seed, fold=int(k)).parent
+                    extra = {"dataset": dataset, "profile": profile, "fold": int(k), "fold_outages": fw,
+                             "size": tc.get("size")}
+                    label = f"{dataset} fold {k} {METHOD_LABELS[method]} seed {seed}"
+                    training = train.TrainingRun(label, method, data, train.size_config(tc, method), tc, seed, out,
+                                                 None, extra)
+                    self.runs.append(SweepRun(label, ctx, int(k), fw, training, method, seed, ecfg["pseudo_gps"],
+                                              aids is not None))
+
+    def add(self, run, fold) -> None:
+        """The rows of one outage run, one per duration (and per seed for a run without one)."""
+        for du in self.durations:
+            mtr = window_metrics(run.errors, run.start, du)
+            # the network's own increment error in this outage (the oracle's sigma axis, bgfn.evaluate.oracle)
+            mtr["increment_rmse_m"] = (increment_rmse(run, self.truth, self.ctx.gnss_interval_s, du)
+                                       if len(run.increments) else float("nan"))
+            for seed in ([run.seed] if run.seed is not None else self.seeds):
+                self.rows.append({"dataset": self.dataset, "start_s": run.start, "duration_s": du,
+                                  "method": run.method, "seed": int(seed), "fold": int(fold),
+                                  **{k: mtr[k] for k in SWEEP_COLUMNS[6:]}})
+
+    def finish(self, results: list) -> tuple[pd.DataFrame, dict]:
+        """The rows and info of :func:`run_sweep` from the results of :attr:`runs` (in their order)."""
+        plan, tc, methods = self.plan, self.tc, self.methods
+        cards = []
+        t_train = t_eval = 0.0
+        for run, (card, runs, train_s, eval_s) in zip(self.runs, results):
+            cards.append(card)
+            for r in runs:
+                self.add(r, run.fold)
+            t_train, t_eval = t_train + train_s, t_eval + eval_s
+        df = pd.DataFrame(self.rows, columns=list(SWEEP_COLUMNS))
+        info = {"dataset": self.dataset, "n_starts": len(plan), "folds": int(plan["fold"].nunique()),
+                "seeds": self.seeds, "durations_s": self.durations, "methods": [METHOD_LABELS[m] for m in methods],
+                "window": int(self.opts["window"]), "size": tc.get("size"), "optimizer": train.optimizer_options(tc),
+                "lr": {METHOD_LABELS[m]: train.method_lr(tc, m) for m in methods},
+                "fold_starts": {int(k): plan.loc[plan["fold"] == k, "start_s"].tolist() for k in plan["fold"].unique()},
+                "train_wall_s": t_train, "eval_wall_s": t_eval + self.t_nav,
+                "train_epochs_run": {f"{c['method']}_fold{c.get('fold')}_seed{c['seed']}": c["epochs_run"]
+                                     for c in cards},
+                "fold_val_rmse_m": {f"{c['method']}_fold{c.get('fold')}_seed{c['seed']}": c["val_rmse_m"]
+                                    for c in cards},
+                "constraints": self.aids.summary() if self.aids is not None else None}
+        return df, info
+
+
 def run_sweep(cfg: dict, profile: str, dataset: str, drive=None, ecfg: dict | None = None,
-              progress: bool = True) -> tuple[pd.DataFrame, dict]:
-    """The outage sweep of one dataset (module docstring).
+              runner: Runner | None = None) -> tuple[pd.DataFrame, dict]:
+    """The outage sweep of one dataset (module docstring), its networks spread over ``runner``.
 
     Returns
     -------
@@ -85,83 +207,13 @@ def run_sweep(cfg: dict, profile: str, dataset: str, drive=None, ecfg: dict | No
         that every (start, seed) pair has every method. With ``nhc_rows`` every method also runs with the
         vehicle constraints (``INS+NHC``, ``<METHOD>+NHC``).
     info : dict
-        Sizes, training and evaluation wall times, fold windows.
+        Sizes, training and evaluation times (summed over the runs, s), fold windows.
     """
     ecfg = ecfg or evaluate_config(cfg.get("evaluate"), cfg.get("train"))
-    sw = ecfg["sweep"]
-    if drive is None:
-        drive = load_drive(dataset, profile=profile)
-    # the sweep's budget, with the learning rates notebook 03 selected for this dataset (same for every fold)
-    tc = sweep_train_config(train.tuned_train_config(cfg, profile, dataset), sw)
-    opts = learning_options(tc)
-    plan = sweep_plan(drive, sw, int(opts["window"]), t_first=filter_start(drive, cfg.get("nav")))
-    durations = sorted(float(d) for d in sw["durations_s"])
-    dmax = durations[-1]
-    seeds = [int(s) for s in sw["seeds"]]
-    methods = list(ecfg["methods"])
-    t0 = time.perf_counter()
-    ctx = navigation_context(drive, cfg.get("nav"), plan["start_s"])
-    rows = []
-    truth = AntennaTruth.of(ctx)
-
-    def add(run, fold):
-        for du in durations:
-            mtr = window_metrics(run.errors, run.start, du)
-            # the network's own increment error in this outage (the oracle's sigma axis, bgfn.evaluate.oracle)
-            mtr["increment_rmse_m"] = (increment_rmse(run, truth, ctx.gnss_interval_s, du) if len(run.increments)
-                                       else float("nan"))
-            for seed in ([run.seed] if run.seed is not None else seeds):
-                rows.append({"dataset": dataset, "start_s": run.start, "duration_s": du, "method": run.method,
-                             "seed": int(seed), "fold": int(fold), **{k: mtr[k] for k in SWEEP_COLUMNS[6:]}})
-
-    fold_of = dict(zip(plan["start_s"], plan["fold"]))
-    windows_all = [(s, dmax) for s in plan["start_s"]]
-    aids = ctx.constraints if ecfg.get("nhc_rows", True) else None
-    for r in run_outages(ctx, windows_all, None, "INS", None, ecfg["pseudo_gps"]):
-        add(r, fold_of[r.start])
-    if aids is not None:
-        for r in run_outages(ctx, windows_all, None, nhc_label("INS"), None, ecfg["pseudo_gps"], constraints=aids):
-            add(r, fold_of[r.start])
-    for s in plan["start_s"]:
-        add(gps_run(ctx, s, dmax), fold_of[s])
-    t_nav = time.perf_counter() - t0
-    attitude = ctx.attitude_table()
-    t_train = t_eval = 0.0
-    jobs = [(k, m, s) for k in sorted(plan["fold"].unique()) for m in methods for s in seeds]
-    data_cache: dict = {}
-    cards = []
-    for k, method, seed in tqdm(jobs, desc=f"sweep {dataset}", disable=not progress):
-        fw = [(s, dmax) for s in plan.loc[plan["fold"] == k, "start_s"]]
-        if k not in data_cache:
-            data_cache = {k: build_learning_data(drive.imu, attitude, drive.gnss, fw, **opts)}
-        path = checkpoint_path(profile, dataset, method, seed, fold=int(k))
-        ta = time.perf_counter()
-        card = train.train_model(method, data_cache[k], train.size_config(tc, method), tc, seed=seed,
-                                 out_dir=path.parent, progress=False,
-                                 extra_card={"dataset": dataset, "profile": profile, "fold": int(k),
-                                             "fold_outages": fw, "size": tc.get("size")})
-        cards.append(card)
-        model = load_model(path)
-        tb = time.perf_counter()
-        for r in run_outages(ctx, fw, model, METHOD_LABELS[method], seed, ecfg["pseudo_gps"]):
-            add(r, k)
-        if aids is not None:
-            for r in run_outages(ctx, fw, model, nhc_label(method), seed, ecfg["pseudo_gps"], constraints=aids):
-                add(r, k)
-        tc_ = time.perf_counter()
-        t_train += tb - ta
-        t_eval += tc_ - tb
-    df = pd.DataFrame(rows, columns=list(SWEEP_COLUMNS))
-    info = {"dataset": dataset, "n_starts": len(plan), "folds": int(plan["fold"].nunique()), "seeds": seeds,
-            "durations_s": durations, "methods": [METHOD_LABELS[m] for m in methods],
-            "window": int(opts["window"]), "size": tc.get("size"), "optimizer": train.optimizer_options(tc),
-            "lr": {METHOD_LABELS[m]: train.method_lr(tc, m) for m in methods},
-            "fold_starts": {int(k): plan.loc[plan["fold"] == k, "start_s"].tolist() for k in plan["fold"].unique()},
-            "train_wall_s": t_train, "eval_wall_s": t_eval + t_nav,
-            "train_epochs_run": {f"{c['method']}_fold{c.get('fold')}_seed{c['seed']}": c["epochs_run"] for c in cards},
-            "fold_val_rmse_m": {f"{c['method']}_fold{c.get('fold')}_seed{c['seed']}": c["val_rmse_m"] for c in cards},
-            "constraints": aids.summary() if aids is not None else None}
-    return df, info
+    sweep = _Sweep(cfg, profile, dataset, drive, ecfg)
+    return sweep.finish((runner or Runner()).map(sweep_run, [(r,) for r in sweep.runs],
+                                                 labels=[r.label for r in sweep.runs], summary=_sweep_summary,
+                                                 desc=f"sweep {dataset}"))
 
 
 def sweep_summary(sweep: pd.DataFrame, n_boot: int = 2000, level: float = 0.95, seed: int = 0,
@@ -258,14 +310,14 @@ def describe_sweep_setup(train_section: dict, ecfg: dict, datasets) -> list[str]
     return lines
 
 
-def run_sweeps(cfg: dict, profile: str, datasets, ecfg: dict, progress: bool = True,
+def run_sweeps(cfg: dict, profile: str, datasets, ecfg: dict, runner: Runner | None = None,
                report: Callable[[str], None] | None = None) -> tuple[pd.DataFrame, dict, dict]:
-    """:func:`run_sweep` of every dataset, one after the other.
+    """:func:`run_sweep` of every dataset, the networks of all of them spread over ``runner`` at once.
 
     Parameters
     ----------
     report : callable, optional
-        Called with a line or two per dataset as soon as it is done (its rows, wall times, fold starts).
+        Called with a line or two per dataset when its rows are in (its rows, times, fold starts).
 
     Returns
     -------
@@ -274,17 +326,27 @@ def run_sweeps(cfg: dict, profile: str, datasets, ecfg: dict, progress: bool = T
     info : dict
         ``{dataset: info of run_sweep}``.
     timings : dict
-        ``{"sweep_<dataset>_s": wall time, s}``.
+        ``{"sweep_<dataset>_s": its learning-free runs' wall time + its networks' run times, s}`` and
+        ``sweep_wall_s`` (the whole sweep's wall time, s; absent without datasets).
     """
-    parts, info, timings = [], {}, {}
-    for name in datasets:
-        t0 = time.perf_counter()
-        df, info[name] = run_sweep(cfg, profile, name, ecfg=ecfg, progress=progress)
+    t0 = time.perf_counter()
+    sweeps = [_Sweep(cfg, profile, name, None, ecfg) for name in datasets]
+    runs = [r for sw in sweeps for r in sw.runs]
+    results = (runner or Runner()).map(sweep_run, [(r,) for r in runs], labels=[r.label for r in runs],
+                                       summary=_sweep_summary, desc="sweep")
+    parts, info, timings, i = [], {}, {}, 0
+    for sw in sweeps:
+        name = sw.dataset
+        df, info[name] = sw.finish(results[i:i + len(sw.runs)])
+        i += len(sw.runs)
         parts.append(df)
-        timings[f"sweep_{name}_s"] = time.perf_counter() - t0
+        timings[f"sweep_{name}_s"] = info[name]["train_wall_s"] + info[name]["eval_wall_s"]
         if report is not None:
             report(f"{name}: {len(df)} rows, training {info[name]['train_wall_s']:.0f} s, evaluation "
-                   f"{info[name]['eval_wall_s']:.0f} s\n  fold starts (s): {info[name]['fold_starts']}")
+                   f"{info[name]['eval_wall_s']:.0f} s (summed over its runs)\n"
+                   f"  fold starts (s): {info[name]['fold_starts']}")
+    if sweeps:
+        timings["sweep_wall_s"] = time.perf_counter() - t0
     rows = pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(columns=list(SWEEP_COLUMNS))
     return rows, info, timings
 

@@ -8,6 +8,8 @@ Modules, one concept each (every public name is re-exported here):
   resume;
 - :mod:`bgfn.train.trained`: :class:`TrainedModel` and :func:`load_trained`, a checkpoint predicting
   delta_p_gps (Eq. pred-gps);
+- :mod:`bgfn.train.tasks`: a network to train as one independent run (:class:`TrainingRun`), all of them spread
+  over a :class:`bgfn.parallel.Runner` (:func:`train_runs`);
 - :mod:`bgfn.train.lr_search`: the learning rate of every method from one grid on a tuning split;
 - :mod:`bgfn.train.profile`: a profile's runs (:class:`TrainingPlan`), its drives and windows, the INS attitude
   input, the training over datasets x methods x seeds;
@@ -30,20 +32,22 @@ from bgfn.train.estimate import estimate_lines, measure_paper_step, paper_traini
 from bgfn.train.loop import set_seed, train_model
 from bgfn.train.lr_search import (LR_SEARCH_COLUMNS, LR_SEARCH_DEFAULTS, LR_SEARCH_FILE, chosen_learning_rates,
                                   lr_search_options, next_learning_rate, search_learning_rates,
-                                  search_profile_learning_rates, search_train_config, selected_train_configs,
-                                  tuned_train_config, with_selected_lr)
+                                  search_profile_learning_rates, search_profile_rates, search_train_config,
+                                  selected_train_configs, tuned_train_config, with_selected_lr)
 from bgfn.train.options import (OPTIMIZER_DEFAULTS, even_subset, method_lr, optimizer_options, size_config,
                                 train_subsection)
 from bgfn.train.plots import plot_motion_coverage, plot_training_curves, plot_val_predictions
 from bgfn.train.profile import (TrainingDataset, TrainingPlan, ins_attitude, prepare_datasets, prepare_learning_data,
-                                train_dataset, val_position_table, val_position_tables)
+                                train_dataset, train_datasets, training_runs, val_position_table,
+                                val_position_tables)
 from bgfn.train.recheck import RECHECK_COLUMNS, capped_runs, recheck_all_windows, recheck_lines, recheck_table
 from bgfn.train.runs import train_profile
 from bgfn.train.tables import (TIMING_COLUMNS, card_line, cards_table, learning_check, summary_table, timing_table,
                                training_metrics, windows_table, without_timing)
+from bgfn.train.tasks import TrainingRun, run_summary, train_run, train_runs
 from bgfn.train.trained import TrainedModel, checkpoint_predictions, load_trained, pick_device, predict_normalized
 from bgfn.train.variants import (VARIANT_RUN_DEFAULTS, VariantPlan, describe_options, train_variants,
-                                 variant_cards_table, variant_learning_data, variant_train_section,
+                                 variant_cards_table, variant_learning_data, variant_runs, variant_train_section,
                                  wall_time_by_variant)
 
 __all__ = [
@@ -56,10 +60,12 @@ __all__ = [
     # learning-rate search
     "LR_SEARCH_DEFAULTS", "LR_SEARCH_FILE", "LR_SEARCH_COLUMNS", "lr_search_options", "search_learning_rates",
     "next_learning_rate", "search_train_config", "with_selected_lr", "tuned_train_config", "search_profile_learning_rates",
-    "selected_train_configs", "chosen_learning_rates",
+    "selected_train_configs", "chosen_learning_rates", "search_profile_rates",
+    # independent runs
+    "TrainingRun", "train_run", "train_runs", "run_summary",
     # a profile's training
     "TrainingPlan", "TrainingDataset", "prepare_datasets", "prepare_learning_data", "ins_attitude",
-    "val_position_table", "val_position_tables", "train_dataset", "train_profile",
+    "val_position_table", "val_position_tables", "train_dataset", "train_datasets", "training_runs", "train_profile",
     # tables and figures
     "REFERENCES", "VAL_POSITIONS", "TIMING_COLUMNS", "cards_table", "learning_check", "summary_table", "without_timing",
     "timing_table", "windows_table", "card_line", "training_metrics", "plot_training_curves",
@@ -68,5 +74,5 @@ __all__ = [
     "RECHECK_COLUMNS", "capped_runs", "recheck_all_windows", "recheck_table", "recheck_lines",
     # input and protocol variants
     "VARIANT_RUN_DEFAULTS", "VariantPlan", "describe_options", "variant_train_section", "variant_learning_data",
-    "train_variants", "variant_cards_table", "wall_time_by_variant",
+    "train_variants", "variant_runs", "variant_cards_table", "wall_time_by_variant",
 ]

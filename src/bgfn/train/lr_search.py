@@ -20,9 +20,10 @@ import pandas as pd
 from bgfn.config import results_dir
 from bgfn.errors import DataError
 from bgfn.learning import LearningData, inner_split
+from bgfn.parallel import Runner
 from bgfn.train import checkpoints
-from bgfn.train.loop import train_model
 from bgfn.train.options import method_lr, size_config, train_subsection
+from bgfn.train.tasks import TrainingRun, train_runs
 
 #: ``train.lr_search``: learning rates tried for every method on :func:`bgfn.learning.inner_split` (null: none).
 #: ``extend``: when a method's best rate is the grid's smallest or largest, up to this many further rates are
@@ -52,7 +53,7 @@ def search_train_config(train_cfg: dict) -> dict:
 
 
 def search_learning_rates(data: LearningData, methods, train_cfg: dict, out_dir: str | Path | None = None,
-                          progress: bool = False) -> pd.DataFrame:
+                          runner: Runner | None = None) -> pd.DataFrame:
     """Train every method once per learning rate of ``train.lr_search.grid`` on a tuning split inside the
     training windows (:func:`bgfn.learning.inner_split`) and mark the rate with the lowest tuning loss.
 
@@ -65,32 +66,44 @@ def search_learning_rates(data: LearningData, methods, train_cfg: dict, out_dir:
     DataFrame
         ``method, lr, tuning_rmse_m, tuning_loss, epochs_run, selected`` (one row per method and rate).
     """
+    table = search_profile_rates({None: (data, out_dir)}, methods, train_cfg, runner)
+    return table.drop(columns="dataset").reset_index(drop=True)
+
+
+def search_profile_rates(learning: dict, methods, train_cfg: dict, runner: Runner | None = None) -> pd.DataFrame:
+    """The search of :func:`search_learning_rates` for several datasets at once (``{dataset: (LearningData,
+    out_dir)}``), in rounds of independent runs spread over ``runner``: the grid, then each ``extend`` step (a
+    rate beyond a grid's edge depends on the rates tried before it). Rows: dataset, method, rate (sorted)."""
     ls = lr_search_options(train_cfg)
     grid = [float(v) for v in (ls["grid"] or [])]
     if not grid:
         raise DataError("train.lr_search", "grid", "a non-empty list of learning rates", repr(ls["grid"]))
     grid = sorted(set(grid))
-    inner = inner_split(data, float(ls["fraction"]))
     budget = search_train_config(train_cfg)
-    rows = []
-    for method in methods:
-        def tune(lr: float) -> dict:
-            cfg = {**budget, "lr": {**(budget.get("lr") or {}), method: lr}}
-            sub = Path(out_dir) / f"lr{lr:g}" if out_dir is not None else None
-            card = train_model(method, inner, size_config(train_cfg, method), cfg, seed=int(ls["seed"]),
-                               out_dir=sub, progress=progress)
-            return {"method": method, "lr": lr, "tuning_rmse_m": card["val_rmse_m"],
-                    "tuning_loss": card["best_val_loss"], "epochs_run": card["epochs_run"]}
+    inner = {name: inner_split(data, float(ls["fraction"])) for name, (data, _) in learning.items()}
+    tried: dict[tuple, list[dict]] = {(name, m): [] for name in learning for m in methods}
 
-        tried = [tune(lr) for lr in grid]
-        for _ in range(int(ls["extend"])):
-            nxt = next_learning_rate([r["lr"] for r in tried], min(tried, key=lambda r: r["tuning_loss"])["lr"])
-            if nxt is None:
-                break
-            tried.append(tune(nxt))
-        rows += sorted(tried, key=lambda r: r["lr"])
+    def run(name, method: str, lr: float) -> TrainingRun:
+        cfg = {**budget, "lr": {**(budget.get("lr") or {}), method: lr}}
+        out_dir = learning[name][1]
+        sub = Path(out_dir) / f"lr{lr:g}" if out_dir is not None else None
+        label = f"{'' if name is None else name + ' '}{method} lr {lr:g}"
+        return TrainingRun(label, method, inner[name], size_config(train_cfg, method), cfg, int(ls["seed"]), sub)
+
+    pending = [(key, lr) for key in tried for lr in grid]
+    for step in range(int(ls["extend"]) + 1):
+        if not pending:
+            break
+        cards = train_runs([run(*key, lr) for key, lr in pending], runner, desc="lr search" + (f" +{step}" if step else ""))
+        for (key, lr), card in zip(pending, cards):
+            tried[key].append({"dataset": key[0], "method": key[1], "lr": lr, "tuning_rmse_m": card["val_rmse_m"],
+                               "tuning_loss": card["best_val_loss"], "epochs_run": card["epochs_run"]})
+        pending = [(key, nxt) for key, rows in tried.items()
+                   if (nxt := next_learning_rate([r["lr"] for r in rows],
+                                                 min(rows, key=lambda r: r["tuning_loss"])["lr"])) is not None]
+    rows = [r for key in tried for r in sorted(tried[key], key=lambda r: r["lr"])]
     table = pd.DataFrame(rows)
-    best = table.groupby("method", sort=False)["tuning_loss"].idxmin()
+    best = table.groupby(["dataset", "method"], sort=False, dropna=False)["tuning_loss"].idxmin()
     table["selected"] = table.index.isin(best.to_numpy())
     return table
 
@@ -131,9 +144,9 @@ def tuned_train_config(cfg: dict, profile: str, dataset: str) -> dict:
 
 
 def search_profile_learning_rates(profile: str, learning: dict[str, LearningData], methods, train_cfg: dict,
-                                  progress: bool = False) -> pd.DataFrame | None:
-    """:func:`search_learning_rates` for every dataset of ``learning`` (``{dataset: LearningData}``); the runs go
-    to ``results/<profile>/models/<dataset>/lr_search/``.
+                                  runner: Runner | None = None) -> pd.DataFrame | None:
+    """:func:`search_learning_rates` for every dataset of ``learning`` (``{dataset: LearningData}``), all its runs
+    spread over ``runner``; the runs go to ``results/<profile>/models/<dataset>/lr_search/``.
 
     Returns
     -------
@@ -143,10 +156,9 @@ def search_profile_learning_rates(profile: str, learning: dict[str, LearningData
     """
     if not lr_search_options(train_cfg)["grid"]:
         return None
-    tables = [search_learning_rates(data, methods, train_cfg, progress=progress,
-                                    out_dir=checkpoints.models_dir(profile, name) / "lr_search").assign(dataset=name)
-              for name, data in learning.items()]
-    return pd.concat(tables)[list(LR_SEARCH_COLUMNS)]
+    table = search_profile_rates({name: (data, checkpoints.models_dir(profile, name) / "lr_search")
+                                  for name, data in learning.items()}, methods, train_cfg, runner)
+    return table[list(LR_SEARCH_COLUMNS)]
 
 
 def selected_train_configs(train_cfg: dict, search: pd.DataFrame | None, datasets) -> dict[str, dict]:

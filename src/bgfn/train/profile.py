@@ -3,7 +3,8 @@
 :class:`TrainingPlan` names the ``(dataset, method, seed)`` runs of a profile's ``train:`` section and the
 evaluation outages kept out of training; :func:`prepare_datasets` loads each drive, runs the GPS/INS filter for
 the attitude input of Eq. (eq21) (:func:`ins_attitude`) and builds its windows; :func:`train_dataset` trains
-every method and seed of one dataset into ``results/<profile>/models/<dataset>/``.
+every method and seed of one dataset into ``results/<profile>/models/<dataset>/`` and
+:func:`train_datasets` every run of the plan, spread over a :class:`bgfn.parallel.Runner`.
 """
 
 from __future__ import annotations
@@ -19,10 +20,10 @@ from bgfn.learning import (VAL_POSITIONS, LearningData, all_windows, build_learn
                            motion_in_windows, val_position_coverage)
 from bgfn.nav import outages
 from bgfn.nav.baseline import run_drive
+from bgfn.parallel import Runner
 from bgfn.train import checkpoints
-from bgfn.train.loop import train_model
 from bgfn.train.options import optimizer_options, size_config
-from bgfn.train.tables import card_line
+from bgfn.train.tasks import TrainingRun, train_runs
 
 #: Learning options :meth:`TrainingPlan.describe` shows (the rest of :data:`bgfn.learning.LEARNING_DEFAULTS`
 #: is in the profile).
@@ -213,33 +214,39 @@ def val_position_tables(plan: TrainingPlan, prepared: dict[str, TrainingDataset]
     return positions[["dataset"] + [col for col in positions.columns if col != "dataset"]]
 
 
-def train_dataset(plan: TrainingPlan, dataset: str, data: LearningData, train_cfg: dict | None = None,
-                  device: str | None = None, progress: bool = False,
-                  echo: Callable[[str], Any] | None = None) -> list[dict]:
-    """Train every ``(method, seed)`` of ``plan`` on ``data`` into ``results/<profile>/models/<dataset>/``.
+def training_runs(plan: TrainingPlan, dataset: str, data: LearningData, train_cfg: dict | None = None,
+                  device: str | None = None) -> list[TrainingRun]:
+    """The ``(method, seed)`` runs of ``plan`` on one dataset's ``data``, into ``results/<profile>/models/<dataset>/``.
 
-    Parameters
-    ----------
-    train_cfg : dict, optional
-        The ``train:`` section with this dataset's learning rates (:mod:`bgfn.train.lr_search`); default
-        :attr:`TrainingPlan.train_cfg`.
-    echo : callable, optional
-        Called with :func:`bgfn.train.tables.card_line` of each card as it is done (e.g. ``print``).
+    ``train_cfg``: the ``train:`` section with this dataset's learning rates (:mod:`bgfn.train.lr_search`);
+    default :attr:`TrainingPlan.train_cfg`.
+    """
+    tc = plan.train_cfg if train_cfg is None else train_cfg
+    out = checkpoints.models_dir(plan.profile, dataset)
+    return [TrainingRun(f"{dataset} {method} seed {seed}", method, data, size_config(tc, method), tc, int(seed), out,
+                        device, {"dataset": dataset, "profile": plan.profile, "size": tc.get("size")})
+            for method in plan.methods for seed in plan.seeds]
+
+
+def train_datasets(plan: TrainingPlan, learning_data: dict[str, LearningData], train_cfgs: dict[str, dict],
+                   runner: Runner | None = None, device: str | None = None,
+                   echo: Callable[[str], Any] | None = None) -> list[dict]:
+    """Train every ``(dataset, method, seed)`` of ``plan`` (:func:`training_runs` of each dataset of
+    ``learning_data`` with its ``train_cfgs`` entry), spread over ``runner``; the cards in that order.
 
     Returns
     -------
     list of dict
         The cards (:func:`bgfn.train.loop.train_model`), with ``dataset``, ``profile`` and ``size``.
     """
-    tc = plan.train_cfg if train_cfg is None else train_cfg
-    out = checkpoints.models_dir(plan.profile, dataset)
-    cards = []
-    for method in plan.methods:
-        for seed in plan.seeds:
-            card = train_model(method, data, size_config(tc, method), tc, seed=seed, out_dir=out, device=device,
-                               progress=progress,
-                               extra_card={"dataset": dataset, "profile": plan.profile, "size": tc.get("size")})
-            cards.append(card)
-            if echo is not None:
-                echo(card_line(card))
-    return cards
+    runs = [run for name, data in learning_data.items()
+            for run in training_runs(plan, name, data, train_cfgs.get(name), device)]
+    return train_runs(runs, runner, desc=f"training {plan.profile}", echo=echo)
+
+
+def train_dataset(plan: TrainingPlan, dataset: str, data: LearningData, train_cfg: dict | None = None,
+                  device: str | None = None, runner: Runner | None = None,
+                  echo: Callable[[str], Any] | None = None) -> list[dict]:
+    """Train every ``(method, seed)`` of ``plan`` on one dataset (:func:`training_runs`); return the cards."""
+    return train_runs(training_runs(plan, dataset, data, train_cfg, device), runner, desc=f"training {dataset}",
+                      echo=echo)

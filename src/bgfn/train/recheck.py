@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import pandas as pd
 
+from bgfn.parallel import Runner
 from bgfn.train import checkpoints
-from bgfn.train.loop import train_model
 from bgfn.train.options import optimizer_options, size_config
 from bgfn.train.tables import initial_val_rmse, lowest_train_loss
+from bgfn.train.tasks import TrainingRun, train_runs
 
 #: Columns of :func:`recheck_table`: the run as reported (capped) and trained again on all windows.
 RECHECK_COLUMNS = ("dataset", "method", "seed", "lr", "n_train", "best_epoch", "n_train_all", "best_epoch_all",
@@ -42,10 +43,10 @@ def capped_runs(cards: list[dict], prepared: dict, train_cfgs: dict[str, dict]) 
 
 
 def recheck_all_windows(plan, cards: list[dict], prepared: dict, train_cfgs: dict[str, dict],
-                        device: str | None = None, progress: bool = False) -> list[dict]:
+                        device: str | None = None, runner: Runner | None = None) -> list[dict]:
     """Train every run of :func:`capped_runs` again on all training windows when the plan's profile sets
-    ``train.recheck_all_windows`` (else nothing); return pairs ``{'capped': card, 'all': new card}`` (a completed
-    network is not trained again).
+    ``train.recheck_all_windows`` (else nothing), spread over ``runner``; return pairs ``{'capped': card, 'all':
+    new card}`` (a completed network is not trained again).
 
     Parameters
     ----------
@@ -57,17 +58,17 @@ def recheck_all_windows(plan, cards: list[dict], prepared: dict, train_cfgs: dic
     """
     if not enabled(plan.train_cfg):
         return []
-    pairs = []
-    for card in capped_runs(cards, prepared, train_cfgs):
+    capped, runs = capped_runs(cards, prepared, train_cfgs), []
+    for card in capped:
         dataset, method, seed = card["dataset"], card["method"], int(card["seed"])
         tc = dict(train_cfgs[dataset])
         tc["optimizer"] = {**(tc.get("optimizer") or {}), "max_train_windows": None}
-        out = checkpoints.all_windows_models_dir(plan.profile, dataset)
-        new = train_model(method, prepared[dataset].data, size_config(tc, method), tc, seed=seed, out_dir=out,
-                          device=device, progress=progress,
-                          extra_card={"dataset": dataset, "profile": plan.profile, "size": tc.get("size")})
-        pairs.append({"capped": card, "all": new})
-    return pairs
+        runs.append(TrainingRun(f"{dataset} {method} seed {seed} (all windows)", method, prepared[dataset].data,
+                                size_config(tc, method), tc, seed, checkpoints.all_windows_models_dir(plan.profile,
+                                                                                                        dataset),
+                                device, {"dataset": dataset, "profile": plan.profile, "size": tc.get("size")}))
+    new = train_runs(runs, runner, desc="recheck on all windows")
+    return [{"capped": c, "all": n} for c, n in zip(capped, new)]
 
 
 def recheck_table(pairs: list[dict]) -> pd.DataFrame:

@@ -23,10 +23,11 @@ from typing import Any, Callable
 
 from bgfn.config import MAIN_VARIANT, merge_sections, variant_config
 from bgfn.learning import LEARNING_DEFAULTS, LearningData, build_learning_data, learning_options
+from bgfn.parallel import Runner
 from bgfn.train import checkpoints
-from bgfn.train.loop import train_model
 from bgfn.train.options import size_config
-from bgfn.train.tables import card_line, cards_table
+from bgfn.train.tables import cards_table
+from bgfn.train.tasks import TrainingRun, train_runs
 
 #: Defaults of ``variant_runs`` (null datasets / methods: the ``train:`` section's).
 VARIANT_RUN_DEFAULTS: dict[str, Any] = {"datasets": None, "methods": None, "seeds": [0]}
@@ -127,9 +128,10 @@ def variant_learning_data(train_section: dict, prepared, outage_windows) -> Lear
     return build_learning_data(prepared.drive.imu, prepared.attitude, prepared.drive.gnss, outage_windows, **opts)
 
 
-def train_variants(vplan: VariantPlan, prepared: dict, train_cfgs: dict[str, dict], device: str | None = None,
-                   progress: bool = False, echo: Callable[[str], Any] | None = None) -> list[dict]:
-    """Train every variant network of ``vplan`` into ``results/<profile>/models/variants/<variant>/<dataset>/``.
+def variant_runs(vplan: VariantPlan, prepared: dict, train_cfgs: dict[str, dict],
+                 device: str | None = None) -> list[TrainingRun]:
+    """Every ``(variant, dataset, method, seed)`` network of ``vplan`` as a run, into
+    ``results/<profile>/models/variants/<variant>/<dataset>/``.
 
     Parameters
     ----------
@@ -138,8 +140,24 @@ def train_variants(vplan: VariantPlan, prepared: dict, train_cfgs: dict[str, dic
     train_cfgs : dict
         ``{dataset: train: section with the selected learning rates}``
         (:func:`bgfn.train.lr_search.selected_train_configs`); the variant's overrides are merged over it.
-    echo : callable, optional
-        Called with :func:`bgfn.train.tables.card_line` of each card, prefixed by the variant.
+    """
+    runs = []
+    for name in vplan.names:
+        for dataset in vplan.datasets:
+            tc = vplan.train_section(name, train_cfgs[dataset])
+            own = prepared[dataset].windows
+            data = variant_learning_data(tc, prepared[dataset], vplan.outage_windows if own is None else own)
+            out = vplan.models_dir(name, dataset)
+            extra = {"variant": name, **describe_options(tc), "dataset": dataset, "profile": vplan.profile,
+                     "size": tc.get("size"), "lr_from": "main search"}
+            runs += [TrainingRun(f"{name} {dataset} {method} seed {seed}", method, data, size_config(tc, method), tc,
+                                 int(seed), out, device, extra) for method in vplan.methods for seed in vplan.seeds]
+    return runs
+
+
+def train_variants(vplan: VariantPlan, prepared: dict, train_cfgs: dict[str, dict], device: str | None = None,
+                   runner: Runner | None = None, echo: Callable[[str], Any] | None = None) -> list[dict]:
+    """Train every variant network of ``vplan`` (:func:`variant_runs`), spread over ``runner``.
 
     Returns
     -------
@@ -147,24 +165,7 @@ def train_variants(vplan: VariantPlan, prepared: dict, train_cfgs: dict[str, dic
         The cards (:func:`bgfn.train.loop.train_model`) with ``variant``, ``inputs``, ``protocol``, ``dataset``,
         ``profile`` and ``size``; a completed network is not trained again.
     """
-    cards = []
-    for name in vplan.names:
-        for dataset in vplan.datasets:
-            tc = vplan.train_section(name, train_cfgs[dataset])
-            own = prepared[dataset].windows
-            data = variant_learning_data(tc, prepared[dataset], vplan.outage_windows if own is None else own)
-            out = vplan.models_dir(name, dataset)
-            for method in vplan.methods:
-                for seed in vplan.seeds:
-                    card = train_model(method, data, size_config(tc, method), tc, seed=seed, out_dir=out,
-                                       device=device, progress=progress,
-                                       extra_card={"variant": name, **describe_options(tc), "dataset": dataset,
-                                                   "profile": vplan.profile, "size": tc.get("size"),
-                                                   "lr_from": "main search"})
-                    cards.append(card)
-                    if echo is not None:
-                        echo(f"{name:>15} " + card_line(card))
-    return cards
+    return train_runs(variant_runs(vplan, prepared, train_cfgs, device), runner, desc="variants", echo=echo)
 
 
 def variant_cards_table(cards: list[dict]):

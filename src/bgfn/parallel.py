@@ -1,0 +1,202 @@
+"""Independent runs side by side: one runner for every loop whose items do not depend on each other.
+
+The runs of a profile are independent: a training run is ``(dataset, method, seed)``, a sweep run
+``(dataset, fold, method, seed)``, an oracle run ``(dataset, window, sigma, seed)``. :class:`Runner` hands them to
+joblib and gives the results back **in the order of the tasks**, whatever order they finish in, so a table built
+from them does not depend on the number of jobs. Each run seeds itself and sets its own torch thread count (the
+profile's ``train.optimizer.num_threads``; a thread count changes the order of floating-point sums), so a run's
+result depends on its own inputs only: the tables are the same with 1 job, with 2 and on a cluster.
+
+Where the runs go (the profile's ``parallel:`` section; ``JOBS=`` and ``DASK_SCHEDULER=`` on the make command line
+win, as the environment variables ``BGFN_JOBS`` and ``DASK_SCHEDULER``):
+
+- ``jobs: 1``: one after the other in this process (no pool, no pickling);
+- ``backend: loky`` (default) with ``jobs`` > 1 or null (= the cores of this machine): joblib's process pool;
+- ``backend: dask`` with a ``scheduler`` address (``tcp://host:8786``): joblib's Dask backend on a
+  ``dask.distributed`` cluster, every worker a Python with this package installed, the checkout on a filesystem
+  the workers share at the same path (they write checkpoints under ``results/<profile>/``; README, "On a
+  cluster").
+
+Progress (:class:`RunProgress`): a tqdm bar over the runs (in a notebook: one bar per loop, no per-batch output)
+and one line per finished run with what it reports, its seconds, the runs left and an ETA. Under ``make
+reproduce`` the lines go to the file named by ``BGFN_PROGRESS_LOG`` (``results/<profile>/logs/<notebook>.log``),
+which make shows on the terminal as they come; without it they are printed.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from dataclasses import dataclass
+from typing import Any, Callable, Iterable, Sequence
+
+from joblib import Parallel, delayed, parallel_config
+from tqdm import tqdm
+
+from bgfn.errors import DataError
+
+#: The ``parallel:`` section's keys and defaults (jobs null: the cores of this machine).
+PARALLEL_DEFAULTS: dict[str, Any] = {"jobs": None, "backend": "loky", "scheduler": None}
+#: The backends :class:`Runner` knows.
+BACKENDS = ("loky", "dask")
+#: Environment variables that override the profile (make passes ``JOBS=`` / ``DASK_SCHEDULER=`` as these).
+JOBS_ENV, SCHEDULER_ENV, PROGRESS_ENV = "BGFN_JOBS", "DASK_SCHEDULER", "BGFN_PROGRESS_LOG"
+
+
+def machine_cores() -> int:
+    """The CPU cores this process may use (its affinity set where the OS says, else ``os.cpu_count()``)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:            # not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+@dataclass(frozen=True)
+class Runner:
+    """Where independent runs go: ``jobs`` processes of ``backend`` (``scheduler``: a Dask scheduler's address).
+
+    Build it from a profile with :meth:`of`; :meth:`map` runs the tasks.
+    """
+
+    jobs: int = 1
+    backend: str = "loky"
+    scheduler: str | None = None
+
+    @classmethod
+    def of(cls, cfg: dict | None = None, environ: dict | None = None) -> "Runner":
+        """The runner of a profile's ``parallel:`` section, with ``BGFN_JOBS`` / ``DASK_SCHEDULER`` of
+        ``environ`` (default ``os.environ``) over it. A Dask scheduler address selects the Dask backend."""
+        env = os.environ if environ is None else environ
+        sec = {**PARALLEL_DEFAULTS, **((cfg or {}).get("parallel") or {})}
+        jobs, backend, scheduler = sec["jobs"], sec["backend"], sec["scheduler"]
+        if env.get(JOBS_ENV, "").strip():
+            jobs = _env_jobs(env[JOBS_ENV])
+        if env.get(SCHEDULER_ENV, "").strip():
+            backend, scheduler = "dask", env[SCHEDULER_ENV].strip()
+        if backend not in BACKENDS:
+            raise DataError("parallel", "backend", f"one of {', '.join(BACKENDS)}", repr(backend))
+        if backend == "dask" and not scheduler:
+            raise DataError("parallel", "scheduler", "a Dask scheduler address (tcp://host:port) with backend dask "
+                            f"(or {SCHEDULER_ENV}=...)", repr(scheduler))
+        return cls(int(jobs) if jobs is not None else machine_cores(), backend, scheduler)
+
+    def describe(self) -> str:
+        """How the runs are spread, in a few words."""
+        if self.backend == "dask":
+            return f"on the Dask cluster at {self.scheduler}"
+        return "one after the other (1 job)" if self.jobs == 1 else f"{self.jobs} processes on this machine (loky)"
+
+    def map(self, fn: Callable, tasks: Sequence[tuple], labels: Sequence[str] | None = None,
+            summary: Callable[[Any], str] | None = None, desc: str = "runs", echo: Callable[[str], Any] | None = None,
+            bar: bool = True) -> list:
+        """``[fn(*task) for task in tasks]``, the tasks spread over the runner's jobs; results in task order.
+
+        Parameters
+        ----------
+        fn : callable
+            A module-level function (the pool pickles it by name).
+        tasks : sequence of tuple
+            The positional arguments of each run.
+        labels : sequence of str, optional
+            What each run is, for its progress line (default ``<desc> <i>``).
+        summary : callable, optional
+            ``summary(result)`` -> what a finished run reports in its line (epochs, best loss, ...).
+        desc : str
+            The bar's and the lines' name of the loop.
+        echo : callable, optional
+            Where the lines go without ``BGFN_PROGRESS_LOG`` (default: printed above the bar).
+        bar : bool
+            Show a tqdm bar over the runs.
+        """
+        tasks = list(tasks)
+        labels = list(labels) if labels is not None else [f"{desc} {i + 1}" for i in range(len(tasks))]
+        progress = RunProgress(len(tasks), desc, echo=echo, bar=bar)
+        results: list = [None] * len(tasks)
+        try:
+            for i, result, seconds in self._unordered(fn, tasks):
+                results[i] = result
+                progress.done(labels[i], seconds, summary(result) if summary is not None else "")
+        finally:
+            progress.close()
+        return results
+
+    def _unordered(self, fn: Callable, tasks: list[tuple]) -> Iterable[tuple[int, Any, float]]:
+        """``(index, result, seconds)`` of every task as it finishes."""
+        if not tasks:
+            return
+        if self.backend == "loky" and (self.jobs == 1 or len(tasks) == 1):
+            for i, task in enumerate(tasks):        # in this process: nothing to pickle, the same numbers
+                yield _timed(i, fn, task)
+            return
+        jobs = min(self.jobs, len(tasks)) if self.backend == "loky" else -1
+        config = ({"backend": "dask", "scheduler_host": self.scheduler} if self.backend == "dask"
+                  else {"backend": "loky", "inner_max_num_threads": 1})
+        with parallel_config(**config):
+            yield from Parallel(n_jobs=jobs, return_as="generator_unordered")(
+                delayed(_timed)(i, fn, task) for i, task in enumerate(tasks))
+
+
+def _timed(i: int, fn: Callable, task: tuple) -> tuple[int, Any, float]:
+    """Run one task where the pool put it; its index and wall time come back with its result."""
+    t0 = time.perf_counter()
+    result = fn(*task)
+    return i, result, time.perf_counter() - t0
+
+
+def _env_jobs(text: str) -> int:
+    """``BGFN_JOBS`` as a job count (a positive integer)."""
+    try:
+        jobs = int(text)
+    except ValueError:
+        jobs = 0
+    if jobs < 1:
+        raise DataError(JOBS_ENV, "jobs", "a positive integer (JOBS=2 on the make command line)", repr(text))
+    return jobs
+
+
+class RunProgress:
+    """A bar over ``total`` runs and one line per finished run (which run, what it reports, seconds, runs left
+    and an ETA from the mean pace so far); the lines go to ``BGFN_PROGRESS_LOG`` when it is set, else to
+    ``echo`` (default: printed above the bar)."""
+
+    def __init__(self, total: int, desc: str, echo: Callable[[str], Any] | None = None, bar: bool = True):
+        self.total, self.desc, self.left = int(total), desc, int(total)
+        self.t0 = time.perf_counter()
+        self.log_path = os.environ.get(PROGRESS_ENV) or None
+        self.bar = tqdm(total=self.total, desc=desc, disable=not bar or self.total == 0, file=sys.stderr,
+                        mininterval=1.0, dynamic_ncols=False, ncols=100)
+        self.echo = echo if echo is not None else (lambda line: tqdm.write(line, file=sys.stdout))
+
+    def line(self, label: str, seconds: float, what: str) -> str:
+        """The progress line of one finished run."""
+        elapsed = time.perf_counter() - self.t0
+        done = self.total - self.left
+        eta = elapsed / done * self.left if done else float("nan")
+        parts = [f"[{self.desc}] {label}", what, f"{seconds:.1f} s", f"{self.left} left",
+                 f"ETA {_clock(eta)}" if self.left else f"all {self.total} in {_clock(elapsed)}"]
+        return " | ".join(p for p in parts if p)
+
+    def done(self, label: str, seconds: float, what: str = "") -> None:
+        """Count one finished run and report it."""
+        self.left -= 1
+        text = self.line(label, seconds, what)
+        if self.log_path:
+            with open(self.log_path, "a", encoding="utf-8") as f:
+                f.write(text + "\n")
+        else:
+            self.echo(text)
+        self.bar.update(1)
+
+    def close(self) -> None:
+        """Close the bar."""
+        self.bar.close()
+
+
+def _clock(seconds: float) -> str:
+    """``m:ss`` (``h:mm:ss`` from an hour), ``?`` when unknown."""
+    if seconds != seconds:
+        return "?"
+    s = int(round(seconds))
+    h, m = divmod(s // 60, 60)
+    return f"{h}:{m:02d}:{s % 60:02d}" if h else f"{m}:{s % 60:02d}"

@@ -1,0 +1,124 @@
+"""The runner of independent runs (bgfn.parallel): where the runs go, results in the runs' order whatever order
+they finish in, one progress line per run, and the same tables with 1 job, 2 loky processes and a Dask cluster."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from bgfn import learning as L, train as T
+from bgfn.errors import DataError
+from bgfn.parallel import PROGRESS_ENV, Runner, RunProgress
+from bgfn.profile_schema import load_profile
+
+
+# ----------------------------------------------------------------------------------------------- settings
+def test_the_profile_says_where_the_runs_go_and_the_environment_wins():
+    assert Runner.of({"parallel": {"jobs": 3}}, environ={}) == Runner(3, "loky", None)
+    assert Runner.of({}, environ={}).jobs >= 1                                  # null: the cores here
+    assert Runner.of({"parallel": {"jobs": 3}}, environ={"BGFN_JOBS": "1"}).jobs == 1
+    assert Runner.of({"parallel": {"jobs": 3}}, environ={"BGFN_JOBS": ""}).jobs == 3   # make's empty JOBS=
+    dask = Runner.of({}, environ={"DASK_SCHEDULER": "tcp://10.0.0.1:8786"})
+    assert (dask.backend, dask.scheduler) == ("dask", "tcp://10.0.0.1:8786")
+    assert "10.0.0.1" in dask.describe() and "2 processes" in Runner(2).describe()
+
+
+@pytest.mark.parametrize("section, environ, key", [
+    ({"backend": "threads"}, {}, "backend"),
+    ({"backend": "dask"}, {}, "scheduler"),
+    ({}, {"BGFN_JOBS": "0"}, "jobs"),
+    ({}, {"BGFN_JOBS": "two"}, "jobs"),
+])
+def test_bad_settings_fail_naming_the_key(section, environ, key):
+    with pytest.raises(DataError) as e:
+        Runner.of({"parallel": section}, environ=environ)
+    assert key in str(e.value)
+
+
+def test_the_profile_check_refuses_dask_without_a_scheduler(monkeypatch):
+    from bgfn.profile_schema import ProfileError, validate
+
+    monkeypatch.delenv("DASK_SCHEDULER", raising=False)
+    cfg = load_profile("smoke")
+    validate({**cfg, "parallel": {"jobs": 2, "backend": "loky", "scheduler": None}})
+    with pytest.raises(ProfileError, match="parallel.scheduler"):
+        validate({**cfg, "parallel": {"backend": "dask"}})
+    with pytest.raises(ProfileError, match="parallel.jobs"):
+        validate({**cfg, "parallel": {"jobs": 0}})
+
+
+# ----------------------------------------------------------------------------------------------- order and lines
+def _slow_square(x: int, delay: float) -> int:
+    time.sleep(delay)
+    return x * x
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_results_come_back_in_the_order_of_the_runs(jobs):
+    # the first run is the slowest: with 2 processes it finishes last, and still comes first
+    lines = []
+    out = Runner(jobs).map(_slow_square, [(3, 0.6), (1, 0.0), (2, 0.0)], labels=["a", "b", "c"],
+                           summary=lambda r: f"got {r}", desc="squares", echo=lines.append, bar=False)
+    assert out == [9, 1, 4]
+    assert len(lines) == 3 and all(line.startswith("[squares] ") for line in lines)
+    if jobs == 2:
+        assert lines[-1].startswith("[squares] a | got 9")
+    assert [line.split(" | ")[3] for line in lines[:2]] == ["2 left", "1 left"]
+    assert lines[-1].split(" | ")[-1].startswith("all 3 in ")
+
+
+def test_progress_lines_carry_the_seconds_runs_left_and_an_eta():
+    p = RunProgress(4, "training", echo=lambda line: None, bar=False)
+    p.t0 -= 10.0                                    # 10 s ago
+    p.left = 2                                      # two of four done: 5 s each -> 10 s to go
+    line = p.line("quick bgfn seed 0", 3.25, "12 epochs")
+    assert line.startswith("[training] quick bgfn seed 0 | 12 epochs | 3.2 s | 2 left | ETA 0:1")
+    p.close()
+
+
+def test_under_make_the_lines_go_to_the_progress_log(tmp_path, monkeypatch):
+    log = tmp_path / "03.log"
+    monkeypatch.setenv(PROGRESS_ENV, str(log))
+    printed = []
+    Runner(1).map(_slow_square, [(2, 0.0), (3, 0.0)], desc="x", echo=printed.append, bar=False)
+    assert printed == []
+    assert [line.split(" | ")[0] for line in log.read_text().splitlines()] == ["[x] x 1", "[x] x 2"]
+
+
+# ----------------------------------------------------------------------------------------------- same tables
+@pytest.fixture(scope="module")
+def smoke_runs(tmp_path_factory):
+    """Every method of the smoke profile (its sizes and budget), two seeds, on a small synthetic drive."""
+    cfg = load_profile("smoke")
+    tc = {**cfg["train"], "optimizer": {**cfg["train"]["optimizer"], "epochs": 2}}
+    imu, att, gnss = L.synthetic_tables(duration_s=240.0, noise=0.05, seed=4)
+    data = L.build_learning_data(imu, att, gnss, [(1100.0, 20.0)], window=50, margin_s=2.0, val_fraction=0.25,
+                                 val_position="end")
+
+    def runs(folder: str):
+        out = tmp_path_factory.mktemp(folder)
+        return [T.TrainingRun(f"{m} seed {s}", m, data, T.size_config(tc, m), tc, s, out, "cpu", {"dataset": "toy"})
+                for m in tc["methods"] for s in (0, 1)]
+    return runs
+
+
+def _table(cards) -> str:
+    return T.without_timing(T.cards_table(cards)).to_csv(index=False)
+
+
+def test_the_tables_are_the_same_with_one_job_and_with_two(smoke_runs):
+    one = T.train_runs(smoke_runs("one"), Runner(1))
+    two = T.train_runs(smoke_runs("two"), Runner(2))
+    assert [c["method"] for c in one] == [c["method"] for c in two]
+    assert _table(one) == _table(two)
+    assert len({c["best_val_loss"] for c in one}) > 1                # the runs differ from each other
+
+
+def test_a_dask_cluster_gives_the_table_loky_gives(smoke_runs):
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                                  silence_logs=40) as cluster:
+        dask = T.train_runs(smoke_runs("dask"), Runner(2, "dask", cluster.scheduler_address))
+    loky = T.train_runs(smoke_runs("loky"), Runner(2))
+    assert _table(dask) == _table(loky)

@@ -6,7 +6,9 @@ Adds to ``results/bench.json``:
   batch = the profile's batch size, window N = the profile's window, torch's default CPU threads;
 - ``infer_ms.<model>.<size>``: latency of one window (batch 1, eval mode, 1 CPU thread), ms;
 - ``train_ratio_bgfn_over_twin.<size>``: BGFN's training throughput divided by its ANN twin's (Transformer),
-  both measured in the same run;
+  measured interleaved (twin step, BGFN step, twin, BGFN, ... in one process, a warm-up round discarded) and
+  taken round by round, so a busy neighbour slows both alike; ``train_ratio_spread.<size>``: that ratio's median,
+  quartiles, rounds and ``unreliable`` (the interquartile range wider than the ratio's distance from 1);
 - ``train_step_profile.<model>.<size>``: one training step of BGFN and its twin under ``torch.profiler``: all
   operators and the dense matrix products alone, s (:func:`bgfn.train.speed.training_step_profile`);
   ``train_ratio_ceiling.<size>``: the twin's profiled step over BGFN's matrix products alone, the ratio BGFN
@@ -14,7 +16,8 @@ Adds to ``results/bench.json``:
 - ``models_bench``: what ran (threads, device, batch, window, parameter counts, repeats).
 
 Sizes come from ``train.sizes`` of ``params/<size>.yaml`` (the same blocks in every profile). Median of a
-few repeats after a warm-up; the paper size gets fewer repeats so that the whole script runs in minutes.
+few repeats after a warm-up (the pair BGFN/twin: :data:`PAIR_ROUNDS` interleaved rounds); the paper size gets
+fewer repeats so that the whole script runs in minutes.
 """
 
 from __future__ import annotations
@@ -26,11 +29,15 @@ import torch
 from bgfn.profile_schema import load_profile
 from bgfn.io import update_json
 from bgfn.models import METHODS, build_model, count_parameters
-from bgfn.train.speed import bench_file, median_time, training_step_profile, training_throughput, twin_ratios
+from bgfn.train.speed import (bench_file, interleaved_times, median_time, paired_ratio, quartiles, ratio_text,
+                              training_step, training_step_profile, training_throughput, twin_ratios)
 
 SIZES = ("quick", "paper")
 #: (training steps, inference calls) measured per size, after one warm-up each.
 REPEATS = {"quick": (5, 30), "paper": (2, 5)}
+#: Interleaved rounds of the BGFN / twin training steps per size (after one warm-up round).
+PAIR_ROUNDS = {"quick": 21, "paper": 9}
+PAIR = ("bgfn", "transformer")
 
 
 def bench(model_name: str, size: str) -> tuple[float, float, int, dict]:
@@ -54,6 +61,17 @@ def bench(model_name: str, size: str) -> tuple[float, float, int, dict]:
                                                                       "repeats": [n_train, n_infer]}
 
 
+def paired_steps(size: str) -> dict[str, list[float]]:
+    """Training step times of BGFN and its twin at ``size``, interleaved (:func:`bgfn.train.speed.interleaved_times`)."""
+    cfg = load_profile(size)["train"]
+    batch, window = int(cfg["optimizer"]["batch_size"]), int(cfg["window"])
+    steps = {}
+    for m in PAIR:
+        torch.manual_seed(0)
+        steps[m] = training_step(build_model(m, dict(cfg["sizes"][m][size])), window, batch)
+    return interleaved_times(steps, PAIR_ROUNDS[size])
+
+
 def step_profile(model_name: str, size: str) -> dict:
     cfg = load_profile(size)["train"]
     torch.manual_seed(0)
@@ -75,17 +93,30 @@ def main(sizes=SIZES, methods=METHODS) -> dict:
             info["problem"][size] = prob
             print(f"{m:>12} {size:>6}: {rate:9.1f} train windows/s, {ms:8.2f} ms/window inference, "
                   f"{n_params} parameters", flush=True)
-    # BGFN's training throughput over its ANN twin's, both measured in this run (issue: at least 1/3), and the
-    # ceiling its matrix products set
-    profiles = {m: {size: step_profile(m, size) for size in sizes} for m in ("bgfn", "transformer") if m in methods}
+    # BGFN's training throughput over its ANN twin's, interleaved round by round, and the ceiling its matrix
+    # products set (the twin's profiled step over BGFN's matrix products alone)
+    spread = {}
+    if all(m in methods for m in PAIR):
+        for size in sizes:
+            times = paired_steps(size)
+            spread[size] = paired_ratio(times["transformer"], times["bgfn"])    # BGFN's throughput / the twin's
+            for m in PAIR:
+                q = quartiles(times[m])
+                train_rate[m][size] = info["problem"][size]["batch"] / q["median"]
+                info.setdefault("pair_step_s", {}).setdefault(m, {})[size] = q
+    profiles = {m: {size: step_profile(m, size) for size in sizes} for m in PAIR if m in methods}
     ratios = twin_ratios(train_rate, profiles)
+    ratios["train_ratio_bgfn_over_twin"].update({size: r["median"] for size, r in spread.items()})
     ratio, ceiling = ratios["train_ratio_bgfn_over_twin"], ratios["train_ratio_ceiling"]
     for size, r in ratio.items():
-        print(f"BGFN / Transformer training throughput, {size}: {r:.2f} (ceiling: twin's step / BGFN's matrix "
-              f"products alone {ceiling.get(size, float('nan')):.2f})", flush=True)
+        c = ceiling.get(size, float("nan"))
+        print(f"BGFN / Transformer training throughput, {size}: "
+              + (ratio_text(spread[size]) if size in spread else f"{r:.2f}")
+              + f"; ceiling (twin's step / BGFN's matrix products alone) {c:.2f}: {100 * r / c:.0f} % of it",
+              flush=True)
     update_json(bench_file(),
                 {"train_windows_per_s": train_rate, "infer_ms": infer_ms, "models_bench": info,
-                 "train_step_profile": profiles, **ratios})
+                 "train_step_profile": profiles, "train_ratio_spread": spread, **ratios})
     return {"train_windows_per_s": train_rate, "infer_ms": infer_ms, "train_ratio_bgfn_over_twin": ratio}
 
 

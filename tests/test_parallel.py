@@ -122,3 +122,27 @@ def test_a_dask_cluster_gives_the_table_loky_gives(smoke_runs):
         dask = T.train_runs(smoke_runs("dask"), Runner(2, "dask", cluster.scheduler_address))
     loky = T.train_runs(smoke_runs("loky"), Runner(2))
     assert _table(dask) == _table(loky)
+
+
+# ----------------------------------------------------------------------------------------------- make bench
+def test_interleaved_timing_alternates_and_discards_the_warm_up():
+    from bgfn.train.speed import interleaved_times
+
+    calls = []
+    times = interleaved_times({"a": lambda: calls.append("a"), "b": lambda: calls.append("b")}, repeats=3, warmup=1)
+    assert calls == ["a", "b"] * 4                       # one warm-up round, then three timed rounds, in turn
+    assert [len(t) for t in times.values()] == [3, 3]
+
+
+def test_a_paired_ratio_is_unreliable_when_its_spread_exceeds_the_difference():
+    from bgfn.train.speed import paired_ratio, quartiles, ratio_text
+
+    assert quartiles([1, 2, 3, 4, 5]) == {"median": 3.0, "q25": 2.0, "q75": 4.0}
+    clear = paired_ratio([1.0, 1.0, 1.0, 1.0, 1.0], [2.0, 2.1, 1.9, 2.0, 2.2])    # ~0.5, spread ~0.02
+    assert clear["median"] == pytest.approx(0.5) and not clear["unreliable"]
+    assert "unreliable" not in ratio_text(clear) and "5 rounds" in ratio_text(clear)
+    noisy = paired_ratio([1.0] * 4, [0.7, 1.0, 1.3, 1.6])                          # ratios 1.43 .. 0.63
+    assert noisy["iqr"] > abs(noisy["median"] - 1.0) and noisy["unreliable"]
+    assert ratio_text(noisy).endswith("unreliable: the spread is wider than the difference")
+    with pytest.raises(ValueError):
+        paired_ratio([1.0], [1.0, 2.0])

@@ -70,6 +70,60 @@ def median_time(fn: Callable[[], object], repeats: int, warmup: int = 1) -> floa
     return statistics.median(times)
 
 
+def interleaved_times(fns: dict[str, Callable[[], object]], repeats: int, warmup: int = 1) -> dict[str, list[float]]:
+    """Wall times of every callable of ``fns``, measured in turn (A, B, A, B, ...) ``repeats`` times after
+    ``warmup`` untimed rounds, s.
+
+    Interleaving exposes each callable to the same neighbours: a process that takes one core for a while slows
+    the A and the B of the same rounds, so their per-round ratio stays, where timing all A's and then all B's
+    would turn the comparison upside down.
+    """
+    if repeats < 1:
+        raise ValueError(f"repeats must be >= 1, got {repeats}")
+    for _ in range(warmup):
+        for fn in fns.values():
+            fn()
+    times: dict[str, list[float]] = {name: [] for name in fns}
+    for _ in range(repeats):
+        for name, fn in fns.items():
+            t0 = time.perf_counter()
+            fn()
+            times[name].append(time.perf_counter() - t0)
+    return times
+
+
+def quartiles(values) -> dict[str, float]:
+    """``{'median', 'q25', 'q75'}`` of ``values`` (inclusive method; one value: all three equal)."""
+    v = sorted(float(x) for x in values)
+    if not v:
+        raise ValueError("quartiles of no values")
+    if len(v) == 1:
+        return {"median": v[0], "q25": v[0], "q75": v[0]}
+    q25, q50, q75 = statistics.quantiles(v, n=4, method="inclusive")
+    return {"median": q50, "q25": q25, "q75": q75}
+
+
+def paired_ratio(numerator: list[float], denominator: list[float], reference: float = 1.0) -> dict:
+    """The ratio of two interleaved series, round by round (:func:`interleaved_times`): median and interquartile
+    range of ``numerator[i] / denominator[i]``.
+
+    ``unreliable`` is True when the interquartile range is wider than the difference the ratio reports, i.e. than
+    ``|median - reference|`` (``reference`` 1: "the two are equally fast"): then the measurement cannot tell
+    which one is faster, or by how much.
+    """
+    if len(numerator) != len(denominator) or not numerator:
+        raise ValueError("paired_ratio needs two series of the same, non-zero length")
+    q = quartiles([a / b for a, b in zip(numerator, denominator)])
+    return {**q, "iqr": q["q75"] - q["q25"], "rounds": len(numerator),
+            "unreliable": bool(q["q75"] - q["q25"] > abs(q["median"] - reference))}
+
+
+def ratio_text(r: dict) -> str:
+    """``0.52 [IQR 0.50-0.55, 15 rounds]`` and ``unreliable`` where :func:`paired_ratio` says so."""
+    return (f"{r['median']:.2f} [IQR {r['q25']:.2f}-{r['q75']:.2f}, {r['rounds']} rounds]"
+            + (" -- unreliable: the spread is wider than the difference" if r["unreliable"] else ""))
+
+
 def _infer(model: nn.Module, x: torch.Tensor) -> Callable[[], object]:
     model.eval()
 
@@ -108,6 +162,12 @@ def _training_step(model: nn.Module, window: int, batch: int, in_channels: int, 
         opt.step()
 
     return step
+
+
+def training_step(model: nn.Module, window: int, batch: int, in_channels: int = 9,
+                  seed: int = 0) -> Callable[[], None]:
+    """One training step (forward, BPTT backward, AdamW step) on a fixed random batch, to time it."""
+    return _training_step(model, window, batch, in_channels, seed)
 
 
 def training_throughput(model: nn.Module, window: int, batch: int, in_channels: int = 9, repeats: int = 3,

@@ -194,6 +194,7 @@ define build_book
 	@find book/notebooks book/_generated -name '.*' -type f -delete   # never a temporary or hidden file
 	@if [ -f "$(RES)/findings.md" ]; then cp "$(RES)/findings.md" book/_generated/; else \
 	  echo "No findings yet: notebook 06 of profile \`$(PROFILE)\` has not written them." > book/_generated/findings.md; fi
+	@$(PY) -m bgfn walltimes --profile $(PROFILE) --markdown book/_generated/wall_times.md
 	@printf '%s\n' "Built from the executed notebooks of profile \`$(PROFILE)\` (\`params/$(PROFILE).yaml\`)," \
 	  "commit \`$$(git rev-parse --short HEAD 2>/dev/null || echo unknown)\`." > book/_generated/build_info.md
 	@rm -f book/_build/.built-*

@@ -2,11 +2,16 @@
 learning rates its search selected once it has run). A command line is an edge of the package: it checks the
 profile and its options (:func:`bgfn.profile_schema.with_overrides`) before anything runs.
 
+``python -m bgfn walltimes``: the wall-time section of the book's "Reproduce it" page
+(:mod:`bgfn.report.walltimes`; ``make book`` writes it), or ``--record JOBS`` to add the notebooks of a finished
+run to the measured runs.
+
 Example::
 
     python -m bgfn train --profile quick --dataset turin-sim-mpu6000 --method bgfn --seed 0
     python -m bgfn train --profile quick --variants        # every network of notebook 03, variants included
     python -m bgfn train --profile paper --jobs 8           # 8 runs at a time (default: the profile's parallel:)
+    python -m bgfn walltimes --profile quick --record 2 --total-s 655   # after make reproduce JOBS=2
 """
 
 from __future__ import annotations
@@ -15,14 +20,43 @@ import argparse
 import sys
 
 from bgfn.errors import DataError
+from bgfn.io import atomic_write_text
 from bgfn.parallel import Runner
 from bgfn.profile_schema import load_profile, with_overrides
+from bgfn.report import walltimes as walltimes_module
 from bgfn.train.runs import train_profile
+
+
+def walltimes(argv) -> int:
+    """``walltimes --profile P [--markdown FILE] [--record JOBS [--total-s S] [--note TEXT]]``."""
+    p = argparse.ArgumentParser(prog="python -m bgfn walltimes", description="Wall times of a profile's notebooks.")
+    p.add_argument("--profile", default="quick")
+    p.add_argument("--markdown", help="write the book's wall-time section here (default: print it)")
+    p.add_argument("--record", type=int, metavar="JOBS", help="add the last run, made with JOBS jobs, to "
+                   "data/measured/reproduce_wall_times.csv")
+    p.add_argument("--total-s", type=float, help="the whole make reproduce's wall time, s (with --record)")
+    p.add_argument("--note", default="", help="how it was measured (with --record)")
+    a = p.parse_args(argv)
+    try:
+        if a.record is not None:
+            walltimes_module.record_run(a.profile, a.record, a.total_s, a.note)
+        text = walltimes_module.wall_time_markdown(a.profile)
+    except DataError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    if a.markdown:
+        atomic_write_text(a.markdown, text)
+    else:
+        print(text)
+    return 0
 
 
 def main(argv=None) -> int:
     """Parse ``--profile``, ``--dataset``, ``--method``, ``--seed`` (each repeatable), ``--device``, ``--jobs`` and
     ``--variants``; train and print one line per finished run (:class:`bgfn.parallel.RunProgress`)."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv[:1] == ["walltimes"]:
+        return walltimes(argv[1:])
     p = argparse.ArgumentParser(prog="python -m bgfn", description="Train BGFN and baselines for a profile.")
     p.add_argument("command", choices=["train"])
     p.add_argument("--profile", default="quick")

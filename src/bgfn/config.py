@@ -360,6 +360,11 @@ def _git(*args: str) -> str | None:
     return res.stdout.strip() if res.returncode == 0 else None
 
 
+def git_commit(short: bool = True) -> str | None:
+    """The checkout's commit (short form by default); None outside a git checkout."""
+    return _git("rev-parse", *(["--short"] if short else []), "HEAD")
+
+
 def run_metadata(profile: str) -> dict[str, Any]:
     """What produced a table: profile, seed, code and package versions. No timestamps.
 

@@ -1,0 +1,144 @@
+"""How long reproducing takes: each notebook's wall time, and how it scales with the number of jobs.
+
+Two sources:
+
+- the executed notebooks of a profile (``results/<profile>/notebooks/*.ipynb``): papermill writes each one's
+  wall time into its metadata (``metadata.papermill.duration``, s): :func:`notebook_wall_times`;
+- measured runs of ``make reproduce`` from a fresh clone with ``JOBS=1`` and ``JOBS=2``, recorded in
+  ``data/measured/reproduce_wall_times.csv`` (:data:`MEASURED_FILE`; ``python -m bgfn walltimes --record``
+  adds the notebooks of a finished run): :func:`scaling_table` puts them side by side and projects more jobs.
+
+The projection is Amdahl's law per notebook: from the wall times with 1 and 2 jobs, the share ``s`` that did
+not get faster (``T2 = T1 (s + (1 - s) / 2)``) is taken as serial, and ``T(n) = T1 (s + (1 - s) / n)``. Its
+assumption, named on the page: the rest divides evenly over ``n`` jobs, i.e. a notebook has at least ``n`` runs
+of about equal length and nothing else (memory, disk, a GPU) is shared. It is an upper bound on the speed-up:
+with fewer runs than jobs, or runs of unequal length, the longest run sets the time.
+"""
+
+from __future__ import annotations
+
+import datetime
+import json
+from pathlib import Path
+
+import pandas as pd
+
+from bgfn.config import PROJECT_ROOT, git_commit, results_dir
+from bgfn.errors import DataError
+from bgfn.io import atomic_write_csv
+
+#: The measured runs (one row per profile, jobs and notebook; ``notebook`` ``total`` = the whole make run).
+MEASURED_FILE = PROJECT_ROOT / "data" / "measured" / "reproduce_wall_times.csv"
+MEASURED_COLUMNS = ("profile", "jobs", "notebook", "wall_s", "date", "commit", "note")
+#: Job counts the page projects to.
+PROJECTED_JOBS = (4, 8, 16)
+
+
+def notebook_wall_times(profile: str) -> pd.DataFrame:
+    """``notebook, wall_s, end`` of every executed notebook of ``profile`` (papermill's metadata), in order."""
+    rows = []
+    for path in sorted((results_dir(profile, create=False) / "notebooks").glob("[0-9]*.ipynb")):
+        try:
+            meta = json.loads(path.read_text(encoding="utf-8"))["metadata"]["papermill"]
+        except (KeyError, ValueError) as exc:
+            raise DataError(str(path), "metadata.papermill", "an executed notebook (papermill's metadata)",
+                            type(exc).__name__) from None
+        rows.append({"notebook": path.stem, "wall_s": float(meta.get("duration") or float("nan")),
+                     "end": meta.get("end_time")})
+    return pd.DataFrame(rows, columns=["notebook", "wall_s", "end"])
+
+
+def read_measured(path: str | Path = MEASURED_FILE) -> pd.DataFrame:
+    """The measured runs (:data:`MEASURED_COLUMNS`); empty when none is recorded."""
+    p = Path(path)
+    if not p.is_file():
+        return pd.DataFrame(columns=list(MEASURED_COLUMNS))
+    table = pd.read_csv(p)
+    missing = [c for c in MEASURED_COLUMNS if c not in table.columns]
+    if missing:
+        raise DataError(str(p), missing[0], f"the columns {', '.join(MEASURED_COLUMNS)}", "missing")
+    return table[list(MEASURED_COLUMNS)]
+
+
+def record_run(profile: str, jobs: int, total_s: float | None = None, note: str = "",
+               path: str | Path = MEASURED_FILE) -> pd.DataFrame:
+    """Add the notebooks of ``profile``'s last run (and the whole make run, ``total_s``, when given) to the
+    measured runs as made with ``jobs`` jobs; a row of the same profile, jobs and notebook is replaced."""
+    times = notebook_wall_times(profile)
+    if times.empty:
+        raise DataError(str(results_dir(profile, create=False) / "notebooks"), "executed notebooks",
+                        f"a finished make reproduce PROFILE={profile}", "none")
+    today, commit = datetime.date.today().isoformat(), git_commit() or "unknown"
+    new = [{"profile": profile, "jobs": int(jobs), "notebook": r.notebook, "wall_s": round(r.wall_s, 1),
+            "date": today, "commit": commit, "note": note} for r in times.itertuples()]
+    if total_s is not None:
+        new.append({"profile": profile, "jobs": int(jobs), "notebook": "total", "wall_s": round(float(total_s), 1),
+                    "date": today, "commit": commit, "note": note})
+    old = read_measured(path)
+    keep = ~old.set_index(["profile", "jobs", "notebook"]).index.isin(
+        [(r["profile"], r["jobs"], r["notebook"]) for r in new])
+    table = pd.concat([old[keep], pd.DataFrame(new)], ignore_index=True)
+    atomic_write_csv(Path(path), table)
+    return table
+
+
+def amdahl(t1: float, t2: float, jobs: int) -> float:
+    """Projected wall time with ``jobs`` jobs from the times with 1 and 2 (module docstring), s."""
+    serial = min(1.0, max(0.0, 2.0 * t2 / t1 - 1.0))
+    return t1 * (serial + (1.0 - serial) / jobs)
+
+
+def scaling_table(measured: pd.DataFrame, profile: str, projected=PROJECTED_JOBS) -> pd.DataFrame:
+    """Per notebook of ``profile``: the measured wall times with 1 and 2 jobs (s), the speed-up, the serial share
+    and the projection to ``projected`` jobs (:func:`amdahl`); empty unless both runs are recorded."""
+    m = measured[measured["profile"] == profile]
+    wide = m.pivot_table(index="notebook", columns="jobs", values="wall_s", aggfunc="last")
+    if 1 not in wide.columns or 2 not in wide.columns:
+        return pd.DataFrame()
+    order = [n for n in m["notebook"].drop_duplicates() if n != "total"] + (["total"] if "total" in wide.index
+                                                                              else [])
+    wide = wide.reindex(order).dropna(subset=[1, 2])
+    out = pd.DataFrame({"1 job (s)": wide[1], "2 jobs (s)": wide[2], "speed-up": wide[1] / wide[2],
+                        "serial share": (2.0 * wide[2] / wide[1] - 1.0).clip(0.0, 1.0)})
+    for n in projected:
+        out[f"{n} jobs (s), projected"] = [amdahl(a, b, n) for a, b in zip(wide[1], wide[2])]
+    return out
+
+
+def wall_time_markdown(profile: str, measured: pd.DataFrame | None = None) -> str:
+    """The wall-time section of the book's "Reproduce it" page: this build's notebooks, then the measured
+    scaling with its projection and assumption."""
+    measured = read_measured() if measured is None else measured
+    lines = [f"### This build (`{profile}`)", ""]
+    times = notebook_wall_times(profile)
+    if times.empty:
+        lines.append("No executed notebook of this profile yet.")
+    else:
+        lines += ["| notebook | wall time |", "|---|---|"]
+        lines += [f"| {r.notebook} | {_minutes(r.wall_s)} |" for r in times.itertuples()]
+        lines.append(f"| all notebooks | {_minutes(times['wall_s'].sum())} |")
+    lines += ["", f"### With 1 and 2 jobs (`{profile}`, measured from a fresh clone)", ""]
+    table = scaling_table(measured, profile)
+    if table.empty:
+        lines.append(f"No run of `{profile}` with both `JOBS=1` and `JOBS=2` is recorded in "
+                     f"`{MEASURED_FILE.relative_to(PROJECT_ROOT)}`.")
+        return "\n".join(lines) + "\n"
+    cols = list(table.columns)
+    lines += ["| notebook | " + " | ".join(cols) + " |", "|---" * (len(cols) + 1) + "|"]
+    for name, r in table.iterrows():
+        cells = [f"{r[c]:.2f}" if c in ("speed-up", "serial share") else f"{r[c]:.0f}" for c in cols]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    runs = measured[measured["profile"] == profile][["jobs", "date", "commit", "note"]].drop_duplicates()
+    lines += ["", "Measured: " + "; ".join(f"{r.jobs} job{'s' if r.jobs > 1 else ''} on {r.date} at commit "
+                                           f"`{r.commit}`" + (f" ({r.note})" if isinstance(r.note, str) and r.note
+                                                             else "") for r in runs.itertuples()) + ".",
+              "", "The projection is Amdahl's law per notebook: the share that did not get faster from 1 to 2 jobs "
+              "stays serial, the rest divides evenly over the jobs. That assumes at least as many runs of about "
+              "equal length as jobs and nothing else shared (memory bandwidth, disk, a GPU), so it is an upper "
+              "bound on the speed-up: with fewer runs than jobs the longest run sets the time."]
+    return "\n".join(lines) + "\n"
+
+
+def _minutes(seconds: float) -> str:
+    """``12.3 min`` from seconds (``-`` when unknown)."""
+    return "-" if seconds != seconds else f"{seconds / 60:.1f} min ({seconds:.0f} s)"

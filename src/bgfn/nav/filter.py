@@ -210,11 +210,17 @@ def update_position(pos, v, c, ba, bg, P, lever, fix, std, lag, innov, gate):
 class AidMeasurement:
     """One aid measurement for :func:`sequential_update`: ``dz`` [m] (computed minus measured), ``H`` [m, 15] its
     Jacobian with respect to the error states (:mod:`bgfn.nav.error_model` order), ``std`` [m] the measurement
-    noise per row (a row with a non-positive or non-finite std is left out)."""
+    noise per row (a row with a non-positive or non-finite std is left out).
+
+    ``gate`` [m], optional: a chi-square threshold per row (0: none). The engine leaves out a row whose
+    normalized innovation squared ``dz^2 / (H P H^T + std^2)`` against the covariance before the epoch's update
+    exceeds it (:func:`gated_std`): the aid says how much it trusts a value, the engine owns the test.
+    """
 
     dz: np.ndarray
     H: np.ndarray
     std: np.ndarray
+    gate: np.ndarray | None = None
 
 
 class AidSchedule(Protocol):
@@ -237,6 +243,14 @@ class Aid(Protocol):
         """Bind to the IMU steps ending at ``time`` (s). ``hold_at``: no GNSS fix comes after this time (an
         outage), so whatever the aid estimates from the GPS-aided solution is held at its value then."""
         ...
+
+
+def gated_std(P: np.ndarray, H: np.ndarray, dz: np.ndarray, std: np.ndarray, gate: np.ndarray) -> np.ndarray:
+    """``std`` with NaN for every row whose normalized innovation squared ``dz^2 / (h P h^T + std^2)`` (against
+    ``P`` before the update) exceeds its ``gate`` > 0 (:class:`AidMeasurement`): such a row is not fused."""
+    s = np.einsum("ij,jk,ik->i", H, P, H) + np.asarray(std, float) ** 2
+    reject = (np.asarray(gate, float) > 0.0) & (np.asarray(dz, float) ** 2 > np.asarray(gate, float) * s)
+    return np.where(reject, np.nan, std)
 
 
 def propagate(r0: int, r1: int, dt, gyro, accel, nav: tuple, q: tuple, out: tuple,
@@ -262,7 +276,8 @@ def propagate(r0: int, r1: int, dt, gyro, accel, nav: tuple, q: tuple, out: tupl
             if m is None:
                 continue
             x = np.zeros(P.shape[0])
-            sequential_update(P, m.H, m.dz, m.std, x, np.empty(m.dz.size))
+            std = m.std if m.gate is None else gated_std(P, m.H, m.dz, m.std, m.gate)
+            sequential_update(P, m.H, m.dz, std, x, np.empty(m.dz.size))
             feedback(pos, v, c, ba, bg, x)
             out_pos[k], out_v[k], out_c[k] = pos, v, c
             out_sd[k] = np.sqrt(np.maximum(np.diag(P), 0.0))

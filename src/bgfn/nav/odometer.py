@@ -1,0 +1,143 @@
+"""An odometer as an aid of the filter engine: the forward speed in the vehicle frame, with its uncertainty.
+
+Beyond the paper (issue 24; the design of OdoNet, TLIO and AI-IMU: the network predicts a quantity that does not
+accumulate, with its own uncertainty, and the filter owns the fusion). At every aid epoch of the vehicle
+constraints (:mod:`bgfn.nav.constraints`: the NHC rows, or ZUPT where the vehicle stands still) the odometer
+adds the forward row of the vehicle-frame velocity::
+
+    z = v^v_x = speed + w,   w ~ N(0, std^2)
+
+With ``M = R_vb C_bn^T`` (NED -> vehicle frame) the computed value is ``v^v_computed = v^v_true + M dV - M [v x] phi``
+(the same linearization as the NHC rows), so the forward row of ``H`` is ``M_x`` on ``dV`` and ``-(M [v x])_x`` on
+``phi``. The three rows are fused one after the other by the engine (:func:`bgfn.nav.filter.sequential_update`).
+At a ZUPT epoch the velocity is zero in every axis and no speed row is added.
+
+The speed and its std come from a :class:`SpeedTrack` (a learned odometer's predictions at the aid epochs, the
+speed held from the outage start, an oracle ...): at an epoch, the track's last value at or before it, no older
+than ``max_age_s``. A row whose normalized innovation squared exceeds the ``gate_probability`` quantile of
+chi-square with one degree of freedom is left out (:attr:`bgfn.nav.filter.AidMeasurement.gate`), so one wild
+prediction cannot pull the solution away.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import chi2
+
+from ..errors import DataError
+from . import error_model as em
+from .constraints import AID_ZUPT, TIME_TOL, Constraints, VehicleSchedule, vehicle_rotation_nb
+from .filter import AidMeasurement
+
+#: Default chi-square probability of the forward-speed row's gate (one degree of freedom).
+DEFAULT_GATE_PROBABILITY = 0.999
+#: Default oldest a speed may be when an aid epoch uses it, s.
+DEFAULT_MAX_AGE_S = 1.5
+
+
+@dataclass(frozen=True)
+class SpeedTrack:
+    """Forward speeds in the vehicle frame with their std: ``time`` [K] (s, increasing), ``speed`` [K] (m/s),
+    ``std`` [K] (m/s, > 0; NaN or a non-positive std: no measurement then)."""
+
+    time: np.ndarray
+    speed: np.ndarray
+    std: np.ndarray
+
+    def __post_init__(self):
+        t, s, d = (np.asarray(a, dtype=float).ravel() for a in (self.time, self.speed, self.std))
+        if not (t.size == s.size == d.size):
+            raise DataError("speed track", "time/speed/std", "three arrays of one length",
+                            f"{t.size}, {s.size}, {d.size}")
+        if t.size > 1 and np.any(np.diff(t) <= 0):
+            raise DataError("speed track", "time", "strictly increasing times", "a repeated or earlier time")
+        object.__setattr__(self, "time", t)
+        object.__setattr__(self, "speed", s)
+        object.__setattr__(self, "std", d)
+
+    def at(self, time, max_age_s: float = DEFAULT_MAX_AGE_S) -> tuple[np.ndarray, np.ndarray]:
+        """``(speed, std)`` in force at each of ``time`` (s): the last value at or before it, NaN when there is
+        none or it is older than ``max_age_s``."""
+        time = np.atleast_1d(np.asarray(time, dtype=float))
+        i = np.searchsorted(self.time, time + TIME_TOL, side="right") - 1
+        ok = (i >= 0) & (time - self.time[np.clip(i, 0, None)] <= max_age_s + TIME_TOL) if self.time.size else \
+            np.zeros(time.size, bool)
+        j = np.clip(i, 0, None)
+        speed = np.where(ok, self.speed[j] if self.time.size else np.nan, np.nan)
+        std = np.where(ok, self.std[j] if self.time.size else np.nan, np.nan)
+        return speed, std
+
+    def scaled(self, factor: float) -> "SpeedTrack":
+        """The same speeds with every std times ``factor`` (a calibration fitted so that the NIS is 1)."""
+        if not (np.isfinite(factor) and factor > 0):
+            raise DataError("speed track", "calibration", "a positive factor", repr(factor))
+        return SpeedTrack(self.time, self.speed, self.std * float(factor))
+
+
+def forward_speed_row(v: np.ndarray, c: np.ndarray, r_vb: np.ndarray) -> tuple[float, np.ndarray]:
+    """The computed forward speed ``(M v)_x`` (m/s) and its row of ``H`` [15] (module docstring)."""
+    m = r_vb @ c.T                                   # NED -> vehicle frame
+    row = np.zeros(em.N_STATES)
+    mv = m @ em.skew_nb(np.ascontiguousarray(v, dtype=float))
+    for j in range(3):
+        row[em.DV_NED[j]] = m[0, j]
+        row[em.PHI_NED[j]] = -mv[0, j]
+    return float(m[0] @ v), row
+
+
+@dataclass(frozen=True)
+class Odometer:
+    """The vehicle constraints plus a forward speed (module docstring): an :class:`~bgfn.nav.filter.Aid`.
+
+    Attributes
+    ----------
+    constraints : Constraints
+        NHC/ZUPT and the vehicle frame (:func:`bgfn.nav.constraints.build_constraints`).
+    track : SpeedTrack
+    gate_probability : float or None
+        Chi-square probability of the speed row's gate (None: no gate).
+    max_age_s : float
+        Oldest speed an epoch uses, s.
+    """
+
+    constraints: Constraints
+    track: SpeedTrack
+    gate_probability: float | None = DEFAULT_GATE_PROBABILITY
+    max_age_s: float = DEFAULT_MAX_AGE_S
+
+    def schedule(self, time, source: str = "imu", hold_at: float | None = None) -> "OdometerSchedule":
+        """The vehicle constraints' schedule (:meth:`Constraints.schedule`) with the speed in force at each step."""
+        vehicle = self.constraints.schedule(time, source, hold_at)
+        speed, std = self.track.at(time, self.max_age_s)
+        p = self.gate_probability
+        if p is not None and not 0.0 < p < 1.0:
+            raise DataError(source, "gate_probability", "a probability in (0, 1), or None for no gate", repr(p))
+        return OdometerSchedule(vehicle.rows, vehicle, speed, std, float(chi2.ppf(p, 1)) if p else 0.0)
+
+    def summary(self) -> dict:
+        """The constraints' summary and how many epochs have a speed."""
+        return {**self.constraints.summary(), "speed_epochs": int(np.count_nonzero(np.isfinite(self.track.speed)))}
+
+
+@dataclass(frozen=True)
+class OdometerSchedule:
+    """The odometer bound to one run's IMU steps: the vehicle constraints' measurement plus the speed row."""
+
+    rows: np.ndarray
+    vehicle: VehicleSchedule
+    speed: np.ndarray
+    std: np.ndarray
+    gate: float
+
+    def measurement(self, k: int, pos, v, c) -> AidMeasurement | None:
+        """NHC (+ the forward speed when one is in force) or ZUPT at the aid epoch after step ``k``."""
+        m = self.vehicle.measurement(k, pos, v, c)
+        if m is None or self.vehicle.aid[k] == AID_ZUPT and m.dz.size == 3 or not np.isfinite(self.speed[k]):
+            return m
+        r_vb = np.empty((3, 3))
+        vehicle_rotation_nb(self.vehicle.mount[k, 0], self.vehicle.mount[k, 1], r_vb)
+        computed, row = forward_speed_row(np.asarray(v, float), np.asarray(c, float), r_vb)
+        return AidMeasurement(np.append(m.dz, computed - self.speed[k]), np.vstack([m.H, row]),
+                              np.append(m.std, self.std[k]), np.append(np.zeros(m.dz.size), self.gate))

@@ -50,7 +50,9 @@ Modules, one concept each (every public name is re-exported here):
 - :mod:`bgfn.learning.references`: the validation RMSE and the zero / last-increment / INS-increment references;
 - :mod:`bgfn.learning.coverage`: headings and speeds seen in training, validation and the outages;
 - :mod:`bgfn.learning.data`: :class:`LearningData`, the learning options, the tuning split;
-- :mod:`bgfn.learning.synthetic`: a toy drive for tests and examples.
+- :mod:`bgfn.learning.synthetic`: a toy drive for tests and examples;
+- :mod:`bgfn.learning.odometry`: beyond the paper, the odometer problem (IMU-only windows -> forward speed) and
+  its ridge baseline.
 """
 
 from bgfn.learning.coverage import (VAL_POSITIONS, motion_in_windows, motion_of_windows, motion_sets, unseen_fraction,

@@ -1,0 +1,167 @@
+"""The odometer learning problem (beyond the paper, issue 24): body-frame IMU windows -> forward speed.
+
+Unlike ``delta_p_gps`` (:mod:`bgfn.learning.targets`), the forward speed does not accumulate, and an IMU window can
+observe it: centripetal acceleration over yaw rate in turns, the vibration spectrum while rolling, stillness at
+stops. The inputs are the six raw IMU channels only (``accel_x..z``, ``gyro_x..z``, body frame): no attitude,
+no GPS-derived or filter velocity, so nothing of the GPS-aided solution leaks into an outage.
+
+Target: the forward speed of the GPS-aided solution in the vehicle frame (:func:`forward_speed`), ``u . v^b`` with
+``v^b = C_bn^T v^n`` and ``u`` the vehicle's x axis in the body frame (the mounting tangents of
+:func:`bgfn.nav.constraints.mounting_track`; zero: the body x axis), at the epochs the windows end at.
+
+The simple learned odometer (``RIDGE-ODO``, the bar a network must clear to justify its cost): ridge regression
+on the log energies of each IMU axis in :data:`BANDS_HZ` (:func:`band_energies`), standardized on the training
+windows; its std is the RMS of its residuals on the validation windows (:class:`RidgeOdometer`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from bgfn.errors import DataError
+from bgfn.learning.windows import _gather, _windows_ending_at
+from bgfn.nav.transform import dcm_from_euler
+from bgfn.schema import ACCEL_COLUMNS, GYRO_COLUMNS
+
+#: The odometer's input channels: the raw body-frame IMU.
+ODOMETER_CHANNELS: tuple[str, ...] = ACCEL_COLUMNS + GYRO_COLUMNS
+#: Frequency bands of :func:`band_energies`, Hz: five log-spaced bands from 0.5 Hz to 50 Hz (the Nyquist
+#: frequency of a 100 Hz IMU).
+BANDS_HZ: tuple[tuple[float, float], ...] = tuple(zip(np.geomspace(0.5, 50.0, 6)[:-1], np.geomspace(0.5, 50.0, 6)[1:]))
+
+
+def forward_speed(solution: pd.DataFrame, mount: np.ndarray | None = None) -> np.ndarray:
+    """Forward speed in the vehicle frame of every row of a solution (reference schema: ``roll, pitch, yaw`` rad,
+    ``v_n, v_e, v_d`` m/s), m/s.
+
+    ``mount`` [n, 2] or [2]: the mounting tangents (yaw, pitch) of the vehicle's x axis in the body frame
+    (:func:`bgfn.nav.constraints.mounting_track`); None: the body x axis.
+    """
+    need = ("roll", "pitch", "yaw", "v_n", "v_e", "v_d")
+    missing = [c for c in need if c not in solution.columns]
+    if missing:
+        raise DataError("solution", missing[0], "a column of the reference schema", "missing")
+    c_bn = dcm_from_euler(*(solution[k].to_numpy(float) for k in ("roll", "pitch", "yaw")))     # [n, 3, 3]
+    v_n = solution[["v_n", "v_e", "v_d"]].to_numpy(float)
+    v_b = np.einsum("nji,nj->ni", c_bn.reshape(-1, 3, 3), v_n)                                # C_bn^T v^n
+    tan = np.zeros((len(v_b), 2)) if mount is None else np.broadcast_to(np.asarray(mount, float), (len(v_b), 2))
+    u = np.column_stack([np.ones(len(v_b)), tan])
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    return np.einsum("ni,ni->n", u, v_b)
+
+
+@dataclass
+class SpeedWindows:
+    """IMU windows ending at epochs and the forward speed there.
+
+    Attributes
+    ----------
+    x : ndarray [M, N, 6] float32
+        Raw body-frame IMU windows (:data:`ODOMETER_CHANNELS`).
+    speed : ndarray [M]
+        Target forward speed, m/s (NaN when unknown: an outage).
+    t_end : ndarray [M]
+        The epoch each window ends at, s.
+    t_start : ndarray [M]
+        Start of the window's first sample interval, s.
+    """
+
+    x: np.ndarray
+    speed: np.ndarray
+    t_end: np.ndarray
+    t_start: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.x)
+
+    def subset(self, idx) -> "SpeedWindows":
+        """The windows at integer/boolean index ``idx``."""
+        return SpeedWindows(self.x[idx], self.speed[idx], self.t_end[idx], self.t_start[idx])
+
+    @property
+    def span(self) -> tuple[np.ndarray, np.ndarray]:
+        """Time span ``[lo, hi]`` each window touches, s (its inputs; the target is at its end)."""
+        return self.t_start, self.t_end
+
+
+def speed_windows(imu: pd.DataFrame, epochs, window: int, speed=None) -> SpeedWindows:
+    """The IMU windows of ``window`` samples ending at each of ``epochs`` (s) that are complete (no gap, no NaN),
+    with ``speed`` at those epochs (NaN when not given)."""
+    if window < 2:
+        raise DataError("train", "window", "at least 2 IMU samples", str(window))
+    t = imu["time"].to_numpy(float)
+    feats = imu[list(ODOMETER_CHANNELS)].to_numpy(float)
+    epochs = np.asarray(epochs, dtype=float)
+    last, ok = _windows_ending_at(t, feats, epochs, window)
+    sp = np.full(epochs.size, np.nan) if speed is None else np.asarray(speed, dtype=float)
+    last, ep, sp = last[ok], epochs[ok], sp[ok]
+    return SpeedWindows(_gather(feats, last, window), sp, ep, t[last - window])
+
+
+def band_energies(x: np.ndarray, rate_hz: float, bands=BANDS_HZ) -> np.ndarray:
+    """Log mean power of every channel of the windows ``x`` [M, N, C] in each band (Hz), after removing each
+    window's mean: features [M, C * len(bands)], channel-major. A band with no frequency bin of the window
+    (too short a window for its lowest band) is an error naming the band."""
+    x = np.asarray(x, dtype=float)
+    n = x.shape[1]
+    spec = np.abs(np.fft.rfft(x - x.mean(axis=1, keepdims=True), axis=1)) ** 2 / n          # [M, F, C]
+    freq = np.fft.rfftfreq(n, 1.0 / rate_hz)
+    out = []
+    for lo, hi in bands:
+        sel = (freq >= lo) & (freq < hi) if hi < freq[-1] else (freq >= lo)
+        if not sel.any():
+            raise DataError("odometer", "bands", f"frequency bins of a {n}-sample window at {rate_hz:g} Hz",
+                            f"none in {lo:.2f}-{hi:.2f} Hz")
+        out.append(np.log(spec[:, sel, :].mean(axis=1) + 1e-12))                             # [M, C]
+    return np.stack(out, axis=-1).reshape(len(x), -1)                                        # [M, C * B]
+
+
+@dataclass
+class RidgeOdometer:
+    """``RIDGE-ODO``: ridge regression of the forward speed on :func:`band_energies` (module docstring).
+
+    Attributes
+    ----------
+    mean, scale : ndarray [F]
+        Standardization of the features (training windows).
+    coef : ndarray [F]
+    intercept : float
+    std_mps : float
+        RMS of the validation residuals, m/s: the std every prediction carries.
+    rate_hz : float
+        IMU rate the features were computed at.
+    alpha : float
+        Ridge penalty on the standardized features.
+    """
+
+    mean: np.ndarray
+    scale: np.ndarray
+    coef: np.ndarray
+    intercept: float
+    std_mps: float
+    rate_hz: float
+    alpha: float
+
+    @classmethod
+    def fit(cls, train: SpeedWindows, val: SpeedWindows, rate_hz: float, alpha: float = 1.0) -> "RidgeOdometer":
+        """Fit on ``train`` (closed form), the std from the residuals on ``val``."""
+        if len(train) < 2 or len(val) < 1:
+            raise DataError("odometer", "windows", "at least 2 training and 1 validation window",
+                            f"{len(train)} and {len(val)}")
+        f = band_energies(train.x, rate_hz)
+        mean, scale = f.mean(axis=0), f.std(axis=0)
+        scale = np.where(scale > 0, scale, 1.0)
+        z = (f - mean) / scale
+        y = train.speed - train.speed.mean()
+        coef = np.linalg.solve(z.T @ z + alpha * np.eye(z.shape[1]), z.T @ y)
+        model = cls(mean, scale, coef, float(train.speed.mean()), float("nan"), float(rate_hz), float(alpha))
+        model.std_mps = float(np.sqrt(np.mean((model.predict(val) - val.speed) ** 2)))
+        return model
+
+    def predict(self, ws: SpeedWindows) -> np.ndarray:
+        """Forward speed of each window, m/s (never negative: a car's odometer)."""
+        z = (band_energies(ws.x, self.rate_hz) - self.mean) / self.scale
+        return np.maximum(z @ self.coef + self.intercept, 0.0)

@@ -1,0 +1,71 @@
+"""The odometer learning problem (bgfn.learning.odometry): the forward-speed target, IMU-only windows, band
+energies checked on sines, and the ridge odometer on a drive whose vibration grows with speed."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from bgfn.errors import DataError
+from bgfn.learning import odometry as od
+
+RATE = 100.0
+
+
+def test_forward_speed_is_the_body_x_velocity_turned_into_the_vehicle_frame():
+    # heading 30 deg, moving along it at 10 m/s, level: forward speed 10
+    sol = pd.DataFrame({"roll": [0.0, 0.1], "pitch": [0.0, 0.0], "yaw": np.radians([30.0, 30.0]),
+                        "v_n": 10 * np.cos(np.radians([30.0, 30.0])), "v_e": 10 * np.sin(np.radians([30.0, 30.0])),
+                        "v_d": [0.0, 0.0]})
+    assert od.forward_speed(sol) == pytest.approx([10.0, 10.0])
+    # the body is turned 2 deg in yaw against the direction of travel: the body x axis sees cos(2 deg) of it, the
+    # vehicle frame with the matching mounting tangent all of it
+    sol2 = sol.assign(yaw=np.radians(32.0))
+    assert od.forward_speed(sol2)[0] == pytest.approx(10 * np.cos(np.radians(2.0)))
+    assert od.forward_speed(sol2, np.array([np.tan(np.radians(-2.0)), 0.0]))[0] == pytest.approx(10.0)
+    with pytest.raises(DataError, match="v_d"):
+        od.forward_speed(sol.drop(columns="v_d"))
+
+
+def test_band_energies_put_a_sine_in_its_band():
+    t = np.arange(200) / RATE
+    x = np.zeros((2, 200, 6))
+    x[0, :, 0] = np.sin(2 * np.pi * 10.0 * t)            # 10 Hz on accel_x: band 3 (7.9-19.9 Hz)
+    x[1, :, 0] = np.sin(2 * np.pi * 1.0 * t)             # 1 Hz: band 0 (0.5-1.26 Hz)
+    f = od.band_energies(x, RATE).reshape(2, 6, len(od.BANDS_HZ))
+    assert np.argmax(f[0, 0]) == 3 and np.argmax(f[1, 0]) == 0
+    assert f[0, 1].max() < -20                             # a silent axis: log of ~0
+    with pytest.raises(DataError, match="bands"):
+        od.band_energies(x[:, :20], RATE)                  # 0.2 s: no bin below 5 Hz
+
+
+def _vibrating_drive(seed=0, duration=600.0):
+    """IMU whose vibration (10-30 Hz) grows in amplitude with a slowly varying speed, and that speed."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(int(duration * RATE)) / RATE
+    speed = 10 + 8 * np.sin(2 * np.pi * t / 150.0)
+    imu = pd.DataFrame({"time": t})
+    for c in od.ODOMETER_CHANNELS:
+        carrier = np.sin(2 * np.pi * rng.uniform(10, 30) * t + rng.uniform(0, 6))
+        imu[c] = 0.05 * speed * carrier + 0.01 * rng.standard_normal(t.size)
+    return imu, t, speed
+
+
+def test_the_ridge_odometer_learns_speed_from_vibration_and_says_how_well():
+    imu, t, speed = _vibrating_drive()
+    epochs = np.arange(5.0, 595.0, 1.0)
+    ws = od.speed_windows(imu, epochs, 200, np.interp(epochs, t, speed))
+    assert ws.x.shape == (len(epochs), 200, 6) and np.all(ws.t_start < ws.t_end)
+    train, val = ws.subset(slice(0, 400)), ws.subset(slice(450, None))
+    model = od.RidgeOdometer.fit(train, val, RATE)
+    err = model.predict(val) - val.speed
+    assert np.sqrt(np.mean(err ** 2)) == pytest.approx(model.std_mps)
+    assert model.std_mps < 0.25 * np.std(val.speed)        # far better than the mean speed (log energy ~ 2 log v)
+    assert (model.predict(val) >= 0).all()
+    with pytest.raises(DataError, match="windows"):
+        od.RidgeOdometer.fit(train.subset(slice(0, 1)), val, RATE)
+
+
+def test_speed_windows_skip_epochs_without_a_full_window():
+    imu, t, speed = _vibrating_drive(duration=30.0)
+    ws = od.speed_windows(imu, [1.0, 2.5, 29.9, 40.0], 200)
+    assert ws.t_end.tolist() == [2.5, 29.9] and np.isnan(ws.speed).all()

@@ -164,8 +164,10 @@ class RunProgress:
         self.total, self.desc, self.left = int(total), desc, int(total)
         self.t0 = time.perf_counter()
         self.log_path = os.environ.get(PROGRESS_ENV) or None
+        # Under make the terminal has the lines, and every refresh of the bar would be kept in the executed notebook
+        # (the book shows each as a line): then the bar is redrawn once a minute at most, else every second.
         self.bar = tqdm(total=self.total, desc=desc, disable=not bar or self.total == 0, file=sys.stderr,
-                        mininterval=1.0, dynamic_ncols=False, ncols=100)
+                        mininterval=60.0 if self.log_path else 1.0, dynamic_ncols=False, ncols=100)
         self.echo = echo if echo is not None else (lambda line: tqdm.write(line, file=sys.stdout))
 
     def line(self, label: str, seconds: float, what: str) -> str:

@@ -91,6 +91,8 @@ SHARED_TABLES: dict[str, str] = {
     "oracle": "outage_oracle.csv",              # notebook 04: the oracle rows (bgfn.evaluate.oracle)
     "oracle_breakeven": "outage_oracle_breakeven.csv",
     "oracle_runs": "outage_oracle_runs.csv",
+    "odometer": "outage_odometer.csv",          # notebook 04: the bars of a learned odometer (bgfn.evaluate.odometers)
+    "odometer_summary": "outage_odometer_summary.csv",
     "variants": "outage_variants.csv",          # notebook 03: the learning-problem variants in the two outages
 }
 #: Where a top-level ``datasets:`` puts its list (the datasets of every notebook), unless the same file or a later

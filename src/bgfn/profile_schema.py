@@ -192,7 +192,10 @@ SCHEMA = section(
                       folds=integer(1), seeds=seq(_SEED, min_len=1), warmup_s=_NONNEG,
                       train=Spec("section", null=True, fields=TRAIN.fields), n_boot=integer(1),
                       level=_FRACTION, boot_seed=_SEED),
-        oracle=section(sigmas_m=seq(_NONNEG), seeds=seq(_SEED, min_len=1), durations_s=seq(_POS))),
+        oracle=section(sigmas_m=seq(_NONNEG), seeds=seq(_SEED, min_len=1), durations_s=seq(_POS)),
+        odometer=section(datasets=seq(text(), null=True), window_s=number(0.5), sigmas_mps=seq(_POS), walk_mps_per_sqrt_s=_NONNEG,
+                         seeds=seq(_SEED, min_len=1), hold_std_mps=_POS, ridge_alpha=_POS,
+                         gate_probability=number(0, 1, lo_open=True, hi_open=True, null=True))),
     energy=section(
         e_mac_pj=_POS, e_ac_pj=_POS, dataset=text(null=True), seed=integer(0, null=True), allow_untrained=flag(),
         max_windows=integer(1, null=True), batch_size=integer(1), sweep_time_steps=seq(integer(1), min_len=1),

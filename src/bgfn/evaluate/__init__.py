@@ -61,6 +61,8 @@ Modules, in the order of the protocol:
 - :mod:`bgfn.evaluate.sweep` -- the outage sweep and its statistics;
 - :mod:`bgfn.evaluate.increments` -- the true increments of a drive, a run's increment error;
 - :mod:`bgfn.evaluate.oracle` -- the oracle rows: true increments plus noise, the break-even accuracy;
+- :mod:`bgfn.evaluate.odometers` -- the bars a learned odometer must clear: INS+NHC, the held speed, RIDGE-ODO and
+  an oracle speed, fused as a forward-speed measurement (beyond the paper);
 - :mod:`bgfn.evaluate.record` -- ``outage_evaluation.json``, the record notebook 06 reads;
 - :mod:`bgfn.evaluate.variants` -- the learning-problem variants of notebook 03 in the two outages.
 
@@ -77,6 +79,8 @@ from bgfn.evaluate.increments import AntennaTruth, increment_errors, increment_r
 from bgfn.evaluate.ins_drift import (DRIFT_COLUMNS, DRIFT_RUN_COLUMNS, drift_sentences, drift_starts, drift_summary,
                                      ins_drift_runs, plot_ins_drift)
 from bgfn.evaluate.networks import ensure_models, load_model
+from bgfn.evaluate.odometers import (ODOMETER_COLUMNS, ODOMETER_METHODS, OdometerSection, odometer_lines,
+                                     odometer_rows, odometer_summary, run_odometer_bars, run_odometer_section)
 from bgfn.evaluate.oracle import (BREAKEVEN_COLUMNS, ORACLE_COLUMNS, OracleIncrements, OracleResult, breakeven_table,
                                   crossing_sigma, curve_at, describe_oracle, method_levels, oracle_interval_table,
                                   oracle_runs, oracle_table, oracle_windows, plot_oracle, run_oracle)
@@ -94,6 +98,8 @@ from bgfn.evaluate.variants import (NO_VARIANT, VARIANT_COLUMNS, VARIANT_METRICS
                                     variant_runs, variant_table)
 
 __all__ = [
+    "ODOMETER_COLUMNS", "ODOMETER_METHODS", "OdometerSection", "odometer_lines", "odometer_rows", "odometer_summary",
+    "run_odometer_bars", "run_odometer_section",
     "DRIFT_COLUMNS", "DRIFT_RUN_COLUMNS", "drift_sentences", "drift_starts", "drift_summary", "ins_drift_runs",
     "plot_ins_drift", "outage_figures",
     "AntennaTruth", "BREAKEVEN_COLUMNS", "ORACLE_COLUMNS", "OracleIncrements", "OracleResult", "breakeven_table",

@@ -1,0 +1,271 @@
+"""The bars a learned odometer must clear (beyond the paper; issue 24), in the outage sweep's windows.
+
+A learned odometer predicts the forward speed and its std from body-frame IMU windows, and the filter fuses it
+with the NHC rows (:mod:`bgfn.nav.odometer`). Before any network, this module measures what such an aid is worth
+on a drive, with the same starts, folds and durations as the sweep (:func:`bgfn.evaluate.sweep.sweep_plan`):
+
+- ``INS+NHC``: the learning-free aid (:mod:`bgfn.nav.constraints`);
+- ``INS+NHC+HOLD``: the forward speed at the outage start held constant, std ``hold_std_mps`` (the dumb prior);
+- ``RIDGE-ODO``: ridge regression on the band energies of the IMU window of ``window_s`` seconds ending at the epoch (:class:`bgfn.learning.odometry.RidgeOdometer`),
+  trained per fold on the GPS-aided solution's forward speed outside that fold's outages (+- ``train.margin_s``),
+  its std the RMS of its residuals on a held-out block in the middle of the remaining windows;
+- ``ORACLE-SPEED``: the reference's horizontal speed plus white noise of std ``sigma`` (the grid ``sigmas_mps``)
+  and a random walk of ``walk_mps_per_sqrt_s``, fused with std ``sigma``: how accurate a speed must be to help.
+
+Every row is fused at the aid epochs (``nav.nhc.rate_hz``) through the chi-square gate (``gate_probability``).
+Each row also carries the speed error the odometer made inside the outage against the reference's speed
+(``speed_rmse_mps``) and the share of epochs within its own 2 sigma (``coverage_2sigma``).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+
+from bgfn.config import SHARED_TABLES
+from bgfn.data import load_drive
+from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
+from bgfn.evaluate.sweep import profile_sweep_plan
+from bgfn.io import atomic_write_csv
+from bgfn.learning import odometry as lo
+from bgfn.learning.split import forbidden_intervals, overlaps
+from bgfn.nav import odometer as no
+from bgfn.paper import nhc_label
+from bgfn.parallel import Runner
+
+HOLD, RIDGE, ORACLE = "INS+NHC+HOLD", "RIDGE-ODO", "ORACLE-SPEED"
+#: Rows of the odometer table, in order.
+ODOMETER_METHODS: tuple[str, ...] = (nhc_label("INS"), HOLD, RIDGE, ORACLE)
+#: Columns of ``tables/outage_odometer.csv``.
+ODOMETER_COLUMNS: tuple[str, ...] = ("dataset", "start_s", "duration_s", "method", "sigma_mps", "seed", "fold",
+                                     "max_h_m", "rmse_h_m", "final_h_m", "speed_rmse_mps", "coverage_2sigma")
+
+
+@dataclass(frozen=True)
+class OdometerRun:
+    """One aid in some outages (an independent run): ``label``, the outages ``(start, duration)``, the aid
+    (:class:`bgfn.nav.odometer.Odometer` or the bare constraints), and what the row records."""
+
+    label: str
+    windows: list
+    aid: object
+    method: str
+    sigma_mps: float
+    seed: int
+    fold: int
+
+
+def odometer_run(ctx, run: OdometerRun, pseudo: dict) -> list:
+    """The outage runs of one :class:`OdometerRun` (no network: the aid alone)."""
+    return run_outages(ctx, run.windows, None, run.method, None, pseudo, constraints=run.aid)
+
+
+def reference_speed(drive, time) -> np.ndarray:
+    """The reference's horizontal speed at ``time`` (s), m/s (a car's forward speed up to its small slip)."""
+    ref = drive.reference
+    return np.interp(np.asarray(time, float), ref["time"].to_numpy(float),
+                     np.hypot(ref["v_n"].to_numpy(float), ref["v_e"].to_numpy(float)))
+
+
+def oracle_track(epochs: np.ndarray, truth: np.ndarray, sigma: float, walk: float, seed: int,
+                 rate_hz: float) -> no.SpeedTrack:
+    """``truth`` plus white noise of std ``sigma`` and a random walk of ``walk`` m/s per sqrt(s), seeded; std
+    ``sigma``."""
+    rng = np.random.default_rng([int(seed), int(round(1e6 * sigma))])
+    drift = np.cumsum(rng.standard_normal(epochs.size)) * walk / np.sqrt(rate_hz)
+    return no.SpeedTrack(epochs, truth + sigma * rng.standard_normal(epochs.size) + drift, np.full(epochs.size,
+                                                                                                    float(sigma)))
+
+
+def fold_ridge(ws: lo.SpeedWindows, all_windows: lo.SpeedWindows, fold_windows, margin_s: float, alpha: float,
+               rate_hz: float, val_fraction: float = 0.2) -> tuple[lo.RidgeOdometer, no.SpeedTrack]:
+    """The ridge odometer of one fold: trained on ``ws`` outside its outages (+- ``margin_s``), validated on the
+    middle ``val_fraction`` of the rest (training windows touching that block left out); its track over
+    ``all_windows``."""
+    lo_, hi_ = ws.span
+    idx = np.flatnonzero(~overlaps(lo_, hi_, forbidden_intervals(fold_windows, margin_s)))
+    n_val = max(1, int(round(val_fraction * idx.size)))
+    val = idx[(idx.size - n_val) // 2:(idx.size - n_val) // 2 + n_val]
+    block = np.array([[ws.t_start[val].min(), ws.t_end[val].max()]])
+    train = idx[~overlaps(lo_[idx], hi_[idx], block)]
+    model = lo.RidgeOdometer.fit(ws.subset(train), ws.subset(val), rate_hz, alpha)
+    pred = model.predict(all_windows)
+    return model, no.SpeedTrack(all_windows.t_end, pred, np.full(pred.size, model.std_mps))
+
+
+def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Runner | None = None,
+                  drive=None) -> tuple[pd.DataFrame, dict]:
+    """The odometer bars of one dataset in the sweep's windows (module docstring): rows
+    (:data:`ODOMETER_COLUMNS`) and facts (the ridge's std per fold, the epochs, the wall time)."""
+    t0 = time.perf_counter()
+    oc, sw = ecfg["odometer"], ecfg["sweep"]
+    drive = drive if drive is not None else load_drive(dataset, profile=profile)
+    plan = profile_sweep_plan(cfg, drive, sw)
+    dmax = max(float(d) for d in sw["durations_s"])
+    ctx = navigation_context(drive, cfg.get("nav"), plan["start_s"])
+    con = ctx.constraints
+    rate = float(con.config.nhc_rate_hz)
+    imu_rate = 1.0 / float(np.median(np.diff(drive.imu["time"].to_numpy(float))))
+    window = int(round(float(oc["window_s"]) * imu_rate))                   # the ridge's band energies need 2 s
+    traj = ctx.full.trajectory
+    tt = traj["time"].to_numpy(float)
+    speed = lo.forward_speed(traj, con.mounting_at(tt))                    # the GPS-aided solution's
+    epochs = np.arange(np.ceil(tt[0] * rate) / rate, tt[-1], 1.0 / rate)
+    all_windows = lo.speed_windows(drive.imu, epochs, window)
+    ws = lo.speed_windows(drive.imu, epochs, window, np.interp(epochs, tt, speed))
+    truth = reference_speed(drive, all_windows.t_end)
+    gate = oc["gate_probability"]
+    margin = float((cfg.get("train") or {}).get("margin_s", 30.0))
+    runs, tracks, facts = [], {}, {"ridge_std_mps": {}, "epochs": int(len(all_windows))}
+    for k in sorted(plan["fold"].unique()):
+        fw = [(float(s), dmax) for s in plan.loc[plan["fold"] == k, "start_s"]]
+        model, track = fold_ridge(ws, all_windows, fw, margin, float(oc["ridge_alpha"]), imu_rate)
+        facts["ridge_std_mps"][int(k)] = model.std_mps
+        runs.append(OdometerRun(f"{dataset} fold {k} {RIDGE}", fw, no.Odometer(con, track, gate), RIDGE,
+                                np.nan, 0, int(k)))
+        tracks[runs[-1].label] = track
+        runs.append(OdometerRun(f"{dataset} fold {k} {nhc_label('INS')}", fw, con, nhc_label("INS"), np.nan, 0,
+                                int(k)))
+        for s, d in fw:
+            v0 = float(np.interp(s, tt, speed))
+            held = no.SpeedTrack(epochs, np.full(epochs.size, v0), np.full(epochs.size, float(oc["hold_std_mps"])))
+            runs.append(OdometerRun(f"{dataset} {s:.0f} s {HOLD}", [(s, d)], no.Odometer(con, held, gate), HOLD,
+                                    np.nan, 0, int(k)))
+            tracks[runs[-1].label] = held
+        for sigma in oc["sigmas_mps"]:
+            for seed in oc["seeds"]:
+                track = oracle_track(all_windows.t_end, truth, float(sigma), float(oc["walk_mps_per_sqrt_s"]),
+                                     int(seed), rate)
+                runs.append(OdometerRun(f"{dataset} fold {k} {ORACLE} {sigma:g} m/s seed {seed}", fw,
+                                        no.Odometer(con, track, gate), ORACLE, float(sigma), int(seed), int(k)))
+                tracks[runs[-1].label] = track
+    results = (runner or Runner()).map(odometer_run, [(ctx, r, ecfg["pseudo_gps"]) for r in runs],
+                                       labels=[r.label for r in runs], desc=f"odometer bars {dataset}")
+    rows = []
+    for run, outs in zip(runs, results):
+        track = tracks.get(run.label)
+        for r in outs:
+            for du in sw["durations_s"]:
+                m = window_metrics(r.errors, r.start, float(du))
+                rows.append({"dataset": dataset, "start_s": r.start, "duration_s": float(du), "method": run.method,
+                             "sigma_mps": run.sigma_mps, "seed": run.seed, "fold": run.fold,
+                             **{c: m[c] for c in ("max_h_m", "rmse_h_m", "final_h_m")},
+                             **speed_errors(track, all_windows.t_end, truth, r.start, float(du))})
+    facts["wall_s"] = time.perf_counter() - t0
+    return pd.DataFrame(rows, columns=list(ODOMETER_COLUMNS)), facts
+
+
+def speed_errors(track: no.SpeedTrack | None, t: np.ndarray, truth: np.ndarray, start: float,
+                 duration: float) -> dict:
+    """``speed_rmse_mps`` and ``coverage_2sigma`` of a track against the true speed inside an outage (NaN
+    without a track)."""
+    if track is None:
+        return {"speed_rmse_mps": np.nan, "coverage_2sigma": np.nan}
+    m = (t > start) & (t <= start + duration + 1e-6)
+    speed, std = track.at(t[m])
+    ok = np.isfinite(speed)
+    if not ok.any():
+        return {"speed_rmse_mps": np.nan, "coverage_2sigma": np.nan}
+    err = speed[ok] - truth[m][ok]
+    return {"speed_rmse_mps": float(np.sqrt(np.mean(err ** 2))),
+            "coverage_2sigma": float(np.mean(np.abs(err) <= 2 * std[ok]))}
+
+
+def run_odometer_bars(cfg: dict, profile: str, datasets, ecfg: dict, runner: Runner | None = None,
+                      report: Callable[[str], None] | None = None) -> tuple[pd.DataFrame, dict]:
+    """:func:`odometer_rows` of every dataset (notebook 04); the rows in dataset order and the facts."""
+    parts, facts = [], {}
+    for name in datasets:
+        rows, facts[name] = odometer_rows(cfg, profile, name, ecfg, runner)
+        parts.append(rows)
+        if report is not None:
+            report(f"{name}: {len(rows)} odometer rows in {facts[name]['wall_s']:.1f} s; RIDGE-ODO std per fold "
+                   + ", ".join(f"{v:.2f} m/s" for v in facts[name]["ridge_std_mps"].values()))
+    rows = pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(columns=list(ODOMETER_COLUMNS))
+    return rows, facts
+
+
+@dataclass
+class OdometerSection:
+    """The odometer bars of notebook 04: the rows, their summary (:func:`odometer_summary`), the lines
+    (:func:`odometer_lines`) and the facts per dataset."""
+
+    rows: pd.DataFrame
+    summary: pd.DataFrame
+    lines: list
+    facts: dict
+
+    def markdown(self) -> str:
+        """The summary at the sweep's durations as a Markdown table (the oracle per sigma), then the lines."""
+        if self.summary.empty:
+            return "No odometer bars (``evaluate.odometer.datasets`` is empty or the sweep has no dataset)."
+        t = self.summary.assign(method=[m if m != ORACLE else f"{m} {s:g} m/s" for m, s in
+                                        zip(self.summary["method"], self.summary["sigma_mps"])])
+        wide = t.pivot_table(index=["dataset", "method"], columns="duration_s", values="max_h_m", sort=False)
+        head = "| dataset | method | " + " | ".join(f"{d:g} s" for d in wide.columns) + " |"
+        body = [f"| {ds} | {m} | " + " | ".join(f"{v:.1f}" for v in r) + " |" for (ds, m), r in wide.iterrows()]
+        return "\n".join(["Median max horizontal error (m) over the sweep's starts:", "", head,
+                          "|---" * (len(wide.columns) + 2) + "|", *body, ""] + [f"- {s}" for s in self.lines])
+
+
+def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | None = None,
+                         timings: dict | None = None, report: Callable[[str], None] | None = None) -> OdometerSection:
+    """Notebook 04's odometer bars: :func:`run_odometer_bars` over ``evaluate.odometer.datasets`` (null: the
+    sweep's), the tables written under ``out`` (``SHARED_TABLES`` ``odometer``, ``odometer_summary``), the wall time
+    added to ``timings`` (``odometer_s``)."""
+    t0 = time.perf_counter()
+    ecfg = setup.config
+    names = ecfg["odometer"]["datasets"]
+    names = list(setup.sweep_datasets) if names is None else list(names)
+    rows, facts = run_odometer_bars(cfg, profile, names, ecfg, runner, report)
+    summary = odometer_summary(rows)
+    tables = Path(out) / "tables"
+    atomic_write_csv(tables / SHARED_TABLES["odometer"], rows, float_format="%.4f")
+    atomic_write_csv(tables / SHARED_TABLES["odometer_summary"], summary, float_format="%.4f")
+    if timings is not None:
+        timings["odometer_s"] = time.perf_counter() - t0
+    return OdometerSection(rows, summary, odometer_lines(summary) if len(summary) else [], facts)
+
+
+def odometer_summary(rows: pd.DataFrame) -> pd.DataFrame:
+    """Median max horizontal error (m) per dataset, duration and method (the oracle per sigma), with the median
+    speed RMSE and 2-sigma coverage, and the median per-start ratio to ``INS+NHC``."""
+    if rows.empty:
+        return pd.DataFrame()
+    base = rows[rows["method"] == nhc_label("INS")].groupby(["dataset", "duration_s", "start_s"])["max_h_m"].first()
+    r = rows.join(base.rename("nhc_m"), on=["dataset", "duration_s", "start_s"])
+    r["ratio_to_nhc"] = r["max_h_m"] / r["nhc_m"]
+    key = ["dataset", "duration_s", "method", "sigma_mps"]
+    out = r.groupby(key, dropna=False, sort=False).agg(
+        max_h_m=("max_h_m", "median"), ratio_to_nhc=("ratio_to_nhc", "median"),
+        speed_rmse_mps=("speed_rmse_mps", "median"), coverage_2sigma=("coverage_2sigma", "median"),
+        runs=("max_h_m", "size")).reset_index()
+    return out.sort_values(["dataset", "duration_s"], kind="stable").reset_index(drop=True)
+
+
+def odometer_lines(summary: pd.DataFrame) -> list[str]:
+    """Per dataset and duration: INS+NHC, the held speed, the ridge odometer and the oracle's break-even."""
+    lines = []
+    for (ds, du), g in summary.groupby(["dataset", "duration_s"], sort=False):
+        by = {m: g[g["method"] == m] for m in ODOMETER_METHODS}
+        nhc = float(by[nhc_label("INS")]["max_h_m"].iloc[0]) if len(by[nhc_label("INS")]) else np.nan
+        part = [f"{ds}, {du:g} s outages (median max horizontal error): INS+NHC {nhc:.1f} m"]
+        for m in (HOLD, RIDGE):
+            if len(by[m]):
+                row = by[m].iloc[0]
+                part.append(f"{m} {row['max_h_m']:.1f} m ({row['ratio_to_nhc']:.2f} of INS+NHC per start"
+                            + (f"; speed RMSE {row['speed_rmse_mps']:.2f} m/s, 2-sigma coverage "
+                               f"{100 * row['coverage_2sigma']:.0f} %" if m == RIDGE else "") + ")")
+        orc = by[ORACLE].sort_values("sigma_mps")
+        better = orc[orc["max_h_m"] < nhc]
+        part.append("an oracle speed beats INS+NHC " + (f"up to a noise of {better['sigma_mps'].max():g} m/s "
+                                                         f"(at {better['sigma_mps'].min():g} m/s: "
+                                                         f"{better['max_h_m'].iloc[0]:.1f} m)" if len(better) else
+                                                         "at no noise level of the grid"))
+        lines.append("; ".join(part) + ".")
+    return lines

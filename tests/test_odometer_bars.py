@@ -1,0 +1,66 @@
+"""The odometer bars (bgfn.evaluate.odometers): the oracle speed's noise, the speed errors and the summary
+checked by hand, and the rows of a synthetic drive laid out as the table says."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from bgfn import evaluate as ev
+from bgfn.evaluate import odometers as O
+from bgfn.nav import odometer as no
+from bgfn.profile_schema import load_profile
+from synthetic_drive import demo_drive
+
+NAV = {"init": {"position_std_m": 1.0, "height_std_m": 2.0, "velocity_std_mps": 0.1, "level_std_deg": 0.2,
+                "azimuth_std_deg": 1.0}}
+
+
+def test_oracle_speed_is_the_truth_plus_seeded_white_noise_and_a_walk():
+    t = np.arange(20000.0)
+    truth = np.full(t.size, 10.0)
+    a = O.oracle_track(t, truth, 0.3, 0.0, seed=1, rate_hz=1.0)
+    assert np.std(a.speed - truth) == pytest.approx(0.3, rel=0.03) and (a.std == 0.3).all()
+    assert np.array_equal(a.speed, O.oracle_track(t, truth, 0.3, 0.0, seed=1, rate_hz=1.0).speed)
+    assert not np.array_equal(a.speed, O.oracle_track(t, truth, 0.3, 0.0, seed=2, rate_hz=1.0).speed)
+    walk = O.oracle_track(t, truth, 1e-9, 0.1, seed=1, rate_hz=1.0)
+    assert np.std(np.diff(walk.speed)) == pytest.approx(0.1, rel=0.03)       # 0.1 m/s per sqrt(s) at 1 Hz
+
+
+def test_speed_errors_by_hand():
+    t = np.arange(0.0, 11.0)
+    truth = np.full(t.size, 10.0)
+    track = no.SpeedTrack(t, truth + np.array([0, 1, -1, 1, -1, 3, 0, 0, 0, 0, 0.0]), np.full(t.size, 0.6))
+    e = O.speed_errors(track, t, truth, start=0.0, duration=5.0)              # epochs 1..5: errors 1,-1,1,-1,3
+    assert e["speed_rmse_mps"] == pytest.approx(np.sqrt((4 + 9) / 5))
+    assert e["coverage_2sigma"] == pytest.approx(4 / 5)                       # |3| > 1.2
+    assert np.isnan(O.speed_errors(None, t, truth, 0.0, 5.0)["speed_rmse_mps"])
+
+
+def test_summary_takes_the_median_ratio_to_ins_nhc_start_by_start():
+    rows = pd.DataFrame([
+        {"dataset": "d", "start_s": s, "duration_s": 30.0, "method": m, "sigma_mps": np.nan, "seed": 0, "fold": 0,
+         "max_h_m": v, "rmse_h_m": 0.0, "final_h_m": 0.0, "speed_rmse_mps": np.nan, "coverage_2sigma": np.nan}
+        for s, nhc, ridge in ((1.0, 10.0, 5.0), (2.0, 20.0, 30.0), (3.0, 40.0, 20.0))
+        for m, v in (("INS+NHC", nhc), ("RIDGE-ODO", ridge))])
+    s = O.odometer_summary(rows).set_index("method")
+    assert s.loc["RIDGE-ODO", "max_h_m"] == 20.0 and s.loc["INS+NHC", "max_h_m"] == 20.0
+    assert s.loc["RIDGE-ODO", "ratio_to_nhc"] == pytest.approx(0.5)          # ratios 0.5, 1.5, 0.5
+    assert s.loc["INS+NHC", "runs"] == 3
+
+
+def test_rows_of_a_synthetic_drive(monkeypatch):
+    drive = demo_drive("synthetic", 150.0, 5.0, 3)
+    cfg = load_profile("smoke")
+    cfg = {**cfg, "nav": NAV, "train": {**cfg["train"], "window": 50, "margin_s": 5.0}}
+    ecfg = ev.evaluate_config({"sweep": {"n_starts": 2, "folds": 2, "durations_s": [10.0, 30.0], "warmup_s": 30.0},
+                               "odometer": {"sigmas_mps": [0.1, 1.0], "seeds": [0, 1]}}, cfg["train"])
+    rows, facts = O.odometer_rows(cfg, "t", "synthetic", ecfg, drive=drive)
+    assert list(rows.columns) == list(O.ODOMETER_COLUMNS)
+    n = rows.groupby(["method", "duration_s"]).size()
+    # 2 starts: INS+NHC, HOLD and RIDGE one row each per start; the oracle 2 sigmas x 2 seeds per start
+    assert n.xs(10.0, level="duration_s").to_dict() == {"INS+NHC": 2, "INS+NHC+HOLD": 2, "RIDGE-ODO": 2,
+                                                         "ORACLE-SPEED": 8}
+    assert rows.loc[rows["method"] == "INS+NHC", "speed_rmse_mps"].isna().all()
+    oracle = rows[rows["method"] == "ORACLE-SPEED"].groupby("sigma_mps")["speed_rmse_mps"].median()
+    assert oracle[0.1] < 0.2 and 0.5 < oracle[1.0] < 1.6
+    assert set(facts["ridge_std_mps"]) == {0, 1} and all(v > 0 for v in facts["ridge_std_mps"].values())

@@ -69,3 +69,28 @@ def test_speed_windows_skip_epochs_without_a_full_window():
     imu, t, speed = _vibrating_drive(duration=30.0)
     ws = od.speed_windows(imu, [1.0, 2.5, 29.9, 40.0], 200)
     assert ws.t_end.tolist() == [2.5, 29.9] and np.isnan(ws.speed).all()
+
+
+def test_beta_nll_by_hand_and_its_weight():
+    import torch
+
+    mean, log_var, y = torch.tensor([0.0, 1.0]), torch.tensor([0.0, np.log(4.0)]), torch.tensor([1.0, 3.0])
+    # plain NLL: 0.5 (log var + r^2 / var) = 0.5 (0 + 1) and 0.5 (log 4 + 4 / 4)
+    plain = 0.5 * ((0 + 1) + (np.log(4.0) + 1)) / 2
+    assert float(od.beta_nll(mean, log_var, y, beta=0.0)) == pytest.approx(plain)
+    # beta 0.5: each term times its std (1 and 2)
+    assert float(od.beta_nll(mean, log_var, y, beta=0.5)) == pytest.approx((0.5 * 1 + 0.5 * (np.log(4.0) + 1) * 2) / 2)
+    # the weight is detached: with beta = 1 the mean's gradient is the MSE's, -(y - mean) / 2 per sample here
+    m = mean.clone().requires_grad_(True)
+    od.beta_nll(m, log_var, y, beta=1.0).backward()
+    assert m.grad.tolist() == pytest.approx([-0.5, -1.0])
+
+
+def test_calibration_factor_makes_the_normalized_residuals_unit():
+    rng = np.random.default_rng(0)
+    r = rng.normal(0, 2.0, 100000)
+    k = od.calibration_factor(r, np.full(r.size, 1.0))          # the std said 1, the errors are 2
+    assert k == pytest.approx(2.0, rel=0.01)
+    assert od.calibration_factor(r, np.full(r.size, k)) == pytest.approx(1.0, rel=1e-9)
+    with pytest.raises(DataError, match="calibration"):
+        od.calibration_factor([np.nan], [1.0])

@@ -12,6 +12,10 @@ Target: the forward speed of the GPS-aided solution in the vehicle frame (:func:
 The simple learned odometer (``RIDGE-ODO``, the bar a network must clear to justify its cost): ridge regression
 on the log energies of each IMU axis in :data:`BANDS_HZ` (:func:`band_energies`), standardized on the training
 windows; its std is the RMS of its residuals on the validation windows (:class:`RidgeOdometer`).
+
+For the networks that predict a speed and its log-variance: the beta-NLL loss (:func:`beta_nll`, so the variance
+cannot swallow the error) and the one calibration factor on their std fitted on held-out windows so that the
+normalized residuals have unit mean square (:func:`calibration_factor`, NIS = 1).
 """
 
 from __future__ import annotations
@@ -165,3 +169,26 @@ class RidgeOdometer:
         """Forward speed of each window, m/s (never negative: a car's odometer)."""
         z = (band_energies(ws.x, self.rate_hz) - self.mean) / self.scale
         return np.maximum(z @ self.coef + self.intercept, 0.0)
+
+
+def beta_nll(mean, log_var, target, beta: float = 0.5):
+    """Gaussian negative log-likelihood of ``target`` under ``N(mean, exp(log_var))``, each sample's term weighted
+    by its own variance to the power ``beta`` (Seitzer et al. 2022, beta-NLL), averaged; torch tensors [M].
+
+    With ``beta = 0`` it is the plain NLL, where a network can "explain away" a hard sample by a large variance
+    and stop fitting its mean; ``beta = 1`` weights every sample like the MSE does for the mean. The weight is
+    detached (a factor, not a path for the gradient), as in the paper that proposes it.
+    """
+    var = log_var.exp()
+    nll = 0.5 * (log_var + (target - mean) ** 2 / var)
+    return (nll * var.detach() ** beta).mean() if beta else nll.mean()
+
+
+def calibration_factor(residuals, std) -> float:
+    """The one factor on a predicted std that makes the normalized residuals' mean square 1 on held-out windows
+    (NIS = 1 for a scalar measurement): ``sqrt(mean((r / std)^2))``; non-finite pairs are left out."""
+    r, s = np.asarray(residuals, dtype=float), np.asarray(std, dtype=float)
+    ok = np.isfinite(r) & np.isfinite(s) & (s > 0)
+    if not ok.any():
+        raise DataError("odometer", "calibration", "held-out residuals with a positive std", "none")
+    return float(np.sqrt(np.mean((r[ok] / s[ok]) ** 2)))

@@ -500,6 +500,8 @@ def test_sections_name_the_notebook_of_a_missing_input(tmp_path):
     assert "notebook 02" in report.kf_section(res)[0] and "kf_baseline.json" in report.kf_section(res)[0]
     assert "notebook 03" in report.training_section(res)[0]
     assert "notebook 04" in report.sweep_section(res)[0]
+    assert "notebook 04" in report.odometer_section(res)[0] and "outage_odometer_summary.csv" in \
+        report.odometer_section(res)[0]
     energy = report.energy_section(res)
     assert "energy.json` is missing" in energy[1] and "notebook 05" in energy[1]
     assert energy[0].data.loc["energy reduction (%)", "paper"] == paper.claims()["energy_reduction_vs_transformer_pct"]
@@ -547,3 +549,20 @@ def test_draw_diagrams_writes_the_papers_figures_made_by_notebook_06(tmp_path):
     written = report.draw_diagrams(load_profile("smoke"), None, tmp_path)
     assert [p.name for p in written] == [e["file"] for e in report.PAPER_FIGURES if e["by"].startswith("notebook 06")]
     assert all(p.parent == tmp_path and p.stat().st_size > 0 for p in written)
+
+
+def test_odometer_section_lists_the_bars_and_the_oracle_per_sigma(tmp_path):
+    res = results(tmp_path)
+    rows = [("INS+NHC", float("nan"), 50.0, 1.0), ("RIDGE-ODO", float("nan"), 45.0, 0.9),
+            ("INS+NHC+HOLD", float("nan"), 44.0, 0.99), ("ORACLE-SPEED", 0.1, 34.0, 0.9),
+            ("ORACLE-SPEED", 2.0, 60.0, 1.1)]
+    summary = pd.DataFrame([{"dataset": "d", "duration_s": 60.0, "method": m, "sigma_mps": s, "max_h_m": v,
+                             "ratio_to_nhc": r, "speed_rmse_mps": 1.0, "coverage_2sigma": 0.95, "runs": 20}
+                            for m, s, v, r in rows])
+    (res.out / "tables").mkdir(parents=True, exist_ok=True)
+    summary.to_csv(res.table("outage_odometer_summary.csv"), index=False)
+    table, lines = report.odometer_section(res)
+    assert list(table.data.index.get_level_values(1)) == ["INS+NHC", "INS+NHC+HOLD", "RIDGE-ODO",
+                                                         "ORACLE-SPEED 0.1 m/s", "ORACLE-SPEED 2 m/s"]
+    assert table.data.loc[("d", "RIDGE-ODO"), "60 s"] == 45.0
+    assert "INS+NHC 50.0 m" in lines and "an oracle speed beats INS+NHC up to a noise of 0.1 m/s" in lines

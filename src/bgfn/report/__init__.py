@@ -35,7 +35,7 @@ from bgfn.report.provenance import (cards_line, meta_line, model_cards, outage_d
                                     run_meta, short_source)
 from bgfn.report.reading import ProfileResults, missing_note, read_csv, read_json, read_results, rel
 from bgfn.report.sections import (OutageSection, energy_section, header_section, kf_section, outage_section,
-                                  shown_tests, sweep_section, training_section)
+                                  odometer_section, shown_tests, sweep_section, training_section)
 from bgfn.report.sentences import (BASELINES, EXTRA_METHODS, EXTRA_TAGS, bullets, comparison_sentences,
                                    energy_sentences, paper_name, reduction_sentences, summary_sentence, win_counts)
 from bgfn.report.tables import (REFERENCE_LABELS, TABLE_STYLES, TRAINING_COLUMNS, best_mask, compact, energy_table,
@@ -60,7 +60,7 @@ __all__ = [
     # the page as sections of pieces to display (notebook 06)
     "Verdict", "VerdictInputs", "verdict_of", "verdict_table",
     "ProfileResults", "read_results", "OutageSection", "header_section", "outage_section", "energy_section",
-    "kf_section", "training_section", "sweep_section", "variants_section", "paper_figure_section",
+    "kf_section", "training_section", "sweep_section", "odometer_section", "variants_section", "paper_figure_section",
     "extra_figure_section", "draw_diagrams", "bullets", "run_meta",
     # a test the paper has no table of (the real drive): which tests the page shows, how it names the paper's
     "shown_tests", "paper_name",

@@ -11,10 +11,10 @@ from dataclasses import dataclass
 
 from bgfn import paper
 from bgfn.config import RUN_RECORDS, SHARED_TABLES
-from bgfn.evaluate import describe_sweep
+from bgfn.evaluate import ODOMETER_METHODS, describe_sweep, odometer_lines
 from bgfn.report.glance import run_header
 from bgfn.report.provenance import cards_line, model_cards, outage_datasets, outage_provenance, provenance, short_source
-from bgfn.report.reading import ProfileResults, missing_note
+from bgfn.report.reading import ProfileResults, missing_note, read_csv
 from bgfn.report.sentences import bullets, comparison_sentences, energy_sentences, reduction_sentences
 from bgfn.report.tables import (compact, energy_table, fmt_num, kf_table, reduction_comparison, style_layout,
                                 sweep_table, training_table)
@@ -131,6 +131,25 @@ def training_section(res: ProfileResults) -> list:
             provenance(file, (res.training or {}).get("meta"), res.current, seeds=res.cfg["train"].get("seeds")),
             "\n".join(f"- `{d}`: {cards_line(model_cards(res.profile, d, res.out.parent))}"
                       for d in tt.index.get_level_values("dataset").unique())]
+
+
+def odometer_section(res: ProfileResults) -> list:
+    """The bars a learned odometer must clear (notebook 04, :mod:`bgfn.evaluate.odometers`): median max horizontal
+    error per dataset, method (the oracle speed per sigma) and duration, then its lines."""
+    file = res.table(SHARED_TABLES["odometer_summary"])
+    summary = read_csv(file)
+    if summary is None or summary.empty:
+        return [missing_note(file, "the odometer bars", "notebook 04, `evaluate.odometer`")]
+    order = {m: i for i, m in enumerate(ODOMETER_METHODS)}
+    t = summary.assign(row=[m if s != s else f"{m} {s:g} m/s" for m, s in zip(summary["method"],
+                                                                              summary["sigma_mps"])],
+                       rank=summary["method"].map(order))
+    wide = (t.sort_values(["dataset", "rank", "sigma_mps"], kind="stable")
+            .pivot_table(index=["dataset", "row"], columns="duration_s", values="max_h_m", sort=False))
+    wide.columns = [f"{c:g} s" for c in wide.columns]
+    return [compact(wide.style.format("{:.1f}"), f"Median max horizontal error (m) over the sweep's starts, "
+                                                 f"profile {res.profile}"),
+            bullets(odometer_lines(summary))]
 
 
 def sweep_section(res: ProfileResults) -> list:

@@ -46,6 +46,9 @@ def test_summary_takes_the_median_ratio_to_ins_nhc_start_by_start():
     assert s.loc["RIDGE-ODO", "max_h_m"] == 20.0 and s.loc["INS+NHC", "max_h_m"] == 20.0
     assert s.loc["RIDGE-ODO", "ratio_to_nhc"] == pytest.approx(0.5)          # ratios 0.5, 1.5, 0.5
     assert s.loc["INS+NHC", "runs"] == 3
+    # differences -5, +10, -20: ranks 1, 2, 3, W+ = 2; exact two-sided p = 2 P(W+ <= 2) = 2 * 3/8
+    assert s.loc["RIDGE-ODO", "p_vs_nhc"] == pytest.approx(0.75)
+    assert np.isnan(s.loc["INS+NHC", "p_vs_nhc"])                            # no non-zero difference
 
 
 def test_rows_of_a_synthetic_drive(monkeypatch):

@@ -9,8 +9,10 @@ on a drive, with the same starts, folds and durations as the sweep (:func:`bgfn.
 - ``RIDGE-ODO``: ridge regression on the band energies of the IMU window of ``window_s`` seconds ending at the epoch (:class:`bgfn.learning.odometry.RidgeOdometer`),
   trained per fold on the GPS-aided solution's forward speed outside that fold's outages (+- ``train.margin_s``),
   its std the RMS of its residuals on a held-out block in the middle of the remaining windows;
-- ``ORACLE-SPEED``: the reference's horizontal speed plus white noise of std ``sigma`` (the grid ``sigmas_mps``)
-  and a random walk of ``walk_mps_per_sqrt_s``, fused with std ``sigma``: how accurate a speed must be to help.
+- ``ORACLE-SPEED``: the reference's horizontal speed plus white noise of std ``sigma`` (the grid ``sigmas_mps``),
+  fused with std ``sigma``: how accurate a speed must be to help; ``ORACLE-SPEED+WALK`` (when
+  ``walk_mps_per_sqrt_s`` > 0): the same plus a random walk the fused std does not know of, the slowly drifting
+  error a learned odometer makes between the drive's situations.
 
 Every row is fused at the aid epochs (``nav.nhc.rate_hz``) through the chi-square gate (``gate_probability``).
 Each row also carries the speed error the odometer made inside the outage against the reference's speed
@@ -37,10 +39,11 @@ from bgfn.learning.split import forbidden_intervals, overlaps
 from bgfn.nav import odometer as no
 from bgfn.paper import nhc_label
 from bgfn.parallel import Runner
+from bgfn.stats import wilcoxon_p
 
-HOLD, RIDGE, ORACLE = "INS+NHC+HOLD", "RIDGE-ODO", "ORACLE-SPEED"
+HOLD, RIDGE, ORACLE, ORACLE_WALK = "INS+NHC+HOLD", "RIDGE-ODO", "ORACLE-SPEED", "ORACLE-SPEED+WALK"
 #: Rows of the odometer table, in order.
-ODOMETER_METHODS: tuple[str, ...] = (nhc_label("INS"), HOLD, RIDGE, ORACLE)
+ODOMETER_METHODS: tuple[str, ...] = (nhc_label("INS"), HOLD, RIDGE, ORACLE, ORACLE_WALK)
 #: Columns of ``tables/outage_odometer.csv``.
 ODOMETER_COLUMNS: tuple[str, ...] = ("dataset", "start_s", "duration_s", "method", "sigma_mps", "seed", "fold",
                                      "max_h_m", "rmse_h_m", "final_h_m", "speed_rmse_mps", "coverage_2sigma")
@@ -137,13 +140,13 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
             runs.append(OdometerRun(f"{dataset} {s:.0f} s {HOLD}", [(s, d)], no.Odometer(con, held, gate), HOLD,
                                     np.nan, 0, int(k)))
             tracks[runs[-1].label] = held
-        for sigma in oc["sigmas_mps"]:
-            for seed in oc["seeds"]:
-                track = oracle_track(all_windows.t_end, truth, float(sigma), float(oc["walk_mps_per_sqrt_s"]),
-                                     int(seed), rate)
-                runs.append(OdometerRun(f"{dataset} fold {k} {ORACLE} {sigma:g} m/s seed {seed}", fw,
-                                        no.Odometer(con, track, gate), ORACLE, float(sigma), int(seed), int(k)))
-                tracks[runs[-1].label] = track
+        walks = [(ORACLE, 0.0)] + ([(ORACLE_WALK, float(oc["walk_mps_per_sqrt_s"]))]
+                                   if oc["walk_mps_per_sqrt_s"] > 0 else [])
+        for (method, walk), sigma, seed in ((w, s, e) for w in walks for s in oc["sigmas_mps"] for e in oc["seeds"]):
+            track = oracle_track(all_windows.t_end, truth, float(sigma), walk, int(seed), rate)
+            runs.append(OdometerRun(f"{dataset} fold {k} {method} {sigma:g} m/s seed {seed}", fw,
+                                    no.Odometer(con, track, gate), method, float(sigma), int(seed), int(k)))
+            tracks[runs[-1].label] = track
     results = (runner or Runner()).map(odometer_run, [(ctx, r, ecfg["pseudo_gps"]) for r in runs],
                                        labels=[r.label for r in runs], desc=f"odometer bars {dataset}")
     rows = []
@@ -204,7 +207,7 @@ class OdometerSection:
         """The summary at the sweep's durations as a Markdown table (the oracle per sigma), then the lines."""
         if self.summary.empty:
             return "No odometer bars (``evaluate.odometer.datasets`` is empty or the sweep has no dataset)."
-        t = self.summary.assign(method=[m if m != ORACLE else f"{m} {s:g} m/s" for m, s in
+        t = self.summary.assign(method=[m if s != s else f"{m} {s:g} m/s" for m, s in
                                         zip(self.summary["method"], self.summary["sigma_mps"])])
         wide = t.pivot_table(index=["dataset", "method"], columns="duration_s", values="max_h_m", sort=False)
         head = "| dataset | method | " + " | ".join(f"{d:g} s" for d in wide.columns) + " |"
@@ -234,7 +237,8 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
 
 def odometer_summary(rows: pd.DataFrame) -> pd.DataFrame:
     """Median max horizontal error (m) per dataset, duration and method (the oracle per sigma), with the median
-    speed RMSE and 2-sigma coverage, and the median per-start ratio to ``INS+NHC``."""
+    speed RMSE and 2-sigma coverage, the median per-start ratio to ``INS+NHC`` and the two-sided Wilcoxon
+    signed-rank p-value of the per-start differences to it (``p_vs_nhc``; seeds' median per start)."""
     if rows.empty:
         return pd.DataFrame()
     base = rows[rows["method"] == nhc_label("INS")].groupby(["dataset", "duration_s", "start_s"])["max_h_m"].first()
@@ -245,6 +249,11 @@ def odometer_summary(rows: pd.DataFrame) -> pd.DataFrame:
         max_h_m=("max_h_m", "median"), ratio_to_nhc=("ratio_to_nhc", "median"),
         speed_rmse_mps=("speed_rmse_mps", "median"), coverage_2sigma=("coverage_2sigma", "median"),
         runs=("max_h_m", "size")).reset_index()
+    # Wilcoxon signed-rank of the per-start difference to INS+NHC (one value per start: the seeds' median)
+    per_start = r.groupby(key + ["start_s"], dropna=False, sort=False)[["max_h_m", "nhc_m"]].median()
+    p = per_start.groupby(level=key, dropna=False, sort=False).apply(
+        lambda g: wilcoxon_p(g["max_h_m"] - g["nhc_m"])).rename("p_vs_nhc").reset_index()
+    out = out.merge(p, on=key, how="left")                  # pandas matches the NaN sigma of non-oracle rows
     return out.sort_values(["dataset", "duration_s"], kind="stable").reset_index(drop=True)
 
 
@@ -259,13 +268,16 @@ def odometer_lines(summary: pd.DataFrame) -> list[str]:
             if len(by[m]):
                 row = by[m].iloc[0]
                 part.append(f"{m} {row['max_h_m']:.1f} m ({row['ratio_to_nhc']:.2f} of INS+NHC per start"
+                            + (f", Wilcoxon p = {row['p_vs_nhc']:.2g}" if "p_vs_nhc" in row else "")
                             + (f"; speed RMSE {row['speed_rmse_mps']:.2f} m/s, 2-sigma coverage "
                                f"{100 * row['coverage_2sigma']:.0f} %" if m == RIDGE else "") + ")")
-        orc = by[ORACLE].sort_values("sigma_mps")
-        better = orc[orc["max_h_m"] < nhc]
-        part.append("an oracle speed beats INS+NHC " + (f"up to a noise of {better['sigma_mps'].max():g} m/s "
-                                                         f"(at {better['sigma_mps'].min():g} m/s: "
-                                                         f"{better['max_h_m'].iloc[0]:.1f} m)" if len(better) else
-                                                         "at no noise level of the grid"))
+        for m, what in ((ORACLE, "an oracle speed"), (ORACLE_WALK, "with a random walk")):
+            orc = by[m].sort_values("sigma_mps")
+            if len(orc):
+                best = orc.loc[orc["max_h_m"].idxmin()]
+                better = orc[orc["max_h_m"] < nhc]
+                part.append(f"{what} beats INS+NHC " + (f"up to a noise of {better['sigma_mps'].max():g} m/s"
+                                                         if len(better) else "at no noise level of the grid")
+                            + f" (its best: {best['max_h_m']:.1f} m at {best['sigma_mps']:g} m/s)")
         lines.append("; ".join(part) + ".")
     return lines

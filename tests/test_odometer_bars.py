@@ -67,3 +67,13 @@ def test_rows_of_a_synthetic_drive(monkeypatch):
     oracle = rows[rows["method"] == "ORACLE-SPEED"].groupby("sigma_mps")["speed_rmse_mps"].median()
     assert oracle[0.1] < 0.2 and 0.5 < oracle[1.0] < 1.6
     assert set(facts["ridge_std_mps"]) == {0, 1} and all(v > 0 for v in facts["ridge_std_mps"].values())
+
+
+def test_the_speed_figure_draws_each_outage_from_its_own_fold():
+    t = np.arange(0.0, 200.0)
+    series = {"time": t, "truth": np.full(t.size, 10.0), "speed": np.where(t > 50, 11.0, np.nan),
+              "std": np.full(t.size, 0.5), "outages": [(60.0, 30.0), (100.0, 30.0), (140.0, 30.0)]}
+    fig = O.plot_speed_series(series, "d", n_outages=2)
+    axes = fig.axes
+    assert len(axes) == 2 and axes[0].get_title() == "start 60 s" and axes[1].get_title() == "start 140 s"
+    assert axes[0].get_ylabel() == "forward speed (m/s)"

@@ -22,18 +22,19 @@ Each row also carries the speed error the odometer made inside the outage agains
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
 from bgfn.config import SHARED_TABLES
-from bgfn.data import load_drive
+from bgfn.data import dataset_id, load_drive
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.evaluate.sweep import profile_sweep_plan
-from bgfn.io import atomic_write_csv
+from bgfn.io import atomic_write_csv, save_figure
 from bgfn.learning import odometry as lo
 from bgfn.learning.split import forbidden_intervals, overlaps
 from bgfn.nav import odometer as no
@@ -125,10 +126,15 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
     gate = oc["gate_probability"]
     margin = float((cfg.get("train") or {}).get("margin_s", 30.0))
     runs, tracks, facts = [], {}, {"ridge_std_mps": {}, "epochs": int(len(all_windows))}
+    honest = {"time": all_windows.t_end, "truth": truth, "speed": np.full(truth.size, np.nan),
+              "std": np.full(truth.size, np.nan), "outages": []}      # each outage's speed from its own fold
     for k in sorted(plan["fold"].unique()):
         fw = [(float(s), dmax) for s in plan.loc[plan["fold"] == k, "start_s"]]
         model, track = fold_ridge(ws, all_windows, fw, margin, float(oc["ridge_alpha"]), imu_rate)
         facts["ridge_std_mps"][int(k)] = model.std_mps
+        inside = overlaps(all_windows.t_end, all_windows.t_end, np.array([[s, s + d] for s, d in fw]))
+        honest["speed"][inside], honest["std"][inside] = track.speed[inside], track.std[inside]
+        honest["outages"] += fw
         runs.append(OdometerRun(f"{dataset} fold {k} {RIDGE}", fw, no.Odometer(con, track, gate), RIDGE,
                                 np.nan, 0, int(k)))
         tracks[runs[-1].label] = track
@@ -160,6 +166,7 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
                              **{c: m[c] for c in ("max_h_m", "rmse_h_m", "final_h_m")},
                              **speed_errors(track, all_windows.t_end, truth, r.start, float(du))})
     facts["wall_s"] = time.perf_counter() - t0
+    facts["ridge_series"] = honest
     return pd.DataFrame(rows, columns=list(ODOMETER_COLUMNS)), facts
 
 
@@ -202,6 +209,7 @@ class OdometerSection:
     summary: pd.DataFrame
     lines: list
     facts: dict
+    figures: list = field(default_factory=list)
 
     def markdown(self) -> str:
         """The summary at the sweep's durations as a Markdown table (the oracle per sigma), then the lines."""
@@ -230,9 +238,38 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
     tables = Path(out) / "tables"
     atomic_write_csv(tables / SHARED_TABLES["odometer"], rows, float_format="%.4f")
     atomic_write_csv(tables / SHARED_TABLES["odometer_summary"], summary, float_format="%.4f")
+    figures = []
+    for name, f in facts.items():
+        figures.append(plot_speed_series(f["ridge_series"], name))
+        save_figure(figures[-1], Path(out) / "figures" / f"odometer_speed_{dataset_id(name)}.png")
+        plt.close(figures[-1])
     if timings is not None:
         timings["odometer_s"] = time.perf_counter() - t0
-    return OdometerSection(rows, summary, odometer_lines(summary) if len(summary) else [], facts)
+    return OdometerSection(rows, summary, odometer_lines(summary) if len(summary) else [], facts, figures)
+
+
+def plot_speed_series(series: dict, dataset: str, n_outages: int = 4):
+    """RIDGE-ODO's speed with its 2-sigma band against the reference's in the first outages of each fold
+    (every outage predicted by the ridge of its own fold, trained without it)."""
+    outages = sorted(series["outages"])
+    pick = [outages[i] for i in np.unique(np.linspace(0, len(outages) - 1, min(n_outages, len(outages))).round()
+                                          .astype(int))] if outages else []
+    fig, axes = plt.subplots(1, max(len(pick), 1), figsize=(3.2 * max(len(pick), 1), 2.8), sharey=True,
+                             squeeze=False)
+    t, truth, speed, std = (np.asarray(series[k], float) for k in ("time", "truth", "speed", "std"))
+    for ax, (s, d) in zip(axes[0], pick):
+        m = (t >= s) & (t <= s + d)
+        ax.fill_between(t[m] - s, speed[m] - 2 * std[m], speed[m] + 2 * std[m], color="tab:orange", alpha=0.25,
+                        label="RIDGE-ODO +- 2 sigma")
+        ax.plot(t[m] - s, speed[m], color="tab:orange", label="RIDGE-ODO")
+        ax.plot(t[m] - s, truth[m], color="black", lw=1.2, label="reference")
+        ax.set_title(f"start {s:.0f} s", fontsize=9)
+        ax.set_xlabel("time in outage (s)")
+    axes[0][0].set_ylabel("forward speed (m/s)")
+    axes[0][0].legend(fontsize=7, loc="best")
+    fig.suptitle(f"{dataset}: the ridge odometer's speed in outages it was not trained on", fontsize=10)
+    fig.tight_layout()
+    return fig
 
 
 def odometer_summary(rows: pd.DataFrame) -> pd.DataFrame:

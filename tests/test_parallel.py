@@ -146,3 +146,45 @@ def test_a_paired_ratio_is_unreliable_when_its_spread_exceeds_the_difference():
     assert ratio_text(noisy).endswith("unreliable: the spread is wider than the difference")
     with pytest.raises(ValueError):
         paired_ratio([1.0], [1.0, 2.0])
+
+
+# ----------------------------------------------------------------------------------------------- the sweep, the oracle
+@pytest.fixture(scope="module")
+def synthetic_sweep_setup(tmp_path_factory):
+    from synthetic_drive import demo_drive
+
+    from bgfn import evaluate as ev
+
+    cfg = load_profile("smoke")
+    nav = {"init": {"position_std_m": 1.0, "height_std_m": 2.0, "velocity_std_mps": 0.1, "level_std_deg": 0.2,
+                    "azimuth_std_deg": 1.0}}
+    cfg = {**cfg, "nav": nav, "train": {**cfg["train"], "window": 20, "margin_s": 5.0}}
+    ecfg = ev.evaluate_config({"methods": ["mlp"], "sweep": {
+        "n_starts": 2, "folds": 2, "durations_s": [10.0], "warmup_s": 30.0, "seeds": [0, 1],
+        "train": {"optimizer": {"epochs": 1, "max_train_windows": 64, "max_val_windows": 32}}}}, cfg["train"])
+    return demo_drive("synthetic", 150.0, 5.0, 3), cfg, ecfg
+
+
+def test_the_sweep_gives_the_same_rows_with_one_job_and_with_two(synthetic_sweep_setup, tmp_path, monkeypatch):
+    from bgfn import config, evaluate as ev
+
+    drive, cfg, ecfg = synthetic_sweep_setup
+    tables = {}
+    for jobs in (1, 2):
+        monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path / f"jobs{jobs}")    # networks trained anew each time
+        rows, info = ev.run_sweep(cfg, "t", "synthetic", drive=drive, ecfg=ecfg, runner=Runner(jobs))
+        tables[jobs] = rows.to_csv(index=False)
+        assert (tmp_path / f"jobs{jobs}").exists()                              # the workers wrote there
+    assert tables[1] == tables[2] and "MLP" in tables[1]
+
+
+def test_the_oracle_grid_gives_the_same_rows_with_one_job_and_with_two(synthetic_sweep_setup):
+    from bgfn import evaluate as ev
+    from bgfn.evaluate import oracle as orc
+
+    drive, cfg, _ = synthetic_sweep_setup
+    windows = [("1", 40.0, 30.0), ("2", 75.0, 30.0)]
+    ctx = ev.navigation_context(drive, cfg["nav"], [s for _, s, _ in windows])
+    grid = {"sigmas_m": [0.0, 0.5, 2.0], "seeds": [0, 1], "durations_s": [30.0]}
+    one, two = (orc.oracle_runs(ctx, windows, grid, runner=Runner(j)) for j in (1, 2))
+    assert one.to_csv(index=False) == two.to_csv(index=False) and len(one) == 2 * (1 + 1 + 2 * 2)

@@ -94,3 +94,30 @@ def test_calibration_factor_makes_the_normalized_residuals_unit():
     assert od.calibration_factor(r, np.full(r.size, k)) == pytest.approx(1.0, rel=1e-9)
     with pytest.raises(DataError, match="calibration"):
         od.calibration_factor([np.nan], [1.0])
+
+
+def test_speed_data_split_is_honest():
+    imu, t, speed = _vibrating_drive()
+    epochs = np.arange(5.0, 595.0, 1.0)
+    ws = od.speed_windows(imu, epochs, 200, np.interp(epochs, t, speed))
+    data = od.build_speed_data(ws, [(300.0, 30.0)], margin_s=10.0, val_fraction=0.2)
+    for part in (data.train, data.val):                     # nothing touches the outage +- margin
+        assert not ((part.t_end > 290.0) & (part.t_start < 340.0)).any()
+    assert data.val.t_start.min() > data.train.t_end.max() or data.val.t_end.max() < data.train.t_start.min() or \
+        not ((data.train.t_end >= data.val.t_start.min()) & (data.train.t_start <= data.val.t_end.max())).any()
+    assert data.norm.y_mean[0] == pytest.approx(data.train.speed.mean())
+    assert data.options["objective"] == "speed" and data.train.y.shape == (len(data.train), 1)
+
+
+def test_a_network_odometer_learns_speed_and_its_uncertainty(tmp_path):
+    from bgfn import train as T
+
+    imu, t, speed = _vibrating_drive()
+    epochs = np.arange(5.0, 595.0, 1.0)
+    data = od.build_speed_data(od.speed_windows(imu, epochs, 200, np.interp(epochs, t, speed)), [(300.0, 30.0)],
+                               margin_s=10.0)
+    cfg = {"optimizer": {"epochs": 15, "batch_size": 16, "lr": 3e-3, "patience": 50}}
+    card = T.train_model("mlp", data, {"n_recent": 200, "hidden": 32}, cfg, seed=0, out_dir=tmp_path)
+    assert "val_rmse_mps" in card and "val_rmse_m" not in card
+    assert card["val_rmse_mps"] < 0.5 * card["val_rmse_mean_mps"]        # far better than the mean speed
+    assert card["best_epoch"] >= 1 and card["history"][0]["val_rmse_mps"] > card["val_rmse_mps"]

@@ -26,6 +26,8 @@ import numpy as np
 import pandas as pd
 
 from bgfn.errors import DataError
+from bgfn.learning.normalize import Normalizer
+from bgfn.learning.split import forbidden_intervals, overlaps
 from bgfn.learning.windows import _gather, _windows_ending_at
 from bgfn.nav.transform import dcm_from_euler
 from bgfn.schema import ACCEL_COLUMNS, GYRO_COLUMNS
@@ -89,6 +91,57 @@ class SpeedWindows:
     def span(self) -> tuple[np.ndarray, np.ndarray]:
         """Time span ``[lo, hi]`` each window touches, s (its inputs; the target is at its end)."""
         return self.t_start, self.t_end
+
+    @property
+    def y(self) -> np.ndarray:
+        """The targets as a column [M, 1] (what a training run's data fingerprint reads)."""
+        return self.speed[:, None]
+
+
+@dataclass
+class SpeedData:
+    """Training and validation windows of a learned odometer and their standardization (training windows only).
+
+    Attributes
+    ----------
+    train, val : SpeedWindows
+    norm : Normalizer
+        Per-channel input and speed standardization (``y_mean``/``y_std`` of length 1).
+    options : dict
+        ``window`` (IMU samples), ``margin_s``, ``val_fraction`` and ``objective: speed``.
+    info : dict
+        Window counts of the split.
+    """
+
+    train: SpeedWindows
+    val: SpeedWindows
+    norm: Normalizer
+    options: dict
+    info: dict
+
+
+def build_speed_data(ws: SpeedWindows, outage_windows=(), margin_s: float = 30.0,
+                     val_fraction: float = 0.2) -> SpeedData:
+    """The honest split of speed windows ``ws`` (sorted by time): windows touching an outage +- ``margin_s`` are
+    dropped, the middle ``val_fraction`` of the rest is the validation block, and training windows touching that
+    block are dropped too; the normalizer is fitted on the training windows."""
+    lo_, hi_ = ws.span
+    idx = np.flatnonzero(~overlaps(lo_, hi_, forbidden_intervals(outage_windows, margin_s)) & np.isfinite(ws.speed))
+    n_val = max(1, int(round(val_fraction * idx.size)))
+    val = idx[(idx.size - n_val) // 2:(idx.size - n_val) // 2 + n_val]
+    if val.size == 0 or idx.size - val.size < 2:
+        raise DataError("train", "windows", "at least 2 training and 1 validation speed window outside the outages",
+                        f"{idx.size} in all")
+    block = np.array([[ws.t_start[val].min(), ws.t_end[val].max()]])
+    train = idx[~overlaps(lo_[idx], hi_[idx], block)]
+    tr, va = ws.subset(train), ws.subset(val)
+    x = tr.x.reshape(-1, tr.x.shape[-1]).astype(np.float64)
+    norm = Normalizer(x.mean(0), np.maximum(x.std(0), 1e-8), np.array([tr.speed.mean()]),
+                      np.array([max(float(tr.speed.std()), 1e-8)]))
+    options = {"window": int(ws.x.shape[1]), "margin_s": float(margin_s), "val_fraction": float(val_fraction),
+               "objective": "speed"}
+    return SpeedData(tr, va, norm, options, {"n_train": int(train.size), "n_val": int(val.size),
+                                             "n_outage_excluded": int(ws.x.shape[0] - idx.size)})
 
 
 def speed_windows(imu: pd.DataFrame, epochs, window: int, speed=None) -> SpeedWindows:

@@ -6,6 +6,7 @@ Modules, one concept each (every public name is re-exported here):
 - :mod:`bgfn.train.options`: the ``train:`` optimizer settings, per-method learning rate, model size blocks;
 - :mod:`bgfn.train.loop`: :func:`train_model`, one ``(method, seed)`` with early stopping, checkpoint, card and
   resume;
+- :mod:`bgfn.train.objectives`: what a run fits, the paper's increments or a learned odometer's speed;
 - :mod:`bgfn.train.trained`: :class:`TrainedModel` and :func:`load_trained`, a checkpoint predicting
   delta_p_gps (Eq. pred-gps);
 - :mod:`bgfn.train.tasks`: a network to train as one independent run (:class:`TrainingRun`), all of them spread

@@ -12,7 +12,8 @@
   scheduler, RNG), from which an interrupted run resumes; removed when the run completes.
 
 Every method gets the same budget (:mod:`bgfn.train.options`): AdamW, the same epochs, batch size, schedule and
-early stopping on the validation loss (MSE of the normalized increments).
+early stopping on the validation loss (MSE of the normalized increments; for a learned odometer's speed data the
+beta-NLL of its speed and variance, :mod:`bgfn.train.objectives`).
 
 A completed run is not redone: if its card exists with the same configuration hash, :func:`train_model`
 returns the card (delete the files to retrain).
@@ -37,9 +38,10 @@ from tqdm import tqdm
 
 from bgfn.errors import DataError
 from bgfn.io import atomic_path, atomic_write_json
-from bgfn.learning import LearningData, from_target_frame, reference_columns, reference_rmse, rmse, to_target_frame
+from bgfn.learning import LearningData
 from bgfn.models import build_model, count_parameters, is_spiking
 from bgfn.train import checkpoints
+from bgfn.train.objectives import objective_of
 from bgfn.train.options import even_subset, method_lr, optimizer_options
 from bgfn.train.trained import pick_device, predict_normalized
 
@@ -96,8 +98,10 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
     ----------
     method : str
         ``bgfn``, ``transformer``, ``at_lstm`` or ``mlp``.
-    data : LearningData
-        Training/validation windows and normalization (:func:`bgfn.learning.build_learning_data`).
+    data : LearningData or SpeedData
+        Training/validation windows and normalization (:func:`bgfn.learning.build_learning_data`; a learned
+        odometer's :func:`bgfn.learning.odometry.build_speed_data`). Its objective
+        (:func:`bgfn.train.objectives.objective_of`) sets the targets, the loss, the error and the references.
     size_cfg : dict
         Model constructor keywords (:func:`bgfn.train.options.size_config`).
     train_cfg : dict
@@ -117,7 +121,7 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
     -------
     dict
         The card: ``method``, ``seed``, ``params``, ``epochs_run``, ``best_epoch``, ``best_val_loss``,
-        ``val_rmse_m``, the references of :func:`bgfn.learning.reference_rmse` on the same windows
+        ``val_rmse_m`` (``val_rmse_mps`` for a speed), the references of the objective on the same windows
         (``val_rmse_zero_m``, ``val_rmse_last_m``, ``val_rmse_ins_m``), ``wall_time_s``, ``device``, ``history``, ...
     """
     size_cfg = dict(size_cfg or {})
@@ -134,6 +138,7 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
         raise DataError("train", "windows", "at least one training and one validation window",
                         f"{len(train_ws)} and {len(val_ws)}")
     in_channels = train_ws.x.shape[-1]
+    obj = objective_of(data)                                # the paper's increments, or an odometer's speed
     config = {"method": method, "seed": int(seed), "card": CARD_VERSION, "size_cfg": size_cfg, "optimizer": o, "lr": lr,
               "options": data.options, "data": _data_fingerprint(data), "device": dev.type}
     chash = _config_hash(config)
@@ -146,7 +151,7 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
         card = json.loads(card_path.read_text())
         if card.get("complete") and card.get("config_hash") == chash:
             # the references need no training: recomputed, so a card written by older code gains new ones
-            refs = reference_columns(reference_rmse(val_ws))
+            refs = obj.references(val_ws)
             if any(json.dumps(card.get(k)) != json.dumps(v) for k, v in refs.items()):   # NaN == NaN here
                 card.update(refs)
                 atomic_write_json(card_path, card)
@@ -158,16 +163,12 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
     sched = _make_scheduler(optim, o)
     gen = torch.Generator().manual_seed(int(seed))
 
-    frame = data.options.get("target_frame", "ned")
     xtr = torch.as_tensor(data.norm.x(train_ws.x))          # [M, N, C]
-    ytr = torch.as_tensor(data.norm.y(to_target_frame(train_ws.y, train_ws.yaw_ref, frame)))   # [M, 2]
+    ytr = obj.targets(train_ws)                             # [M, 2] increments, or [M, 1] speeds
     xva = data.norm.x(val_ws.x)
-    yva = torch.as_tensor(data.norm.y(to_target_frame(val_ws.y, val_ws.yaw_ref, frame)))
-
-    def to_metres(pred_normalized):                         # model outputs -> (dN, dE), m
-        return from_target_frame(data.norm.y_inverse(pred_normalized), val_ws.yaw_ref, frame)
+    yva = obj.targets(val_ws)
     spiking = is_spiking(model)
-    loss_fn = nn.MSELoss()
+    loss_fn = obj.loss
 
     history: list[dict] = []
     best = {"val_loss": float("inf"), "epoch": -1}
@@ -199,8 +200,8 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
         te = time.perf_counter()
         pred = predict_normalized(model, xva, o["eval_batch_size"], dev)
         val_loss = float(loss_fn(torch.as_tensor(pred), yva))
-        history.append({"epoch": 0, "train_loss": None, "val_loss": val_loss, "val_rmse_m": rmse(to_metres(pred),
-                        val_ws.y), "lr": optim.param_groups[0]["lr"], "time_s": time.perf_counter() - te})
+        history.append({"epoch": 0, "train_loss": None, "val_loss": val_loss, obj.metric_key: obj.error(pred, val_ws),
+                        "lr": optim.param_groups[0]["lr"], "time_s": time.perf_counter() - te})
         best = {"val_loss": val_loss, "epoch": 0}
         keep_best(0)
         start_epoch = 1
@@ -230,12 +231,12 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
             count += len(b)
         pred = predict_normalized(model, xva, o["eval_batch_size"], dev)
         val_loss = float(loss_fn(torch.as_tensor(pred), yva))
-        val_rmse = rmse(to_metres(pred), val_ws.y)
+        val_rmse = obj.error(pred, val_ws)
         cur_lr = optim.param_groups[0]["lr"]
         if sched is not None:
             sched.step(val_loss) if o["schedule"] == "plateau" else sched.step()
         history.append({"epoch": epoch, "train_loss": total / max(count, 1), "val_loss": val_loss,
-                        "val_rmse_m": val_rmse, "lr": cur_lr, "time_s": time.perf_counter() - te})
+                        obj.metric_key: val_rmse, "lr": cur_lr, "time_s": time.perf_counter() - te})
         if val_loss < best["val_loss"] * (1.0 - o["min_delta"]):
             best = {"val_loss": val_loss, "epoch": epoch}
             bad_epochs = 0
@@ -258,14 +259,13 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
         model.load_state_dict(torch.load(best_path, map_location=dev, weights_only=False)["state_dict"])
     elif "state" in best:
         model.load_state_dict(best.pop("state"))
-    pred_m = to_metres(predict_normalized(model, xva, o["eval_batch_size"], dev))
-    refs = reference_rmse(val_ws)
+    pred = predict_normalized(model, xva, o["eval_batch_size"], dev)
     card = {
         "method": method, "seed": int(seed), "params": count_parameters(model), "size_cfg": size_cfg,
         "lr": lr, "optimizer": o, "options": data.options, "in_channels": in_channels,
         "epochs_run": epochs_run, "best_epoch": best["epoch"], "best_val_loss": best["val_loss"],
         "stopped_early": epochs_run < int(o["epochs"]),
-        "val_rmse_m": rmse(pred_m, val_ws.y), **reference_columns(refs),
+        obj.metric_key: obj.error(pred, val_ws), **obj.references(val_ws),
         "n_train": len(train_ws), "n_val": len(val_ws), "split": data.info,
         "wall_time_s": wall, "train_windows_per_s": (len(train_ws) * epochs_run / wall) if wall > 0 else None,
         "device": dev.type if dev.type == "cpu" else torch.cuda.get_device_name(dev),

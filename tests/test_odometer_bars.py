@@ -51,22 +51,31 @@ def test_summary_takes_the_median_ratio_to_ins_nhc_start_by_start():
     assert np.isnan(s.loc["INS+NHC", "p_vs_nhc"])                            # no non-zero difference
 
 
-def test_rows_of_a_synthetic_drive(monkeypatch):
+def test_rows_of_a_synthetic_drive(monkeypatch, tmp_path):
+    from bgfn import config
+
+    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)            # the network odometers' checkpoints
     drive = demo_drive("synthetic", 150.0, 5.0, 3)
     cfg = load_profile("smoke")
     cfg = {**cfg, "nav": NAV, "train": {**cfg["train"], "window": 50, "margin_s": 5.0}}
     ecfg = ev.evaluate_config({"sweep": {"n_starts": 2, "folds": 2, "durations_s": [10.0, 30.0], "warmup_s": 30.0},
-                               "odometer": {"sigmas_mps": [0.1, 1.0], "seeds": [0, 1]}}, cfg["train"])
+                               "odometer": {"sigmas_mps": [0.1, 1.0], "seeds": [0, 1], "methods": ["mlp"]}},
+                              cfg["train"])
     rows, facts = O.odometer_rows(cfg, "t", "synthetic", ecfg, drive=drive)
     assert list(rows.columns) == list(O.ODOMETER_COLUMNS)
     n = rows.groupby(["method", "duration_s"]).size()
     # 2 starts: INS+NHC, HOLD and RIDGE one row each per start; the oracle 2 sigmas x 2 seeds per start
     assert n.xs(10.0, level="duration_s").to_dict() == {"INS+NHC": 2, "INS+NHC+HOLD": 2, "RIDGE-ODO": 2,
-                                                         "ORACLE-SPEED": 8}
+                                                         "MLP-ODO": 2, "ORACLE-SPEED": 8}
     assert rows.loc[rows["method"] == "INS+NHC", "speed_rmse_mps"].isna().all()
     oracle = rows[rows["method"] == "ORACLE-SPEED"].groupby("sigma_mps")["speed_rmse_mps"].median()
     assert oracle[0.1] < 0.2 and 0.5 < oracle[1.0] < 1.6
     assert set(facts["ridge_std_mps"]) == {0, 1} and all(v > 0 for v in facts["ridge_std_mps"].values())
+    # one network odometer per fold, its std calibrated on its own validation windows
+    assert sorted(facts["networks"]) == ["MLP-ODO fold 0 seed 0", "MLP-ODO fold 1 seed 0"]
+    assert all(f["calibration"] > 0 for f in facts["networks"].values())
+    assert rows.loc[rows["method"] == "MLP-ODO", "speed_rmse_mps"].notna().all()
+    assert (tmp_path / "t").exists()
 
 
 def test_the_speed_figure_draws_each_outage_from_its_own_fold():

@@ -9,6 +9,10 @@ on a drive, with the same starts, folds and durations as the sweep (:func:`bgfn.
 - ``RIDGE-ODO``: ridge regression on the band energies of the IMU window of ``window_s`` seconds ending at the epoch (:class:`bgfn.learning.odometry.RidgeOdometer`),
   trained per fold on the GPS-aided solution's forward speed outside that fold's outages (+- ``train.margin_s``),
   its std the RMS of its residuals on a held-out block in the middle of the remaining windows;
+- ``BGFN-ODO``, ``Transformer-ODO``, ``AT-LSTM-ODO``, ``MLP-ODO`` (``methods``): the networks as learned odometers,
+  the forward speed and its log-variance from the same IMU-only windows, trained per fold with beta-NLL
+  (:class:`bgfn.train.objectives.SpeedObjective`) and the sweep's budget, their std calibrated on their validation
+  windows (NIS = 1) (:func:`network_odometers`);
 - ``ORACLE-SPEED``: the reference's horizontal speed plus white noise of std ``sigma`` (the grid ``sigmas_mps``),
   fused with std ``sigma``: how accurate a speed must be to help; ``ORACLE-SPEED+WALK`` (when
   ``walk_mps_per_sqrt_s`` > 0): the same plus a random walk the fused std does not know of, the slowly drifting
@@ -33,18 +37,24 @@ import pandas as pd
 from bgfn.config import SHARED_TABLES
 from bgfn.data import dataset_id, load_drive
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
-from bgfn.evaluate.sweep import profile_sweep_plan
+from bgfn.evaluate.sweep import profile_sweep_plan, sweep_train_config
 from bgfn.io import atomic_write_csv, save_figure
 from bgfn.learning import odometry as lo
 from bgfn.learning.split import forbidden_intervals, overlaps
+from bgfn.train.checkpoints import checkpoint_name, models_dir
+from bgfn.train.objectives import SpeedObjective
 from bgfn.nav import odometer as no
-from bgfn.paper import nhc_label
+from bgfn import train
+from bgfn.paper import METHOD_LABELS, nhc_label
 from bgfn.parallel import Runner
 from bgfn.stats import wilcoxon_p
 
 HOLD, RIDGE, ORACLE, ORACLE_WALK = "INS+NHC+HOLD", "RIDGE-ODO", "ORACLE-SPEED", "ORACLE-SPEED+WALK"
+#: A network odometer's row: ``BGFN-ODO``, ``Transformer-ODO``, ...
+ODO_SUFFIX = "-ODO"
+NETWORK_ODOMETERS: tuple[str, ...] = tuple(f"{label}{ODO_SUFFIX}" for label in METHOD_LABELS.values())
 #: Rows of the odometer table, in order.
-ODOMETER_METHODS: tuple[str, ...] = (nhc_label("INS"), HOLD, RIDGE, ORACLE, ORACLE_WALK)
+ODOMETER_METHODS: tuple[str, ...] = (nhc_label("INS"), HOLD, RIDGE, *NETWORK_ODOMETERS, ORACLE, ORACLE_WALK)
 #: Columns of ``tables/outage_odometer.csv``.
 ODOMETER_COLUMNS: tuple[str, ...] = ("dataset", "start_s", "duration_s", "method", "sigma_mps", "seed", "fold",
                                      "max_h_m", "rmse_h_m", "final_h_m", "speed_rmse_mps", "coverage_2sigma")
@@ -153,6 +163,14 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
             runs.append(OdometerRun(f"{dataset} fold {k} {method} {sigma:g} m/s seed {seed}", fw,
                                     no.Odometer(con, track, gate), method, float(sigma), int(seed), int(k)))
             tracks[runs[-1].label] = track
+    nets = network_odometers(cfg, profile, dataset, ecfg, plan, ws, all_windows, margin, runner)
+    facts["networks"] = {}
+    for (label, k, seed), (track, fact) in nets.items():
+        fw = [(float(s), dmax) for s in plan.loc[plan["fold"] == k, "start_s"]]
+        runs.append(OdometerRun(f"{dataset} fold {k} {label} seed {seed}", fw, no.Odometer(con, track, gate), label,
+                                np.nan, seed, k))
+        tracks[runs[-1].label] = track
+        facts["networks"][f"{label} fold {k} seed {seed}"] = fact
     results = (runner or Runner()).map(odometer_run, [(ctx, r, ecfg["pseudo_gps"]) for r in runs],
                                        labels=[r.label for r in runs], desc=f"odometer bars {dataset}")
     rows = []
@@ -168,6 +186,46 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
     facts["wall_s"] = time.perf_counter() - t0
     facts["ridge_series"] = honest
     return pd.DataFrame(rows, columns=list(ODOMETER_COLUMNS)), facts
+
+
+def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, plan: pd.DataFrame, ws: lo.SpeedWindows,
+                      all_windows: lo.SpeedWindows, margin_s: float, runner: Runner | None = None) -> dict:
+    """The learned odometers of ``evaluate.odometer.methods`` (``BGFN-ODO`` ...), per sweep fold and seed: each
+    trained on that fold's honest speed data (:func:`bgfn.learning.odometry.build_speed_data`) with the sweep's
+    budget and the learning rate notebook 03 selected for the method, its std calibrated on its validation
+    windows (:func:`bgfn.learning.odometry.calibration_factor`, NIS = 1), and its speed over every epoch.
+
+    Returns ``{(label, fold, seed): (SpeedTrack, facts)}``.
+    """
+    oc, sw = ecfg["odometer"], ecfg["sweep"]
+    if not oc["methods"]:
+        return {}
+    tc = sweep_train_config(train.tuned_train_config(cfg, profile, dataset), sw)
+    dmax = max(float(d) for d in sw["durations_s"])
+    data, runs, keys = {}, [], []
+    for k in sorted(plan["fold"].unique()):
+        fw = [(float(s), dmax) for s in plan.loc[plan["fold"] == k, "start_s"]]
+        data[int(k)] = lo.build_speed_data(ws, fw, margin_s, float(tc.get("val_fraction", 0.2)))
+        out = models_dir(profile, dataset, int(k)) / "odometer"
+        for m in oc["methods"]:
+            for seed in oc["network_seeds"]:
+                label = f"{METHOD_LABELS[m]}{ODO_SUFFIX}"
+                runs.append(train.TrainingRun(f"{dataset} fold {k} {label} seed {seed}", m, data[int(k)],
+                                              train.size_config(tc, m), tc, int(seed), out, None,
+                                              {"dataset": dataset, "profile": profile, "fold": int(k),
+                                               "objective": "speed"}))
+                keys.append((label, int(k), int(seed)))
+    cards = train.train_runs(runs, runner, desc=f"odometer networks {dataset}")
+    tracks = {}
+    for key, run, card in zip(keys, runs, cards):
+        net = train.load_trained(Path(run.out_dir) / checkpoint_name(run.method, run.seed), device="cpu")
+        obj = SpeedObjective(run.data)
+        speed_val, std_val = obj.to_units(train.predict_normalized(net.model, net.norm.x(run.data.val.x)))
+        factor = lo.calibration_factor(speed_val - run.data.val.speed, std_val)
+        speed, std = obj.to_units(train.predict_normalized(net.model, net.norm.x(all_windows.x)))
+        tracks[key] = (no.SpeedTrack(all_windows.t_end, np.maximum(speed, 0.0), std * factor),
+                       {"calibration": factor, "val_rmse_mps": card["val_rmse_mps"], "epochs": card["epochs_run"]})
+    return tracks
 
 
 def speed_errors(track: no.SpeedTrack | None, t: np.ndarray, truth: np.ndarray, start: float,
@@ -301,13 +359,13 @@ def odometer_lines(summary: pd.DataFrame) -> list[str]:
         by = {m: g[g["method"] == m] for m in ODOMETER_METHODS}
         nhc = float(by[nhc_label("INS")]["max_h_m"].iloc[0]) if len(by[nhc_label("INS")]) else np.nan
         part = [f"{ds}, {du:g} s outages (median max horizontal error): INS+NHC {nhc:.1f} m"]
-        for m in (HOLD, RIDGE):
+        for m in (HOLD, RIDGE, *NETWORK_ODOMETERS):
             if len(by[m]):
                 row = by[m].iloc[0]
                 part.append(f"{m} {row['max_h_m']:.1f} m ({row['ratio_to_nhc']:.2f} of INS+NHC per start"
                             + (f", Wilcoxon p = {row['p_vs_nhc']:.2g}" if "p_vs_nhc" in row else "")
                             + (f"; speed RMSE {row['speed_rmse_mps']:.2f} m/s, 2-sigma coverage "
-                               f"{100 * row['coverage_2sigma']:.0f} %" if m == RIDGE else "") + ")")
+                               f"{100 * row['coverage_2sigma']:.0f} %" if m != HOLD else "") + ")")
         for m, what in ((ORACLE, "an oracle speed"), (ORACLE_WALK, "with a random walk")):
             orc = by[m].sort_values("sigma_mps")
             if len(orc):

@@ -57,8 +57,10 @@ def train_run(run: TrainingRun) -> dict:
 
 def run_summary(card: dict) -> str:
     """What a finished run reports on its progress line: epochs, best validation loss and where, RMSE."""
-    return (f"{card['epochs_run']} epochs, best val loss {card['best_val_loss']:.4g} (epoch {card['best_epoch']}), "
-            f"val RMSE {card['val_rmse_m']:.3f} m")
+    error = (f"val RMSE {card['val_rmse_m']:.3f} m" if "val_rmse_m" in card else
+             f"val RMSE {card['val_rmse_mps']:.3f} m/s" if "val_rmse_mps" in card else "")
+    return (f"{card['epochs_run']} epochs, best val loss {card['best_val_loss']:.4g} (epoch {card['best_epoch']})"
+            + (f", {error}" if error else ""))
 
 
 def train_runs(runs: Sequence[TrainingRun], runner: Runner | None = None, desc: str = "training",

@@ -11,7 +11,8 @@ on a drive, with the same starts, folds and durations as the sweep (:func:`bgfn.
   its std the RMS of its residuals on a held-out block in the middle of the remaining windows;
 - ``BGFN-ODO``, ``Transformer-ODO``, ``AT-LSTM-ODO``, ``MLP-ODO`` (``methods``): the networks as learned odometers,
   the forward speed and its log-variance from the same IMU-only windows, trained per fold with beta-NLL
-  (:class:`bgfn.train.objectives.SpeedObjective`) and the sweep's budget, their std calibrated on their validation
+  (:class:`bgfn.train.objectives.SpeedObjective`) with the sweep's budget and the profile's ``train.lr`` (the same
+  for every network: notebook 03's search tuned its rates for the increments), their std calibrated on their validation
   windows (NIS = 1) (:func:`network_odometers`);
 - ``ORACLE-SPEED``: the reference's horizontal speed plus white noise of std ``sigma`` (the grid ``sigmas_mps``),
   fused with std ``sigma``: how accurate a speed must be to help; ``ORACLE-SPEED+WALK`` (when
@@ -192,7 +193,7 @@ def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, plan: p
                       all_windows: lo.SpeedWindows, margin_s: float, runner: Runner | None = None) -> dict:
     """The learned odometers of ``evaluate.odometer.methods`` (``BGFN-ODO`` ...), per sweep fold and seed: each
     trained on that fold's honest speed data (:func:`bgfn.learning.odometry.build_speed_data`) with the sweep's
-    budget and the learning rate notebook 03 selected for the method, its std calibrated on its validation
+    budget and the profile's ``train.lr`` (not the increments' search), its std calibrated on its validation
     windows (:func:`bgfn.learning.odometry.calibration_factor`, NIS = 1), and its speed over every epoch.
 
     Returns ``{(label, fold, seed): (SpeedTrack, facts)}``.
@@ -200,7 +201,9 @@ def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, plan: p
     oc, sw = ecfg["odometer"], ecfg["sweep"]
     if not oc["methods"]:
         return {}
-    tc = sweep_train_config(train.tuned_train_config(cfg, profile, dataset), sw)
+    # the same learning rate for every network (train.lr): notebook 03's search tuned the rates for the increments,
+    # another target, and one of its picks (e.g. 0.27 for BGFN on the real drive) can cripple a speed network
+    tc = sweep_train_config(cfg["train"], sw)
     dmax = max(float(d) for d in sw["durations_s"])
     data, runs, keys = {}, [], []
     for k in sorted(plan["fold"].unique()):

@@ -145,13 +145,14 @@ data: $(STAMP)
 # papermill writes to a temporary name; only a complete run is renamed to the target, so a failed run leaves
 # no executed notebook behind (and Make redoes it next time). The notebook's runner (bgfn.parallel) writes one
 # line per finished run to $(RES)/logs/<notebook>.log (BGFN_PROGRESS_LOG); `tail` shows them here as they come
+# (the first on a line of its own, below papermill's cell bar)
 # and stops after this recipe's shell ($$$$) has ended, having shown the last ones.
 $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(PARAMS) $(SRC) $(STAMP) | data $(KERNEL_CONFIG)
 	@mkdir -p $(@D) $(RES)/logs
 	@$(MAKE) clean-debris
 	@echo "==> [$(PROFILE)] papermill $<"
 	@tmp="$(@D)/.$*.running-$$$$.ipynb"; log="$(RES)/logs/$*.log"; : > "$$log"; \
-	tail --pid=$$$$ -s 0.5 -n +1 -f "$$log" 2>/dev/null | sed -u 's/^/    /' & \
+	tail --pid=$$$$ -s 0.5 -n +1 -f "$$log" 2>/dev/null | sed -u 's/^/    /; 1s/^/\n/' & \
 	if BGFN_PROGRESS_LOG="$(CURDIR)/$$log" $(VENV_ABS)/bin/papermill "$<" "$$tmp" -p profile $(PROFILE) \
 	     --cwd "$(CURDIR)" -k python3 --progress-bar $(PAPERMILL_FLAGS); then \
 	  mv -f "$$tmp" "$@"; \

@@ -80,7 +80,8 @@ from bgfn.evaluate.ins_drift import (DRIFT_COLUMNS, DRIFT_RUN_COLUMNS, drift_sen
                                      ins_drift_runs, plot_ins_drift)
 from bgfn.evaluate.networks import ensure_models, load_model
 from bgfn.evaluate.odometers import (ODOMETER_COLUMNS, ODOMETER_METHODS, OdometerSection, odometer_lines,
-                                     odometer_rows, odometer_summary, run_odometer_bars, run_odometer_section)
+                                     odometer_rows, odometer_summary, odometer_table, run_odometer_bars,
+                                     run_odometer_section)
 from bgfn.evaluate.oracle import (BREAKEVEN_COLUMNS, ORACLE_COLUMNS, OracleIncrements, OracleResult, breakeven_table,
                                   crossing_sigma, curve_at, describe_oracle, method_levels, oracle_interval_table,
                                   oracle_runs, oracle_table, oracle_windows, plot_oracle, run_oracle)
@@ -99,7 +100,7 @@ from bgfn.evaluate.variants import (NO_VARIANT, VARIANT_COLUMNS, VARIANT_METRICS
 
 __all__ = [
     "ODOMETER_COLUMNS", "ODOMETER_METHODS", "OdometerSection", "odometer_lines", "odometer_rows", "odometer_summary",
-    "run_odometer_bars", "run_odometer_section",
+    "odometer_table", "run_odometer_bars", "run_odometer_section",
     "DRIFT_COLUMNS", "DRIFT_RUN_COLUMNS", "drift_sentences", "drift_starts", "drift_summary", "ins_drift_runs",
     "plot_ins_drift", "outage_figures",
     "AntennaTruth", "BREAKEVEN_COLUMNS", "ORACLE_COLUMNS", "OracleIncrements", "OracleResult", "breakeven_table",

@@ -41,7 +41,7 @@ from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.evaluate.sweep import profile_sweep_plan, sweep_train_config
 from bgfn.io import atomic_write_csv, save_figure
 from bgfn.learning import odometry as lo
-from bgfn.learning.split import forbidden_intervals, overlaps
+from bgfn.learning.split import overlaps
 from bgfn.train.checkpoints import checkpoint_name, models_dir
 from bgfn.train.objectives import SpeedObjective
 from bgfn.nav import odometer as no
@@ -97,18 +97,11 @@ def oracle_track(epochs: np.ndarray, truth: np.ndarray, sigma: float, walk: floa
                                                                                                     float(sigma)))
 
 
-def fold_ridge(ws: lo.SpeedWindows, all_windows: lo.SpeedWindows, fold_windows, margin_s: float, alpha: float,
-               rate_hz: float, val_fraction: float = 0.2) -> tuple[lo.RidgeOdometer, no.SpeedTrack]:
-    """The ridge odometer of one fold: trained on ``ws`` outside its outages (+- ``margin_s``), validated on the
-    middle ``val_fraction`` of the rest (training windows touching that block left out); its track over
-    ``all_windows``."""
-    lo_, hi_ = ws.span
-    idx = np.flatnonzero(~overlaps(lo_, hi_, forbidden_intervals(fold_windows, margin_s)))
-    n_val = max(1, int(round(val_fraction * idx.size)))
-    val = idx[(idx.size - n_val) // 2:(idx.size - n_val) // 2 + n_val]
-    block = np.array([[ws.t_start[val].min(), ws.t_end[val].max()]])
-    train = idx[~overlaps(lo_[idx], hi_[idx], block)]
-    model = lo.RidgeOdometer.fit(ws.subset(train), ws.subset(val), rate_hz, alpha)
+def fold_ridge(data: lo.SpeedData, all_windows: lo.SpeedWindows, alpha: float,
+               rate_hz: float) -> tuple[lo.RidgeOdometer, no.SpeedTrack]:
+    """The ridge odometer of one fold, fitted on the fold's honest split (:func:`bgfn.learning.odometry.
+    build_speed_data`), its std from the validation block; its track over ``all_windows``."""
+    model = lo.RidgeOdometer.fit(data.train, data.val, rate_hz, alpha)
     pred = model.predict(all_windows)
     return model, no.SpeedTrack(all_windows.t_end, pred, np.full(pred.size, model.std_mps))
 
@@ -136,12 +129,16 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
     truth = reference_speed(drive, all_windows.t_end)
     gate = oc["gate_probability"]
     margin = float((cfg.get("train") or {}).get("margin_s", 30.0))
+    val_fraction = float((cfg.get("train") or {}).get("val_fraction", 0.2))
+    folds = {int(k): [(float(s), dmax) for s in plan.loc[plan["fold"] == k, "start_s"]]
+             for k in sorted(plan["fold"].unique())}
+    # one honest split per fold: the ridge and the networks learn from the same windows
+    data = {k: lo.build_speed_data(ws, fw, margin, val_fraction) for k, fw in folds.items()}
     runs, tracks, facts = [], {}, {"ridge_std_mps": {}, "epochs": int(len(all_windows))}
     honest = {"time": all_windows.t_end, "truth": truth, "speed": np.full(truth.size, np.nan),
               "std": np.full(truth.size, np.nan), "outages": []}      # each outage's speed from its own fold
-    for k in sorted(plan["fold"].unique()):
-        fw = [(float(s), dmax) for s in plan.loc[plan["fold"] == k, "start_s"]]
-        model, track = fold_ridge(ws, all_windows, fw, margin, float(oc["ridge_alpha"]), imu_rate)
+    for k, fw in folds.items():
+        model, track = fold_ridge(data[k], all_windows, float(oc["ridge_alpha"]), imu_rate)
         facts["ridge_std_mps"][int(k)] = model.std_mps
         inside = overlaps(all_windows.t_end, all_windows.t_end, np.array([[s, s + d] for s, d in fw]))
         honest["speed"][inside], honest["std"][inside] = track.speed[inside], track.std[inside]
@@ -164,12 +161,11 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
             runs.append(OdometerRun(f"{dataset} fold {k} {method} {sigma:g} m/s seed {seed}", fw,
                                     no.Odometer(con, track, gate), method, float(sigma), int(seed), int(k)))
             tracks[runs[-1].label] = track
-    nets = network_odometers(cfg, profile, dataset, ecfg, plan, ws, all_windows, margin, runner)
+    nets = network_odometers(cfg, profile, dataset, ecfg, data, all_windows, runner)
     facts["networks"] = {}
     for (label, k, seed), (track, fact) in nets.items():
-        fw = [(float(s), dmax) for s in plan.loc[plan["fold"] == k, "start_s"]]
-        runs.append(OdometerRun(f"{dataset} fold {k} {label} seed {seed}", fw, no.Odometer(con, track, gate), label,
-                                np.nan, seed, k))
+        runs.append(OdometerRun(f"{dataset} fold {k} {label} seed {seed}", folds[k], no.Odometer(con, track, gate),
+                                label, np.nan, seed, k))
         tracks[runs[-1].label] = track
         facts["networks"][f"{label} fold {k} seed {seed}"] = fact
     results = (runner or Runner()).map(odometer_run, [(ctx, r, ecfg["pseudo_gps"]) for r in runs],
@@ -189,26 +185,23 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
     return pd.DataFrame(rows, columns=list(ODOMETER_COLUMNS)), facts
 
 
-def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, plan: pd.DataFrame, ws: lo.SpeedWindows,
-                      all_windows: lo.SpeedWindows, margin_s: float, runner: Runner | None = None) -> dict:
+def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, data: dict[int, lo.SpeedData],
+                      all_windows: lo.SpeedWindows, runner: Runner | None = None) -> dict:
     """The learned odometers of ``evaluate.odometer.methods`` (``BGFN-ODO`` ...), per sweep fold and seed: each
-    trained on that fold's honest speed data (:func:`bgfn.learning.odometry.build_speed_data`) with the sweep's
+    trained on that fold's honest speed data (``data``, :func:`bgfn.learning.odometry.build_speed_data`) with the sweep's
     budget and the profile's ``train.lr`` (not the increments' search), its std calibrated on its validation
     windows (:func:`bgfn.learning.odometry.calibration_factor`, NIS = 1), and its speed over every epoch.
 
     Returns ``{(label, fold, seed): (SpeedTrack, facts)}``.
     """
-    oc, sw = ecfg["odometer"], ecfg["sweep"]
+    oc = ecfg["odometer"]
     if not oc["methods"]:
         return {}
     # the same learning rate for every network (train.lr): notebook 03's search tuned the rates for the increments,
     # another target, and one of its picks (e.g. 0.27 for BGFN on the real drive) can cripple a speed network
-    tc = sweep_train_config(cfg["train"], sw)
-    dmax = max(float(d) for d in sw["durations_s"])
-    data, runs, keys = {}, [], []
-    for k in sorted(plan["fold"].unique()):
-        fw = [(float(s), dmax) for s in plan.loc[plan["fold"] == k, "start_s"]]
-        data[int(k)] = lo.build_speed_data(ws, fw, margin_s, float(tc.get("val_fraction", 0.2)))
+    tc = sweep_train_config(cfg["train"], ecfg["sweep"])
+    runs, keys = [], []
+    for k in sorted(data):
         out = models_dir(profile, dataset, int(k)) / "odometer"
         for m in oc["methods"]:
             for seed in oc["network_seeds"]:
@@ -273,16 +266,27 @@ class OdometerSection:
     figures: list = field(default_factory=list)
 
     def markdown(self) -> str:
-        """The summary at the sweep's durations as a Markdown table (the oracle per sigma), then the lines."""
+        """The summary at the sweep's durations as a Markdown table (:func:`odometer_table`), then the lines."""
         if self.summary.empty:
             return "No odometer bars (``evaluate.odometer.datasets`` is empty or the sweep has no dataset)."
-        t = self.summary.assign(method=[m if s != s else f"{m} {s:g} m/s" for m, s in
-                                        zip(self.summary["method"], self.summary["sigma_mps"])])
-        wide = t.pivot_table(index=["dataset", "method"], columns="duration_s", values="max_h_m", sort=False)
-        head = "| dataset | method | " + " | ".join(f"{d:g} s" for d in wide.columns) + " |"
+        wide = odometer_table(self.summary)
+        head = "| dataset | method | " + " | ".join(wide.columns) + " |"
         body = [f"| {ds} | {m} | " + " | ".join(f"{v:.1f}" for v in r) + " |" for (ds, m), r in wide.iterrows()]
         return "\n".join(["Median max horizontal error (m) over the sweep's starts:", "", head,
                           "|---" * (len(wide.columns) + 2) + "|", *body, ""] + [f"- {s}" for s in self.lines])
+
+
+def odometer_table(summary: pd.DataFrame) -> pd.DataFrame:
+    """:func:`odometer_summary`'s median max horizontal error (m) wide: a row per dataset and method in the order of
+    :data:`ODOMETER_METHODS` (an oracle per sigma, ``ORACLE-SPEED 0.5 m/s``), a column per duration (``30 s``)."""
+    order = {m: i for i, m in enumerate(ODOMETER_METHODS)}
+    t = summary.assign(row=[m if s != s else f"{m} {s:g} m/s" for m, s in zip(summary["method"],
+                                                                              summary["sigma_mps"])],
+                       rank=summary["method"].map(order))
+    wide = (t.sort_values(["dataset", "rank", "sigma_mps"], kind="stable")
+            .pivot_table(index=["dataset", "row"], columns="duration_s", values="max_h_m", sort=False))
+    wide.columns = [f"{c:g} s" for c in wide.columns]
+    return wide
 
 
 def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | None = None,

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 from bgfn import paper
 from bgfn.config import RUN_RECORDS, SHARED_TABLES
-from bgfn.evaluate import ODOMETER_METHODS, describe_sweep, odometer_lines
+from bgfn.evaluate import describe_sweep, odometer_lines, odometer_table
 from bgfn.report.glance import run_header
 from bgfn.report.provenance import cards_line, model_cards, outage_datasets, outage_provenance, provenance, short_source
 from bgfn.report.reading import ProfileResults, missing_note, read_csv
@@ -140,13 +140,7 @@ def odometer_section(res: ProfileResults) -> list:
     summary = read_csv(file)
     if summary is None or summary.empty:
         return [missing_note(file, "the odometer bars", "notebook 04, `evaluate.odometer`")]
-    order = {m: i for i, m in enumerate(ODOMETER_METHODS)}
-    t = summary.assign(row=[m if s != s else f"{m} {s:g} m/s" for m, s in zip(summary["method"],
-                                                                              summary["sigma_mps"])],
-                       rank=summary["method"].map(order))
-    wide = (t.sort_values(["dataset", "rank", "sigma_mps"], kind="stable")
-            .pivot_table(index=["dataset", "row"], columns="duration_s", values="max_h_m", sort=False))
-    wide.columns = [f"{c:g} s" for c in wide.columns]
+    wide = odometer_table(summary)
     return [compact(wide.style.format("{:.1f}"), f"Median max horizontal error (m) over the sweep's starts, "
                                                  f"profile {res.profile}"),
             bullets(odometer_lines(summary))]

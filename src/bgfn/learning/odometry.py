@@ -28,7 +28,7 @@ import pandas as pd
 from bgfn.errors import DataError
 from bgfn.learning.normalize import Normalizer
 from bgfn.learning.split import forbidden_intervals, overlaps
-from bgfn.learning.windows import _gather, _windows_ending_at
+from bgfn.learning.windows import gather_windows, windows_ending_at
 from bgfn.nav.transform import dcm_from_euler
 from bgfn.schema import ACCEL_COLUMNS, GYRO_COLUMNS
 
@@ -152,10 +152,10 @@ def speed_windows(imu: pd.DataFrame, epochs, window: int, speed=None) -> SpeedWi
     t = imu["time"].to_numpy(float)
     feats = imu[list(ODOMETER_CHANNELS)].to_numpy(float)
     epochs = np.asarray(epochs, dtype=float)
-    last, ok = _windows_ending_at(t, feats, epochs, window)
+    last, ok = windows_ending_at(t, feats, epochs, window)
     sp = np.full(epochs.size, np.nan) if speed is None else np.asarray(speed, dtype=float)
     last, ep, sp = last[ok], epochs[ok], sp[ok]
-    return SpeedWindows(_gather(feats, last, window), sp, ep, t[last - window])
+    return SpeedWindows(gather_windows(feats, last, window), sp, ep, t[last - window])
 
 
 def band_energies(x: np.ndarray, rate_hz: float, bands=BANDS_HZ) -> np.ndarray:

@@ -79,8 +79,8 @@ class WindowSet:
         return np.minimum(self.t_start, self.t_from), np.maximum(self.t_end, self.t_to)
 
 
-def _windows_ending_at(t: np.ndarray, feats: np.ndarray, t_ends: np.ndarray, window: int,
-                       max_gap_factor: float = 1.5) -> tuple[np.ndarray, np.ndarray]:
+def windows_ending_at(t: np.ndarray, feats: np.ndarray, t_ends: np.ndarray, window: int,
+                      max_gap_factor: float = 1.5) -> tuple[np.ndarray, np.ndarray]:
     """Indices of the last IMU sample with time <= each ``t_end`` and a validity mask (N samples, no gap, no NaN)."""
     dt_nom = np.median(np.diff(t))
     tol = 1e-6 * dt_nom
@@ -100,7 +100,8 @@ def _windows_ending_at(t: np.ndarray, feats: np.ndarray, t_ends: np.ndarray, win
     return last, ok
 
 
-def _gather(feats: np.ndarray, last: np.ndarray, window: int) -> np.ndarray:
+def gather_windows(feats: np.ndarray, last: np.ndarray, window: int) -> np.ndarray:
+    """The ``window`` samples of ``feats`` [n, C] ending at each row index ``last`` [M]: [M, N, C] float32."""
     idx = last[:, None] - window + 1 + np.arange(window)[None, :]       # [M, N]
     return feats[idx].astype(np.float32)                                # [M, N, C]
 
@@ -158,10 +159,10 @@ def make_windows(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.DataFrame, 
     keep = (np.arange(len(y)) % max(1, int(epoch_stride)) == 0) & ~bad
     t_from, t_to, y, y_last, y_ins = t_from[keep], t_to[keep], y[keep], y_last[keep], y_ins[keep]
     t_end_epoch = t_to if alignment == "ending" else t_from
-    last, ok = _windows_ending_at(t, feats, t_end_epoch, window)
+    last, ok = windows_ending_at(t, feats, t_end_epoch, window)
     last, t_from, t_to, y, y_last, y_ins = last[ok], t_from[ok], t_to[ok], y[ok], y_last[ok], y_ins[ok]
     yaw_ref = feats[last, YAW_CHANNEL]
-    x = encode_yaw(_gather(feats, last, window), yaw_encoding)
+    x = encode_yaw(gather_windows(feats, last, window), yaw_encoding)
     return WindowSet(x=x, y=y, t_from=t_from, t_to=t_to, t_end=t[last], t_start=t[last - window],
                      y_last=y_last, yaw_ref=yaw_ref, channels=channels, n_screened=int(bad.sum()), y_ins=y_ins)
 
@@ -190,13 +191,13 @@ def prediction_windows(imu: pd.DataFrame, attitude: pd.DataFrame, epochs, window
         raise DataError("outage", "epochs", "at least 2 strictly increasing epoch times")
     t, feats, channels = sample_features(imu, attitude, extra_channels)
     t_from, t_to = epochs[:-1], epochs[1:]
-    last, ok = _windows_ending_at(t, feats, t_to if alignment == "ending" else t_from, window)
+    last, ok = windows_ending_at(t, feats, t_to if alignment == "ending" else t_from, window)
     if not ok.all():
         bad = (t_to if alignment == "ending" else t_from)[~ok][0]
         raise DataError("imu/attitude", "time", f"{window} gap-free IMU samples with attitude before each "
                         "pseudo-GNSS epoch", f"none ending at t = {bad:.3f} s")
     yaw_ref = feats[last, YAW_CHANNEL]
-    x = encode_yaw(_gather(feats, last, window), yaw_encoding)
+    x = encode_yaw(gather_windows(feats, last, window), yaw_encoding)
     nan = np.full((len(t_from), 2), np.nan)
     return WindowSet(x=x, y=nan, t_from=t_from, t_to=t_to, t_end=t[last], t_start=t[last - window],
                      y_last=nan.copy(), yaw_ref=yaw_ref, channels=channels)

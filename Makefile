@@ -191,6 +191,7 @@ define build_book
 	@echo "==> book from $(RES)/notebooks"
 	@rm -rf book/notebooks book/_generated && mkdir -p book/notebooks book/_generated
 	@cp $(EXEC) book/notebooks/
+	@$(PY) -m bgfn.report.book_notebooks book/notebooks/*.ipynb   # one parameters cell: the run's values
 	@for d in tables figures; do if [ -d "$(RES)/$$d" ]; then cp -r "$(RES)/$$d" book/_generated/; fi; done
 	@find book/notebooks book/_generated -name '.*' -type f -delete   # never a temporary or hidden file
 	@if [ -f "$(RES)/findings.md" ]; then cp "$(RES)/findings.md" book/_generated/; else \

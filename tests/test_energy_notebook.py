@@ -12,6 +12,7 @@ import torch
 
 from bgfn import energy
 from bgfn.config import PROJECT_ROOT
+from bgfn.energy.odometer import OdometerEnergy, odometer_dataset
 from bgfn.energy.record import REPORTED_KEYS
 from bgfn.learning import WindowSet
 from bgfn.models import build_model
@@ -249,3 +250,23 @@ def test_only_the_spiking_network_must_have_learned(tmp_path, monkeypatch):
     (folder / "bgfn_seed0.json").write_text(json.dumps({"best_epoch": 0}))
     with pytest.raises(DataError, match="best epoch >= 1"):
         energy.load_measured("smoke", cfg)
+
+
+# ----------------------------------------------------------------------------------------------- odometers
+def test_the_odometer_audit_measures_the_recorded_drive_and_sums_by_hand():
+    from_cfg = {"evaluate": {"sweep": {"datasets": ["turin-sim-mpu6000", "rtklib-drive0708"]},
+                             "odometer": {"datasets": None, "methods": ["bgfn", "transformer"]}}}
+    assert odometer_dataset(from_cfg) == "rtklib-drive0708"                      # the recorded drive first
+    from_cfg["evaluate"]["odometer"]["methods"] = []
+    assert odometer_dataset(from_cfg) is None                                    # no odometer network trained
+    snn, ann = _hand_counts()
+    odo = OdometerEnergy("d", 0, {}, {"bgfn": energy.table_from_counts(snn, "BGFN-ODO", E_MAC, E_AC),
+                                      "transformer": energy.table_from_counts(ann, "Transformer-ODO", E_MAC, E_AC)},
+                         0.1, 8)
+    # the same hand sums as the paper's model: 260 pJ against 1100 pJ
+    assert odo.totals().set_index("model")["energy_uj"].to_dict() == pytest.approx(
+        {"BGFN-ODO": 260e-6, "Transformer-ODO": 1100e-6})
+    assert odo.reduction_pct == pytest.approx(100 * (1 - 260 / 1100))
+    assert list(odo.table.columns[:2]) == ["dataset", "model"] and set(odo.table["dataset"]) == {"d"}
+    alone = OdometerEnergy("d", 0, {}, {"bgfn": odo.tables["bgfn"]}, 0.1, 8)
+    assert np.isnan(alone.reduction_pct) and "no Transformer-ODO was trained" in alone.lines()[1]

@@ -80,9 +80,25 @@ def test_rows_of_a_synthetic_drive(monkeypatch, tmp_path):
 
 def test_the_speed_figure_draws_each_outage_from_its_own_fold():
     t = np.arange(0.0, 200.0)
-    series = {"time": t, "truth": np.full(t.size, 10.0), "speed": np.where(t > 50, 11.0, np.nan),
-              "std": np.full(t.size, 0.5), "outages": [(60.0, 30.0), (100.0, 30.0), (140.0, 30.0)]}
+    series = {"time": t, "truth": np.full(t.size, 10.0), "outages": [(60.0, 30.0), (100.0, 30.0), (140.0, 30.0)],
+              "tracks": {"RIDGE-ODO": (np.where(t > 50, 11.0, np.nan), np.full(t.size, 0.5)),
+                         "BGFN-ODO": (np.where(t > 50, 9.0, np.nan), np.full(t.size, 1.5))}}
     fig = O.plot_speed_series(series, "d", n_outages=2)
     axes = fig.axes
     assert len(axes) == 2 and axes[0].get_title() == "start 60 s" and axes[1].get_title() == "start 140 s"
     assert axes[0].get_ylabel() == "forward speed (m/s)"
+    # both odometers and the reference, each a line over the 31 epochs of its outage
+    lines = {ln.get_label(): ln.get_ydata() for ln in axes[0].get_lines()}
+    assert set(lines) == {"RIDGE-ODO (+- 2 sigma)", "BGFN-ODO (+- 2 sigma)", "reference"}
+    assert np.allclose(lines["BGFN-ODO (+- 2 sigma)"], 9.0) and len(lines["reference"]) == 31
+
+
+def test_the_error_growth_figure_has_one_line_per_row_and_the_oracle_at_its_grid_ends():
+    rows = [{"method": m, "sigma_mps": np.nan, "duration_s": d, "max_h_m": e * d}
+            for m, e in (("INS+NHC", 1.0), ("RIDGE-ODO", 0.8), ("BGFN-ODO", 0.9)) for d in (10.0, 30.0, 60.0)]
+    rows += [{"method": "ORACLE-SPEED", "sigma_mps": s, "duration_s": d, "max_h_m": s * d}
+             for s in (0.05, 0.5, 2.0) for d in (10.0, 30.0, 60.0)]
+    fig = O.plot_error_growth(pd.DataFrame(rows), "d")
+    lines = {ln.get_label(): ln.get_ydata() for ln in fig.axes[0].get_lines()}
+    assert set(lines) == {"INS+NHC", "RIDGE-ODO", "BGFN-ODO", "ORACLE-SPEED 0.05 m/s", "ORACLE-SPEED 2 m/s"}
+    assert np.allclose(lines["RIDGE-ODO"], [8.0, 24.0, 48.0])

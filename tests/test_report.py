@@ -20,6 +20,7 @@ import pytest
 
 from bgfn import paper, report
 from bgfn.config import PROJECT_ROOT
+from bgfn.report.book_notebooks import one_parameters_cell, rewrite
 
 BOOK = PROJECT_ROOT / "book"
 
@@ -566,3 +567,19 @@ def test_odometer_section_lists_the_bars_and_the_oracle_per_sigma(tmp_path):
                                                          "ORACLE-SPEED 0.1 m/s", "ORACLE-SPEED 2 m/s"]
     assert table.data.loc[("d", "RIDGE-ODO"), "60 s"] == 45.0
     assert "INS+NHC 50.0 m" in lines and "an oracle speed beats INS+NHC up to a noise of 0.1 m/s" in lines
+
+
+def test_the_book_shows_one_parameters_cell_with_the_values_of_the_run(tmp_path):
+    def cell(src, tags=()):
+        return {"cell_type": "code", "metadata": {"tags": list(tags)}, "source": src, "outputs": []}
+
+    nb = {"cells": [cell("# title"), cell('profile = "quick"\n# compared profiles\nvariants = ["a"]  # shown', ["parameters"]),
+                    cell('# Parameters\nprofile = "paper"\nextra = 3\n', ["injected-parameters"]), cell("x = 1")]}
+    path = tmp_path / "nb.ipynb"
+    path.write_text(json.dumps(nb))
+    rewrite(path)
+    out = json.loads(path.read_text())
+    assert len(out["cells"]) == 3 and not any("injected-parameters" in c["metadata"]["tags"] for c in out["cells"])
+    # the run's value in the notebook's own cell, its comments kept; a value the cell did not assign is appended
+    assert out["cells"][1]["source"] == 'profile = "paper"\n# compared profiles\nvariants = ["a"]  # shown\nextra = 3'
+    assert one_parameters_cell({"cells": [cell("x = 1", ["parameters"])]})["cells"][0]["source"] == "x = 1"

@@ -1,9 +1,10 @@
-"""The verdict (results page, first section): its table and the five answers from hand-made tables."""
+"""The verdict (results page, first section): its table and the six answers from hand-made tables."""
 
 import numpy as np
 import pandas as pd
 import pytest
 
+from bgfn.report.odometer_verdict import ORACLE_ODO_ROW, OdometerInputs
 from bgfn.report.verdict import (ORACLE_ROW, VerdictInputs, answer_accuracy, answer_free_aids, answer_protocol,
                                  answer_speed, headline, verdict_sentences, verdict_table)
 
@@ -120,3 +121,67 @@ def test_speed_answer_says_which_networks_learned_with_and_without_velocity():
     assert answer_speed(verdict_table(unfit), unfit).endswith(
         " The 2 that never improved did not fit their training windows either (median lowest training loss 1.02; "
         "predicting the training mean: about 1).")
+
+
+def _odometer(twin_offset: float = 0.0, coverage: float = 0.95):
+    """Hand-made odometer tables of dataset d: 10 starts x 2 durations; INS+NHC 10 m per 30 s, RIDGE-ODO 8 m,
+    BGFN-ODO 6 m (+ a start-dependent wiggle), its twin BGFN-ODO + ``twin_offset``; the oracle at 0.1 / 1 m/s."""
+    rows, starts = [], np.arange(10) * 100.0
+    for du in (30.0, 60.0):
+        k = du / 30.0
+        for i, s in enumerate(starts):
+            wiggle = 0.1 * ((i * 7) % 5)
+            for method, v in (("INS+NHC", 10.0), ("INS+NHC+HOLD", 12.0), ("RIDGE-ODO", 8.0),
+                              ("BGFN-ODO", 6.0 + wiggle), ("Transformer-ODO", 6.0 + wiggle + twin_offset)):
+                rows.append({"dataset": "d", "start_s": s, "duration_s": du, "method": method, "sigma_mps": np.nan,
+                             "seed": 0, "max_h_m": v * k + 0.01 * i})
+    rows = pd.DataFrame(rows)
+    summary = []
+    for (du, m), g in rows.groupby(["duration_s", "method"]):
+        nhc = rows[(rows["method"] == "INS+NHC") & (rows["duration_s"] == du)]["max_h_m"].to_numpy()
+        summary.append({"dataset": "d", "duration_s": du, "method": m, "sigma_mps": np.nan,
+                        "max_h_m": g["max_h_m"].median(), "ratio_to_nhc": float(np.median(g["max_h_m"] / nhc)),
+                        "speed_rmse_mps": 0.5 if m.endswith("-ODO") else np.nan,
+                        "coverage_2sigma": coverage if m.endswith("-ODO") else np.nan,
+                        "p_vs_nhc": 0.002 if m != "INS+NHC" else np.nan})
+    for du in (30.0, 60.0):
+        for sigma, v in ((0.1, 2.0), (1.0, 20.0)):
+            summary.append({"dataset": "d", "duration_s": du, "method": "ORACLE-SPEED", "sigma_mps": sigma,
+                            "max_h_m": v * du / 30.0, "ratio_to_nhc": np.nan, "speed_rmse_mps": sigma,
+                            "coverage_2sigma": 0.95, "p_vs_nhc": 0.001})
+    energy = pd.DataFrame({"dataset": "d", "model": ["BGFN-ODO", "Transformer-ODO"], "layer": "total",
+                           "energy_uj": [0.5, 2.0]})
+    return OdometerInputs(rows, pd.DataFrame(summary), energy)
+
+
+def test_odometer_rows_answer_and_headline_read_the_odometer_tables():
+    inp = _inputs(odometer=_odometer())
+    t = verdict_table(inp).set_index("row")
+    # after BGFN+NHC: the held speed, the learned odometers, the oracle at BGFN-ODO's speed error
+    rows = list(t.index)
+    assert rows[rows.index("BGFN+NHC") + 1:rows.index("BGFN+NHC") + 6] == [
+        "INS+NHC+HOLD", "RIDGE-ODO", "BGFN-ODO", "Transformer-ODO", ORACLE_ODO_ROW]
+    assert t.loc["RIDGE-ODO", "sweep 60 s"] == pytest.approx(16.045) and np.isnan(t.loc["RIDGE-ODO", "outage 1"])
+    assert t.loc["BGFN-ODO", "p 30 s"] == 0.002 and t.loc["BGFN-ODO", "runs"] == 1
+    # log-log between (0.1 m/s, 4 m) and (1 m/s, 40 m) at 0.5 m/s: 4 * 10^log10(5) = 20 m at 60 s
+    assert t.loc[ORACLE_ODO_ROW, "sweep 60 s"] == pytest.approx(20.0)
+    answer = verdict_sentences(inp, verdict_table(inp))[5]
+    assert answer.startswith("Does a learned odometer help? In the sweep's windows (10 starts")
+    assert "The best learned odometer at 60 s is BGFN-ODO: it beats INS+NHC at 30 s and 60 s (p < 0.05)." in answer
+    assert "no different from its ANN twin" in answer                      # identical per start: no difference
+    assert "0.5 µJ per prediction against the twin's 2 µJ (75 % less)" in answer
+    assert "95 % of epochs within its +-2 sigma (calibrated" in answer
+    assert "beats INS+NHC at 60 s up to a noise of 0.1 m/s; at BGFN-ODO's speed error it reaches 20.0 m" in answer
+    head = headline(inp, verdict_table(inp))
+    assert head.startswith("field test (d): A learned odometer beats INS+NHC at 60 s: BGFN-ODO ")
+    assert "The paper's design, median max error over the 30 s sweep: BGFN 85.0 m" in head
+    # a twin that is 2 m worse at every start: BGFN-ODO is better than it; an overconfident std is named
+    worse = _inputs(odometer=_odometer(twin_offset=2.0, coverage=0.7))
+    answer = verdict_sentences(worse, verdict_table(worse))[5]
+    assert "better than its ANN twin" in answer and "(overconfident" in answer
+
+
+def test_odometer_answer_without_its_tables_says_not_measured():
+    inp = _inputs()
+    assert verdict_sentences(inp, verdict_table(inp))[5].endswith("have not run for this drive (`evaluate.odometer`).")
+    assert "odometer" not in headline(inp, verdict_table(inp))

@@ -94,6 +94,7 @@ SHARED_TABLES: dict[str, str] = {
     "odometer": "outage_odometer.csv",          # notebook 04: the bars of a learned odometer (bgfn.evaluate.odometers)
     "odometer_summary": "outage_odometer_summary.csv",
     "variants": "outage_variants.csv",          # notebook 03: the learning-problem variants in the two outages
+    "energy_odometer": "energy_odometer.csv",   # notebook 05: the learned odometers' energy (bgfn.energy.odometer)
 }
 #: Where a top-level ``datasets:`` puts its list (the datasets of every notebook), unless the same file or a later
 #: one in the ``base:`` chain sets that section's own ``datasets``.

@@ -103,6 +103,16 @@ def nhc_label(method: str) -> str:
     return label(method) + NHC_SUFFIX
 
 
+#: Suffix of a network trained as a learned odometer (forward speed and its std fused with the NHC rows; beyond
+#: the paper, issue 24): ``BGFN-ODO``.
+ODO_SUFFIX = "-ODO"
+
+
+def odometer_label(method: str) -> str:
+    """Label of a network trained as a learned odometer: ``bgfn`` -> ``BGFN-ODO``."""
+    return label(method) + ODO_SUFFIX
+
+
 def base_label(method: str) -> str:
     """The label without the constraints' suffix: ``BGFN+NHC`` -> ``BGFN`` (others as given)."""
     return method[: -len(NHC_SUFFIX)] if method.endswith(NHC_SUFFIX) else method

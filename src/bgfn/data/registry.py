@@ -36,3 +36,12 @@ DATASETS: dict[str, dict] = {
     "rtklib-drive0708": {"seed": 0, "imu_rate_hz": 100.0, **UBLOX_PARAMS, "imu_errors": {},
                          "imu_time_offset_s": IMU_TIME_OFFSET_S, "t_start": None, "t_end": None},
 }
+#: The datasets whose IMU is simulated (from a smoothed reference): every other drive, a CSV folder included,
+#: carries a recorded IMU, the decisive test of an outage aid (the results page shows those first).
+SIMULATED_IMU: frozenset[str] = frozenset({"turin-sim-ekinox", "turin-sim-mpu6000"})
+
+
+def recorded_first(datasets) -> list:
+    """``datasets`` with the recorded-IMU drives first, each group in its given order."""
+    datasets = list(datasets)
+    return [d for d in datasets if d not in SIMULATED_IMU] + [d for d in datasets if d in SIMULATED_IMU]

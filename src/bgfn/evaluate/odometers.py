@@ -42,18 +42,17 @@ from bgfn.evaluate.sweep import profile_sweep_plan, sweep_train_config
 from bgfn.io import atomic_write_csv, save_figure
 from bgfn.learning import odometry as lo
 from bgfn.learning.split import overlaps
-from bgfn.train.checkpoints import checkpoint_name, models_dir
+from bgfn.train.checkpoints import checkpoint_name, odometer_models_dir
 from bgfn.train.objectives import SpeedObjective
 from bgfn.nav import odometer as no
 from bgfn import train
-from bgfn.paper import METHOD_LABELS, nhc_label
+from bgfn.paper import METHOD_LABELS, nhc_label, odometer_label
 from bgfn.parallel import Runner
 from bgfn.stats import wilcoxon_p
 
 HOLD, RIDGE, ORACLE, ORACLE_WALK = "INS+NHC+HOLD", "RIDGE-ODO", "ORACLE-SPEED", "ORACLE-SPEED+WALK"
 #: A network odometer's row: ``BGFN-ODO``, ``Transformer-ODO``, ...
-ODO_SUFFIX = "-ODO"
-NETWORK_ODOMETERS: tuple[str, ...] = tuple(f"{label}{ODO_SUFFIX}" for label in METHOD_LABELS.values())
+NETWORK_ODOMETERS: tuple[str, ...] = tuple(odometer_label(m) for m in METHOD_LABELS)
 #: Rows of the odometer table, in order.
 ODOMETER_METHODS: tuple[str, ...] = (nhc_label("INS"), HOLD, RIDGE, *NETWORK_ODOMETERS, ORACLE, ORACLE_WALK)
 #: Columns of ``tables/outage_odometer.csv``.
@@ -118,8 +117,7 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
     ctx = navigation_context(drive, cfg.get("nav"), plan["start_s"])
     con = ctx.constraints
     rate = float(con.config.nhc_rate_hz)
-    imu_rate = 1.0 / float(np.median(np.diff(drive.imu["time"].to_numpy(float))))
-    window = int(round(float(oc["window_s"]) * imu_rate))                   # the ridge's band energies need 2 s
+    window, imu_rate = lo.window_samples(drive.imu, oc["window_s"])       # the ridge's band energies need 2 s
     traj = ctx.full.trajectory
     tt = traj["time"].to_numpy(float)
     speed = lo.forward_speed(traj, con.mounting_at(tt))                    # the GPS-aided solution's
@@ -135,13 +133,18 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
     # one honest split per fold: the ridge and the networks learn from the same windows
     data = {k: lo.build_speed_data(ws, fw, margin, val_fraction) for k, fw in folds.items()}
     runs, tracks, facts = [], {}, {"ridge_std_mps": {}, "epochs": int(len(all_windows))}
-    honest = {"time": all_windows.t_end, "truth": truth, "speed": np.full(truth.size, np.nan),
-              "std": np.full(truth.size, np.nan), "outages": []}      # each outage's speed from its own fold
+    honest = {"time": all_windows.t_end, "truth": truth, "outages": [], "tracks": {}}   # each outage: its own fold's
+
+    def keep(label: str, track: no.SpeedTrack, inside: np.ndarray) -> None:
+        """Put ``track``'s speed and std inside one fold's outages into the honest series of ``label``."""
+        speed, std = honest["tracks"].setdefault(label, (np.full(truth.size, np.nan), np.full(truth.size, np.nan)))
+        speed[inside], std[inside] = track.at(all_windows.t_end[inside])
+
     for k, fw in folds.items():
         model, track = fold_ridge(data[k], all_windows, float(oc["ridge_alpha"]), imu_rate)
         facts["ridge_std_mps"][int(k)] = model.std_mps
         inside = overlaps(all_windows.t_end, all_windows.t_end, np.array([[s, s + d] for s, d in fw]))
-        honest["speed"][inside], honest["std"][inside] = track.speed[inside], track.std[inside]
+        keep(RIDGE, track, inside)
         honest["outages"] += fw
         runs.append(OdometerRun(f"{dataset} fold {k} {RIDGE}", fw, no.Odometer(con, track, gate), RIDGE,
                                 np.nan, 0, int(k)))
@@ -168,6 +171,9 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
                                 label, np.nan, seed, k))
         tracks[runs[-1].label] = track
         facts["networks"][f"{label} fold {k} seed {seed}"] = fact
+        if seed == min(oc["network_seeds"]):
+            keep(label, track, overlaps(all_windows.t_end, all_windows.t_end,
+                                        np.array([[s, s + d] for s, d in folds[k]])))
     results = (runner or Runner()).map(odometer_run, [(ctx, r, ecfg["pseudo_gps"]) for r in runs],
                                        labels=[r.label for r in runs], desc=f"odometer bars {dataset}")
     rows = []
@@ -181,7 +187,7 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
                              **{c: m[c] for c in ("max_h_m", "rmse_h_m", "final_h_m")},
                              **speed_errors(track, all_windows.t_end, truth, r.start, float(du))})
     facts["wall_s"] = time.perf_counter() - t0
-    facts["ridge_series"] = honest
+    facts["speed_series"] = honest
     return pd.DataFrame(rows, columns=list(ODOMETER_COLUMNS)), facts
 
 
@@ -202,10 +208,10 @@ def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, data: d
     tc = sweep_train_config(cfg["train"], ecfg["sweep"])
     runs, keys = [], []
     for k in sorted(data):
-        out = models_dir(profile, dataset, int(k)) / "odometer"
+        out = odometer_models_dir(profile, dataset, int(k))
         for m in oc["methods"]:
             for seed in oc["network_seeds"]:
-                label = f"{METHOD_LABELS[m]}{ODO_SUFFIX}"
+                label = odometer_label(m)
                 runs.append(train.TrainingRun(f"{dataset} fold {k} {label} seed {seed}", m, data[int(k)],
                                               train.size_config(tc, m), tc, int(seed), out, None,
                                               {"dataset": dataset, "profile": profile, "fold": int(k),
@@ -305,34 +311,68 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
     atomic_write_csv(tables / SHARED_TABLES["odometer_summary"], summary, float_format="%.4f")
     figures = []
     for name, f in facts.items():
-        figures.append(plot_speed_series(f["ridge_series"], name))
-        save_figure(figures[-1], Path(out) / "figures" / f"odometer_speed_{dataset_id(name)}.png")
-        plt.close(figures[-1])
+        for fig, stem in ((plot_speed_series(f["speed_series"], name), "odometer_speed"),
+                          (plot_error_growth(summary[summary["dataset"] == name], name), "odometer_growth")):
+            save_figure(fig, Path(out) / "figures" / f"{stem}_{dataset_id(name)}.png")
+            plt.close(fig)
+            figures.append(fig)
     if timings is not None:
         timings["odometer_s"] = time.perf_counter() - t0
     return OdometerSection(rows, summary, odometer_lines(summary) if len(summary) else [], facts, figures)
 
 
+#: Colours of the speed bands (:func:`plot_speed_series`): the ridge, then the networks.
+_BAND_COLOURS = ("tab:orange", "tab:blue", "tab:green", "tab:red", "tab:purple")
+
+
 def plot_speed_series(series: dict, dataset: str, n_outages: int = 4):
-    """RIDGE-ODO's speed with its 2-sigma band against the reference's in the first outages of each fold
-    (every outage predicted by the ridge of its own fold, trained without it)."""
+    """The learned odometers' speed (RIDGE-ODO and each network's first seed) with their 2-sigma bands against the
+    reference's in a few outages spread over the drive, every outage predicted by the odometers of its own fold
+    (trained without it)."""
     outages = sorted(series["outages"])
     pick = [outages[i] for i in np.unique(np.linspace(0, len(outages) - 1, min(n_outages, len(outages))).round()
                                           .astype(int))] if outages else []
-    fig, axes = plt.subplots(1, max(len(pick), 1), figsize=(3.2 * max(len(pick), 1), 2.8), sharey=True,
+    fig, axes = plt.subplots(1, max(len(pick), 1), figsize=(3.4 * max(len(pick), 1), 3.0), sharey=True,
                              squeeze=False)
-    t, truth, speed, std = (np.asarray(series[k], float) for k in ("time", "truth", "speed", "std"))
+    t, truth = np.asarray(series["time"], float), np.asarray(series["truth"], float)
     for ax, (s, d) in zip(axes[0], pick):
         m = (t >= s) & (t <= s + d)
-        ax.fill_between(t[m] - s, speed[m] - 2 * std[m], speed[m] + 2 * std[m], color="tab:orange", alpha=0.25,
-                        label="RIDGE-ODO +- 2 sigma")
-        ax.plot(t[m] - s, speed[m], color="tab:orange", label="RIDGE-ODO")
-        ax.plot(t[m] - s, truth[m], color="black", lw=1.2, label="reference")
+        for colour, (label, (speed, std)) in zip(_BAND_COLOURS, series["tracks"].items()):
+            ax.fill_between(t[m] - s, speed[m] - 2 * std[m], speed[m] + 2 * std[m], color=colour, alpha=0.15)
+            ax.plot(t[m] - s, speed[m], color=colour, lw=1.0, label=f"{label} (+- 2 sigma)")
+        ax.plot(t[m] - s, truth[m], color="black", lw=1.4, label="reference")
         ax.set_title(f"start {s:.0f} s", fontsize=9)
         ax.set_xlabel("time in outage (s)")
     axes[0][0].set_ylabel("forward speed (m/s)")
-    axes[0][0].legend(fontsize=7, loc="best")
-    fig.suptitle(f"{dataset}: the ridge odometer's speed in outages it was not trained on", fontsize=10)
+    axes[0][0].legend(fontsize=6, loc="best")
+    fig.suptitle(f"{dataset}: the learned odometers' speed in outages they were not trained on", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def plot_error_growth(summary: pd.DataFrame, dataset: str):
+    """Median max horizontal error against the outage duration, one line per odometer row (the oracle speed at its
+    smallest and largest sigma, dashed)."""
+    fig, ax = plt.subplots(figsize=(6.4, 3.8))
+    for method in ODOMETER_METHODS:
+        g = summary[summary["method"] == method]
+        if not len(g):
+            continue
+        if method in (ORACLE, ORACLE_WALK):
+            for sigma in sorted(g["sigma_mps"].unique())[::max(1, g["sigma_mps"].nunique() - 1)]:
+                h = g[g["sigma_mps"] == sigma].sort_values("duration_s")
+                ax.plot(h["duration_s"], h["max_h_m"], ls="--", lw=1.0, marker=".",
+                        label=f"{method} {sigma:g} m/s")
+        else:
+            g = g.sort_values("duration_s")
+            ax.plot(g["duration_s"], g["max_h_m"], marker="o", lw=2.0 if method == nhc_label("INS") else 1.3,
+                    color="black" if method == nhc_label("INS") else None, label=method)
+    ax.set_xlabel("outage duration (s)")
+    ax.set_ylabel("median max horizontal error (m)")
+    ax.set_yscale("log")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7, ncol=2)
+    ax.set_title(f"{dataset}: error growth over the outage, sweep starts", fontsize=10)
     fig.tight_layout()
     return fig
 

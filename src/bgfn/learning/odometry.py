@@ -144,6 +144,13 @@ def build_speed_data(ws: SpeedWindows, outage_windows=(), margin_s: float = 30.0
                                              "n_outage_excluded": int(ws.x.shape[0] - idx.size)})
 
 
+def window_samples(imu: pd.DataFrame, window_s: float) -> tuple[int, float]:
+    """(IMU samples in a window of ``window_s`` seconds, the IMU rate in Hz) of a drive's IMU table: the odometer's
+    window (``evaluate.odometer.window_s``), the same for the ridge, the networks and the energy audit."""
+    rate = 1.0 / float(np.median(np.diff(imu["time"].to_numpy(float))))
+    return int(round(float(window_s) * rate)), rate
+
+
 def speed_windows(imu: pd.DataFrame, epochs, window: int, speed=None) -> SpeedWindows:
     """The IMU windows of ``window`` samples ending at each of ``epochs`` (s) that are complete (no gap, no NaN),
     with ``speed`` at those epochs (NaN when not given)."""

@@ -11,6 +11,8 @@ from dataclasses import dataclass
 
 from bgfn import paper
 from bgfn.config import RUN_RECORDS, SHARED_TABLES
+from bgfn.data.names import dataset_id
+from bgfn.data.registry import recorded_first
 from bgfn.evaluate import describe_sweep, odometer_lines, odometer_table
 from bgfn.report.glance import run_header
 from bgfn.report.provenance import cards_line, model_cards, outage_datasets, outage_provenance, provenance, short_source
@@ -135,15 +137,18 @@ def training_section(res: ProfileResults) -> list:
 
 def odometer_section(res: ProfileResults) -> list:
     """The bars a learned odometer must clear (notebook 04, :mod:`bgfn.evaluate.odometers`): median max horizontal
-    error per dataset, method (the oracle speed per sigma) and duration, then its lines."""
+    error per dataset, method (the oracle speed per sigma) and duration, its lines, then per dataset (recorded drives
+    first) the odometers' speed in a few outages and the error growth over the outage."""
     file = res.table(SHARED_TABLES["odometer_summary"])
     summary = read_csv(file)
     if summary is None or summary.empty:
         return [missing_note(file, "the odometer bars", "notebook 04, `evaluate.odometer`")]
     wide = odometer_table(summary)
+    figures = [res.out / "figures" / f"{stem}_{dataset_id(d)}.png" for d in recorded_first(summary["dataset"].unique())
+               for stem in ("odometer_speed", "odometer_growth")]
     return [compact(wide.style.format("{:.1f}"), f"Median max horizontal error (m) over the sweep's starts, "
                                                  f"profile {res.profile}"),
-            bullets(odometer_lines(summary))]
+            bullets(odometer_lines(summary)), *[f for f in figures if f.is_file()]]
 
 
 def sweep_section(res: ProfileResults) -> list:

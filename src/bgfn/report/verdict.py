@@ -9,6 +9,11 @@ outage sweep, and sentences answering the five questions a navigation engineer a
    on the validation block (which networks improved on their initial weights, and how far).
 4. *Was the paper's protocol leaky?* The networks trained on the whole drive, test outages included.
 5. *Is the INS row comparable?* The INS row under NaveGo v1.4's bias modelling (:mod:`bgfn.nav.ins_setups`).
+6. *Does a learned odometer help?* The networks trained as odometers (forward speed and its std fused with the NHC
+   rows; beyond the paper, issue 24) against INS+NHC, the spiking one against its twin, at what energy
+   (:mod:`bgfn.report.odometer_verdict`).
+
+The recorded drives come first: a simulated IMU is kinder than a real one, so the decisive test is the real drive.
 
 Every number comes from ``results/<profile>/tables/``; a table that a notebook has not written leaves its cells
 empty and its sentence says so. Nothing here is typed by hand.
@@ -25,8 +30,11 @@ import pandas as pd
 from bgfn import paper
 from bgfn.config import MAIN_VARIANT, SHARED_TABLES
 from bgfn.data.names import dataset_id
+from bgfn.data.registry import recorded_first
 from bgfn.evaluate.tables import table_paths
 from bgfn.nav.ins_setups import gap_explained
+from bgfn.report.odometer_verdict import (OdometerInputs, answer_odometer, odometer_headline, odometer_rows,
+                                          read_odometer_inputs)
 from bgfn.report.reading import read_csv
 
 #: Rows of the verdict table, in order: (label, method label in the tables). The oracle row is built apart.
@@ -59,6 +67,7 @@ class VerdictInputs:
     training: pd.DataFrame | None = None            # training_runs.csv: the main networks' cards
     training_variants: pd.DataFrame | None = None   # training_variants.csv: the variants' cards
     training_all_windows: pd.DataFrame | None = None    # training_all_windows.csv: untrained runs, all windows
+    odometer: OdometerInputs | None = None          # outage_odometer*.csv, energy_odometer.csv
 
     @classmethod
     def read(cls, out: str | Path, dataset: str) -> "VerdictInputs":
@@ -78,7 +87,10 @@ class VerdictInputs:
                    of(read_csv(tables / SHARED_TABLES["kf_ins_tuning"])),
                    of(read_csv(tables / SHARED_TABLES["training_runs"])),
                    of(read_csv(tables / SHARED_TABLES["training_variants"])),
-                   of(read_csv(tables / SHARED_TABLES["training_all_windows"])))
+                   of(read_csv(tables / SHARED_TABLES["training_all_windows"])),
+                   read_odometer_inputs(read_csv(tables / SHARED_TABLES["odometer"]),
+                                        read_csv(tables / SHARED_TABLES["odometer_summary"]),
+                                        read_csv(tables / SHARED_TABLES["energy_odometer"]), dataset))
 
 
 def _outage_value(seeds: pd.DataFrame | None, method: str, outage: int) -> float:
@@ -163,6 +175,8 @@ def verdict_table(inp: VerdictInputs) -> pd.DataFrame:
                          "outage 2": _oracle_value(inp.breakeven, "2", None),
                          **{f"sweep {d:g} s": _oracle_value(inp.breakeven, "sweep", d) for d in SWEEP_DURATIONS},
                          **{f"p {d:g} s": float("nan") for d in SWEEP_DURATIONS}, "runs": 0})
+        if method == f"{SUBJECT}+NHC" and inp.odometer is not None:
+            rows += odometer_rows(inp.odometer, SWEEP_DURATIONS)
     if inp.variants is not None and len(inp.variants):
         v = inp.variants[(inp.variants["method"] == SUBJECT)]
         for variant, g in v.groupby("variant", sort=False):
@@ -368,9 +382,9 @@ def answer_ins_tuning(inp: VerdictInputs) -> str:
 
 
 def verdict_sentences(inp: VerdictInputs, table: pd.DataFrame, claims: dict | None = None) -> list[str]:
-    """The five answers for one test, in the issue's order."""
+    """The six answers for one test, in the issues' order."""
     return [answer_accuracy(inp), answer_free_aids(table), answer_speed(table, inp), answer_protocol(table, claims),
-            answer_ins_tuning(inp)]
+            answer_ins_tuning(inp), answer_odometer(inp.odometer or OdometerInputs(None, None, None), SWEEP_DURATIONS)]
 
 
 def headline(inp: VerdictInputs, table: pd.DataFrame) -> str:
@@ -387,7 +401,9 @@ def headline(inp: VerdictInputs, table: pd.DataFrame) -> str:
         vals = (_mean_outages(b), _mean_outages(i), _mean_outages(n))
         where = "mean max error in the paper's two outages"
     word = "below" if vals[0] < vals[1] else "above"
-    return (f"{title} ({inp.dataset}), {where}: BGFN {_m(vals[0])}, {word} standalone INS ({_m(vals[1])}); "
+    odo = odometer_headline(inp.odometer, SWEEP_DURATIONS) if inp.odometer is not None else ""
+    return (f"{title} ({inp.dataset}): " + (f"{odo[0].upper()}{odo[1:]}. " if odo else "")
+            + f"The paper's design, {where}: BGFN {_m(vals[0])}, {word} standalone INS ({_m(vals[1])}); "
             f"INS with non-holonomic constraints {_m(vals[2])}.")
 
 
@@ -411,11 +427,11 @@ class Verdict:
         return [headline(self.inputs[d], self.tables[d]) for d in self.inputs]
 
     def pieces(self) -> list:
-        """What the results page shows: per test a title, the table and the five answers."""
+        """What the results page shows: per test a title, its headline, the table and the six answers."""
         out = []
         for d, inp in self.inputs.items():
             title = paper.TESTS[inp.test]["title"] if inp.test in paper.TESTS else inp.test
-            out += [f"### {title}: `{d}`", format_table(self.tables[d]),
+            out += [f"### {title}: `{d}`", f"**{headline(inp, self.tables[d])}**", format_table(self.tables[d]),
                     "\n".join(f"{k}. {a}" for k, a in enumerate(self.answers[d], 1))]
         return out
 
@@ -423,7 +439,7 @@ class Verdict:
 def verdict_of(res) -> Verdict:
     """The verdict of every dataset notebook 04 evaluated for ``res`` (:class:`bgfn.report.reading.ProfileResults`).
     """
-    datasets = list(dict.fromkeys(res.cfg["evaluate"]["datasets"]))
+    datasets = recorded_first(dict.fromkeys(res.cfg["evaluate"]["datasets"]))   # the decisive test first
     inputs = {d: VerdictInputs.read(res.out, d) for d in datasets}
     tables = {d: verdict_table(inp) for d, inp in inputs.items()}
     answers = {d: verdict_sentences(inputs[d], tables[d], res.claims) for d in datasets}

@@ -79,6 +79,16 @@ def all_windows_models_dir(profile: str, dataset: str, create: bool = True) -> P
     return _made(results_dir(profile, create=create) / "models" / ALL_WINDOWS_DIR / dataset_id(dataset), create)
 
 
+#: Folder of a sweep fold's models that holds its learned odometers (:mod:`bgfn.evaluate.odometers`).
+ODOMETER_DIR = "odometer"
+
+
+def odometer_models_dir(profile: str, dataset: str, fold: int, create: bool = True) -> Path:
+    """``results/<profile>/models/<dataset id>/fold<k>/odometer/`` (the networks trained as odometers on that
+    fold), created unless ``create`` is False."""
+    return _made(models_dir(profile, dataset, fold, create) / ODOMETER_DIR, create)
+
+
 def checkpoint_path(profile: str, dataset: str, method: str, seed: int, fold: int | None = None,
                     create: bool = True) -> Path:
     """``results/<profile>/models/<dataset id>/[fold<k>/]<method>_seed<seed>.pt``."""

@@ -1,0 +1,141 @@
+"""The energy of the learned odometers (beyond the paper, issue 24): ``BGFN-ODO`` against its ANN twin
+``Transformer-ODO``, counted by the same rules as the paper's model (:mod:`bgfn.energy.rules`).
+
+Which networks: the odometers that notebook 04 trained (:mod:`bgfn.evaluate.odometers`) on the first dataset of
+``evaluate.odometer.datasets`` (null: the sweep's), recorded drives first, in sweep fold 0, with the first of
+``evaluate.odometer.network_seeds``. Which windows: ``energy.max_windows`` IMU windows of the odometer's length
+(``evaluate.odometer.window_s``) evenly spaced over that drive: an odometer reads the raw body-frame IMU only, so
+every stretch of the drive is an input it meets in an outage. Each network reads them with its own training
+normalization.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from bgfn.data import load_drive
+from bgfn.data.registry import recorded_first
+from bgfn.energy.checkpoint import MEASURED, SPIKING, check_trained
+from bgfn.energy.counts import layer_counts, mean_rate
+from bgfn.energy.tables import reduction_pct, stack_tables, table_from_counts, total_energy_uj
+from bgfn.learning import odometry as lo
+from bgfn.paper import odometer_label
+from bgfn.train import load_trained
+from bgfn.train.checkpoints import card_path, checkpoint_name, odometer_models_dir
+
+#: The sweep fold whose odometers are measured (every fold trains the same networks on other windows).
+FOLD = 0
+def odometer_dataset(cfg: dict) -> str | None:
+    """The dataset whose odometers are measured: the first of ``evaluate.odometer.datasets`` (null: the sweep's),
+    recorded drives first; None when the profile trains no odometer network."""
+    ecfg = cfg.get("evaluate") or {}
+    oc = ecfg.get("odometer") or {}
+    if not oc.get("methods"):
+        return None
+    names = oc.get("datasets")
+    names = (ecfg.get("sweep") or {}).get("datasets") or [] if names is None else names
+    names = recorded_first(names)
+    return names[0] if names else None
+
+
+@dataclass
+class OdometerEnergy:
+    """Energy per prediction of the measured odometers.
+
+    Attributes
+    ----------
+    dataset : str
+    seed : int
+    paths : dict
+        Method -> checkpoint (the methods of :data:`bgfn.energy.checkpoint.MEASURED` that were trained).
+    tables : dict
+        Method -> per-layer energy table (:func:`bgfn.energy.tables.table_from_counts`).
+    mean_rate : float
+        BGFN-ODO's mean input firing rate.
+    n_windows : int
+    """
+
+    dataset: str
+    seed: int
+    paths: dict[str, Path]
+    tables: dict[str, pd.DataFrame]
+    mean_rate: float
+    n_windows: int
+
+    @property
+    def table(self) -> pd.DataFrame:
+        """Every measured network's layers (:func:`bgfn.energy.tables.stack_tables`; ``model``: ``BGFN-ODO`` ...),
+        the dataset in the first column."""
+        table = stack_tables(self.tables)
+        table.insert(0, "dataset", self.dataset)
+        return table
+
+    @property
+    def reduction_pct(self) -> float:
+        """BGFN-ODO's energy saved against its twin, % (NaN without the twin)."""
+        if not set(MEASURED) <= set(self.tables):
+            return float("nan")
+        return reduction_pct(self.tables["bgfn"], self.tables["transformer"])
+
+    def totals(self) -> pd.DataFrame:
+        """One row per network: label, energy per prediction (µJ), MACs, SOPs."""
+        rows = []
+        for m, t in self.tables.items():
+            tot = t[t["layer"] == "total"].iloc[0]
+            rows.append({"model": tot["model"], "energy_uj": total_energy_uj(t), "macs": float(tot["macs"]),
+                         "sops": float(tot["sops"])})
+        return pd.DataFrame(rows)
+
+    def lines(self) -> list[str]:
+        """Which networks, on which windows, and the reduction."""
+        e = {m: total_energy_uj(t) for m, t in self.tables.items()}
+        out = [f"{self.dataset}, sweep fold {FOLD}, seed {self.seed}: {self.n_windows} IMU windows evenly spaced over "
+               f"the drive; BGFN-ODO mean input firing rate {self.mean_rate:.3f}"]
+        if np.isfinite(self.reduction_pct):
+            out.append(f"BGFN-ODO {e['bgfn']:.4g} µJ, Transformer-ODO {e['transformer']:.4g} µJ per prediction: "
+                       f"{self.reduction_pct:.1f} % less energy for the spiking odometer")
+        else:
+            out.append(f"BGFN-ODO {e['bgfn']:.4g} µJ per prediction; no Transformer-ODO was trained "
+                       f"(evaluate.odometer.methods) to compare with")
+        return out
+
+
+def odometer_energy(profile: str, cfg: dict, e_mac: float, e_ac: float, batch_size: int = 32) -> OdometerEnergy | None:
+    """Count the measured odometers (module docstring); None when the profile trains no odometer network.
+
+    Raises
+    ------
+    FileNotFoundError
+        BGFN-ODO's checkpoint is missing (notebook 04 writes it); the message names the file.
+    bgfn.errors.DataError
+        BGFN-ODO never improved on its initial weights (unless ``energy.allow_untrained``).
+    """
+    dataset = odometer_dataset(cfg)
+    if dataset is None:
+        return None
+    oc = cfg["evaluate"]["odometer"]
+    seed = int(list(oc.get("network_seeds") or [0])[0])
+    folder = odometer_models_dir(profile, dataset, FOLD, create=False)
+    paths = {m: folder / checkpoint_name(m, seed) for m in MEASURED if m in oc["methods"]}
+    if "bgfn" not in paths or not paths["bgfn"].is_file():
+        raise FileNotFoundError(f"BGFN-ODO's checkpoint not found: {folder / checkpoint_name('bgfn', seed)} -- "
+                                f"notebook 04_outage_evaluation.ipynb trains it (evaluate.odometer.methods)")
+    paths = {m: p for m, p in paths.items() if p.is_file()}
+    allow = bool((cfg.get("energy") or {}).get("allow_untrained", False))
+    for m in SPIKING:
+        check_trained(json.loads(card_path(paths[m]).read_text()), card_path(paths[m]), allow)
+    trained = {m: load_trained(p, device="cpu") for m, p in paths.items()}
+    drive = load_drive(dataset, profile=profile)
+    window, _ = lo.window_samples(drive.imu, oc["window_s"])
+    t = drive.imu["time"].to_numpy(float)
+    n = int((cfg.get("energy") or {}).get("max_windows") or 128)
+    ws = lo.speed_windows(drive.imu, np.linspace(t[window], t[-1], n), window)
+    counts = {m: layer_counts(tm.model.eval(), tm.norm.x(ws.x).astype(np.float32), batch_size)
+              for m, tm in trained.items()}
+    tables = {m: table_from_counts(c, odometer_label(m), e_mac, e_ac) for m, c in counts.items()}
+    return OdometerEnergy(dataset, seed, paths, tables, mean_rate(counts["bgfn"]), len(ws))

@@ -1,0 +1,77 @@
+"""The executed notebooks as the book shows them: one parameters cell per page.
+
+papermill keeps a notebook's own ``parameters`` cell and inserts a copy below it, tagged
+``injected-parameters``, with the values of the run (``profile = "paper"``). The book would show both, the
+first with the notebook's defaults. :func:`one_parameters_cell` writes the run's values into the notebook's own
+cell (its comments kept) and drops papermill's copy, so a reader sees one cell with the values that produced the
+page. ``make book`` applies it to the copies under ``book/notebooks/``, never to ``results/<profile>/notebooks/``.
+
+``python -m bgfn.report.book_notebooks FILE.ipynb ...`` rewrites each file in place.
+"""
+
+from __future__ import annotations
+
+import ast
+import json
+import re
+import sys
+from pathlib import Path
+
+from bgfn.io import atomic_write_text
+
+#: The tags papermill reads and writes.
+PARAMETERS_TAG, INJECTED_TAG = "parameters", "injected-parameters"
+_ASSIGNMENT = re.compile(r"^(?P<name>[A-Za-z_]\w*)\s*=\s*(?P<value>.*?)(?P<comment>\s+#.*)?$")
+
+
+def _tags(cell: dict) -> list:
+    return cell.get("metadata", {}).get("tags", [])
+
+
+def _source(cell: dict) -> str:
+    src = cell.get("source", "")
+    return "".join(src) if isinstance(src, list) else src
+
+
+def injected_values(source: str) -> dict[str, str]:
+    """``name -> value expression`` of the top-level assignments of papermill's injected cell."""
+    out = {}
+    for node in ast.parse(source).body:
+        if isinstance(node, ast.Assign) and len(node.targets) == 1 and isinstance(node.targets[0], ast.Name):
+            out[node.targets[0].id] = ast.get_source_segment(source, node.value)
+    return out
+
+
+def one_parameters_cell(nb: dict) -> dict:
+    """``nb`` with the injected values written into its own parameters cell and the injected cell removed
+    (unchanged when either cell is missing). A value injected for a name the cell does not assign is appended
+    to it, so nothing the run used is hidden."""
+    cells = nb.get("cells", [])
+    own = next((c for c in cells if PARAMETERS_TAG in _tags(c)), None)
+    injected = next((c for c in cells if INJECTED_TAG in _tags(c)), None)
+    if own is None or injected is None:
+        return nb
+    values = injected_values(_source(injected))
+    lines, seen = [], set()
+    for line in _source(own).splitlines():
+        m = _ASSIGNMENT.match(line)
+        if m and m["name"] in values:
+            seen.add(m["name"])
+            line = f"{m['name']} = {values[m['name']]}{m['comment'] or ''}"
+        lines.append(line)
+    lines += [f"{k} = {v}" for k, v in values.items() if k not in seen]
+    own["source"] = "\n".join(lines)
+    nb["cells"] = [c for c in cells if c is not injected]
+    return nb
+
+
+def rewrite(path: str | Path) -> None:
+    """Apply :func:`one_parameters_cell` to a notebook file in place (atomically)."""
+    path = Path(path)
+    nb = one_parameters_cell(json.loads(path.read_text(encoding="utf-8")))
+    atomic_write_text(path, json.dumps(nb, indent=1, ensure_ascii=False) + "\n")
+
+
+if __name__ == "__main__":
+    for name in sys.argv[1:]:
+        rewrite(name)

@@ -1,0 +1,258 @@
+"""The learned odometer in the verdict (beyond the paper, issue 24): its rows in the verdict table, the sixth
+question ("does a learned odometer help?") and its clause in each dataset's headline.
+
+Read from notebook 04's odometer tables (:mod:`bgfn.evaluate.odometers`: ``outage_odometer.csv`` with one row per
+start, seed and duration, ``outage_odometer_summary.csv`` with the medians, the ratio to INS+NHC per start and the
+Wilcoxon p against it) and notebook 05's ``energy_odometer.csv`` (:mod:`bgfn.energy.odometer`). Nothing here is
+typed by hand; a missing table leaves its cells empty and its sentence says so.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from bgfn.evaluate.odometers import HOLD, ORACLE, RIDGE
+from bgfn.paper import METHOD_LABELS, nhc_label, odometer_label
+from bgfn.stats import wilcoxon_p
+
+#: The spiking odometer and its ANN twin.
+SUBJECT_ODO, TWIN_ODO = odometer_label("bgfn"), odometer_label("transformer")
+#: The learned odometers, the ridge first (the bar the networks must clear).
+LEARNED: tuple[str, ...] = (RIDGE, *(odometer_label(m) for m in METHOD_LABELS))
+#: Rows the verdict table gains, in order (the oracle row is built apart).
+ODOMETER_ROWS: tuple[str, ...] = (HOLD, *LEARNED)
+#: Label of the oracle row: the reference's speed plus white noise as large as BGFN-ODO's own speed error.
+ORACLE_ODO_ROW = f"oracle speed at {SUBJECT_ODO}'s speed error"
+#: What an odometer reads (the verdict table's ``inputs``).
+ODOMETER_INPUTS = "body-frame IMU"
+#: The coverage of +-2 sigma that a calibrated Gaussian std gives, and the band the issue calls calibrated.
+CALIBRATED_COVERAGE = (0.90, 0.98)
+#: Wilcoxon p below which a difference is called one.
+ALPHA = 0.05
+
+
+@dataclass
+class OdometerInputs:
+    """One dataset's odometer tables (None where a notebook has not written one)."""
+
+    rows: pd.DataFrame | None       # outage_odometer.csv
+    summary: pd.DataFrame | None    # outage_odometer_summary.csv
+    energy: pd.DataFrame | None     # energy_odometer.csv (only the dataset notebook 05 measured)
+
+    @property
+    def measured(self) -> bool:
+        return self.summary is not None and len(self.summary) > 0
+
+    def cell(self, method: str, duration: float, column: str = "max_h_m") -> float:
+        """The summary's ``column`` of ``method`` (not the oracle) at ``duration`` (NaN when absent)."""
+        if not self.measured:
+            return float("nan")
+        s = self.summary
+        sel = s[(s["method"] == method) & np.isclose(s["duration_s"].astype(float), duration)]
+        return float(sel[column].iloc[0]) if len(sel) else float("nan")
+
+    def has(self, method: str) -> bool:
+        return self.measured and bool((self.summary["method"] == method).any())
+
+    def runs(self, method: str) -> int:
+        """Runs per start of ``method`` (its seeds)."""
+        if self.rows is None or not len(self.rows):
+            return 0
+        sel = self.rows[self.rows["method"] == method]
+        return int(sel.groupby(["duration_s", "start_s"]).size().max()) if len(sel) else 0
+
+    def n_starts(self) -> int:
+        if self.rows is None or not len(self.rows):
+            return 0
+        return int(self.rows.loc[self.rows["method"] == nhc_label("INS"), "start_s"].nunique())
+
+    def oracle_at(self, sigma: float, duration: float) -> float:
+        """The oracle speed's median max error at noise ``sigma`` m/s, interpolated in log-log over the grid (NaN
+        outside it)."""
+        if not self.measured or not np.isfinite(sigma) or sigma <= 0:
+            return float("nan")
+        s = self.summary
+        g = s[(s["method"] == ORACLE) & np.isclose(s["duration_s"].astype(float), duration)].sort_values("sigma_mps")
+        g = g[g["sigma_mps"] > 0]
+        if len(g) < 2 or not g["sigma_mps"].min() <= sigma <= g["sigma_mps"].max():
+            return float("nan")
+        return float(np.exp(np.interp(np.log(sigma), np.log(g["sigma_mps"]), np.log(g["max_h_m"]))))
+
+    def oracle_breakeven(self, duration: float) -> float:
+        """The largest sigma of the grid at which the oracle speed still beats INS+NHC (NaN: at none)."""
+        if not self.measured:
+            return float("nan")
+        s = self.summary
+        g = s[(s["method"] == ORACLE) & np.isclose(s["duration_s"].astype(float), duration)]
+        better = g[g["max_h_m"] < self.cell(nhc_label("INS"), duration)]
+        return float(better["sigma_mps"].max()) if len(better) else float("nan")
+
+    def pair_p(self, a: str, b: str, duration: float) -> tuple[float, float]:
+        """(median per-start difference a - b in m, Wilcoxon p), the seeds' median per start."""
+        if self.rows is None or not len(self.rows):
+            return float("nan"), float("nan")
+        r = self.rows[np.isclose(self.rows["duration_s"].astype(float), duration)]
+        per = r[r["method"].isin([a, b])].groupby(["method", "start_s"])["max_h_m"].median().unstack(0)
+        if a not in per or b not in per:
+            return float("nan"), float("nan")
+        diff = (per[a] - per[b]).dropna()
+        if not len(diff):
+            return float("nan"), float("nan")
+        # identical at every start: no difference at all (the signed-rank test has no nonzero pair to rank)
+        return float(diff.median()), 1.0 if (diff == 0).all() else wilcoxon_p(diff)
+
+    def energy_uj(self, method: str) -> float:
+        """Energy per prediction of ``method``'s odometer (µJ), NaN when notebook 05 did not measure it."""
+        if self.energy is None or not len(self.energy):
+            return float("nan")
+        sel = self.energy[(self.energy["model"] == method) & (self.energy["layer"] == "total")]
+        return float(sel["energy_uj"].iloc[0]) if len(sel) else float("nan")
+
+
+def read_odometer_inputs(odometer: pd.DataFrame | None, summary: pd.DataFrame | None,
+                         energy: pd.DataFrame | None, dataset: str) -> OdometerInputs:
+    """The tables restricted to ``dataset`` (the energy table only when its ``dataset`` column names it)."""
+    def of(df):
+        return None if df is None or "dataset" not in df.columns else df[df["dataset"] == dataset]
+
+    return OdometerInputs(of(odometer), of(summary), of(energy))
+
+
+def odometer_rows(odo: OdometerInputs, durations) -> list[dict]:
+    """The verdict table's odometer rows (sweep columns only: the paper's two outages have no odometer run): the
+    held speed, every learned odometer, then the oracle speed at BGFN-ODO's own speed RMSE; ``p``: Wilcoxon of the
+    row against INS+NHC over the starts."""
+    if not odo.measured:
+        return []
+    rows = []
+    for method in ODOMETER_ROWS:
+        if not odo.has(method):
+            continue
+        rows.append({"row": method, "inputs": ODOMETER_INPUTS if method != HOLD else "speed at the outage start",
+                     "protocol": "honest" if method != HOLD else "-", "outage 1": np.nan, "outage 2": np.nan,
+                     **{f"sweep {d:g} s": odo.cell(method, d) for d in durations},
+                     **{f"p {d:g} s": odo.cell(method, d, "p_vs_nhc") for d in durations}, "runs": odo.runs(method)})
+    if odo.has(SUBJECT_ODO) and odo.has(ORACLE):
+        rows.append({"row": ORACLE_ODO_ROW, "inputs": "-", "protocol": "-", "outage 1": np.nan, "outage 2": np.nan,
+                     **{f"sweep {d:g} s": odo.oracle_at(odo.cell(SUBJECT_ODO, d, "speed_rmse_mps"), d)
+                        for d in durations},
+                     **{f"p {d:g} s": np.nan for d in durations}, "runs": 0})
+    return rows
+
+
+def _m(x: float) -> str:
+    return "n/a" if not np.isfinite(x) else f"{x:.1f} m"
+
+
+def _p(p: float) -> str:
+    return "n/a" if not np.isfinite(p) else f"{p:.2g}"
+
+
+def best_learned(odo: OdometerInputs, duration: float) -> str | None:
+    """The learned odometer with the smallest median max error at ``duration`` (None without any)."""
+    vals = {m: odo.cell(m, duration) for m in LEARNED if odo.has(m)}
+    vals = {m: v for m, v in vals.items() if np.isfinite(v)}
+    return min(vals, key=vals.get) if vals else None
+
+
+def beats(odo: OdometerInputs, method: str, duration: float) -> bool:
+    """``method`` below INS+NHC at ``duration`` in median and significantly so (Wilcoxon p < :data:`ALPHA`)."""
+    return (odo.cell(method, duration) < odo.cell(nhc_label("INS"), duration)
+            and odo.cell(method, duration, "p_vs_nhc") < ALPHA)
+
+
+def twin_word(odo: OdometerInputs, duration: float) -> str | None:
+    """BGFN-ODO against its ANN twin over the starts: "no different from", "better than" or "worse than" (Wilcoxon
+    at :data:`ALPHA`); None without the twin."""
+    diff, p = odo.pair_p(SUBJECT_ODO, TWIN_ODO, duration)
+    if not np.isfinite(p):
+        return None
+    return "no different from" if p >= ALPHA else "better than" if diff < 0 else "worse than"
+
+
+def twin_comparison(odo: OdometerInputs, duration: float) -> str:
+    """:func:`twin_word` with the twin's error, the median difference per start and the p-value."""
+    word = twin_word(odo, duration)
+    if word is None:
+        return "not compared with its ANN twin (no Transformer-ODO)"
+    diff, p = odo.pair_p(SUBJECT_ODO, TWIN_ODO, duration)
+    return (f"{word} its ANN twin ({_m(odo.cell(TWIN_ODO, duration))}; median difference per start {diff:+.1f} m, "
+            f"Wilcoxon p {_p(p)})")
+
+
+def _energy(odo: OdometerInputs) -> str:
+    e_snn, e_ann = odo.energy_uj("BGFN-ODO"), odo.energy_uj("Transformer-ODO")
+    if not np.isfinite(e_snn):
+        return "its energy was not measured for this drive (notebook 05 audits one drive's odometers)"
+    if not np.isfinite(e_ann):
+        return f"at {e_snn:.3g} µJ per prediction"
+    return (f"at {e_snn:.3g} µJ per prediction against the twin's {e_ann:.3g} µJ "
+            f"({100 * (1 - e_snn / e_ann):.0f} % less)")
+
+
+def answer_odometer(odo: OdometerInputs, durations) -> str:
+    """Question 6: does a learned odometer beat INS+NHC, does the spiking one match its twin, how calibrated is it,
+    how far is it from an oracle speed, at what energy."""
+    q = "Does a learned odometer help?"
+    if not odo.measured:
+        return f"{q} Not measured: notebook 04's odometer bars have not run for this drive (`evaluate.odometer`)."
+    d_short, d_long = min(durations), max(durations)
+    nhc = nhc_label("INS")
+
+    def pair(m):
+        vals = [odo.cell(m, d) for d in durations]
+        return "n/a" if not np.isfinite(vals).any() else "/".join(f"{v:.1f}" for v in vals) + " m"
+
+    text = [f"{q} In the sweep's windows ({odo.n_starts()} starts, every odometer trained on its fold's other "
+            f"windows), median max horizontal error at {'/'.join(f'{d:g}' for d in durations)} s: {nhc} "
+            f"{pair(nhc)} (no learning), the speed held from the outage start {pair(HOLD)}"]
+    for m in LEARNED:
+        if odo.has(m):
+            ratio = "/".join(f"{odo.cell(m, d, 'ratio_to_nhc'):.2f}" for d in durations)
+            text.append(f"{m} {pair(m)} ({ratio} of {nhc} per start, p {'/'.join(_p(odo.cell(m, d, 'p_vs_nhc')) for d in durations)})")
+    out = "; ".join(text) + "."
+    best = best_learned(odo, d_long)
+    if best is not None:
+        won = [d for d in durations if beats(odo, best, d)]
+        out += (f" The best learned odometer at {d_long:g} s is {best}: it "
+                + (f"beats {nhc} at {' and '.join(f'{d:g} s' for d in won)} (p < {ALPHA:g})." if won
+                   else f"does not beat {nhc} significantly."))
+    if odo.has(SUBJECT_ODO):
+        rmse = odo.cell(SUBJECT_ODO, d_long, "speed_rmse_mps")
+        cov = odo.cell(SUBJECT_ODO, d_long, "coverage_2sigma")
+        lo, hi = CALIBRATED_COVERAGE
+        calib = ("calibrated" if lo <= cov <= hi else "overconfident" if cov < lo else "underconfident")
+        out += (f" {SUBJECT_ODO} is {twin_comparison(odo, d_long)} at {d_long:g} s, {_energy(odo)}. Its speed error in "
+                f"the outages: RMSE {rmse:.2f} m/s, {100 * cov:.0f} % of epochs within its +-2 sigma ({calib}: "
+                f"{100 * lo:.0f}-{100 * hi:.0f} % is the band of a calibrated std).")
+        be = odo.oracle_breakeven(d_long)
+        at = odo.oracle_at(rmse, d_long)
+        out += (f" An oracle speed (the reference's plus white noise) beats {nhc} at {d_long:g} s "
+                + (f"up to a noise of {be:g} m/s" if np.isfinite(be) else "at no noise level of its grid")
+                + (f"; at {SUBJECT_ODO}'s speed error it reaches {_m(at)}" if np.isfinite(at) else "")
+                + " (how accurate a speed must be, and what better learning could give with this filter).")
+    return out
+
+
+def odometer_headline(odo: OdometerInputs, durations) -> str:
+    """One clause for the dataset's headline: whether a learned odometer beats INS+NHC at the longest duration,
+    and BGFN-ODO against its twin and at what energy; empty when not measured."""
+    if not odo.measured:
+        return ""
+    d = max(durations)
+    nhc = nhc_label("INS")
+    best = best_learned(odo, d)
+    if best is None:
+        return ""
+    head = (f"a learned odometer beats {nhc} at {d:g} s: {best} {_m(odo.cell(best, d))} against "
+            f"{_m(odo.cell(nhc, d))} (p {_p(odo.cell(best, d, 'p_vs_nhc'))})" if beats(odo, best, d) else
+            f"no learned odometer beats {nhc} significantly at {d:g} s ({_m(odo.cell(nhc, d))}; best {best} "
+            f"{_m(odo.cell(best, d))}, p {_p(odo.cell(best, d, 'p_vs_nhc'))})")
+    if odo.has(SUBJECT_ODO):
+        word = twin_word(odo, d)
+        head += (f"; {SUBJECT_ODO} {_m(odo.cell(SUBJECT_ODO, d))}"
+                 + (f" is {word} its ANN twin ({_m(odo.cell(TWIN_ODO, d))})" if word else "") + f", {_energy(odo)}")
+    return head

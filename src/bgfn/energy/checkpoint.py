@@ -12,6 +12,7 @@ import numpy as np
 from torch import nn
 
 from bgfn.config import PROJECT_ROOT, read_profile
+from bgfn.data.names import dataset_id
 from bgfn.errors import DataError
 from bgfn.learning import WindowSet
 from bgfn.train import TrainedModel, even_subset, load_trained, prepare_learning_data
@@ -178,7 +179,10 @@ def load_measured(profile: str, cfg: dict | None = None, methods=MEASURED) -> Me
         if m in SPIKING:        # firing rates depend on the weights; the twin's MAC count does not
             check_trained(cards[m], card_path(paths[m]), allow)
     first = paths[methods[0]]
-    return MeasuredModels(profile, first.parent.name, parse_checkpoint(first).seed, paths, trained, cards)
+    # the dataset as the profile names it (a CSV drive by its folder path), the checkpoints' folder being its id
+    names = [d for d in (cfg.get("train") or {}).get("datasets") or [] if dataset_id(d) == first.parent.name]
+    return MeasuredModels(profile, names[0] if names else first.parent.name, parse_checkpoint(first).seed, paths,
+                          trained, cards)
 
 
 # ---------------------------------------------------------------------------------------------------

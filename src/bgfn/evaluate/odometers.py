@@ -60,6 +60,11 @@ ODOMETER_COLUMNS: tuple[str, ...] = ("dataset", "start_s", "duration_s", "method
                                      "max_h_m", "rmse_h_m", "final_h_m", "speed_rmse_mps", "coverage_2sigma")
 
 
+#: Columns of ``tables/outage_odometer_summary.csv`` (:func:`odometer_summary`).
+SUMMARY_COLUMNS: tuple[str, ...] = ("dataset", "duration_s", "method", "sigma_mps", "max_h_m", "ratio_to_nhc",
+                                    "speed_rmse_mps", "coverage_2sigma", "runs", "p_vs_nhc")
+
+
 @dataclass(frozen=True)
 class OdometerRun:
     """One aid in some outages (an independent run): ``label``, the outages ``(start, duration)``, the aid
@@ -382,7 +387,7 @@ def odometer_summary(rows: pd.DataFrame) -> pd.DataFrame:
     speed RMSE and 2-sigma coverage, the median per-start ratio to ``INS+NHC`` and the two-sided Wilcoxon
     signed-rank p-value of the per-start differences to it (``p_vs_nhc``; seeds' median per start)."""
     if rows.empty:
-        return pd.DataFrame()
+        return pd.DataFrame(columns=list(SUMMARY_COLUMNS))
     base = rows[rows["method"] == nhc_label("INS")].groupby(["dataset", "duration_s", "start_s"])["max_h_m"].first()
     r = rows.join(base.rename("nhc_m"), on=["dataset", "duration_s", "start_s"])
     r["ratio_to_nhc"] = r["max_h_m"] / r["nhc_m"]
@@ -396,7 +401,7 @@ def odometer_summary(rows: pd.DataFrame) -> pd.DataFrame:
     p = per_start.groupby(level=key, dropna=False, sort=False).apply(
         lambda g: wilcoxon_p(g["max_h_m"] - g["nhc_m"])).rename("p_vs_nhc").reset_index()
     out = out.merge(p, on=key, how="left")                  # pandas matches the NaN sigma of non-oracle rows
-    return out.sort_values(["dataset", "duration_s"], kind="stable").reset_index(drop=True)
+    return out.sort_values(["dataset", "duration_s"], kind="stable").reset_index(drop=True)[list(SUMMARY_COLUMNS)]
 
 
 def odometer_lines(summary: pd.DataFrame) -> list[str]:

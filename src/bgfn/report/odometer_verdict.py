@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from bgfn.data.names import dataset_id
 from bgfn.evaluate.odometers import HOLD, ORACLE, RIDGE
 from bgfn.paper import METHOD_LABELS, nhc_label, odometer_label
 from bgfn.stats import wilcoxon_p
@@ -112,11 +113,18 @@ class OdometerInputs:
         return float(sel["energy_uj"].iloc[0]) if len(sel) else float("nan")
 
 
+def same_dataset(column: pd.Series, dataset: str) -> pd.Series:
+    """Which rows of a table's ``dataset`` column name ``dataset``: by its id (:func:`bgfn.data.names.dataset_id`), so
+    a CSV drive matches whether a table wrote its folder path or its own name."""
+    target, names = dataset_id(dataset), column.astype(str)
+    return names.map({d: d == dataset or dataset_id(d) == target for d in names.unique()})
+
+
 def read_odometer_inputs(odometer: pd.DataFrame | None, summary: pd.DataFrame | None,
                          energy: pd.DataFrame | None, dataset: str) -> OdometerInputs:
     """The tables restricted to ``dataset`` (the energy table only when its ``dataset`` column names it)."""
     def of(df):
-        return None if df is None or "dataset" not in df.columns else df[df["dataset"] == dataset]
+        return None if df is None or "dataset" not in df.columns else df[same_dataset(df["dataset"], dataset)]
 
     return OdometerInputs(of(odometer), of(summary), of(energy))
 

@@ -30,7 +30,10 @@ def read_csv(path: str | Path) -> pd.DataFrame | None:
     path = Path(path)
     if not path.is_file():
         return None
-    return pd.read_csv(path, comment="#")
+    try:
+        return pd.read_csv(path, comment="#")
+    except pd.errors.EmptyDataError:         # a table with nothing to say (no rows, no header): empty, not missing
+        return pd.DataFrame()
 
 
 def read_json(path: str | Path) -> dict | None:

@@ -34,7 +34,7 @@ from bgfn.data.registry import recorded_first
 from bgfn.evaluate.tables import table_paths
 from bgfn.nav.ins_setups import gap_explained
 from bgfn.report.odometer_verdict import (OdometerInputs, answer_odometer, odometer_headline, odometer_rows,
-                                          read_odometer_inputs)
+                                          read_odometer_inputs, same_dataset)
 from bgfn.report.reading import read_csv
 
 #: Rows of the verdict table, in order: (label, method label in the tables). The oracle row is built apart.
@@ -76,8 +76,8 @@ class VerdictInputs:
         test = paper.test_of(dataset) or dataset_id(dataset)
         tables = out / "tables"
 
-        def of(df):
-            return None if df is None or "dataset" not in df.columns else df[df["dataset"] == dataset]
+        def of(df):      # a table names a CSV drive by its path or by its own name: compare the ids
+            return None if df is None or "dataset" not in df.columns else df[same_dataset(df["dataset"], dataset)]
 
         return cls(dataset, test, of(read_csv(table_paths(out, test)["seeds"])),
                    of(read_csv(tables / SHARED_TABLES["sweep_summary"])),
@@ -199,10 +199,11 @@ def _row(table: pd.DataFrame, label: str) -> pd.Series | None:
 
 
 def _mean_outages(row: pd.Series | None) -> float:
+    """Mean of a row's max errors over the outages it has (a user's drive may have one), NaN without any."""
     if row is None:
         return float("nan")
-    vals = [row["outage 1"], row["outage 2"]]
-    return float(np.mean(vals)) if all(np.isfinite(vals)) else float("nan")
+    vals = np.array([row["outage 1"], row["outage 2"]], dtype=float)
+    return float(vals[np.isfinite(vals)].mean()) if np.isfinite(vals).any() else float("nan")
 
 
 def answer_accuracy(inp: VerdictInputs) -> str:
@@ -399,7 +400,8 @@ def headline(inp: VerdictInputs, table: pd.DataFrame) -> str:
         where = "median max error over the 30 s sweep"
     else:
         vals = (_mean_outages(b), _mean_outages(i), _mean_outages(n))
-        where = "mean max error in the paper's two outages"
+        where = ("mean max error in the paper's two outages" if paper.has_own_values(inp.test)
+                 else "mean max error in the profile's outages")
     word = "below" if vals[0] < vals[1] else "above"
     odo = odometer_headline(inp.odometer, SWEEP_DURATIONS) if inp.odometer is not None else ""
     return (f"{title} ({inp.dataset}): " + (f"{odo[0].upper()}{odo[1:]}. " if odo else "")

@@ -7,7 +7,7 @@ One network = one ``(dataset, method, seed)`` of a profile (a fold ``k`` for the
                                                  <method>_seed<seed>.last.pt   while training: resumable state
 
 A variant of the profile's learning problem (:mod:`bgfn.train.variants`) keeps its networks apart, under
-``results/<profile>/models/variants/<variant>/<dataset>/`` (:func:`variant_models_dir`), with the same names.
+``results/<profile>/models/variants/<variant>/<dataset id>/`` (:func:`variant_models_dir`), with the same names.
 
 Every module builds these names with :func:`checkpoint_path` (or :func:`checkpoint_name` under a folder it
 was given) and reads them back with :func:`parse_checkpoint`; nothing else spells the pattern. The folder is the
@@ -21,8 +21,10 @@ import re
 from pathlib import Path
 from typing import NamedTuple
 
+from bgfn import config
 from bgfn.config import results_dir
 from bgfn.data.names import dataset_id
+from bgfn.errors import DataError
 
 #: Suffixes of the three files of one network.
 BEST_SUFFIX, CARD_SUFFIX, LAST_SUFFIX = ".pt", ".json", ".last.pt"
@@ -52,7 +54,10 @@ def models_dir(profile: str, dataset: str, fold: int | None = None, create: bool
 
 
 def _made(folder: Path, create: bool) -> Path:
-    """``folder``, created (with its parents) when ``create``."""
+    """``folder``, created (with its parents) when ``create``; an error when it would lie outside
+    ``results/`` (a dataset given by its folder path must never become a path here)."""
+    if not folder.resolve().is_relative_to(config.RESULTS_ROOT.resolve()):
+        raise DataError("models", "folder", f"a folder under {config.RESULTS_ROOT}", str(folder))
     if create:
         folder.mkdir(parents=True, exist_ok=True)
     return folder
@@ -63,9 +68,10 @@ VARIANTS_DIR = "variants"
 
 
 def variant_models_dir(profile: str, variant: str, dataset: str, create: bool = True) -> Path:
-    """``results/<profile>/models/variants/<variant>/<dataset>/`` (a variant's networks), created unless
+    """``results/<profile>/models/variants/<variant>/<dataset id>/`` (a variant's networks), created unless
     ``create`` is False."""
-    return _made(results_dir(profile, create=create) / "models" / VARIANTS_DIR / variant / dataset, create)
+    return _made(results_dir(profile, create=create) / "models" / VARIANTS_DIR / variant / dataset_id(dataset),
+                 create)
 
 
 #: Folder of ``results/<profile>/models/`` that holds the runs trained again on all windows (:mod:`bgfn.train.recheck`).

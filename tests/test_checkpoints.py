@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
+import torch
 
 from bgfn.train import checkpoints as ck
 from bgfn import config
+from bgfn.errors import DataError
 
 
 def test_checkpoint_path_round_trips_through_the_parser(tmp_path, monkeypatch):
@@ -32,3 +35,32 @@ def test_cards_lists_only_network_cards_of_the_folder(tmp_path):
 def test_a_foreign_file_name_is_refused(name):
     with pytest.raises(ValueError, match="not a network file"):
         ck.parse_checkpoint(name)
+
+
+def test_a_drive_named_by_its_folder_path_keeps_every_model_folder_under_results(tmp_path, monkeypatch):
+    results = tmp_path / "results"
+    monkeypatch.setattr(config, "RESULTS_ROOT", results)
+    log = tmp_path / "logs" / "run 3"
+    log.mkdir(parents=True)
+    # the variants, the odometers and the recheck of a drive given by an absolute path: its id, never the path
+    for folder in (ck.variant_models_dir("p", "velocity", str(log)), ck.odometer_models_dir("p", str(log), 0),
+                   ck.all_windows_models_dir("p", str(log)), ck.models_dir("p", str(log))):
+        assert folder.is_relative_to(results / "p" / "models") and "run-3" in folder.parts
+    assert list(log.iterdir()) == []                       # nothing written into the user's data folder
+    with pytest.raises(DataError, match="a folder under"):
+        ck._made(tmp_path / "elsewhere", create=True)
+    assert not (tmp_path / "elsewhere").exists()
+
+
+def test_a_corrupt_or_foreign_checkpoint_is_one_error_naming_its_file(tmp_path, monkeypatch):
+    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)
+    path = ck.checkpoint_path("p", "d", "bgfn", 0)
+    path.write_bytes(b"not a checkpoint")
+    with pytest.raises(DataError, match=r"bgfn_seed0\.pt.*make reproduce PROFILE=p"):
+        ck.read_checkpoint(path)
+    # a pickle that would run code (weights_only refuses it) is not loaded either
+    torch.save({"state_dict": {}, "hook": np.random.default_rng(0)}, path)
+    with pytest.raises(DataError, match="checkpoint"):
+        ck.read_checkpoint(path)
+    torch.save({"state_dict": {"w": torch.ones(2)}, "norm": {"x_mean": [0.0]}}, path)
+    assert ck.read_checkpoint(path)["state_dict"]["w"].sum() == 2.0

@@ -17,9 +17,13 @@ folder name), so a drive named by a folder path never writes outside ``results/<
 
 from __future__ import annotations
 
+import pickle
 import re
+import zipfile
 from pathlib import Path
-from typing import NamedTuple
+from typing import Any, NamedTuple
+
+import torch
 
 from bgfn import config
 from bgfn.config import results_dir
@@ -133,3 +137,32 @@ def cards(folder: str | Path) -> list[Path]:
     """The cards ``<method>_seed<k>.json`` directly in ``folder`` (sorted; fold folders not entered)."""
     folder = Path(folder)
     return sorted(p for p in folder.glob(f"*{CARD_SUFFIX}") if _NAME_RE.match(p.name))
+
+
+def read_checkpoint(path: str | Path, map_location: Any = "cpu") -> dict:
+    """A checkpoint of :mod:`bgfn.train` (best or resumable state), loaded with ``weights_only=True``: tensors,
+    numbers, strings, lists and dicts only, never arbitrary pickled code from a file under ``results/``.
+
+    Raises
+    ------
+    bgfn.errors.DataError
+        The file is corrupt, truncated or not one of ours; the message names it and how to train it again.
+    """
+    path = Path(path)
+    try:
+        ck = torch.load(path, map_location=map_location, weights_only=True)
+    except (pickle.UnpicklingError, RuntimeError, EOFError, zipfile.BadZipFile, ValueError, OSError) as exc:
+        raise DataError(path, "checkpoint", f"a checkpoint written by bgfn.train (delete it and run "
+                        f"`make reproduce PROFILE={_profile_of(path)}` to train it again)",
+                        f"{type(exc).__name__}: {str(exc).splitlines()[0][:200] if str(exc) else 'unreadable'}") from None
+    if not isinstance(ck, dict):
+        raise DataError(path, "checkpoint", "a dict written by bgfn.train", type(ck).__name__)
+    return ck
+
+
+def _profile_of(path: Path) -> str:
+    """The profile whose ``results/<profile>/`` holds ``path`` (``<profile>`` when it lies elsewhere)."""
+    try:
+        return path.resolve().relative_to(config.RESULTS_ROOT.resolve()).parts[0]
+    except ValueError:
+        return "<profile>"

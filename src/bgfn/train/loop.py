@@ -174,7 +174,7 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
     best = {"val_loss": float("inf"), "epoch": -1}
     start_epoch, bad_epochs, elapsed_before = 0, 0, 0.0
     if last_path is not None and last_path.exists():
-        st = torch.load(last_path, map_location=dev, weights_only=False)
+        st = checkpoints.read_checkpoint(last_path, dev)
         if st.get("config_hash") == chash:
             model.load_state_dict(st["model"])
             optim.load_state_dict(st["optim"])
@@ -256,7 +256,7 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
 
     # best weights -> validation metrics
     if best_path is not None and best_path.exists():
-        model.load_state_dict(torch.load(best_path, map_location=dev, weights_only=False)["state_dict"])
+        model.load_state_dict(checkpoints.read_checkpoint(best_path, dev)["state_dict"])
     elif "state" in best:
         model.load_state_dict(best.pop("state"))
     pred = predict_normalized(model, xva, o["eval_batch_size"], dev)

@@ -76,7 +76,7 @@ class TrainedModel:
 def load_trained(path: str | Path, device: str | None = None) -> TrainedModel:
     """Load a best checkpoint ``<method>_seed<k>.pt`` written by :func:`bgfn.train.loop.train_model`."""
     dev = pick_device(device)
-    ck = torch.load(Path(path), map_location=dev, weights_only=False)
+    ck = checkpoints.read_checkpoint(path, dev)
     model = build_model(ck["method"], ck["size_cfg"], in_channels=ck["in_channels"]).to(dev)
     model.load_state_dict(ck["state_dict"])
     model.eval()

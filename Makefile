@@ -85,7 +85,7 @@ export DASK_SCHEDULER
 # the venv's IPython kernel configuration (tools/ipython_kernel_config.py, installed by `make venv`)
 KERNEL_CONFIG := $(VENV)/etc/ipython/ipython_kernel_config.py
 
-.PHONY: help reproduce notebooks book test bench clean clean-debris distclean venv data lock strip
+.PHONY: help reproduce notebooks _reproduce _notebooks book test bench clean clean-debris distclean venv data lock strip
 
 # A profile is a plain name (params/<name>.yaml); anything with a path in it would write outside results/.
 ifneq ($(shell printf '%s' '$(PROFILE)' | grep -Ex '[A-Za-z0-9][A-Za-z0-9_-]*'),$(PROFILE))
@@ -93,8 +93,12 @@ $(error PROFILE '$(PROFILE)' is not a profile name: expected letters, digits, '_
 endif
 
 ifneq ($(filter reproduce notebooks book,$(MAKECMDGOALS)),)
-ifeq ($(wildcard $(PARAMS)),)
-$(error unknown PROFILE '$(PROFILE)': $(PARAMS) does not exist (available: $(basename $(notdir $(wildcard params/*.yaml)))))
+ifeq ($(wildcard params/$(PROFILE).yaml),)
+$(error unknown PROFILE '$(PROFILE)': params/$(PROFILE).yaml does not exist (available: $(basename $(notdir $(wildcard params/*.yaml)))))
+endif
+# a `base:` that names no profile: say so here, not as make's "No rule to make target"
+ifneq ($(filter-out $(wildcard $(PARAMS)),$(PARAMS)),)
+$(error profile '$(PROFILE)': its base chain names $(firstword $(filter-out $(wildcard $(PARAMS)),$(PARAMS))), which does not exist -- fix `base:` in $(lastword $(filter $(wildcard $(PARAMS)),$(PARAMS))) (available: $(basename $(notdir $(wildcard params/*.yaml)))))
 endif
 endif
 
@@ -181,7 +185,7 @@ $(RES)/notebooks/06_results.ipynb: $(RES)/notebooks/05_energy_estimate.ipynb dat
 VARIANTS := quick-heading
 $(RES)/notebooks/06_results.ipynb: $(wildcard $(filter-out $(RES)/%,$(VARIANTS:%=results/%/notebooks/05_energy_estimate.ipynb)))
 
-notebooks: $(EXEC)
+_notebooks: $(EXEC)
 
 # ---------------------------------------------------------------- book
 # The book shows the executed notebooks of $(PROFILE) (copied to the gitignored book/notebooks/) and the
@@ -213,7 +217,19 @@ book: $(STAMP)
 	if [ -n "$$missing" ]; then echo "error: not executed yet:$$missing -- run: make reproduce PROFILE=$(PROFILE)" >&2; exit 1; fi
 	$(build_book)
 
-reproduce: $(BOOK_STAMP)
+# One run per profile at a time: `reproduce` and `notebooks` hold an flock on $(RES)/.lock (which names the
+# holder's PID) for the whole run, so a second run of the same profile refuses at once instead of overwriting
+# the first one's results or cleaning its live files as debris; other profiles run beside it.
+LOCK := $(RES)/.lock
+reproduce notebooks:
+	@mkdir -p $(RES); exec 9>>"$(LOCK)"; \
+	if ! flock -n 9; then \
+	  echo "error: make $@ PROFILE=$(PROFILE) is already running (PID $$(cat "$(LOCK)" 2>/dev/null || echo unknown)," \
+	       "lock $(LOCK)); wait for it to end or stop it -- two runs of one profile would overwrite each other's results" >&2; \
+	  exit 1; fi; \
+	echo $$$$ > "$(LOCK)"; $(MAKE) _$@
+
+_reproduce: $(BOOK_STAMP)
 	@echo "==> done (PROFILE=$(PROFILE)): results in $(RES)/, book at $(BOOK_HTML)"
 
 # ---------------------------------------------------------------- tests, benchmarks
@@ -241,7 +257,8 @@ strip: $(STAMP)
 
 # ---------------------------------------------------------------- cleaning
 # Debris of an interrupted run of $(PROFILE): papermill's temporary notebooks and half-written outputs
-# (bgfn.io.atomic_path names them .<name>.<random>.tmp<suffix>). Notebooks run one at a time, so none is live.
+# (bgfn.io.atomic_path names them .<name>.<random>.tmp<suffix>). It runs inside the profile's lock (reproduce,
+# notebooks) and notebooks run one at a time, so none of them is live.
 clean-debris:
 	@if [ -d "$(RES)" ]; then find "$(RES)" -type f \( -name '.*.running-*.ipynb' -o -name '.*.tmp*' \) \
 	  -print -delete | sed 's/^/    removed debris of an interrupted run: /'; fi

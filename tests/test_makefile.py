@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import fcntl
 import shutil
 import subprocess
 
@@ -55,3 +56,39 @@ def test_debris_of_an_interrupted_run_is_removed_and_results_are_kept(tmp_path):
     assert res.returncode == 0, res.stderr
     assert not any(p.exists() for p in debris) and all(p.exists() for p in kept)
     assert res.stdout.count("removed debris") == 3
+
+
+def _checkout(tmp_path):
+    """The Makefile, the lock and the profiles in a folder of their own (nothing else: make must refuse first)."""
+    repo = tmp_path / "repo"
+    (repo / "params").mkdir(parents=True)
+    for name in ("Makefile", "requirements.lock"):
+        shutil.copy(PROJECT_ROOT / name, repo / name)
+    for p in (PROJECT_ROOT / "params").glob("*.yaml"):
+        shutil.copy(p, repo / "params" / p.name)
+    return repo
+
+
+def test_a_base_that_names_no_profile_is_one_error_naming_the_file_to_fix(tmp_path):
+    repo = _checkout(tmp_path)
+    (repo / "params" / "mine.yaml").write_text("base: nosuch\n")
+    res = _make("-n", "reproduce", "PROFILE=mine", cwd=repo)
+    assert res.returncode != 0 and "No rule to make target" not in res.stderr
+    assert "params/nosuch.yaml, which does not exist -- fix `base:` in params/mine.yaml" in res.stderr
+
+
+def test_a_second_run_of_the_same_profile_refuses_at_once_naming_the_first(tmp_path):
+    repo = _checkout(tmp_path)
+    lock = repo / "results" / "smoke" / ".lock"
+    lock.parent.mkdir(parents=True)
+    live = repo / "results" / "smoke" / "notebooks" / ".03_bgfn_training.running-4242.ipynb"
+    live.parent.mkdir()
+    live.write_text("the first run's notebook")
+    with open(lock, "w") as held:
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)        # the first run holds the profile's lock
+        held.write("4242\n")
+        held.flush()
+        res = _make("reproduce", "PROFILE=smoke", cwd=repo)
+    assert res.returncode != 0 and "already running (PID 4242" in res.stderr
+    assert live.exists()                                        # its live files are not cleaned as debris
+    assert not (repo / ".venv").exists()                        # refused before anything was made

@@ -50,6 +50,13 @@ BAD = {
     "rates in deg/s": ("imu", lambda d: _imu(d, **{c: (lambda t, c=c: np.degrees(t[c]) + 3.0)
                                                    for c in ("gyro_x", "gyro_y", "gyro_z")}),
                        "gyro_x/gyro_y/gyro_z", "deg/s"),
+    "rates in deg/s with a sharp turn": (   # a value beyond a MEMS gyro's range in rad/s: still a unit mistake
+        "imu", lambda d: _imu(d, **{c: (lambda t, c=c: _spike(c, 60.0)(t.assign(**{c: np.degrees(t[c]) + 3.0})))
+                                    for c in ("gyro_x", "gyro_y", "gyro_z")}), "gyro_x/gyro_y/gyro_z", "deg/s"),
+    "two seconds of +50 m/s^2 on one axis": (
+        "imu", lambda d: _imu(d, accel_y=lambda t: t["accel_y"] + np.where(
+            (t["time"] > t["time"].iloc[0] + 20) & (t["time"] <= t["time"].iloc[0] + 22), 50.0, 0.0)),
+        "accel_y", "stuck, offset or saturated axis"),
     "a spike in the IMU": ("imu", lambda d: _imu(d, accel_y=_spike("accel_y", 2e9)), "accel_x/accel_y/accel_z",
                            "corrupted sample"),
     "a spike in the GNSS height": ("gnss", lambda d: d.gnss.assign(h=_spike("h", 2e9, row=7)), "h", "height"),

@@ -32,6 +32,9 @@ F_Z_MEDIAN_MIN_G = 0.5
 RATE_P99_MAX = 3.0
 #: A single sample beyond any MEMS sensor's range: |f| (m/s^2, about 20 g) or |w| (rad/s, 2300 deg/s).
 F_SPIKE_MAX, RATE_SPIKE_MAX = 200.0, 40.0
+#: The specific force averaged over this long (s) stays within this many g of the drive's median: a car brakes or
+#: corners at under 1 g, a walker's steps average out within a second.
+SUSTAINED_S, SUSTAINED_MAX_G = 1.0, 1.5
 #: Plausible median sampling intervals, s: IMU 10 kHz..1 Hz, GNSS and reference 1 kHz..0.1 Hz.
 IMU_STEP_RANGE, FIX_STEP_RANGE = (1e-4, 1.0), (1e-3, 10.0)
 #: Ellipsoidal heights of a road drive, m.
@@ -107,11 +110,7 @@ def _check_imu(imu: pd.DataFrame, src: str) -> dict:
     f = imu[list(ACCEL_COLUMNS)].to_numpy(float)                # [K, 3] m/s^2
     w = imu[list(GYRO_COLUMNS)].to_numpy(float)                 # [K, 3] rad/s
     fn, wn = np.linalg.norm(f, axis=1), np.linalg.norm(w, axis=1)
-    for norm, cols, limit, unit in ((fn, ACCEL_COLUMNS, F_SPIKE_MAX, "m/s^2"), (wn, GYRO_COLUMNS, RATE_SPIKE_MAX, "rad/s")):
-        k = int(np.argmax(norm))
-        if norm[k] > limit:
-            raise DataError(src, "/".join(cols), f"|value| below {limit:g} {unit} (beyond any MEMS sensor's range: a "
-                            "corrupted sample)", f"{norm[k]:.4g} {unit} at row {k} (time {t[k]:.3f} s)")
+    # units and axes first (medians and percentiles): a log in deg/s or g is a unit mistake, not a corrupted sample
     f_med = float(np.median(fn)) / G
     if not F_MEDIAN_RANGE_G[0] <= f_med <= F_MEDIAN_RANGE_G[1]:
         cause = (" -- accelerations in g? (expected m/s^2)" if 0.5 / G <= f_med <= 1.5 / G
@@ -130,7 +129,31 @@ def _check_imu(imu: pd.DataFrame, src: str) -> dict:
     if rate_p99 > RATE_P99_MAX:
         raise DataError(src, "gyro_x/gyro_y/gyro_z", f"angular rates a road vehicle reaches (99th percentile of |w| "
                         f"below {RATE_P99_MAX:g} rad/s) -- rates in deg/s? (expected rad/s)", f"{rate_p99:.4g} rad/s")
+    for norm, cols, limit, unit in ((fn, ACCEL_COLUMNS, F_SPIKE_MAX, "m/s^2"), (wn, GYRO_COLUMNS, RATE_SPIKE_MAX, "rad/s")):
+        k = int(np.argmax(norm))
+        if norm[k] > limit:
+            raise DataError(src, "/".join(cols), f"|value| below {limit:g} {unit} (beyond any MEMS sensor's range: a "
+                            "corrupted sample)", f"{norm[k]:.4g} {unit} at row {k} (time {t[k]:.3f} s)")
+    _check_sustained_force(t, f, step, src)
     return {"f_median_g": f_med, "f_z_median_g": fz_med, "rate_p99": rate_p99}
+
+
+def _check_sustained_force(t: np.ndarray, f: np.ndarray, step: float, src: str) -> None:
+    """The specific force averaged over :data:`SUSTAINED_S` departs from the drive's median (gravity, at rest or
+    cruising) by more than :data:`SUSTAINED_MAX_G`: no road vehicle or walker accelerates so long so hard; a stuck
+    or offset axis, or a saturated segment, does."""
+    n = max(1, int(round(SUSTAINED_S / step)))
+    if len(f) < n:
+        return
+    c = np.vstack([np.zeros((1, 3)), np.cumsum(f - np.median(f, axis=0), axis=0)])
+    mean = (c[n:] - c[:-n]) / n                                   # [K - n + 1, 3] mean over each n-sample window
+    dev = np.linalg.norm(mean, axis=1) / G
+    k = int(np.argmax(dev))
+    if dev[k] > SUSTAINED_MAX_G:
+        axis = ACCEL_COLUMNS[int(np.argmax(np.abs(mean[k])))]
+        raise DataError(src, axis, f"a specific force whose mean over {SUSTAINED_S:g} s stays within "
+                        f"{SUSTAINED_MAX_G:g} g of the drive's median (a vehicle's or walker's accelerations)",
+                        f"{dev[k]:.3g} g from {t[k]:.3f} s to {t[k + n - 1]:.3f} s (a stuck, offset or saturated axis?)")
 
 
 def _check_positions(table: pd.DataFrame, src: str) -> None:

@@ -63,6 +63,14 @@ def test_a_bad_variant_names_its_file_the_key_and_the_value(params, case):
     assert err.value.field == key and words in str(err.value), str(err.value)
 
 
+def test_an_inherited_variant_list_naming_a_drive_not_trained_names_the_base_that_set_it(params):
+    (params / "mine.yaml").write_text("profile: mine\nbase: smoke\ndescription: v\ndatasets: [rtklib-drive0708]\n")
+    with pytest.raises(DataError) as err:
+        load_profile("mine")
+    assert err.value.source == str(params / "smoke.yaml") and err.value.field == "variant_runs.datasets"
+    assert "['turin-sim-mpu6000']" in str(err.value) and "variant_runs: {datasets: null}" in str(err.value)
+
+
 def test_noise_scale_auto_and_alignment_options_are_accepted(params):
     (params / "mine.yaml").write_text("profile: mine\nbase: smoke\ndescription: v\n"
                                       "nav: {noise_scale: auto, alignment: {mode: gnss, heading_time_s: 5.0}}\n")

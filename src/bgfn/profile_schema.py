@@ -429,6 +429,13 @@ def _check_variants(cfg: dict) -> None:
     bad = [m for m in (cfg.get("variant_runs") or {}).get("methods") or [] if m not in METHOD_LABELS]
     if bad:
         raise ProfileError("variant_runs.methods", f"method ids among {', '.join(METHOD_LABELS)}", _fmt(bad))
+    # a list inherited from a base (smoke's [turin-sim-mpu6000]) may name a drive this profile never loads
+    trained = list((cfg.get("train") or {}).get("datasets") or [])
+    bad = [d for d in (cfg.get("variant_runs") or {}).get("datasets") or [] if d not in trained]
+    if cfg.get("variants") and bad:
+        raise ProfileError("variant_runs.datasets", f"drives among train.datasets {trained} (a base's list may name "
+                           "drives this profile does not train: set variant_runs: {datasets: null} for all of them, "
+                           "or variants: {} for none)", _fmt(bad))
 
 
 def validate(cfg: dict) -> None:

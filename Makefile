@@ -85,7 +85,7 @@ export DASK_SCHEDULER
 # the venv's IPython kernel configuration (tools/ipython_kernel_config.py, installed by `make venv`)
 KERNEL_CONFIG := $(VENV)/etc/ipython/ipython_kernel_config.py
 
-.PHONY: help reproduce notebooks _reproduce _notebooks book test bench clean clean-debris distclean venv data lock strip
+.PHONY: FORCE help reproduce notebooks _reproduce _notebooks book test bench clean clean-debris distclean venv data lock strip
 
 # A profile is a plain name (params/<name>.yaml); anything with a path in it would write outside results/.
 ifneq ($(shell printf '%s' '$(PROFILE)' | grep -Ex '[A-Za-z0-9][A-Za-z0-9_-]*'),$(PROFILE))
@@ -170,7 +170,13 @@ $(RES)/.profile-checked: $(PARAMS) $(SRC) $(STAMP) | data
 	@echo "==> [$(PROFILE)] check params/$(PROFILE).yaml"
 	@$(PY) -m bgfn.profile_schema $(PROFILE)
 	@mkdir -p $(@D) && touch $@
-$(RES)/notebooks/01_data_prep.ipynb: $(RES)/.profile-checked
+$(RES)/notebooks/01_data_prep.ipynb: $(RES)/.profile-checked $(RES)/.data-fingerprint
+
+# The profile's own CSV drives (a folder in `datasets:`): their files' sizes and times, rewritten only when they
+# changed (python -m bgfn.data fingerprint), so an edited or touched drive reruns every notebook, and only then.
+$(RES)/.data-fingerprint: FORCE | $(STAMP)
+	@mkdir -p $(@D) && $(PY) -m bgfn.data fingerprint $(PROFILE) --write $@ > /dev/null
+FORCE:
 
 # Each notebook reads what the previous one wrote.
 $(RES)/notebooks/02_kf_baseline.ipynb: $(RES)/notebooks/01_data_prep.ipynb

@@ -7,6 +7,7 @@ reference at 5 Hz (not at the IMU epochs), a 1 Hz GNSS with a lever arm, times i
 
 from __future__ import annotations
 
+import os
 import shutil
 
 import numpy as np
@@ -18,7 +19,7 @@ from bgfn import config
 from bgfn.data import Drive, load_drive, write_csv_drive
 from bgfn.data import imu_errors as ie
 from bgfn.data.csv_meta import DEFAULT_IMU_PROFILE, META_KEYS, read_meta
-from bgfn.data.names import dataset_folder, dataset_id, unique_ids
+from bgfn.data.names import data_fingerprint, dataset_folder, dataset_id, profile_datasets, unique_ids
 from bgfn.data.regrid import GAP_SAMPLES, interpolate_reference
 from bgfn.errors import DataError
 from bgfn.nav import earth, sim
@@ -363,3 +364,15 @@ def test_top_level_datasets_reach_every_notebook_and_a_section_still_wins(tmp_pa
     with pytest.raises(DataError) as err:
         load_profile("bad")
     assert err.value.field == "datasets" and err.value.source == str(params / "bad.yaml")
+
+
+def test_the_data_fingerprint_changes_when_a_drive_file_is_touched_and_only_then(tmp_path, truth):
+    log = _write_log(tmp_path / "run", truth)
+    cfg = {"data": {"datasets": [str(log), "turin-sim-ekinox"]}, "evaluate": {"sweep": {"datasets": [str(log)]}}}
+    assert profile_datasets(cfg) == [str(log), "turin-sim-ekinox"]
+    first = data_fingerprint(profile_datasets(cfg))
+    assert data_fingerprint(profile_datasets(cfg)) == first                     # nothing changed: same stamp
+    assert data_fingerprint(["turin-sim-ekinox"]) == data_fingerprint([])       # checksummed elsewhere
+    st = (log / "imu.csv").stat()
+    os.utime(log / "imu.csv", ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000_000))   # `touch imu.csv`
+    assert data_fingerprint(profile_datasets(cfg)) != first

@@ -29,7 +29,7 @@ from typing import Any
 from bgfn.config import (MAIN_VARIANT, VARIANT_NAME, VARIANT_RUN_KEYS, file_setting, profile_chain, read_profile,
                          set_keys, variant_config)
 from bgfn.data import load_drive
-from bgfn.data.names import unique_ids
+from bgfn.data.names import profile_datasets, unique_ids
 from bgfn.errors import DataError
 from bgfn.evaluate import EVALUATE_DEFAULTS, evaluate_config, sweep_plan
 from bgfn.learning import learning_options
@@ -321,14 +321,6 @@ def _check_window_list(path: str, entry: list, t0, t1) -> None:
                                _fmt([s, d]))
 
 
-def _profile_datasets(cfg: dict) -> list[str]:
-    """Every dataset a notebook of the profile loads (data, nav, train, evaluate and its sweep), in order."""
-    ev = cfg.get("evaluate") or {}
-    return list(dict.fromkeys(
-        [d for sec in ("data", "nav", "train", "evaluate") for d in (cfg.get(sec) or {}).get("datasets") or []]
-        + ((ev.get("sweep") or {}).get("datasets") or [])))
-
-
 def _check_outage_entries(cfg: dict) -> None:
     """Each list entry well formed; each rule names its rule; a mapping answers for every dataset."""
     data = cfg.get("data") or {}
@@ -343,7 +335,7 @@ def _check_outage_entries(cfg: dict) -> None:
             _check_window_list(path, entry, t0, t1)
     spec = cfg.get("outage_windows")
     if isinstance(spec, dict) and DEFAULT_KEY not in spec:      # every dataset a notebook loads needs its outages
-        uncovered = [d for d in _profile_datasets(cfg) if d not in spec]
+        uncovered = [d for d in profile_datasets(cfg) if d not in spec]
         if uncovered:
             raise ProfileError("outage_windows", f"an entry for every dataset of the profile, or a '{DEFAULT_KEY}' "
                                "entry", f"none for {', '.join(uncovered)}")

@@ -22,6 +22,7 @@ name read back from a result file (a model card, a table's ``dataset`` column) g
 
 from __future__ import annotations
 
+import hashlib
 import re
 from pathlib import Path
 
@@ -108,3 +109,28 @@ def unique_ids(names, source: str | Path = "profile") -> dict[str, str]:
         seen[i] = name
         ids[name] = i
     return ids
+
+
+def profile_datasets(cfg: dict) -> list[str]:
+    """Every dataset a notebook of a profile loads (``data``, ``nav``, ``train``, ``evaluate`` and its sweep), in
+    order, each once, as the profile names it."""
+    ev = cfg.get("evaluate") or {}
+    return list(dict.fromkeys(
+        [d for sec in ("data", "nav", "train", "evaluate") for d in (cfg.get(sec) or {}).get("datasets") or []]
+        + ((ev.get("sweep") or {}).get("datasets") or [])))
+
+
+def data_fingerprint(names) -> str:
+    """A hash of the files of every CSV folder among ``names`` (each file's name, size and modification time), so
+    that ``make`` reruns a profile whose drive was edited (or touched); the registered datasets are checksummed by
+    :mod:`bgfn.data.acquire` and not part of it. The hash of nothing when no name is a folder."""
+    h = hashlib.sha256()
+    for name in names:
+        folder = dataset_folder(name)
+        if folder is None:
+            continue
+        h.update(str(folder).encode())
+        for f in sorted(p for p in folder.iterdir() if p.is_file()):
+            st = f.stat()
+            h.update(f"{f.name}\0{st.st_size}\0{st.st_mtime_ns}\n".encode())
+    return h.hexdigest()[:16]

@@ -167,7 +167,7 @@ def test_odometer_rows_answer_and_headline_read_the_odometer_tables():
     assert t.loc[ORACLE_ODO_ROW, "sweep 60 s"] == pytest.approx(20.0)
     answer = verdict_sentences(inp, verdict_table(inp))[5]
     assert answer.startswith("Does a learned odometer help? In the sweep's windows (10 starts")
-    assert "The best learned odometer at 60 s is BGFN-ODO: it beats INS+NHC at 30 s and 60 s (p < 0.05)." in answer
+    assert "else among all) is BGFN-ODO: it beats INS+NHC at 30 s and 60 s (p < 0.05)." in answer
     assert "no different from its ANN twin" in answer                      # identical per start: no difference
     assert "0.5 µJ per prediction against the twin's 2 µJ (75 % less)" in answer
     assert "95 % of epochs within its +-2 sigma (calibrated" in answer
@@ -185,3 +185,14 @@ def test_odometer_answer_without_its_tables_says_not_measured():
     inp = _inputs()
     assert verdict_sentences(inp, verdict_table(inp))[5].endswith("have not run for this drive (`evaluate.odometer`).")
     assert "odometer" not in headline(inp, verdict_table(inp))
+
+
+def test_the_best_learned_odometer_is_one_that_beats_ins_nhc_when_one_does():
+    odo = _odometer()
+    # BGFN-ODO lowest median but not significant; RIDGE-ODO higher but significant: RIDGE-ODO is named
+    s = odo.summary
+    s.loc[s["method"] == "BGFN-ODO", "p_vs_nhc"] = 0.3
+    s.loc[s["method"] == "Transformer-ODO", "p_vs_nhc"] = 0.3
+    inp = _inputs(odometer=odo)
+    assert "A learned odometer beats INS+NHC at 60 s: RIDGE-ODO 16.0 m against 20.0 m (p 0.002)" in headline(
+        inp, verdict_table(inp))

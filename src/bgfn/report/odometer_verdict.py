@@ -160,10 +160,13 @@ def _p(p: float) -> str:
 
 
 def best_learned(odo: OdometerInputs, duration: float) -> str | None:
-    """The learned odometer with the smallest median max error at ``duration`` (None without any)."""
+    """The learned odometer with the smallest median max error at ``duration`` among those that beat INS+NHC
+    (:func:`beats`), else among all (None without any)."""
     vals = {m: odo.cell(m, duration) for m in LEARNED if odo.has(m)}
     vals = {m: v for m, v in vals.items() if np.isfinite(v)}
-    return min(vals, key=vals.get) if vals else None
+    winners = {m: v for m, v in vals.items() if beats(odo, m, duration)}
+    pool = winners or vals
+    return min(pool, key=pool.get) if pool else None
 
 
 def beats(odo: OdometerInputs, method: str, duration: float) -> bool:
@@ -225,7 +228,8 @@ def answer_odometer(odo: OdometerInputs, durations) -> str:
     best = best_learned(odo, d_long)
     if best is not None:
         won = [d for d in durations if beats(odo, best, d)]
-        out += (f" The best learned odometer at {d_long:g} s is {best}: it "
+        out += (f" The best learned odometer at {d_long:g} s (the lowest median among those that beat {nhc}, else "
+                f"among all) is {best}: it "
                 + (f"beats {nhc} at {' and '.join(f'{d:g} s' for d in won)} (p < {ALPHA:g})." if won
                    else f"does not beat {nhc} significantly."))
     if odo.has(SUBJECT_ODO):

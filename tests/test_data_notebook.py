@@ -17,7 +17,7 @@ def test_notebook_01_is_stored_clean_with_a_parameters_cell():
     assert "parameters" in first["metadata"].get("tags", [])
     src = "".join(first["source"])
     assert 'profile = "quick"' in src
-    assert "outage_windows(cfg, d, name)" in "".join("".join(c["source"]) for c in code)    # the profile's one key
+    assert "outage_windows(cfg, d, e)" in "".join("".join(c["source"]) for c in code)    # the profile's one key
     assert "from bgfn.profile_schema import load_profile" in "".join(code[1]["source"])   # checked at the edge
     body = "".join("".join(c["source"]) for c in code)
     for name in ("trajectory_3d.png", "trajectory_map.png", "imu_channels.png", "dataset_{name}.csv"):

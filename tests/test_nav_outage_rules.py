@@ -193,7 +193,7 @@ def test_check_with_drives_applies_the_rule_to_each_drive(params, monkeypatch):
     path = params / "mine.yaml"
     head = ("profile: mine\nbase: smoke\ndescription: v\ndata: {t_start: null, t_end: null}\n"
             "nav: {datasets: [sim]}\ntrain: {datasets: [sim]}\n"
-            "evaluate: {datasets: [sim], sweep: {datasets: []}}\n")
+            "evaluate: {datasets: [sim], sweep: {datasets: []}}\nvariant_runs: {datasets: null}\n")
     path.write_text(head + "outage_windows: {sim: {rule: cruise_and_manoeuvre}}\n")
     (line,) = check_with_drives("mine")
     assert "outages picked by the rule [[1225.0, 30.0], [1385.0, 30.0]]" in line

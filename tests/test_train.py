@@ -409,7 +409,8 @@ def test_training_metrics_gather_what_training_json_holds():
     cards = [{"dataset": "a", "method": "mlp", "seed": 0, "params": 10, "epochs_run": 3, "best_epoch": 2,
               "wall_time_s": 1.5, "val_rmse_m": 0.5, "val_rmse_zero_m": 1.0, "val_rmse_last_m": 0.2}]
     runs, summary = T.cards_table(cards), T.summary_table(cards)
-    plan = T.TrainingPlan.of(with_overrides(load_profile("smoke"), {"train.datasets": ["a"]}),
+    plan = T.TrainingPlan.of(with_overrides(load_profile("smoke"), {"train.datasets": ["a"],
+                                                                    "variant_runs.datasets": ["a"]}),
                              outage_windows=[(1100.0, 10.0)])
     m = T.training_metrics(plan, prepared, runs, summary, T.windows_table(prepared))
     assert list(m) == ["runs", "summary", "windows", "learning_options", "outage_windows", "meta"]

@@ -304,3 +304,28 @@ def test_baseline_has_the_ins_nhc_row_beside_the_ins_row():
     pd.testing.assert_frame_equal(plain.trajectory, b.full.trajectory, check_exact=True)
     with_gps = baseline.run_baseline(drive, baseline.nav_config({"constraints_in_gps_run": True}), windows)
     assert not np.allclose(with_gps.full.trajectory["lat"], b.full.trajectory["lat"], rtol=0, atol=1e-12)
+
+
+def test_the_platform_decides_which_aids_run():
+    """The stop-and-go drive above: a car gets NHC while moving and ZUPT at the stop, a walker only the ZUPT (it
+    steps sideways), anything else neither; the lines say so."""
+    t = np.arange(7001) / RATE
+    ramp = lambda a, b: np.clip((t - a) / (b - a), 0, 1)
+    speed = 10.0 * (1 - 0.5 * (1 - np.cos(np.pi * ramp(15, 20)))) + 10.0 * 0.5 * (1 - np.cos(np.pi * ramp(60, 65)))
+    imu = _imu(_road(speed))
+    kinds = {p: np.bincount(cn.build_constraints(imu, EKINOX, _body_frame(), platform=p).aid, minlength=3)
+             for p in ("car", "walker", "other")}
+    assert kinds["car"][cn.AID_NHC] > 0 and kinds["car"][cn.AID_ZUPT] >= 39            # the stop and the start
+    assert kinds["walker"][cn.AID_NHC] == 0 and kinds["walker"][cn.AID_ZUPT] == kinds["car"][cn.AID_ZUPT]
+    assert kinds["other"][cn.AID_NHC] == 0 and kinds["other"][cn.AID_ZUPT] == 0
+    walker = cn.build_constraints(imu, EKINOX, _body_frame(), platform="walker")
+    assert walker.summary()["platform"] == "walker" and walker.config.describe().startswith("platform walker: ZUPT")
+    # a still epoch at speed (the detector fooled): a car gets the NHC instead, a walker no aid at all
+    for platform, expect in (("walker", None), ("car", 2)):
+        sched = cn.build_constraints(imu, EKINOX, _body_frame(), platform=platform).schedule(
+            imu["time"].to_numpy(float))
+        k = int(sched.rows[sched.aid[sched.rows] == cn.AID_ZUPT][0])
+        m = sched.measurement(k, None, np.array([5.0, 0.0, 0.0]), np.eye(3))
+        assert (m is None) if expect is None else (len(m.dz) == expect)
+    with pytest.raises(DataError, match="platform"):
+        cn.build_constraints(imu, EKINOX, _body_frame(), platform="boat")

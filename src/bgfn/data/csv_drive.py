@@ -36,19 +36,21 @@ from bgfn.data.names import safe_id
 from bgfn.data.navego import check_time
 from bgfn.data.physics import check_drive
 from bgfn.data.regrid import check_gaps, imu_on_grid, interpolate_reference, median_rate_hz
+from bgfn.data.time_offset import TOLERANCE_S, estimate_gnss_offset
 from bgfn.errors import DataError
 from bgfn.io import atomic_write_csv, atomic_write_text
-from bgfn.schema import GNSS_COLUMNS, GNSS_FIX_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS
+from bgfn.nav.transform import dcm_from_euler
+from bgfn.schema import ACCEL_COLUMNS, GNSS_COLUMNS, GNSS_FIX_COLUMNS, GYRO_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS
 
 #: Reference attitude columns: all three or none.
 ATTITUDE_COLUMNS: tuple[str, ...] = ("roll", "pitch", "yaw")
 #: Files of a CSV drive and their required columns.
 CSV_FILES = {
     "imu.csv": IMU_COLUMNS,
-    "gnss.csv": GNSS_FIX_COLUMNS,
+    "gnss.csv": tuple(c for c in GNSS_FIX_COLUMNS if not c.startswith("std_")),   # the std: file or meta.yaml
     "reference.csv": tuple(c for c in REFERENCE_COLUMNS if c not in ATTITUDE_COLUMNS),
 }
-_OPTIONAL = {"gnss.csv": ("v_n", "v_e", "v_d"), "reference.csv": ATTITUDE_COLUMNS}
+_OPTIONAL = {"gnss.csv": ("std_n", "std_e", "std_d", "v_n", "v_e", "v_d"), "reference.csv": ATTITUDE_COLUMNS}
 #: Table of the drive each file holds.
 TABLE_OF = {"imu.csv": "imu", "gnss.csv": "gnss", "reference.csv": "reference"}
 
@@ -117,6 +119,63 @@ def _check_attitude(path: Path, header: list[str], ref: pd.DataFrame) -> None:
                             f"data row {k + 1}")
 
 
+def _gnss_std(gnss: pd.DataFrame, path: Path, header: list[str], default, meta_path: Path) -> pd.DataFrame:
+    """The fixes with their std: the file's ``std_n, std_e, std_d`` (all three, positive), else ``meta.yaml``'s
+    ``gnss_std_m`` for every fix; one error naming both when neither is given."""
+    cols = ["std_n", "std_e", "std_d"]
+    given = [c for c in cols if c in header]
+    if not given:
+        if default is None:
+            raise DataError(path, "std_n/std_e/std_d", f"the fixes' std columns, or gnss_std_m [north, east, down] "
+                            f"in {meta_path} for a receiver that reports no accuracy", "neither")
+        return gnss.assign(**{c: float(v) for c, v in zip(cols, default)})
+    if len(given) < 3:
+        raise DataError(path, [c for c in cols if c not in given][0], "all of std_n, std_e, std_d or none",
+                        f"{', '.join(given)} only")
+    std = gnss[cols].to_numpy(float)
+    if not np.isfinite(std).all() or (std <= 0).any():
+        raise DataError(path, "std_n/std_e/std_d", "positive position std, m", f"min {np.nanmin(std)}, "
+                        f"{int((~np.isfinite(std)).sum())} empty")
+    return gnss
+
+
+def _on_imu_clock(imu: pd.DataFrame, gnss: pd.DataFrame, auto: bool, files: dict, meta_path: Path) -> tuple:
+    """The fixes (already shifted by a stated latency) shifted by the estimated offset when ``auto``, then the offset
+    left between them and the IMU estimated (:func:`bgfn.data.time_offset.estimate_gnss_offset`); one error naming
+    both files when it exceeds :data:`~bgfn.data.time_offset.TOLERANCE_S`. Returns the fixes and the facts
+    (``meta["gnss_offset"]``)."""
+    applied = 0.0
+    if auto:
+        est = estimate_gnss_offset(imu, gnss)
+        if not est.estimable:
+            raise DataError(meta_path, "gnss_latency_s", "auto: an offset the data can show (turns while moving, "
+                            "seen by the gyros and the GNSS course); give the latency in seconds instead", est.line())
+        applied = est.offset_s
+    gnss = gnss.assign(time=gnss["time"] - applied)
+    est = estimate_gnss_offset(imu, gnss)
+    if est.estimable and abs(est.offset_s) > TOLERANCE_S:
+        leap = " -- GNSS in UTC against an IMU in GPS time (18 s apart)?" if abs(abs(est.offset_s) - 18.0) < 1.5 else ""
+        raise DataError(files["gnss"], "time", f"fixes on the clock of {files['imu']} within {TOLERANCE_S:g} s "
+                        f"(a known delay: gnss_latency_s or imu_time_offset_s in {meta_path})",
+                        f"stamps {est.offset_s:+.2f} s late against the IMU's (the turn rates of both correlate "
+                        f"{est.correlation:.2f} at that lag){leap}")
+    return gnss, {"applied_latency_s": float(applied), "residual_s": est.offset_s, "correlation": est.correlation,
+                  "fixes": est.fixes, "line": est.line()}
+
+
+def rotate_imu(imu: pd.DataFrame, mounting_deg) -> pd.DataFrame:
+    """The IMU rows in the body frame: ``x_b = C x_s`` for the rates and specific forces, ``C`` the rotation of the
+    IMU's axes in the body frame by ``mounting_deg`` = [roll, pitch, yaw] (deg, ZYX as the attitude); unchanged
+    for zeros."""
+    if not np.any(mounting_deg):
+        return imu
+    c = dcm_from_euler(*np.radians(np.asarray(mounting_deg, float))).reshape(3, 3)     # sensor -> body
+    out = imu.copy()
+    for cols in (list(GYRO_COLUMNS), list(ACCEL_COLUMNS)):
+        out[cols] = imu[cols].to_numpy(float) @ c.T
+    return out
+
+
 def _header(path: Path) -> list[str]:
     return [str(c).strip() for c in pd.read_csv(path, comment="#", skipinitialspace=True, nrows=0).columns]
 
@@ -152,16 +211,20 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_st
     if not folder.is_dir():
         raise DataError(folder, "folder", "a folder with imu.csv, gnss.csv, reference.csv", "no such folder")
     files = {TABLE_OF[name]: folder / name for name in CSV_FILES}
+    meta_path = folder / META_FILE
+    user = read_meta(meta_path)            # first: its keys say how to read the tables
     raw = {TABLE_OF[name]: read_table(folder / name, cols, _OPTIONAL.get(name, ())) for name, cols in CSV_FILES.items()}
     _check_attitude(files["reference"], _header(files["reference"]), raw["reference"])
-    gnss = raw["gnss"]
-    std = gnss[["std_n", "std_e", "std_d"]].to_numpy(float)
-    if (std <= 0).any():
-        raise DataError(files["gnss"], "std_n/std_e/std_d", "positive position std, m", f"min {std.min()}")
-    meta_path = folder / META_FILE
-    user = read_meta(meta_path)
+    gnss = _gnss_std(raw["gnss"], files["gnss"], _header(files["gnss"]), user["gnss_std_m"], meta_path)
+    # the clocks and the mounting that meta.yaml states, before the checks that would blame them on the data
+    raw["imu"] = rotate_imu(raw["imu"], user["imu_mounting_deg"]).assign(
+        time=lambda t: t["time"] + user["imu_time_offset_s"])
+    latency = user["gnss_latency_s"]
+    gnss = gnss.assign(time=gnss["time"] - (0.0 if latency == "auto" else latency))
     # units and axes on the files' own rows, so that each message names the CSV file, column and data row
     check_drive(Drive(str(folder), raw["reference"], raw["imu"], gnss), {t: str(p) for t, p in files.items()})
+    # then the clocks, on plausible data: a unit mistake is not blamed on a clock offset
+    gnss, offset = _on_imu_clock(raw["imu"], gnss, latency == "auto", files, meta_path)
     for table in ("imu", "reference"):
         check_gaps(raw[table]["time"].to_numpy(float), files[table])
     t_imu, t_ref = raw["imu"]["time"].to_numpy(float), raw["reference"]["time"].to_numpy(float)
@@ -190,6 +253,10 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_st
         "imu_errors": user["imu_errors"],
         "imu_errors_source": user["imu_errors_source"],
         "source": user["source"] or f"CSV drive {folder}",
+        "platform": user["platform"],
+        "time_shifts_s": {"imu_time_offset_s": user["imu_time_offset_s"], "gnss_latency_s": user["gnss_latency_s"]},
+        "gnss_offset": offset,
+        "imu_mounting_deg": user["imu_mounting_deg"],
         "params": {"folder": str(folder), "imu_rate_hz": imu_rate_hz, "t_start": t_start, "t_end": t_end},
     }
     return Drive(user["name"] or safe_id(folder.name), reference, imu, gnss, meta)

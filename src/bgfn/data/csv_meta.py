@@ -11,6 +11,17 @@ key                meaning (all optional; the file itself is optional)
                    :func:`bgfn.nav.state.noise_from_imu_errors`): a mapping of keys of
                    :mod:`bgfn.data.imu_errors` laid over the profile ``base`` (``mpu6000`` or
                    ``ekinox-d``; default :data:`DEFAULT_IMU_PROFILE`), plus ``model`` (a free label)
+``platform``       what moves the IMU: ``car`` (default: NHC and ZUPT, the vehicle frame estimated),
+                   ``walker`` (ZUPT only) or ``other`` (neither) (:data:`bgfn.nav.constraints.PLATFORM_AIDS`)
+``imu_mounting_deg``  [roll, pitch, yaw] of the IMU's axes in the body frame (x forward, y right, z down),
+                   deg; the IMU rows are rotated into the body frame at load; default [0, 0, 0]
+``imu_time_offset_s``  added to every IMU time (a logger's delay), s; default 0
+``gnss_latency_s``  subtracted from every GNSS time (a receiver stamps a fix when it arrives, later than the
+                   epoch it is valid at), s, >= 0, or ``auto``: the offset estimated from the data
+                   (:mod:`bgfn.data.time_offset`); default 0. Without it, an estimated offset beyond 0.5 s
+                   is an error naming both files
+``gnss_std_m``     [north, east, down] std of a fix, m, for a ``gnss.csv`` without ``std_n, std_e, std_d``
+                   (a receiver that reports no accuracy); no default: such a file needs it
 =================  ====================================================================================
 
 Without ``meta.yaml``, or without ``imu_errors``, the filter uses the consumer-MEMS profile
@@ -44,7 +55,12 @@ ID_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 #: Error profile of :mod:`bgfn.data.imu_errors` used when ``meta.yaml`` gives no ``imu_errors`` (or no ``base``).
 DEFAULT_IMU_PROFILE = "mpu6000"
 #: Top-level keys of ``meta.yaml``.
-META_KEYS: tuple[str, ...] = ("name", "lever_arm_m", "source", "imu_errors")
+META_KEYS: tuple[str, ...] = ("name", "lever_arm_m", "source", "imu_errors", "platform", "imu_mounting_deg",
+                              "imu_time_offset_s", "gnss_latency_s", "gnss_std_m")
+#: ``platform`` values (the aids of each: :data:`bgfn.nav.constraints.PLATFORM_AIDS`).
+PLATFORMS: tuple[str, ...] = ("car", "walker", "other")
+#: Largest time shift a meta key may state, s: beyond it the log's clocks disagree by more than a delay.
+MAX_TIME_SHIFT_S = 5.0
 #: Keys of its ``imu_errors`` mapping: the error parameters, the profile they override, a label.
 IMU_ERROR_KEYS: tuple[str, ...] = VECTOR_KEYS + OPTIONAL_VECTOR_KEYS + SCALAR_KEYS + ("base", "model")
 
@@ -137,7 +153,9 @@ def read_meta(path: str | Path) -> dict:
     -------
     dict
         ``name`` (str or None: the folder's name), ``lever_arm_m`` (list of 3 floats, m), ``source`` (str or
-        None), ``imu_errors`` (:func:`bgfn.data.imu_errors.error_params` output), ``imu_errors_source`` (str).
+        None), ``imu_errors`` (:func:`bgfn.data.imu_errors.error_params` output), ``imu_errors_source`` (str),
+        ``platform``, ``imu_mounting_deg`` (list of 3), ``imu_time_offset_s``, ``gnss_latency_s`` (s),
+        ``gnss_std_m`` (list of 3 or None).
 
     Raises
     ------
@@ -147,17 +165,49 @@ def read_meta(path: str | Path) -> dict:
     path = Path(path)
     meta = _load(path) if path.is_file() else {}
     name = _checked_name(path, meta)
-    larm_raw = meta.get("lever_arm_m", [0.0, 0.0, 0.0])
-    try:
-        larm = np.asarray(larm_raw, dtype=float).ravel()
-    except (TypeError, ValueError):
-        larm = np.array([np.nan])
-    if larm.size != 3 or not np.isfinite(larm).all():
-        raise DataError(path, "lever_arm_m", "3 finite numbers [x, y, z], m (antenna in the body frame)",
-                        str(larm_raw))
+    larm = _vector(path, meta, "lever_arm_m", [0.0, 0.0, 0.0], "3 finite numbers [x, y, z], m (antenna in the body "
+                   "frame)")
+    mounting = _vector(path, meta, "imu_mounting_deg", [0.0, 0.0, 0.0], "3 finite numbers [roll, pitch, yaw], deg "
+                       "(the IMU's axes in the body frame)")
+    if np.any(np.abs(mounting) > 360.0):
+        raise DataError(path, "imu_mounting_deg", "angles in degrees within [-360, 360]", str(mounting.tolist()))
+    std = meta.get("gnss_std_m")
+    if std is not None:
+        std = _vector(path, meta, "gnss_std_m", None, "3 positive numbers [north, east, down], m")
+        if (std <= 0).any():
+            raise DataError(path, "gnss_std_m", "3 positive numbers [north, east, down], m", str(std.tolist()))
+    platform = meta.get("platform", PLATFORMS[0])
+    if platform not in PLATFORMS:
+        raise DataError(path, "platform", f"one of {', '.join(PLATFORMS)} (which aids apply)", repr(platform))
+    shifts = {}
+    for key in ("imu_time_offset_s", "gnss_latency_s"):
+        value = meta.get(key, 0.0)
+        if key == "gnss_latency_s" and value == "auto":      # estimated at load (bgfn.data.time_offset)
+            shifts[key] = "auto"
+            continue
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+            raise DataError(path, key, "a number of seconds", repr(value))
+        if abs(value) > MAX_TIME_SHIFT_S or (key == "gnss_latency_s" and value < 0):
+            raise DataError(path, key, f"a delay of at most {MAX_TIME_SHIFT_S:g} s" + (" and >= 0" if key ==
+                            "gnss_latency_s" else "") + " (larger: the clocks differ, e.g. by the 18 s between GPS "
+                            "time and UTC; convert the times instead)", repr(value))
+        shifts[key] = float(value)
     source = meta.get("source")
     if source is not None and not isinstance(source, str):
         raise DataError(path, "source", "free text", type(source).__name__)
     imu_errors, origin = imu_errors_from(path, meta.get("imu_errors"))
     return {"name": name, "lever_arm_m": larm.tolist(), "source": source, "imu_errors": imu_errors,
-            "imu_errors_source": origin}
+            "imu_errors_source": origin, "platform": platform, "imu_mounting_deg": mounting.tolist(),
+            "gnss_std_m": None if std is None else std.tolist(), **shifts}
+
+
+def _vector(path: Path, meta: dict, key: str, default, expected: str) -> np.ndarray:
+    """``meta[key]`` (or ``default``) as 3 finite floats; one error naming the file and key otherwise."""
+    raw = meta.get(key, default)
+    try:
+        vec = np.asarray(raw, dtype=float).ravel()
+    except (TypeError, ValueError):
+        vec = np.array([np.nan])
+    if vec.size != 3 or not np.isfinite(vec).all():
+        raise DataError(path, key, expected, str(raw))
+    return vec

@@ -124,7 +124,7 @@ def outage_constraints(drive, cfg: dict, trajectory: pd.DataFrame):
     """The vehicle constraints of the ``INS+NHC`` runs of ``drive``: the stillness detector over its IMU and the
     vehicle frame from the GPS-aided ``trajectory`` (:func:`bgfn.nav.constraints.build_constraints`)."""
     return cn.build_constraints(drive.imu, drive.meta["imu_errors"], cn.constraint_config(cfg), trajectory,
-                                source=drive.name)
+                                source=drive.name, platform=drive.meta.get("platform", cn.DEFAULT_PLATFORM))
 
 
 def run_drive(drive, section: dict | None = None, snapshots: dict | None = None) -> FilterResult:
@@ -354,7 +354,16 @@ class Baseline:
         """Notebook 02's sentences of this run: the self-alignment and the noise search (when they ran) and the
         NIS verdict of the GPS-aided run (:func:`bgfn.nav.consistency.nis_line`)."""
         setup = self.setup.lines(self.drive_name) if self.setup is not None else []
-        return setup + [nis_line(self.drive_name, nis_summary(self.full.updates))]
+        return setup + [nis_line(self.drive_name, nis_summary(self.full.updates))] + self.aid_lines()
+
+    def aid_lines(self) -> list[str]:
+        """Which aids the ``INS+NHC`` rows ran, and why (the drive's platform), with their epoch counts."""
+        c = self.constraints
+        if not c:
+            return []
+        what = cn.ConstraintConfig(platform=c.get("platform", cn.DEFAULT_PLATFORM)).describe()
+        return [f"{self.drive_name}: the INS+NHC rows' aids -- {what}; {c['aid_epochs']} aid epochs over the drive, "
+                f"{c['zupt_epochs']} of them ZUPT (still {100 * c['still_fraction']:.0f} % of the IMU rows)"]
 
 
 def run_baseline(drive, cfg: dict, windows) -> Baseline:

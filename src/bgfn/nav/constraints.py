@@ -42,7 +42,7 @@ Inside an outage no fix updates it: it is held at its value at the outage start 
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numba
 import numpy as np
@@ -67,6 +67,12 @@ ZUPT_DEFAULTS: dict = {"std_mps": 0.05, "window_s": 2.0, "accel_ratio": 1.5, "gy
                        "max_speed_mps": 2.0}
 #: Mounting choices: the vehicle frame estimated from the GPS-aided solution, or the IMU body frame.
 MOUNTINGS = ("estimate", "none")
+#: What moves the IMU (a drive's ``meta["platform"]``, ``meta.yaml``'s ``platform``) -> (NHC, ZUPT): a car rolls
+#: without slipping sideways or leaving the road, so both; a walker stops and stands but steps sideways, so ZUPT
+#: alone; anything else (a drone, a cart of unknown kind) neither.
+PLATFORM_AIDS: dict[str, tuple[bool, bool]] = {"car": (True, True), "walker": (False, True), "other": (False, False)}
+#: The platform of a drive that does not say (every shipped drive is a car).
+DEFAULT_PLATFORM = "car"
 
 
 @dataclass(frozen=True)
@@ -102,6 +108,24 @@ class ConstraintConfig:
     accel_ratio: float = ZUPT_DEFAULTS["accel_ratio"]
     gyro_ratio: float = ZUPT_DEFAULTS["gyro_ratio"]
     zupt_max_speed_mps: float = ZUPT_DEFAULTS["max_speed_mps"]
+    platform: str = DEFAULT_PLATFORM
+
+    @property
+    def nhc(self) -> bool:
+        """Whether the platform takes the non-holonomic constraints (:data:`PLATFORM_AIDS`)."""
+        return PLATFORM_AIDS[self.platform][0]
+
+    @property
+    def zupt(self) -> bool:
+        """Whether the platform takes zero-velocity updates (:data:`PLATFORM_AIDS`)."""
+        return PLATFORM_AIDS[self.platform][1]
+
+    def describe(self) -> str:
+        """Which aids run, and why (the platform)."""
+        aids = [a for a, on in (("NHC", self.nhc), ("ZUPT", self.zupt)) if on]
+        return (f"platform {self.platform}: " + (" and ".join(aids) if aids else "no vehicle constraint")
+                + {"car": "", "walker": " (no NHC: a walker steps sideways)",
+                   "other": " (neither: no motion model is known)"}[self.platform])
 
     def __post_init__(self):
         for name in ("nhc_std_mps", "nhc_rate_hz", "zupt_std_mps", "window_s"):
@@ -114,6 +138,8 @@ class ConstraintConfig:
                 raise DataError("params nav.nhc/nav.zupt", name, "a number >= 0", repr(value))
         if self.mounting not in MOUNTINGS:
             raise DataError("params nav.nhc", "mounting", f"one of {MOUNTINGS}", repr(self.mounting))
+        if self.platform not in PLATFORM_AIDS:
+            raise DataError("drive meta", "platform", f"one of {', '.join(PLATFORM_AIDS)}", repr(self.platform))
 
 
 def constraint_config(nav_cfg: dict) -> ConstraintConfig:
@@ -323,13 +349,15 @@ class Constraints:
     def summary(self) -> dict:
         """JSON-ready facts: aid epochs, ZUPT epochs, the share of still IMU rows, the final mounting angles (deg)."""
         yaw, pitch = np.degrees(np.arctan(self.mount[-1])) if self.mount.size else (0.0, 0.0)
-        return {"aid_epochs": int(np.count_nonzero(self.aid)), "zupt_epochs": int(np.count_nonzero(self.aid == AID_ZUPT)),
+        return {"platform": self.config.platform, "aid_epochs": int(np.count_nonzero(self.aid)),
+                "zupt_epochs": int(np.count_nonzero(self.aid == AID_ZUPT)),
                 "still_fraction": float(np.mean(self.still)) if self.still.size else 0.0,
                 "mounting_yaw_deg": float(yaw), "mounting_pitch_deg": float(pitch)}
 
 
 def build_constraints(imu: pd.DataFrame, imu_errors: dict, config: ConstraintConfig,
-                      trajectory: pd.DataFrame | None = None, source: str = "drive") -> Constraints:
+                      trajectory: pd.DataFrame | None = None, source: str = "drive",
+                      platform: str = DEFAULT_PLATFORM) -> Constraints:
     """Detector, aid schedule and vehicle frame of a drive.
 
     Parameters
@@ -343,12 +371,16 @@ def build_constraints(imu: pd.DataFrame, imu_errors: dict, config: ConstraintCon
         A GPS-aided solution (reference schema) for the vehicle frame; None: the body frame.
     source : str
         Name used in error messages.
+    platform : str
+        What moves the IMU (:data:`PLATFORM_AIDS`): which aids apply; the vehicle frame is estimated for a car only.
     """
+    config = replace(config, platform=platform)
     t = imu["time"].to_numpy(float)
     still, _, _ = stillness(imu, imu_errors, config, source)
     epochs = aid_epochs(t, config.nhc_rate_hz)
-    aid = np.where(epochs, np.where(still, AID_ZUPT, AID_NHC), AID_NONE).astype(np.int8)
-    mount_time, mount = mounting_track(trajectory, config)
+    moving = AID_NHC if config.nhc else AID_NONE
+    aid = np.where(epochs, np.where(still & config.zupt, AID_ZUPT, moving), AID_NONE).astype(np.int8)
+    mount_time, mount = mounting_track(trajectory if config.nhc else None, config)
     return Constraints(config, t, aid, still, mount_time, mount)
 
 
@@ -421,7 +453,10 @@ class VehicleSchedule:
         if kind == AID_NONE:
             return None
         if kind == AID_ZUPT and np.sqrt(v @ v) > self.config.zupt_max_speed_mps:
-            kind = AID_NHC              # a vibration-free IMU at constant speed reads as still: no ZUPT at speed
+            # a vibration-free IMU at constant speed reads as still: no ZUPT at speed (NHC where the platform has it)
+            kind = AID_NHC if self.config.nhc else AID_NONE
+            if kind == AID_NONE:
+                return None
         n = em.N_STATES
         if kind == AID_ZUPT:
             dz, H = np.empty(3), np.empty((3, n))
@@ -433,6 +468,7 @@ class VehicleSchedule:
         return AidMeasurement(dz, H, np.full(2, self.config.nhc_std_mps))
 
 
-__all__ = ["AID_NHC", "AID_NONE", "AID_ZUPT", "ConstraintConfig", "Constraints", "NHC_DEFAULTS", "ZUPT_DEFAULTS",
+__all__ = ["AID_NHC", "AID_NONE", "AID_ZUPT", "ConstraintConfig", "Constraints", "DEFAULT_PLATFORM", "NHC_DEFAULTS",
+           "PLATFORM_AIDS", "ZUPT_DEFAULTS",
            "aid_epochs", "build_constraints", "constraint_config", "mounting_track", "nhc_measurement",
            "rest_noise", "stillness", "vehicle_rotation", "VehicleSchedule", "zupt_measurement"]

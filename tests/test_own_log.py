@@ -23,7 +23,7 @@ from bgfn.data.names import data_fingerprint, dataset_folder, dataset_id, profil
 from bgfn.data.regrid import GAP_SAMPLES, interpolate_reference
 from bgfn.errors import DataError
 from bgfn.nav import earth, sim
-from bgfn.profile_schema import load_profile, with_overrides
+from bgfn.profile_schema import check_with_drives, load_profile, with_overrides
 
 pytestmark = pytest.mark.usefixtures("repo_untouched")
 
@@ -110,8 +110,6 @@ def test_a_csv_log_named_by_its_path_runs_notebooks_01_to_04(tmp_path, monkeypat
     cfg = load_profile("mine")
     assert cfg["profile"] == "mine"                               # the file's name
     assert cfg["description"] == "profile 'mine': 'quick' with its own settings"     # none written
-    from bgfn.profile_schema import check_with_drives
-
     assert check_with_drives("mine")[0].startswith(f"{log}: {T0:.2f}..")    # make's check step, with the data
     name = str(log)
     assert [cfg[s]["datasets"] for s in ("data", "nav", "train", "evaluate")] == [[name]] * 4
@@ -441,3 +439,17 @@ def test_gnss_on_another_clock_is_one_error_naming_both_files_or_is_estimated_wh
     d = load_drive(folder)
     assert d.meta["gnss_offset"]["applied_latency_s"] == pytest.approx(0.9, abs=0.1)    # 0.8 s + the drive's own
     assert abs(d.meta["gnss_offset"]["residual_s"]) < 0.1
+
+
+def test_a_margin_too_long_for_a_short_log_is_named_as_the_cause(tmp_path, monkeypatch, truth):
+    log = _write_log(tmp_path / "run", truth)
+    params = tmp_path / "params"
+    params.mkdir()
+    shutil.copy(config.PARAMS_DIR / "quick.yaml", params / "quick.yaml")
+    (params / "mine.yaml").write_text(f"base: quick\ndatasets: [{log}]\noutage_windows: [{OUTAGE}]\n"
+                                      "train: {margin_s: 120.0}\n")
+    monkeypatch.setattr(config, "PARAMS_DIR", params)
+    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path / "results")
+    with pytest.raises(DataError) as err:
+        check_with_drives("mine")
+    assert err.value.field == "train.margin_s" and "set train.margin_s to at most" in str(err.value)

@@ -535,6 +535,14 @@ def check_with_drives(profile: str) -> list[str]:
         window_s = int(opts["window"]) / rate
         margin = float(opts["margin_s"])
         blocked = sum(d + 2 * margin for _, d in windows)
+        if window_s >= (t1 - t0) - blocked and (t1 - t0) - sum(d for _, d in windows) > window_s:
+            # the outages alone leave room: the margins take it (a short log under a margin made for long drives)
+            raise DataError(path, "train.margin_s", f"a margin that leaves training data in {name}: its "
+                            f"{t1 - t0:.1f} s less the outages ({sum(d for _, d in windows):g} s) and 2 x "
+                            f"{margin:g} s of margin per outage leave {(t1 - t0) - blocked:.1f} s, less than one "
+                            f"input window ({window_s:g} s); set train.margin_s to at most "
+                            f"{max(0.0, ((t1 - t0) - sum(d for _, d in windows) - window_s) / (2 * len(windows))):.1f} s "
+                            f"or record a longer log", f"{margin:g} s")
         if window_s >= (t1 - t0) - blocked:
             raise DataError(path, "train.window", f"a window shorter than the GPS-available data of {name} "
                             f"({(t1 - t0) - blocked:.1f} s outside the outages and their margins)",

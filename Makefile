@@ -147,7 +147,9 @@ data: $(STAMP)
 
 # ---------------------------------------------------------------- notebooks
 # papermill writes to a temporary name; only a complete run is renamed to the target, so a failed run leaves
-# no executed notebook behind (and Make redoes it next time). The notebook's runner (bgfn.parallel) writes one
+# no executed notebook behind (and Make redoes it next time), and the tables, figures and arrays it wrote (every
+# file of $(RES) newer than its start, outside models/ and logs/) are removed: no half of a notebook's outputs
+# stays beside the other half's older copies. Its networks stay: they are checkpoints a rerun resumes from. The notebook's runner (bgfn.parallel) writes one
 # line per finished run to $(RES)/logs/<notebook>.log (BGFN_PROGRESS_LOG); `tail` shows them here as they come
 # (the first on a line of its own, below papermill's cell bar)
 # and stops after this recipe's shell ($$$$) has ended, having shown the last ones.
@@ -156,11 +158,17 @@ $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(PARAMS) $(SRC) $(STAMP) | data $(K
 	@$(MAKE) clean-debris
 	@echo "==> [$(PROFILE)] papermill $<"
 	@tmp="$(@D)/.$*.running-$$$$.ipynb"; log="$(RES)/logs/$*.log"; : > "$$log"; \
+	started="$(RES)/logs/.started-$*"; touch "$$started"; \
 	tail --pid=$$$$ -s 0.5 -n +1 -f "$$log" 2>/dev/null | sed -u 's/^/    /; 1s/^/\n/' & \
 	if BGFN_PROGRESS_LOG="$(CURDIR)/$$log" $(VENV_ABS)/bin/papermill "$<" "$$tmp" -p profile $(PROFILE) \
 	     --cwd "$(CURDIR)" -k python3 --progress-bar $(PAPERMILL_FLAGS); then \
-	  mv -f "$$tmp" "$@"; \
-	else rm -f "$$tmp"; echo "error: $< failed under PROFILE=$(PROFILE); nothing written to $@ (log: $$log)" >&2; \
+	  mv -f "$$tmp" "$@"; rm -f "$$started"; \
+	else rm -f "$$tmp"; \
+	  find "$(RES)" -type f -newer "$$started" -not -path "$(RES)/models/*" -not -path "$(RES)/logs/*" \
+	    -not -name .lock -print -delete | sed 's/^/    removed a partial output of the failed notebook: /'; \
+	  rm -f "$$started"; \
+	  echo "error: $< failed under PROFILE=$(PROFILE); nothing written to $@, and none of its tables, figures or" \
+	       "arrays kept (its networks stay in $(RES)/models/: training resumes; log: $$log)" >&2; \
 	  exit 1; fi
 
 # The profile is checked before the first notebook runs: its schema (every notebook's load_profile checks that

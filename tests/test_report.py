@@ -20,7 +20,8 @@ import pytest
 
 from bgfn import paper, report
 from bgfn.config import PROJECT_ROOT
-from bgfn.report.book_notebooks import one_parameters_cell, rewrite
+from bgfn.report.book_notebooks import main as book_main
+from bgfn.report.book_notebooks import one_parameters_cell, rewrite, warnings_in
 
 BOOK = PROJECT_ROOT / "book"
 
@@ -583,3 +584,18 @@ def test_the_book_shows_one_parameters_cell_with_the_values_of_the_run(tmp_path)
     # the run's value in the notebook's own cell, its comments kept; a value the cell did not assign is appended
     assert out["cells"][1]["source"] == 'profile = "paper"\n# compared profiles\nvariants = ["a"]  # shown\nextra = 3'
     assert one_parameters_cell({"cells": [cell("x = 1", ["parameters"])]})["cells"][0]["source"] == "x = 1"
+
+
+def test_a_warning_in_an_executed_notebook_stops_the_book(tmp_path):
+    nb = {"cells": [{"cell_type": "code", "metadata": {}, "source": "x", "outputs": [
+        {"output_type": "stream", "name": "stderr",
+         "text": ["/src/bgfn/learning/coverage.py:57: RuntimeWarning: invalid value encountered in cast\n",
+                  "  hit = [c in seen]\n"]},
+        {"output_type": "stream", "name": "stdout", "text": "a UserWarning: in printed text is not a warning\n"}]}]}
+    assert warnings_in(nb) == ["cell 0: RuntimeWarning: invalid value encountered in cast"]
+    path = tmp_path / "nb.ipynb"
+    path.write_text(json.dumps(nb))
+    assert book_main([str(path)]) == 1
+    nb["cells"][0]["outputs"] = nb["cells"][0]["outputs"][1:]
+    path.write_text(json.dumps(nb))
+    assert book_main([str(path)]) == 0

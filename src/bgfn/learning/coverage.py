@@ -24,12 +24,16 @@ def motion_of_windows(ws: WindowSet) -> pd.DataFrame:
 
 def motion_in_windows(reference: pd.DataFrame, windows, step_s: float = 1.0) -> pd.DataFrame:
     """Heading (deg) and horizontal speed (m/s) of the ``reference`` every ``step_s`` inside ``windows``
-    ((start, duration) pairs, s): what the networks meet in the evaluation outages."""
+    ((start, duration) pairs, s): what the networks meet in the evaluation outages. A reference without attitude
+    (an RTK solution) gives the course of its velocity instead of the yaw (a car's heading while it moves)."""
     t = reference["time"].to_numpy(float)
+    heading = reference["yaw"].to_numpy(float)
+    if not np.isfinite(heading).all():
+        heading = np.arctan2(reference["v_e"].to_numpy(float), reference["v_n"].to_numpy(float))
     rows = []
     for start, duration in windows:
         ts = np.arange(float(start), float(start) + float(duration), step_s)
-        yaw = np.interp(ts, t, np.unwrap(reference["yaw"].to_numpy(float)))
+        yaw = np.interp(ts, t, np.unwrap(heading))
         v = np.interp(ts, t, np.hypot(reference["v_n"].to_numpy(float), reference["v_e"].to_numpy(float)))
         rows.append(pd.DataFrame({"heading_deg": np.degrees(yaw) % 360.0, "speed_mps": v}))
     return pd.concat(rows, ignore_index=True) if rows else pd.DataFrame(columns=["heading_deg", "speed_mps"])
@@ -53,6 +57,9 @@ def unseen_fraction(train: pd.DataFrame, other: pd.DataFrame, heading_bin_deg: f
     def cells(df):
         return set(zip((df["heading_deg"].to_numpy() // heading_bin_deg).astype(int),
                        (df["speed_mps"].to_numpy() // speed_bin_mps).astype(int)))
+    train, other = train.dropna(), other.dropna()
+    if len(other) == 0:
+        return float("nan")
     seen = cells(train)
     hit = [c in seen for c in zip((other["heading_deg"].to_numpy() // heading_bin_deg).astype(int),
                                   (other["speed_mps"].to_numpy() // speed_bin_mps).astype(int))]

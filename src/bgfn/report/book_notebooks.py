@@ -6,7 +6,12 @@ first with the notebook's defaults. :func:`one_parameters_cell` writes the run's
 cell (its comments kept) and drops papermill's copy, so a reader sees one cell with the values that produced the
 page. ``make book`` applies it to the copies under ``book/notebooks/``, never to ``results/<profile>/notebooks/``.
 
-``python -m bgfn.report.book_notebooks FILE.ipynb ...`` rewrites each file in place.
+The same step refuses a notebook that printed a warning (:func:`warnings_in`): a ``RuntimeWarning`` or a
+``UserWarning`` in an executed notebook is a defect of ours (an all-NaN column plotted, a legend without lines)
+that the reader would otherwise see in the book.
+
+``python -m bgfn.report.book_notebooks FILE.ipynb ...`` rewrites each file in place, then exits 1 naming every
+warning found.
 """
 
 from __future__ import annotations
@@ -65,6 +70,21 @@ def one_parameters_cell(nb: dict) -> dict:
     return nb
 
 
+_WARNING = re.compile(r"\b\w*Warning: .*")
+
+
+def warnings_in(nb: dict) -> list[str]:
+    """``cell <k>: <the warning line>`` for every warning a code cell printed (its stderr stream)."""
+    out = []
+    for k, cell in enumerate(nb.get("cells", [])):
+        for o in cell.get("outputs", []):
+            if o.get("output_type") == "stream" and o.get("name") == "stderr":
+                text = o.get("text", "")
+                out += [f"cell {k}: {m.group(0)[:200]}" for m in _WARNING.finditer("".join(text) if isinstance(
+                    text, list) else text)]
+    return out
+
+
 def rewrite(path: str | Path) -> None:
     """Apply :func:`one_parameters_cell` to a notebook file in place (atomically)."""
     path = Path(path)
@@ -72,6 +92,18 @@ def rewrite(path: str | Path) -> None:
     atomic_write_text(path, json.dumps(nb, indent=1, ensure_ascii=False) + "\n")
 
 
-if __name__ == "__main__":
-    for name in sys.argv[1:]:
+def main(paths) -> int:
+    """Rewrite each notebook (:func:`rewrite`); 1 when any printed a warning (each named), else 0."""
+    found = []
+    for name in paths:
         rewrite(name)
+        found += [f"{name}: {w}" for w in warnings_in(json.loads(Path(name).read_text(encoding="utf-8")))]
+    if found:
+        print("error: warnings in the executed notebooks (fix their cause; the book does not show them):\n  "
+              + "\n  ".join(found), file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -83,6 +83,9 @@ def plot_motion_coverage(sets: dict, title: str = ""):
     :func:`bgfn.learning.motion_in_windows`)."""
     fig, axes = plt.subplots(1, 2, figsize=(11, 3.4))
     for i, (label, df) in enumerate(sets.items()):
+        df = df.dropna()                                  # no heading where a reference has no attitude or motion
+        if not len(df):
+            continue
         axes[0].hist(df["heading_deg"], bins=np.arange(0, 361, 15), density=True, histtype="step", lw=1.5,
                      color=f"C{i}", label=f"{label} ({len(df)})")
         axes[1].hist(df["speed_mps"], bins=np.arange(0, max(25.0, float(df["speed_mps"].max()) + 1), 1.0),

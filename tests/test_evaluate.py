@@ -239,17 +239,25 @@ def test_window_metrics_match_nav_metrics(ctx5):
     assert m["rmse_h_m"] == pytest.approx(ref["rmse_horizontal"])
     assert m["final_h_m"] == pytest.approx(ref["end_horizontal"])
     assert m["max_h_m"] == pytest.approx(ref["max_horizontal"])
-    # a prefix of a long run is the short outage (causal): same numbers as a 5 s run
+    # a prefix of a long run is the short outage (causal): same numbers as a 5 s run, NEES included
     short = ev.run_outages(ctx5, [(s, 5.0)], None)[0]
-    assert ev.window_metrics(run.errors, s, 5.0) == pytest.approx(ev.window_metrics(short.errors, s, 5.0))
+    assert ev.window_metrics(run.errors, s, 5.0, run.sd) == pytest.approx(
+        ev.window_metrics(short.errors, s, 5.0, short.sd))
+    # NEES by hand: the last epoch's north/east error over the filter's own std there, squared and summed
+    e, sd = run.errors.iloc[-1], run.sd.iloc[-1]
+    nees = (e["north"] / sd["sd_north_m"]) ** 2 + (e["east"] / sd["sd_east_m"]) ** 2
+    assert ev.window_metrics(run.errors, s, d, run.sd)["nees_h"] == pytest.approx(nees)
+    assert np.isnan(m["nees_h"]) and 0.0 < sd["sd_north_m"] < 100.0                    # no sd: not measured
+    # the std grows through the outage (no fix), from the GPS-aided level at the start
+    assert run.sd["sd_north_m"].iloc[-1] > run.sd["sd_north_m"].iloc[0] > 0.0
 
 
 def test_prefix_of_a_hybrid_run_is_the_shorter_outage(ctx5):
     s = WINDOWS[0][0]
     long = ev.run_outages(ctx5, [(s, 20.0)], Heading(), "BGFN", 0)[0]
     short = ev.run_outages(ctx5, [(s, 7.0)], Heading(), "BGFN", 0)[0]
-    assert ev.window_metrics(long.errors, s, 7.0) == pytest.approx(ev.window_metrics(short.errors, s, 7.0),
-                                                                   abs=1e-9)
+    assert ev.window_metrics(long.errors, s, 7.0, long.sd) == pytest.approx(
+        ev.window_metrics(short.errors, s, 7.0, short.sd), abs=1e-9)
 
 
 def test_gps_row_is_the_smallest_and_fusion_rate_must_divide_gnss_rate(ctx5):

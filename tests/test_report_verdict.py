@@ -196,3 +196,21 @@ def test_the_best_learned_odometer_is_one_that_beats_ins_nhc_when_one_does():
     inp = _inputs(odometer=odo)
     assert "A learned odometer beats INS+NHC at 60 s: RIDGE-ODO 16.0 m against 20.0 m (p 0.002)" in headline(
         inp, verdict_table(inp))
+
+
+def test_the_ins_rows_carry_the_filters_consistency_and_question_five_says_it():
+    nees = pd.DataFrame([
+        {"dataset": "d", "window": "sweep", "duration_s": 60.0, "method": "INS", "runs": 20, "median_nees": 40.0,
+         "inside_95": 0.3, "verdict": "overconfident"},
+        {"dataset": "d", "window": "sweep", "duration_s": 30.0, "method": "INS", "runs": 20, "median_nees": 1.2,
+         "inside_95": 0.95, "verdict": "consistent"},
+        {"dataset": "d", "window": "outage 1", "duration_s": 30.0, "method": "INS+NHC", "runs": 1, "median_nees": 1.0,
+         "inside_95": 1.0, "verdict": "consistent"}])
+    inp = _inputs(nees=nees)
+    t = verdict_table(inp).set_index("row")
+    assert t.loc["INS", "covariance"] == "overconfident"          # the sweep's 60 s speaks for the row
+    assert t.loc["INS+NHC", "covariance"] == "consistent"         # no sweep row: the paper's outage
+    assert t.loc["BGFN", "covariance"] == "-"
+    five = verdict_sentences(inp, verdict_table(inp))[4]
+    assert ("the filter is overconfident: the INS row's median NEES of the horizontal position in the 60 s sweep is "
+            "40 (30 % of the runs inside the 95 % bound") in five and "weighted too little" in five

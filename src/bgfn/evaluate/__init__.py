@@ -61,6 +61,8 @@ Modules, in the order of the protocol:
 - :mod:`bgfn.evaluate.sweep` -- the outage sweep and its statistics;
 - :mod:`bgfn.evaluate.increments` -- the true increments of a drive, a run's increment error;
 - :mod:`bgfn.evaluate.oracle` -- the oracle rows: true increments plus noise, the break-even accuracy;
+- :mod:`bgfn.evaluate.nees` -- the filter's consistency in the outages: NEES of the horizontal position at each
+  window's end against its covariance, per method and duration (``tables/outage_nees.csv``);
 - :mod:`bgfn.evaluate.odometers` -- the bars a learned odometer must clear: INS+NHC, the held speed, RIDGE-ODO and
   an oracle speed, fused as a forward-speed measurement (beyond the paper);
 - :mod:`bgfn.evaluate.record` -- ``outage_evaluation.json``, the record notebook 06 reads;
@@ -79,6 +81,7 @@ from bgfn.evaluate.increments import AntennaTruth, increment_errors, increment_r
 from bgfn.evaluate.ins_drift import (DRIFT_COLUMNS, DRIFT_RUN_COLUMNS, drift_sentences, drift_starts, drift_summary,
                                      ins_drift_runs, plot_ins_drift)
 from bgfn.evaluate.networks import ensure_models, load_model
+from bgfn.evaluate.nees import NEES_COLUMNS, nees_lines, nees_section, nees_summary
 from bgfn.evaluate.odometers import (ODOMETER_COLUMNS, ODOMETER_METHODS, OdometerSection, odometer_lines,
                                      odometer_rows, odometer_summary, odometer_table, run_odometer_bars,
                                      run_odometer_section)
@@ -90,7 +93,7 @@ from bgfn.evaluate.record import RECORD_FILE, evaluation_record, write_evaluatio
 from bgfn.evaluate.sensitivity import (SENSITIVITY_COLUMNS, Sensitivity, pseudo_std_sensitivity, save_sensitivity,
                                        sensitivity_table)
 from bgfn.evaluate.sweep import (describe_sweep, describe_sweep_setup, describe_sweep_size, profile_sweep_plan,
-                                 run_sweep, run_sweeps, sweep_comparisons, sweep_interval_table, sweep_plan,
+                                 pairs_style, run_sweep, run_sweeps, sweep_comparisons, sweep_interval_table, sweep_plan,
                                  sweep_summary, sweep_train_config)
 from bgfn.evaluate.tables import (TableResult, aggregate_seeds, describe_tables, error_reduction, error_series,
                                   evaluate_dataset, fix_error_table, representative_seeds, run_tables,
@@ -99,7 +102,7 @@ from bgfn.evaluate.variants import (NO_VARIANT, VARIANT_COLUMNS, VARIANT_METRICS
                                     variant_runs, variant_table)
 
 __all__ = [
-    "ODOMETER_COLUMNS", "ODOMETER_METHODS", "OdometerSection", "odometer_lines", "odometer_rows", "odometer_summary",
+    "NEES_COLUMNS", "nees_lines", "nees_section", "nees_summary", "ODOMETER_COLUMNS", "ODOMETER_METHODS", "OdometerSection", "odometer_lines", "odometer_rows", "odometer_summary",
     "odometer_table", "run_odometer_bars", "run_odometer_section",
     "DRIFT_COLUMNS", "DRIFT_RUN_COLUMNS", "drift_sentences", "drift_starts", "drift_summary", "ins_drift_runs",
     "plot_ins_drift", "outage_figures",
@@ -115,7 +118,7 @@ __all__ = [
     "gps_run", "load_model", "navigation_context", "ours_above_paper", "paper_table_title",
     "plot_gps_row", "plot_outage", "plot_sweep_boxes", "pseudo_gps_positions", "pseudo_std_sensitivity",
     "reduction_table", "representative_seeds", "run_outages", "run_sweep", "run_sweeps", "run_tables",
-    "save_sensitivity", "save_table_result", "sensitivity_table", "sweep_comparisons", "sweep_interval_table",
+    "save_sensitivity", "save_table_result", "sensitivity_table", "sweep_comparisons", "sweep_interval_table", "pairs_style",
     "profile_sweep_plan", "sweep_plan", "sweep_summary", "sweep_train_config", "table_file", "table_paths",
     "window_metrics",
     "write_evaluation_record",

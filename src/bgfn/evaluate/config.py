@@ -29,9 +29,10 @@ COLORS: dict[str, str] = {**_BASE_COLORS, **{nhc_label(m): c for m, c in _BASE_C
 METRIC_COLUMNS: tuple[str, ...] = ("max_east_m", "max_north_m", "rmse_h_m", "final_h_m")
 TABLE_COLUMNS: tuple[str, ...] = ("outage", "method") + METRIC_COLUMNS
 #: Columns of ``tables/outage_sweep.csv``; ``increment_rmse_m``: a network's predicted delta_p_gps against the true
-#: ones inside the outage, RMSE per horizontal axis (:func:`bgfn.evaluate.increments.increment_rmse`; NaN for INS, GPS).
+#: ones inside the outage, RMSE per horizontal axis (:func:`bgfn.evaluate.increments.increment_rmse`; NaN for INS, GPS);
+#: ``nees_h``: the horizontal NEES at the window's end against the filter's own covariance (:mod:`bgfn.evaluate.nees`).
 SWEEP_COLUMNS: tuple[str, ...] = ("dataset", "start_s", "duration_s", "method", "seed", "fold", "max_east_m",
-                                  "max_north_m", "max_h_m", "rmse_h_m", "final_h_m", "increment_rmse_m")
+                                  "max_north_m", "max_h_m", "rmse_h_m", "final_h_m", "increment_rmse_m", "nees_h")
 #: The paper's test -> our outage table file (``results/<profile>/tables/``).
 TABLE_FILES: dict[str, str] = {test: spec["file"] for test, spec in TESTS.items()}
 #: Simulated dataset -> the dataset with NaveGo's recorded IMU, and the file it needs.

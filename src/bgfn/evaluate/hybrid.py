@@ -179,6 +179,9 @@ class OutageRun:
         (m, the sum of Eq. pred-gps), ``std_m``.
     errors : DataFrame or None
         :func:`bgfn.nav.metrics.navigation_errors` of ``trajectory`` plus ``t_rel`` (s since the start).
+    sd : DataFrame or None
+        The filter's own horizontal position std at the rows of ``trajectory``: ``time``, ``sd_north_m``,
+        ``sd_east_m`` (m; None for the ``GPS`` row): what :func:`window_metrics` compares the errors with (NEES).
     """
 
     method: str
@@ -190,6 +193,7 @@ class OutageRun:
     pseudo: pd.DataFrame = field(default_factory=lambda: pd.DataFrame(
         columns=["time", "lat", "lon", "h", "cum_dn", "cum_de", "std_m"]))
     errors: pd.DataFrame | None = None
+    sd: pd.DataFrame | None = None
 
 
 def _extra_columns(options: dict) -> tuple[str, ...]:
@@ -233,6 +237,7 @@ class _Run:
         self.out_pos, self.out_v = np.empty((n, 3)), np.empty((n, 3))
         self.out_c, self.out_sd = np.empty((n, 3, 3)), np.empty((n, em.N_STATES))
         self.out_pos[0], self.out_v[0], self.out_c[0] = self.pos, self.v, self.c
+        self.out_sd[0] = np.sqrt(np.maximum(np.diag(self.P), 0.0))
         self.row = 0
         self.schedule = None
         if constraints is not None:
@@ -311,6 +316,14 @@ class _Run:
 
     def trajectory(self) -> pd.DataFrame:
         return trajectory_frame(self.times, self.out_pos, self.out_v, self.out_c)
+
+    def position_sd(self) -> pd.DataFrame:
+        """The filter's horizontal position std (m) at every output row, from its latitude and longitude error
+        states (rad) through the radii of curvature."""
+        lat, h = self.out_pos[:, 0], self.out_pos[:, 2]
+        r_m, r_n = earth.curvature_radii(lat)
+        return pd.DataFrame({"time": self.times, "sd_north_m": self.out_sd[:, em.DLAT] * (r_m + h),
+                             "sd_east_m": self.out_sd[:, em.DLON] * (r_n + h) * np.cos(lat)})
 
 
 def _rows_at(times: np.ndarray, t) -> np.ndarray:
@@ -416,7 +429,8 @@ def run_outages(ctx: NavContext, windows, predictor=None, method: str = "INS", s
         traj = r.trajectory()
         run = OutageRun(method, seed, r.start, r.duration, traj,
                         pd.DataFrame(incs[i], columns=["time", "dn", "de"]),
-                        pd.DataFrame(fixes[i], columns=["time", "lat", "lon", "h", "cum_dn", "cum_de", "std_m"]))
+                        pd.DataFrame(fixes[i], columns=["time", "lat", "lon", "h", "cum_dn", "cum_de", "std_m"]),
+                        sd=r.position_sd())
         if errors:
             e = metrics.navigation_errors(traj, ctx.drive.reference, ctx.drive.meta)
             e.insert(1, "t_rel", e["time"] - r.start)
@@ -441,14 +455,18 @@ def gps_run(ctx: NavContext, start: float, duration: float, errors: bool = True)
 
 
 # ----------------------------------------------------------------------------------------------- metrics
-def window_metrics(errors: pd.DataFrame, start: float, duration: float) -> dict:
+def window_metrics(errors: pd.DataFrame, start: float, duration: float, sd: pd.DataFrame | None = None) -> dict:
     """Error numbers of one run over ``[start, start + duration]``.
 
     Returns
     -------
     dict
         ``max_east_m``, ``max_north_m`` (max |error|, paper Tables 1-2), ``max_h_m`` (max horizontal),
-        ``rmse_h_m`` (horizontal RMSE over the IMU epochs), ``final_h_m`` (horizontal error at the last epoch).
+        ``rmse_h_m`` (horizontal RMSE over the IMU epochs), ``final_h_m`` (horizontal error at the last epoch),
+        ``nees_h``: the normalized estimation error squared of the horizontal position at the last epoch against the
+        filter's own std there (``sd``, :attr:`OutageRun.sd`; NaN without it), ``(e_N / sd_N)^2 + (e_E / sd_E)^2``:
+        chi-square with 2 degrees of freedom when the filter is consistent (the north-east correlation of its
+        covariance left out: :mod:`bgfn.evaluate.nees`).
     """
     t = errors["time"].to_numpy(float)
     m = (t >= start - 1e-6) & (t <= start + duration + 1e-6)
@@ -456,5 +474,11 @@ def window_metrics(errors: pd.DataFrame, start: float, duration: float) -> dict:
         raise DataError("errors", "time", f"epochs inside [{start}, {start + duration}]", "none")
     e, n = errors["east"].to_numpy(float)[m], errors["north"].to_numpy(float)[m]
     h = np.hypot(e, n)
+    nees = float("nan")
+    if sd is not None and len(sd):
+        k = int(np.flatnonzero(m)[-1])
+        j = int(np.argmin(np.abs(sd["time"].to_numpy(float) - t[k])))
+        if abs(float(sd["time"].iloc[j]) - t[k]) < 1e-6:
+            nees = float((n[-1] / sd["sd_north_m"].iloc[j]) ** 2 + (e[-1] / sd["sd_east_m"].iloc[j]) ** 2)
     return {"max_east_m": float(np.abs(e).max()), "max_north_m": float(np.abs(n).max()), "max_h_m": float(h.max()),
-            "rmse_h_m": float(np.sqrt(np.mean(h ** 2))), "final_h_m": float(h[-1])}
+            "rmse_h_m": float(np.sqrt(np.mean(h ** 2))), "final_h_m": float(h[-1]), "nees_h": nees}

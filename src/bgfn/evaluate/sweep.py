@@ -162,7 +162,7 @@ class _Sweep:
     def add(self, run, fold) -> None:
         """The rows of one outage run, one per duration (and per seed for a run without one)."""
         for du in self.durations:
-            mtr = window_metrics(run.errors, run.start, du)
+            mtr = window_metrics(run.errors, run.start, du, run.sd)
             # the network's own increment error in this outage (the oracle's sigma axis, bgfn.evaluate.oracle)
             mtr["increment_rmse_m"] = (increment_rmse(run, self.truth, self.ctx.gnss_interval_s, du)
                                        if len(run.increments) else float("nan"))
@@ -355,6 +355,12 @@ def describe_sweep_size(sweep: pd.DataFrame) -> str:
     """``<n> rows, <a> starts x <b> durations x <c> methods x <d> seeds`` of a sweep table."""
     return (f"{len(sweep)} rows, {sweep['start_s'].nunique()} starts x {sweep['duration_s'].nunique()} durations x "
             f"{sweep['method'].nunique()} methods x {sweep['seed'].nunique()} seeds")
+
+
+def pairs_style(pairs: pd.DataFrame):
+    """:func:`sweep_comparisons` styled for notebook 04 (win rate and ratios with two decimals, p with two digits)."""
+    return pairs.style.format({"win_rate": "{:.2f}", "median_diff_m": "{:+.1f}", "median_ratio": "{:.2f}",
+                               "p_value": "{:.2g}", "p_value_by_start": "{:.2g}"}).hide(axis="index")
 
 
 def sweep_interval_table(summary: pd.DataFrame) -> pd.DataFrame:

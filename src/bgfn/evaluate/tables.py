@@ -133,7 +133,7 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
             runs += run_outages(ctx, windows, model, nhc_label(method), seed, ecfg["pseudo_gps"], constraints=aids)
     outage_no = {s: i + 1 for i, (s, _) in enumerate(windows)}
     rows = [{"outage": outage_no[r.start], "start_s": r.start, "method": r.method, "seed": r.seed,
-             **window_metrics(r.errors, r.start, r.duration)} for r in runs]
+             **window_metrics(r.errors, r.start, r.duration, r.sd)} for r in runs]
     per_seed = pd.DataFrame(rows)
     fixes = fix_errors(drive.gnss, drive.reference, ctx.lever, drive.meta)
     # a dataset that stands for none of the paper's tests names its table files by its id (never a folder path)

@@ -49,7 +49,9 @@ SWEEP_DURATIONS: tuple[float, ...] = (30.0, 60.0)
 ORACLE_ROW = "oracle at BGFN's increment error"
 #: Columns of :func:`verdict_table`.
 VERDICT_COLUMNS: tuple[str, ...] = ("row", "inputs", "protocol", "outage 1", "outage 2", "sweep 30 s", "sweep 60 s",
-                                    "p 30 s", "p 60 s", "runs")
+                                    "p 30 s", "p 60 s", "runs", "covariance")
+#: Rows whose filter consistency in the outages the table states (``covariance``: :mod:`bgfn.evaluate.nees`).
+NEES_ROWS: tuple[str, ...] = ("INS", "INS+NHC")
 
 
 @dataclass
@@ -68,6 +70,7 @@ class VerdictInputs:
     training_variants: pd.DataFrame | None = None   # training_variants.csv: the variants' cards
     training_all_windows: pd.DataFrame | None = None    # training_all_windows.csv: untrained runs, all windows
     odometer: OdometerInputs | None = None          # outage_odometer*.csv, energy_odometer.csv
+    nees: pd.DataFrame | None = None                # outage_nees.csv: the filter's consistency in outages
 
     @classmethod
     def read(cls, out: str | Path, dataset: str) -> "VerdictInputs":
@@ -90,7 +93,8 @@ class VerdictInputs:
                    of(read_csv(tables / SHARED_TABLES["training_all_windows"])),
                    read_odometer_inputs(read_csv(tables / SHARED_TABLES["odometer"]),
                                         read_csv(tables / SHARED_TABLES["odometer_summary"]),
-                                        read_csv(tables / SHARED_TABLES["energy_odometer"]), dataset))
+                                        read_csv(tables / SHARED_TABLES["energy_odometer"]), dataset),
+                   of(read_csv(tables / SHARED_TABLES["nees"])))
 
 
 def _outage_value(seeds: pd.DataFrame | None, method: str, outage: int) -> float:
@@ -139,6 +143,17 @@ def _oracle_value(breakeven: pd.DataFrame | None, outage: str, duration: float |
     return float(sel["oracle_at_rmse_m"].iloc[0]) if len(sel) else float("nan")
 
 
+def nees_of(nees: pd.DataFrame | None, method: str) -> pd.Series | None:
+    """The NEES row (:mod:`bgfn.evaluate.nees`) that speaks for ``method``: the sweep at its longest verdict duration
+    (:data:`SWEEP_DURATIONS`), else the paper's first outage; None without one."""
+    if nees is None or not len(nees):
+        return None
+    g = nees[nees["method"] == method]
+    sweep = g[(g["window"] == "sweep") & np.isclose(g["duration_s"].astype(float), max(SWEEP_DURATIONS))]
+    pick = sweep if len(sweep) else g[g["window"] != "sweep"]
+    return pick.iloc[0] if len(pick) else None
+
+
 def _main_inputs(variants: pd.DataFrame | None) -> str:
     """The main networks' inputs as the variants table describes them (its ``main`` rows), ``Eq. (eq21)`` for
     the paper's; the paper's when there is no variants table."""
@@ -168,7 +183,9 @@ def verdict_table(inp: VerdictInputs) -> pd.DataFrame:
                      "outage 1": _outage_value(inp.seeds, method, 1), "outage 2": _outage_value(inp.seeds, method, 2),
                      **{f"sweep {d:g} s": _sweep_value(inp.sweep_summary, method, d) for d in SWEEP_DURATIONS},
                      **{f"p {d:g} s": _p_value(inp.sweep_pairs, method, d) for d in SWEEP_DURATIONS},
-                     "runs": _runs(inp.seeds, method)})
+                     "runs": _runs(inp.seeds, method),
+                     "covariance": (str(nees_of(inp.nees, method)["verdict"]) if method in NEES_ROWS
+                                    and nees_of(inp.nees, method) is not None else "-")})
         if method == "INS+NHC":
             rows.append({"row": ORACLE_ROW, "inputs": "-", "protocol": "-",
                          "outage 1": _oracle_value(inp.breakeven, "1", None),
@@ -370,7 +387,8 @@ def _numbers(node) -> list[float]:
 def answer_ins_tuning(inp: VerdictInputs) -> str:
     """Question 5: the INS row under NaveGo v1.4's bias modelling beside ours and the paper's."""
     if inp.ins_tuning is None or not len(inp.ins_tuning):
-        return "Is the INS row comparable? Not measured: notebook 02's INS-setup table has not run."
+        return "Is the INS row comparable? Not measured: notebook 02's INS-setup table has not run." + \
+            consistency_sentence(inp)
     gap = gap_explained(inp.ins_tuning)
     g = gap[gap["setup"] == "navego"]
     if not len(g):
@@ -379,7 +397,21 @@ def answer_ins_tuning(inp: VerdictInputs) -> str:
     whose = "" if paper.has_own_values(inp.test) else " (its field test: it has no table of this drive)"
     return (f"Is the INS row comparable? Mean of the INS row's max east and north errors: {_m(r['shipped_m'])} with "
             f"our filter, {_m(r['setup_m'])} with NaveGo v1.4's bias modelling, {_m(r['paper_m'])} in the paper"
-            f"{whose}.")
+            f"{whose}." + consistency_sentence(inp))
+
+
+def consistency_sentence(inp: VerdictInputs) -> str:
+    """Whether the filter's covariance at the end of the outages matches its errors (the INS row's NEES), or ''."""
+    r = nees_of(inp.nees, "INS")
+    if r is None:
+        return ""
+    where = f"the {float(r['duration_s']):g} s sweep" if r["window"] == "sweep" else f"the paper's {r['window']}"
+    return (f" During the outages the filter is {r['verdict']}: the INS row's median NEES of the horizontal position "
+            f"in {where} is {float(r['median_nees']):.3g} ({100 * float(r['inside_95']):.0f} % of the runs inside the "
+            f"95 % bound; a consistent filter: 1.39 and 95 %), so every aid fused with it is weighted "
+            + {"overconfident": "too little (the filter believes its drift smaller than it is).",
+               "underconfident": "too much (the filter believes its drift larger than it is).",
+               "consistent": "as its accuracy deserves."}.get(str(r["verdict"]), "as measured."))
 
 
 def verdict_sentences(inp: VerdictInputs, table: pd.DataFrame, claims: dict | None = None) -> list[str]:

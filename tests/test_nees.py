@@ -1,0 +1,51 @@
+"""The filter's consistency in outages (bgfn.evaluate.nees): NEES summaries and words from hand-made rows."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from bgfn.evaluate import nees as N
+
+
+def _sweep():
+    rng = np.random.default_rng(0)
+    rows = []
+    for du in (30.0, 60.0):
+        for start in range(200):
+            # a consistent filter: the NEES is chi-square(2) = 2 x Exp(1) ...
+            rows.append({"dataset": "d", "start_s": float(start), "duration_s": du, "method": "INS",
+                         "nees_h": 2.0 * rng.exponential()})
+            # ... an overconfident one: errors 4 times its std
+            rows.append({"dataset": "d", "start_s": float(start), "duration_s": du, "method": "INS+NHC",
+                         "nees_h": 16.0 * 2.0 * rng.exponential()})
+            rows.append({"dataset": "d", "start_s": float(start), "duration_s": du, "method": "GPS", "nees_h": np.nan})
+    return pd.DataFrame(rows)
+
+
+def test_chi_square_constants_and_words():
+    assert N.CHI2_MEDIAN == pytest.approx(1.3863, abs=1e-4) and N.CHI2_95 == pytest.approx(5.9915, abs=1e-4)
+    assert N.verdict(1.4) == "consistent" and N.verdict(30.0) == "overconfident"
+    assert N.verdict(0.1) == "underconfident" and N.verdict(float("nan")) == "not measured"
+
+
+def test_the_summary_finds_the_consistent_and_the_overconfident_filter(tmp_path):
+    per_seed = pd.DataFrame({"outage": [1, 1, 2], "method": ["INS", "INS", "INS"], "nees_h": [1.0, 3.0, 100.0]})
+    results = {"d": SimpleNamespace(per_seed=per_seed, windows=[(10.0, 30.0), (50.0, 30.0)])}
+    s = N.nees_summary(_sweep(), results)
+    assert list(s.columns) == list(N.NEES_COLUMNS)
+    sw = s[s["window"] == "sweep"].set_index(["method", "duration_s"])
+    assert ("GPS", 30.0) not in sw.index                               # no covariance: no row
+    assert sw.loc[("INS", 30.0), "verdict"] == "consistent" and sw.loc[("INS", 30.0), "inside_95"] == pytest.approx(
+        0.95, abs=0.04)
+    assert sw.loc[("INS+NHC", 60.0), "verdict"] == "overconfident" and sw.loc[("INS+NHC", 60.0), "inside_95"] < 0.3
+    paper = s[s["window"] != "sweep"].set_index("window")
+    assert paper.loc["outage 1", "median_nees"] == 2.0 and paper.loc["outage 1", "duration_s"] == 30.0
+    assert paper.loc["outage 2", "verdict"] == "overconfident"
+    lines = N.nees_lines(s)
+    assert lines[0].startswith("d, NEES of the horizontal position") and "INS 30 s: median" in lines[0]
+    assert N.nees_section(tmp_path, results, _sweep()) == lines
+    assert (tmp_path / "tables" / "outage_nees.csv").is_file() and (tmp_path / "figures" / "outage_nees_d.png").is_file()

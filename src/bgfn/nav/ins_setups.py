@@ -8,8 +8,9 @@ starts from the GPS-aided filter's state, so its drift depends on how that filte
 - ``shipped``: our filter as every other result uses it (random-walk biases, the full constant bias in P0);
 - ``navego``: the filter set up as NaveGo v1.4's ``ins_gnss.m`` (:mod:`bgfn.nav.navego_setup`);
 - ``navego-reset``: the same GPS-aided run, then each outage's INS started with its bias estimates cleared:
-  only the profile's static biases are removed, as by NaveGo v1.4 whose bias estimate is the latest
-  correction alone (:mod:`bgfn.nav.navego_setup`, "Not reproduced"; the latest correction is neglected);
+  only the profile's static biases are removed: a bound for a filter that keeps no accumulated bias estimate
+  (a later ``ins_gnss.m``, Version 012; v1.4 as mirrored, Version 011, accumulates them as ours does:
+  :mod:`bgfn.nav.navego_setup`, "Not reproduced");
 - ``paper``: the paper's INS row (:func:`bgfn.paper.published_values`: the field test's beside the real drive),
   only for a dataset that stands for one of its tests.
 
@@ -33,7 +34,7 @@ from .baseline import Baseline, filter_imu, nav_config, run_baseline
 from .filter import run_outage
 from .outages import check_windows
 
-#: Setup of the INS row with the bias estimates cleared at the outage start (NaveGo v1.4's bound).
+#: Setup of the INS row with the bias estimates cleared at the outage start (a bound: no accumulated bias estimate).
 RESET = "navego-reset"
 #: Label of the paper's row.
 PAPER = "paper"

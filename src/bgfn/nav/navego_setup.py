@@ -6,23 +6,22 @@ it, and NaveGo models them differently from our shipped filter (:func:`bgfn.nav.
 This module reproduces NaveGo's *setup* in our filter; ``nav.ins_tuning: shipped`` (the default) leaves every
 result as it was, ``navego`` selects this one.
 
-What NaveGo v1.4 does (files of ``rodralez/NaveGo``; ``ins_gnss.m`` Version 012 of 2022-07-19 is the one
-stored at the commit whose ``misc/navego_print_version.m`` prints "NaveGo, release v1.4" and is still the
-newest stored; the helpers are their newest stored versions, all dated before it. Line numbers of those
-versions):
+What NaveGo v1.4 does, read from its source as mirrored in ``../shared/navego-v1.4/`` (``ins-gnss/ins_gnss.m``
+Version 011 of 2022-04, ``ins-gnss/F_update.m`` Version 010, ``ins-gnss/kf_prediction.m`` Version 001,
+``conversions/imu_si_errors.m`` Version 011; line numbers of those files):
 
 1. *Static biases removed, as known constants.* Every IMU sample is corrected before the strapdown with the
    profile's static biases ``gb_sta``/``ab_sta`` (``ins-gnss/ins_gnss.m`` lines 251-252,
    ``wb_corrected = imu.wb(i,:)' - gb_dyn - imu.gb_sta'``); they are never estimated.
 2. *Bias states = dynamic biases only.* The bias block of P0 is ``diag(gb_dyn, ab_dyn)^2`` (``ins_gnss.m``
-   line 200): the static part's uncertainty is not in the filter.
+   line 193): the static part's uncertainty is not in the filter.
 3. *The bias estimate starts at the dynamic-bias value.* ``gb_dyn = imu.gb_dyn'`` (lines 186-187) is
-   subtracted from the first samples, and the prior error state is ``[0, gb_dyn, ab_dyn]`` (line 199): the
+   subtracted from the first samples, and the prior error state is ``[0, gb_dyn, ab_dyn]`` (line 192): the
    one-sigma values of the profile are used as an initial estimate.
 4. *Gauss-Markov bias model.* ``F`` has ``-1/gb_corr`` and ``-1/ab_corr`` on the bias block
    (``ins-gnss/F_update.m`` Version 010, lines 164 and 171) and ``G`` an identity for the bias driving noise
    (line 158).
-5. *Driving noise ``gb_dyn^2 / gb_corr``.* ``Q = diag(arw, vrw, gb_psd, ab_psd)^2`` (``ins_gnss.m`` line 202)
+5. *Driving noise ``gb_dyn^2 / gb_corr``.* ``Q = diag(arw, vrw, gb_psd, ab_psd)^2`` (``ins_gnss.m`` line 195)
    with the root PSD ``gb_psd = gb_dyn / sqrt(gb_corr)`` (``conversions/imu_si_errors.m`` Version 011,
    lines 95 and 101). That is half the PSD ``2 sigma^2 / tau`` that keeps a first-order Gauss-Markov process
    at its stationary std ``sigma`` (the shipped filter's choice): NaveGo's bias states settle at
@@ -48,11 +47,12 @@ white noise                 ``*_noise_density`` (``arw``, ``vrw``) x        the 
 
 Not reproduced (our filter stays the paper's, Eqs. eq3/eq4): NaveGo also fuses the GNSS velocity, propagates
 P only at the GNSS epochs, starts from the first fix and ``ini_align``, and corrects with a ZUPT heuristic
-(lines 280-315). And Version 012 zeroes the *whole* error state before each update (``kf.xp = zeros(n, 1)``,
-line 366, where Version 011 zeroed states 1-9 only), so that ``gb_dyn = -kf.xp(10:12)`` (lines 412-413) is
-the latest correction alone: NaveGo v1.4 does not accumulate its bias estimates. Our filter accumulates them
-(closed-loop feedback, :mod:`bgfn.nav.filter`); :func:`bgfn.nav.ins_setups.ins_tuning_table` bounds that
-difference with a run whose bias estimates are cleared at the outage start.
+(lines 280-315). Before each update it zeroes the error states 1-9 only (``kf.xp(1:9) = 0.0``, line 363): the
+bias states 10-15 are carried from update to update (``xi = A xp``, ``kf_prediction.m`` line 54), and
+``gb_dyn = -kf.xp(10:12)`` (lines 408-409) is the accumulated estimate, as in our closed-loop filter. (An earlier
+reading of a later ``ins_gnss.m``, Version 012, which zeroes the whole state and so does not accumulate them, is
+why :func:`bgfn.nav.ins_setups.ins_tuning_table` also shows a run whose bias estimates are cleared at the outage
+start; v1.4 as mirrored here is Version 011.)
 """
 
 from __future__ import annotations

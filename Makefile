@@ -4,6 +4,7 @@
 #                  [JOBS=n] [DASK_SCHEDULER=tcp://host:8786]   runs at a time here / on a Dask cluster
 #   make test                                    pytest (fails when no test ran)
 #   make book [PROFILE=...]                      rebuild the book from already executed notebooks
+#   make navego-check [PROFILE=...]              NaveGo v1.4 itself under GNU Octave beside our INS rows
 #   make bench | make strip | make clean | make distclean | make lock | make help
 #
 # Make's file dependencies keep a second `make reproduce` cheap: an executed notebook is redone only when its
@@ -85,7 +86,7 @@ export DASK_SCHEDULER
 # the venv's IPython kernel configuration (tools/ipython_kernel_config.py, installed by `make venv`)
 KERNEL_CONFIG := $(VENV)/etc/ipython/ipython_kernel_config.py
 
-.PHONY: FORCE help reproduce notebooks _reproduce _notebooks book test bench clean clean-debris distclean venv data lock strip
+.PHONY: FORCE help reproduce notebooks _reproduce _notebooks navego-check book test bench clean clean-debris distclean venv data lock strip
 
 # A profile is a plain name (params/<name>.yaml); anything with a path in it would write outside results/.
 ifneq ($(shell printf '%s' '$(PROFILE)' | grep -Ex '[A-Za-z0-9][A-Za-z0-9_-]*'),$(PROFILE))
@@ -103,7 +104,7 @@ endif
 endif
 
 help:
-	@sed -n '3,6p' Makefile | sed 's/^# \{0,1\}//'
+	@sed -n '3,7p' Makefile | sed 's/^# \{0,1\}//'
 
 # ---------------------------------------------------------------- environment
 venv: $(STAMP) $(KERNEL_CONFIG)
@@ -268,6 +269,15 @@ strip: $(STAMP)
 	  dirty = [p for p in paths if any(c.get("outputs") or c.get("execution_count") for c in nbformat.read(p, 4).cells if c.cell_type == "code")]; \
 	  [nbformat.write((lambda nb: ([c.update(outputs=[], execution_count=None) for c in nb.cells if c.cell_type == "code"], nb)[1])(nbformat.read(p, 4)), p) for p in dirty]; \
 	  print("stripped:", " ".join(dirty) if dirty else "nothing (all notebooks clean)")'
+
+# ---------------------------------------------------------------- NaveGo beside us
+# NaveGo v1.4's own ins_gnss.m under GNU Octave on the Turin drives and the profile's outages (issue 26;
+# tools/navego_check.py, NaveGo read from ../shared/navego-v1.4): its numbers go to data/measured/navego_check.csv,
+# which the book shows beside our `navego` setup. Not part of `reproduce`: the artifact never needs Octave.
+navego-check: $(STAMP)
+	@command -v octave >/dev/null || { echo "error: GNU Octave is not installed -- apt-get install -y octave" \
+	  "octave-control (Debian/Ubuntu), then make navego-check" >&2; exit 1; }
+	$(PY) tools/navego_check.py --profile $(PROFILE)
 
 # ---------------------------------------------------------------- cleaning
 # Debris of an interrupted run of $(PROFILE): papermill's temporary notebooks and half-written outputs

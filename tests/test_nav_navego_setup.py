@@ -170,7 +170,8 @@ def test_ins_tuning_table_runs_every_setup_beside_the_papers_row(drive, tmp_path
     shipped = baseline.run_baseline(drive, cfg, WINDOWS)
     table = ins_setups.ins_tuning_table(drive, cfg, WINDOWS, baseline=shipped)
     assert list(table.columns) == list(ins_setups.COLUMNS)
-    assert table["setup"].tolist() == [s for s in ins_setups.SETUPS for _ in (1, 2)]
+    # NaveGo's own run (make navego-check) has no row for this synthetic drive
+    assert table["setup"].tolist() == [s for s in ins_setups.SETUPS if s != ins_setups.NAVEGO_RUN for _ in (1, 2)]
     assert set(table["test"]) == {"dataset"}
     rows = table.set_index(["setup", "outage"])
     navego = baseline.run_baseline(drive, {**cfg, "ins_tuning": "navego"}, WINDOWS)
@@ -244,3 +245,18 @@ def test_gap_explained_and_its_sentences():
     assert "overshoots the paper's row (280 % of the gap)" in ins_setups.sentences(over)[0]
     # a dataset that stands for no paper test has no gap to explain
     assert ins_setups.gap_explained(over.assign(dataset="synthetic").query("setup != 'paper'")).empty
+
+
+def test_navegos_own_rows_are_read_for_the_profiles_outages_only(tmp_path):
+    path = tmp_path / "navego_check.csv"
+    pd.DataFrame([{"dataset": "d", "outage": 1, "start_s": 100.0, "duration_s": 30.0, "max_east_m": 5.0,
+                   "max_north_m": 6.0, "aided_rms_h_m": 0.5, "setting": "position only", "navego": "v1.4",
+                   "octave": "8", "date": "2026-11-25", "commit": "abc"},
+                  {"dataset": "d", "outage": 2, "start_s": 300.0, "duration_s": 30.0, "max_east_m": 7.0,
+                   "max_north_m": 8.0, "aided_rms_h_m": 0.5, "setting": "position only", "navego": "v1.4",
+                   "octave": "8", "date": "2026-11-25", "commit": "abc"}]).to_csv(path, index=False)
+    # the profile's outages: the second one measured (now its Outage 1), the first one not
+    got = ins_setups.navego_measured("d", [(300.0, 30.0), (500.0, 30.0)], path)
+    assert got[["outage", "max_east_m"]].values.tolist() == [[1, 7.0]]
+    assert ins_setups.navego_measured("other", [(300.0, 30.0)], path).empty
+    assert ins_setups.navego_measured("d", [(300.0, 30.0)], tmp_path / "missing.csv").empty

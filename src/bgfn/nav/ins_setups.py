@@ -27,7 +27,7 @@ import numpy as np
 import pandas as pd
 
 from .. import paper
-from ..config import SHARED_TABLES
+from ..config import PROJECT_ROOT, SHARED_TABLES
 from ..io import atomic_write_csv
 from . import metrics, navego_setup
 from .baseline import Baseline, filter_imu, nav_config, run_baseline
@@ -38,8 +38,30 @@ from .outages import check_windows
 RESET = "navego-reset"
 #: Label of the paper's row.
 PAPER = "paper"
-#: Row order of the table: our setups, then the paper's.
-SETUPS: tuple[str, ...] = navego_setup.INS_TUNINGS + (RESET, PAPER)
+#: Label of NaveGo v1.4 itself, run under GNU Octave on the same drive and outages (``make navego-check``).
+NAVEGO_RUN = "NaveGo (Octave)"
+#: Row order of the table: our setups, NaveGo's own run, then the paper's.
+SETUPS: tuple[str, ...] = navego_setup.INS_TUNINGS + (RESET, NAVEGO_RUN, PAPER)
+#: What ``tools/navego_check.py`` measured (NaveGo's INS-only errors in the outages), with date and commit.
+NAVEGO_CHECK_FILE = PROJECT_ROOT / "data" / "measured" / "navego_check.csv"
+#: Its columns.
+NAVEGO_CHECK_COLUMNS: tuple[str, ...] = ("dataset", "outage", "start_s", "duration_s", "max_east_m", "max_north_m",
+                                         "aided_rms_h_m", "setting", "navego", "octave", "date", "commit")
+
+
+def navego_measured(dataset: str, windows, path: Path = NAVEGO_CHECK_FILE) -> pd.DataFrame:
+    """NaveGo's own rows of ``dataset`` from ``path`` whose outage matches one of ``windows`` (same start and
+    duration; the profile's ``Outage k`` numbering); empty when the check has not run for them."""
+    if not Path(path).is_file():
+        return pd.DataFrame(columns=list(NAVEGO_CHECK_COLUMNS))
+    t = pd.read_csv(path)
+    t = t[t["dataset"] == dataset]
+    rows = []
+    for k, (s, d) in enumerate(windows, 1):
+        hit = t[np.isclose(t["start_s"], s) & np.isclose(t["duration_s"], d)]
+        if len(hit):
+            rows.append(hit.iloc[0].to_dict() | {"outage": k})
+    return pd.DataFrame(rows, columns=list(NAVEGO_CHECK_COLUMNS))
 #: Columns of :func:`ins_tuning_table`.
 COLUMNS: tuple[str, ...] = ("dataset", "test", "outage", "setup", "max_east_m", "max_north_m")
 
@@ -85,12 +107,14 @@ def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None
         imu = filter_imu(drive, c)
         for k, w in enumerate(checked):
             s = b.states[f"outage_{k + 1}"].copy()
-            s.gyro_bias[:] = 0.0      # NaveGo v1.4 keeps no accumulated bias estimate (ins_gnss.m l. 366, 412)
+            s.gyro_bias[:] = 0.0      # a bound: no accumulated bias estimate (a later ins_gnss.m, Version 012)
             s.accel_bias[:] = 0.0
             e = metrics.navigation_errors(run_outage(imu, s, w, b.noise, lever, source=drive.name).trajectory,
                                           drive.reference, drive.meta)
             m = metrics.outage_metrics(e, w)
             rows.append(_row(drive.name, test, k + 1, RESET, m["max_abs_east"], m["max_abs_north"]))
+    for r in navego_measured(drive.name, checked).itertuples(index=False):
+        rows.append(_row(drive.name, test, r.outage, NAVEGO_RUN, r.max_east_m, r.max_north_m))
     if test:
         for r in paper.published_values(test).query("method == 'INS'").itertuples(index=False):
             rows.append(_row(drive.name, test, r.outage, PAPER, r.max_east_m, r.max_north_m))
@@ -186,7 +210,8 @@ def sentences(table: pd.DataFrame) -> list[str]:
     """Plain sentences from :func:`gap_explained`: per dataset, the mean INS max error under each setup, the
     paper's, and the share of the gap each setup explains."""
     gap = gap_explained(table)
-    names = {"navego": "NaveGo v1.4's setup", RESET: "that setup with the bias estimates cleared at the outage start"}
+    names = {"navego": "NaveGo v1.4's setup", RESET: "that setup with the bias estimates cleared at the outage start",
+             NAVEGO_RUN: "NaveGo v1.4 itself, run under Octave on the same drive and outages"}
     out = []
     for dataset, g in gap.groupby("dataset", sort=False):
         first = g.iloc[0]
@@ -194,8 +219,19 @@ def sentences(table: pd.DataFrame) -> list[str]:
                  for r in g.itertuples(index=False)]
         out.append(f"{dataset} ({paper.TESTS[first.test]['title']}): the INS max error (mean of east and north over "
                    f"the outages) is {first.shipped_m:.1f} m with the shipped filter against the paper's "
-                   f"{first.paper_m:.1f} m; " + "; ".join(parts) + ".")
+                   f"{first.paper_m:.1f} m; " + "; ".join(parts) + "." + _against_navego(g))
     return out
+
+
+def _against_navego(gap: pd.DataFrame) -> str:
+    """Our ``navego`` setup against NaveGo's own run (issue 26: within 30 % of it?), when both are there."""
+    by = {r.setup: r.setup_m for r in gap.itertuples(index=False)}
+    if "navego" not in by or NAVEGO_RUN not in by or not by[NAVEGO_RUN] > 0:
+        return ""
+    ratio = by["navego"] / by[NAVEGO_RUN]
+    return (f" Our setup of NaveGo gives {ratio:.2f} times NaveGo's own INS error "
+            + ("(within 30 %)." if abs(ratio - 1.0) <= 0.3 else "(more than 30 % apart: methods page, 'NaveGo run "
+                                                                  "beside us', lists the differences)."))
 
 
 def save_table(out, table: pd.DataFrame) -> Path:
@@ -209,5 +245,6 @@ def read_table(out) -> pd.DataFrame | None:
     return pd.read_csv(path) if path.exists() else None
 
 
-__all__ = ["COLUMNS", "PAPER", "RESET", "SETUPS", "gap_explained", "ins_tuning_table", "ins_tuning_tables", "layout",
+__all__ = ["COLUMNS", "NAVEGO_CHECK_COLUMNS", "NAVEGO_CHECK_FILE", "NAVEGO_RUN", "PAPER", "RESET", "SETUPS",
+           "navego_measured", "gap_explained", "ins_tuning_table", "ins_tuning_tables", "layout",
            "layouts", "read_table", "save_table", "sentences"]

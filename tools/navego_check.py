@@ -1,0 +1,178 @@
+"""NaveGo v1.4 run beside ours (issue 26): its INS-only errors in the paper's outages and its GPS-aided accuracy.
+
+``make navego-check`` (or ``python tools/navego_check.py``) exports each drive to NaveGo's ``imu``/``gnss`` structs,
+removes the fixes inside the profile's outages (as NaveGo's ``gnss_outage.m`` does), runs NaveGo's own
+``ins_gnss.m`` under GNU Octave (Debian packages ``octave`` and ``octave-control``), and compares its trajectory
+with the drive's reference: the max |east| and |north| error in each outage and the horizontal RMS outside them.
+The numbers go to ``data/measured/navego_check.csv`` with the date, the commit and the versions, which the book
+reads (the *NaveGo* rows beside our ``navego`` setup, :mod:`bgfn.nav.ins_setups`).
+
+NaveGo's source is read from ``../shared/navego-v1.4/`` (LGPL-3.0) at run time; nothing of it is copied here. It
+is a tool, not part of the package: the artifact never needs Octave.
+
+Settings, each chosen to compare like with like (listed in the CSV's ``setting`` column):
+
+- the IMU error parameters are the drive's ``meta['imu_errors']`` in NaveGo's names (``arw``, ``vrw``, ``gb_sta`` =
+  ``*_bias_fixed``, ``gb_dyn`` = ``*_bias_instability``, ``gb_corr``, ``gb_psd = gb_dyn / sqrt(gb_corr)`` as
+  NaveGo's ``imu_si_errors.m``), times the profile's ``nav.noise_scale``;
+- ``position only`` (default): NaveGo fuses the fixes' velocity too; ours does not, so the velocity rows get a std
+  of 100 m/s (they carry nothing). ``--fuse-velocity`` keeps the file's velocity (NaveGo's own way) where it has
+  one;
+- the initial attitude is the reference's at the first fix, its std the profile's ``nav.init``; ZUPT off
+  (``zupt_th = 0``: our INS row has none).
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import scipy.io
+
+from bgfn.config import PROJECT_ROOT, git_commit
+from bgfn.data import load_drive
+from bgfn.io import atomic_write_csv
+from bgfn.nav.baseline import nav_config
+from bgfn.nav.earth import curvature_radii
+from bgfn.nav.outages import outage_windows
+from bgfn.nav.ins_setups import NAVEGO_CHECK_COLUMNS, NAVEGO_CHECK_FILE
+from bgfn.profile_schema import load_profile
+
+NAVEGO_DIR = PROJECT_ROOT.parent / "shared" / "navego-v1.4"
+DATASETS = ("turin-sim-ekinox", "turin-sim-mpu6000")
+#: The velocity std that makes NaveGo's velocity rows carry nothing (position-only, as our filter), m/s.
+NO_VELOCITY_STD = 100.0
+
+
+def _vec(x) -> np.ndarray:
+    return np.broadcast_to(np.asarray(x, dtype=float), (3,)).astype(float)
+
+
+def export(drive, windows, nav: dict, fuse_velocity: bool) -> tuple[dict, dict, str]:
+    """NaveGo's ``imu`` and ``gnss`` structs of ``drive`` (module docstring) and the setting in words."""
+    g = drive.gnss.reset_index(drop=True)
+    t_fix = g["time"].to_numpy(float)
+    imu = drive.imu[drive.imu["time"] >= t_fix[0] - 1e-9].reset_index(drop=True)     # starts at the first fix
+    lat, h = g["lat"].to_numpy(float), g["h"].to_numpy(float)
+    r_m, r_n = curvature_radii(lat)
+    has_vel = np.isfinite(g[["v_n", "v_e", "v_d"]].to_numpy(float)).all()
+    if fuse_velocity and has_vel:
+        vel, stdv, setting = g[["v_n", "v_e", "v_d"]].to_numpy(float), np.full(3, 0.1), "velocity fused (file's)"
+    else:     # position only: the velocity from the fixes, carrying nothing (std 100 m/s)
+        north, east = (lat - lat[0]) * (r_m + h), (g["lon"].to_numpy(float) - g["lon"].iloc[0]) * (r_n + h) * np.cos(lat)
+        vel = np.column_stack([np.gradient(north, t_fix), np.gradient(east, t_fix), -np.gradient(h, t_fix)])
+        stdv, setting = np.full(3, NO_VELOCITY_STD), "position only"
+    keep = np.ones(len(g), bool)
+    for s, d in windows:                                   # gnss_outage.m: the fixes inside the outages removed
+        keep &= ~((t_fix > s) & (t_fix < s + d))
+    e = drive.meta["imu_errors"]
+    scale = float(nav.get("noise_scale") if isinstance(nav.get("noise_scale"), (int, float)) else 1.0)
+    ref = drive.reference
+    t_ref = ref["time"].to_numpy(float)
+    att0 = [float(np.interp(imu["time"].iloc[0], t_ref, np.unwrap(ref[c].to_numpy(float)) if c == "yaw"
+                            else ref[c].to_numpy(float))) for c in ("roll", "pitch", "yaw")]
+    init = nav["init"]
+    std_m = np.median(g[["std_n", "std_e", "std_d"]].to_numpy(float), axis=0)
+    freq = 1.0 / float(np.median(np.diff(imu["time"].to_numpy(float))))
+    gb_dyn, ab_dyn = _vec(e["gyro_bias_instability"]), _vec(e["accel_bias_instability"])
+    gb_corr, ab_corr = _vec(e["gyro_bias_corr_time"]), _vec(e["accel_bias_corr_time"])
+    imu_s = {"t": imu["time"].to_numpy(float)[:, None],
+             "fb": imu[["accel_x", "accel_y", "accel_z"]].to_numpy(float),
+             "wb": imu[["gyro_x", "gyro_y", "gyro_z"]].to_numpy(float),
+             "arw": scale * _vec(e["gyro_noise_density"]), "vrw": scale * _vec(e["accel_noise_density"]),
+             "g_std": scale * _vec(e["gyro_noise_density"]) * np.sqrt(freq),
+             "a_std": scale * _vec(e["accel_noise_density"]) * np.sqrt(freq),
+             "gb_sta": _vec(e["gyro_bias_fixed"]), "ab_sta": _vec(e["accel_bias_fixed"]),
+             "gb_dyn": gb_dyn, "ab_dyn": ab_dyn, "gb_corr": gb_corr, "ab_corr": ab_corr,
+             "gb_psd": gb_dyn / np.sqrt(gb_corr), "ab_psd": ab_dyn / np.sqrt(ab_corr), "freq": freq,
+             "ini_align": np.array(att0),
+             "ini_align_err": np.radians([init["level_std_deg"], init["level_std_deg"], init["azimuth_std_deg"]])}
+    gnss_s = {"t": t_fix[keep][:, None], "lat": lat[keep][:, None], "lon": g["lon"].to_numpy(float)[keep][:, None],
+              "h": h[keep][:, None], "vel": vel[keep],
+              "std": np.array([std_m[0] / (r_m[0] + h[0]), std_m[1] / ((r_n[0] + h[0]) * np.cos(lat[0])), std_m[2]]),
+              "stdm": std_m, "stdv": stdv, "larm": _vec(drive.meta.get("lever_arm_m", [0, 0, 0]))[:, None],
+              "freq": 1.0 / float(np.median(np.diff(t_fix))), "zupt_th": 0.0, "zupt_win": 0.0,
+              "eps": float(np.median(np.diff(imu["time"].to_numpy(float)))) / 3.0}
+    return imu_s, gnss_s, setting
+
+
+def errors(nav_file: Path, drive, windows) -> list[dict]:
+    """NaveGo's max |east| / |north| error per outage and its horizontal RMS outside the outages (m)."""
+    m = scipy.io.loadmat(nav_file)
+    t, lat, lon, h = (np.asarray(m[k], float).ravel() for k in ("t", "lat", "lon", "h"))
+    ref = drive.reference
+    t_ref = ref["time"].to_numpy(float)
+    lat_r, lon_r = np.interp(t, t_ref, ref["lat"].to_numpy(float)), np.interp(t, t_ref, ref["lon"].to_numpy(float))
+    r_m, r_n = curvature_radii(lat_r)
+    north, east = (lat - lat_r) * (r_m + h), (lon - lon_r) * (r_n + h) * np.cos(lat_r)
+    out_of = np.zeros(t.size, bool)
+    rows = []
+    for k, (s, d) in enumerate(windows, 1):
+        sel = (t >= s) & (t <= s + d)
+        out_of |= sel
+        rows.append({"outage": k, "start_s": s, "duration_s": d, "max_east_m": float(np.abs(east[sel]).max()),
+                     "max_north_m": float(np.abs(north[sel]).max())})
+    aided = ~out_of & (t > t[0] + 60.0)              # after a minute of convergence
+    rms = float(np.sqrt(np.mean(north[aided] ** 2 + east[aided] ** 2)))
+    return [{**r, "aided_rms_h_m": rms} for r in rows]
+
+
+def octave_version(octave: str) -> str:
+    out = subprocess.run([octave, "--version"], capture_output=True, text=True, timeout=60).stdout
+    return out.splitlines()[0].strip() if out else "unknown"
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--profile", default="quick")
+    p.add_argument("--datasets", nargs="*", default=list(DATASETS))
+    p.add_argument("--octave", default="octave")
+    p.add_argument("--navego", default=str(NAVEGO_DIR), help="NaveGo's source (default ../shared/navego-v1.4)")
+    p.add_argument("--fuse-velocity", action="store_true", help="NaveGo fuses the file's velocity (its own way)")
+    p.add_argument("--out", default=str(NAVEGO_CHECK_FILE))
+    a = p.parse_args(argv)
+    octave = shutil.which(a.octave)
+    if octave is None:
+        print("error: GNU Octave not found -- install it with `apt-get install -y octave octave-control` "
+              "(Debian/Ubuntu), then run `make navego-check` again", file=sys.stderr)
+        return 2
+    if not (Path(a.navego) / "ins-gnss" / "ins_gnss.m").is_file():
+        print(f"error: NaveGo's source not found in {a.navego} (expected ins-gnss/ins_gnss.m)", file=sys.stderr)
+        return 2
+    cfg = load_profile(a.profile)
+    nav = nav_config(cfg["nav"])
+    rows, version = [], octave_version(octave)
+    for name in a.datasets:
+        drive = load_drive(name, profile=a.profile)
+        windows = outage_windows(cfg, drive, name)
+        imu_s, gnss_s, setting = export(drive, windows, nav, a.fuse_velocity)
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = Path(tmp)
+            scipy.io.savemat(tmp / "in.mat", {"imu": imu_s, "gnss": gnss_s, "att_mode": "quaternion"})
+            print(f"==> {name}: NaveGo's ins_gnss under {version} ({len(imu_s['t'])} IMU rows, "
+                  f"{len(gnss_s['t'])} fixes, {setting})", flush=True)
+            cmd = [octave, "--no-gui", "--quiet", "--no-window-system", "--eval",
+                   f"addpath('{PROJECT_ROOT / 'tools'}'); navego_check('{tmp / 'in.mat'}', '{tmp / 'out.mat'}', "
+                   f"'{Path(a.navego).resolve()}')"]
+            subprocess.run(cmd, check=True)
+            for r in errors(tmp / "out.mat", drive, windows):
+                rows.append({"dataset": name, **r, "setting": setting, "navego": "v1.4 (ins_gnss.m Version 011)",
+                             "octave": version, "date": datetime.date.today().isoformat(),
+                             "commit": git_commit() or "unknown"})
+                print(f"    outage {r['outage']}: max |E| {r['max_east_m']:.2f} m, max |N| {r['max_north_m']:.2f} m; "
+                      f"GPS-aided RMS {r['aided_rms_h_m']:.2f} m")
+    table = pd.DataFrame(rows, columns=list(NAVEGO_CHECK_COLUMNS))
+    atomic_write_csv(a.out, table, float_format="%.4f")
+    print(f"wrote {a.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -10,11 +10,11 @@ function navego_check(in_file, out_file, navego_dir)
 %
 % This file is ours (MIT); NaveGo (LGPL-3.0) is only called.
 
+  if exist('OCTAVE_VERSION', 'builtin')
+    pkg load control            % ins_gnss calls obsv() (Debian: octave-control); loaded first, because it has a
+  end                           % kalman() of its own that NaveGo's kalman.m must shadow (addpath puts it in front)
   for sub = {'conversions', 'ins', 'ins-gnss', 'simulation', 'misc', 'performance-analysis'}
     addpath(fullfile(navego_dir, sub{1}));
-  end
-  if exist('OCTAVE_VERSION', 'builtin')
-    pkg load control            % ins_gnss calls obsv() (Debian: octave-control)
   end
   data = load(in_file);
   nav_e = ins_gnss(data.imu, data.gnss, data.att_mode);

@@ -99,7 +99,9 @@ def export(drive, windows, nav: dict, fuse_velocity: bool) -> tuple[dict, dict, 
               "std": np.array([std_m[0] / (r_m[0] + h[0]), std_m[1] / ((r_n[0] + h[0]) * np.cos(lat[0])), std_m[2]]),
               "stdm": std_m, "stdv": stdv, "larm": _vec(drive.meta.get("lever_arm_m", [0, 0, 0]))[:, None],
               "freq": 1.0 / float(np.median(np.diff(t_fix))), "zupt_th": 0.0, "zupt_win": 0.0,
-              "eps": float(np.median(np.diff(imu["time"].to_numpy(float)))) / 3.0}
+              # a fix is fused at the IMU epoch within half an interval of it (NaveGo's examples use a third, but
+              # the Ekinox fixes lie half an IMU interval off the IMU grid: with a third none would ever be fused)
+              "eps": 0.5 * float(np.median(np.diff(imu["time"].to_numpy(float))))}
     return imu_s, gnss_s, setting
 
 

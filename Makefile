@@ -188,7 +188,7 @@ $(RES)/.data-fingerprint: FORCE | $(STAMP)
 FORCE:
 
 # Each notebook reads what the previous one wrote.
-$(RES)/notebooks/02_kf_baseline.ipynb: $(RES)/notebooks/01_data_prep.ipynb
+$(RES)/notebooks/02_kf_baseline.ipynb: $(RES)/notebooks/01_data_prep.ipynb $(wildcard data/measured/navego_check.csv)
 $(RES)/notebooks/03_bgfn_training.ipynb: $(RES)/notebooks/02_kf_baseline.ipynb
 $(RES)/notebooks/04_outage_evaluation.ipynb: $(RES)/notebooks/03_bgfn_training.ipynb
 $(RES)/notebooks/05_energy_estimate.ipynb: $(RES)/notebooks/04_outage_evaluation.ipynb

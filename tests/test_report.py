@@ -227,6 +227,7 @@ def test_training_and_sweep_tables():
 #: Numbers with a unit the book may type: the paper's and the profiles' settings, never a result.
 ALLOWED: dict[str, str] = {
     "0.05 m": "truth smoothing sigma (setting, deviations row 5)",
+    "100 m/s": "the velocity std that makes NaveGo's velocity rows carry nothing (setting of make navego-check)",
     "10 %": "Ekinox run-to-run bias part (setting, row 7)",
     "3 %": "MPU-6000 scale-factor tolerance (setting, row 8)",
     "2 %": "MPU-6000 cross-axis tolerance (setting, row 8)",

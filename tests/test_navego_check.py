@@ -1,0 +1,36 @@
+"""tools/navego_check.py's export to NaveGo's structs (no Octave needed): what NaveGo is given is what we use."""
+
+from __future__ import annotations
+
+import importlib.util
+
+import numpy as np
+import pytest
+
+from bgfn.config import PROJECT_ROOT
+from bgfn.data.imu_errors import error_params
+from bgfn.nav.baseline import nav_config
+from synthetic_drive import exact_drive
+
+spec = importlib.util.spec_from_file_location("navego_check", PROJECT_ROOT / "tools" / "navego_check.py")
+navego_check = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(navego_check)
+
+
+def test_the_export_gives_navego_our_imu_errors_our_outages_and_position_only_fixes():
+    drive = exact_drive(120.0, imu_errors=error_params("mpu6000"), lever_arm_m=[0.1, 0.0, -0.2])
+    t0 = float(drive.gnss["time"].iloc[0])
+    windows = [(t0 + 40.0, 30.0)]
+    imu, gnss, setting = navego_check.export(drive, windows, nav_config({}), fuse_velocity=False)
+    assert setting == "position only" and (gnss["stdv"] == navego_check.NO_VELOCITY_STD).all()
+    t = gnss["t"][:, 0]
+    assert not ((t > t0 + 40.0) & (t < t0 + 70.0)).any() and len(t) == len(drive.gnss) - 29   # 29 fixes removed
+    assert imu["t"][0, 0] >= t0 and imu["fb"].shape == (len(imu["t"]), 3)                    # from the first fix
+    e = error_params("mpu6000")
+    np.testing.assert_allclose(imu["gb_psd"], np.asarray(e["gyro_bias_instability"]) /
+                               np.sqrt(e["gyro_bias_corr_time"]))                           # imu_si_errors.m
+    assert gnss["eps"] == pytest.approx(0.005) and gnss["zupt_th"] == 0.0                     # half an IMU step
+    # the velocity from the fixes follows the reference's (exact fixes of a smooth drive)
+    ref_v = np.interp(t, drive.reference["time"], drive.reference["v_n"])
+    assert np.abs(gnss["vel"][5:-5, 0] - ref_v[5:-5]).max() < 0.2
+    assert gnss["larm"].shape == (3, 1) and gnss["larm"][0, 0] == 0.1

@@ -68,6 +68,10 @@ EXTRA_FIGURES: tuple[dict[str, str], ...] = (
                   "manoeuvre, as in the paper's field test)."} for k in (1, 2)),
     {"label": "outage sweep", "file": "outage_sweep_{dataset}.png", "by": "notebook 04", "datasets": "sweep",
      "caption": "Max horizontal error over many outage starts and durations ({dataset})."},
+    {"label": "the filter's consistency in outages", "file": "outage_nees_{dataset}.png", "by": "notebook 04",
+     "datasets": "sweep",
+     "caption": "Median NEES of the horizontal position at the outage end against the filter's own covariance, "
+                "per method and duration ({dataset}); a consistent filter stays near the dashed median line."},
     {"label": "training curves", "file": "training_curves_{dataset}.png", "by": "notebook 03",
      "caption": "Training and validation loss per epoch ({dataset})."},
     {"label": "headings and speeds seen", "file": "motion_coverage_{dataset}.png", "by": "notebook 03",

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from types import SimpleNamespace
 
 import numpy as np
@@ -9,6 +10,11 @@ import pandas as pd
 import pytest
 
 from bgfn.evaluate import nees as N
+from bgfn.profile_schema import load_profile
+from synthetic_drive import demo_drive
+
+NAV = {"init": {"position_std_m": 1.0, "height_std_m": 2.0, "velocity_std_mps": 0.1, "level_std_deg": 0.2,
+                "azimuth_std_deg": 1.0}}
 
 
 def _sweep():
@@ -49,3 +55,18 @@ def test_the_summary_finds_the_consistent_and_the_overconfident_filter(tmp_path)
     assert lines[0].startswith("d, NEES of the horizontal position") and "INS 30 s: median" in lines[0]
     assert N.nees_section(tmp_path, results, _sweep()) == lines
     assert (tmp_path / "tables" / "outage_nees.csv").is_file() and (tmp_path / "figures" / "outage_nees_d.png").is_file()
+
+
+def test_the_scan_finds_a_larger_gyro_bias_instability_less_confident():
+    """A synthetic drive with biased gyros the filter's error model under-states: the larger the bias
+    instability the filter is told, the smaller its NEES; the profile's value is marked; simulated drives skipped."""
+    drive = demo_drive("synthetic", 150.0, 5.0, 3)
+    cfg = load_profile("smoke")
+    cfg = {**cfg, "nav": NAV, "evaluate": {**cfg["evaluate"], "sweep": {**cfg["evaluate"]["sweep"], "n_starts": 3,
+                                                                        "warmup_s": 30.0, "durations_s": [10.0]}}}
+    scan = N.consistency_scan(cfg, [drive], durations=(10.0,), values_dps=(0.01, 1.0))
+    assert list(scan.columns) == list(N.SCAN_COLUMNS) and scan["profile"].sum() == 1
+    grid = scan[~scan["profile"]].set_index("gyro_bias_instability_dps")
+    assert grid.loc[1.0, "median_nees"] < grid.loc[0.01, "median_nees"]
+    assert N.scan_lines(scan)[0].startswith("synthetic: with the profile's gyro bias instability")
+    assert N.consistency_scan(cfg, [dataclasses.replace(drive, name="turin-sim-mpu6000")]).empty

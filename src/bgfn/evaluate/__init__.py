@@ -81,7 +81,8 @@ from bgfn.evaluate.increments import AntennaTruth, increment_errors, increment_r
 from bgfn.evaluate.ins_drift import (DRIFT_COLUMNS, DRIFT_RUN_COLUMNS, drift_sentences, drift_starts, drift_summary,
                                      ins_drift_runs, plot_ins_drift)
 from bgfn.evaluate.networks import ensure_models, load_model
-from bgfn.evaluate.nees import NEES_COLUMNS, nees_lines, nees_section, nees_summary
+from bgfn.evaluate.nees import (NEES_COLUMNS, consistency_scan, nees_lines, nees_section, nees_summary,
+                                scan_lines)
 from bgfn.evaluate.odometers import (ODOMETER_COLUMNS, ODOMETER_METHODS, OdometerSection, odometer_lines,
                                      odometer_rows, odometer_summary, odometer_table, run_odometer_bars,
                                      run_odometer_section)
@@ -102,7 +103,7 @@ from bgfn.evaluate.variants import (NO_VARIANT, VARIANT_COLUMNS, VARIANT_METRICS
                                     variant_runs, variant_table)
 
 __all__ = [
-    "NEES_COLUMNS", "nees_lines", "nees_section", "nees_summary", "ODOMETER_COLUMNS", "ODOMETER_METHODS", "OdometerSection", "odometer_lines", "odometer_rows", "odometer_summary",
+    "NEES_COLUMNS", "consistency_scan", "nees_lines", "nees_section", "nees_summary", "scan_lines", "ODOMETER_COLUMNS", "ODOMETER_METHODS", "OdometerSection", "odometer_lines", "odometer_rows", "odometer_summary",
     "odometer_table", "run_odometer_bars", "run_odometer_section",
     "DRIFT_COLUMNS", "DRIFT_RUN_COLUMNS", "drift_sentences", "drift_starts", "drift_summary", "ins_drift_runs",
     "plot_ins_drift", "outage_figures",

@@ -15,11 +15,18 @@ by the orders of magnitude that separate a consistent from an inconsistent filte
 Per dataset, method and duration (the sweep) or outage (the paper's two): the median NEES, the share of runs
 inside the 95 % bound, and a word: *consistent* when the median lies within a factor :data:`FACTOR` of 1.39,
 *overconfident* above, *underconfident* below.
+
+Which setting explains an inconsistent filter? :func:`consistency_scan` (notebook 02) runs the standalone INS from
+the sweep's starts of each recorded drive (a simulated IMU's error model is known exactly) with the gyro bias
+instability of the filter's error model set to each value of a grid: the INS drift of a MEMS IMU over tens of
+seconds is the heading error its gyro biases build, and a filter that under-states them is overconfident.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
+from typing import Callable
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -27,6 +34,9 @@ import pandas as pd
 
 from bgfn.config import SHARED_TABLES
 from bgfn.data.names import dataset_id
+from bgfn.data.registry import SIMULATED_IMU
+from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
+from bgfn.evaluate.sweep import profile_sweep_plan
 from bgfn.io import atomic_write_csv, save_figure
 
 #: chi-square with 2 degrees of freedom: its median (2 ln 2) and its 95 % quantile (-2 ln 0.05).
@@ -125,3 +135,56 @@ def nees_section(out: str | Path, results: dict, sweep: pd.DataFrame | None) -> 
         save_figure(fig, Path(out) / "figures" / f"outage_nees_{dataset_id(name)}.png")
         plt.close(fig)
     return nees_lines(summary)
+
+
+#: Gyro bias instabilities the scan tries, deg/s (the MPU-6000 profile's 0.01 deg/s up to 0.3 deg/s).
+SCAN_GYRO_BIAS_DPS: tuple[float, ...] = (0.01, 0.03, 0.1, 0.3)
+#: Columns of ``tables/kf_nees_scan.csv``.
+SCAN_COLUMNS: tuple[str, ...] = ("dataset", "gyro_bias_instability_dps", "profile", "duration_s", "runs",
+                                 "median_nees", "inside_95", "median_max_h_m", "verdict")
+
+
+def consistency_scan(cfg: dict, drives, durations=(30.0, 60.0), values_dps=SCAN_GYRO_BIAS_DPS,
+                     report: Callable[[str], None] | None = None) -> pd.DataFrame:
+    """The INS NEES of every recorded drive among ``drives`` from the sweep's starts (``evaluate.sweep``) with the
+    filter's gyro bias instability set to each of ``values_dps`` (deg/s, every axis) and to the profile's own
+    (``profile`` True): median NEES, share inside the 95 % bound, median max horizontal error, per duration."""
+    rows = []
+    for drive in drives:
+        if drive.name in SIMULATED_IMU:
+            continue
+        starts = [float(x) for x in profile_sweep_plan(cfg, drive, cfg["evaluate"]["sweep"])["start_s"]]
+        own = float(np.degrees(np.mean(drive.meta["imu_errors"]["gyro_bias_instability"])))
+        grid = [float(v) for v in values_dps if not np.isclose(v, own)]
+        for value in sorted(grid + [own]):
+            errors = {**drive.meta["imu_errors"], "gyro_bias_instability": [float(np.radians(value))] * 3}
+            d = dataclasses.replace(drive, meta={**drive.meta, "imu_errors": errors})
+            ctx = navigation_context(d, cfg.get("nav"), starts)
+            runs = run_outages(ctx, [(s, max(durations)) for s in starts], None, "INS", None,
+                               cfg["evaluate"]["pseudo_gps"])
+            for du in durations:
+                m = [window_metrics(r.errors, r.start, du, r.sd) for r in runs]
+                nees = np.array([x["nees_h"] for x in m])
+                rows.append({"dataset": drive.name, "gyro_bias_instability_dps": float(f"{value:.4g}"),
+                             "profile": bool(np.isclose(value, own)), "duration_s": du, "runs": len(m),
+                             "median_nees": float(np.median(nees)), "inside_95": float(np.mean(nees <= CHI2_95)),
+                             "median_max_h_m": float(np.median([x["max_h_m"] for x in m])),
+                             "verdict": verdict(float(np.median(nees)))})
+            if report is not None:
+                report(f"{drive.name}: gyro bias instability {value:g} deg/s -> INS median NEES "
+                       + ", ".join(f"{r['median_nees']:.3g} at {r['duration_s']:g} s" for r in rows[-len(durations):]))
+    return pd.DataFrame(rows, columns=list(SCAN_COLUMNS))
+
+
+def scan_lines(scan: pd.DataFrame) -> list[str]:
+    """Per recorded drive: the profile's setting and its word, and the values of the grid that are consistent."""
+    lines = []
+    for ds, g in scan.groupby("dataset", sort=False):
+        longest = g[g["duration_s"] == g["duration_s"].max()]
+        own = longest[longest["profile"]]
+        ok = longest.loc[longest["verdict"] == "consistent", "gyro_bias_instability_dps"]
+        lines.append(f"{ds}: with the profile's gyro bias instability ({own['gyro_bias_instability_dps'].iloc[0]:g} "
+                     f"deg/s) the INS is {own['verdict'].iloc[0]} at {longest['duration_s'].iloc[0]:g} s (median NEES "
+                     f"{own['median_nees'].iloc[0]:.3g}); consistent with "
+                     + (", ".join(f"{v:g}" for v in ok) + " deg/s" if len(ok) else "no value of the grid") + ".")
+    return lines

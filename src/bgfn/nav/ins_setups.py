@@ -113,7 +113,7 @@ def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None
                                           drive.reference, drive.meta)
             m = metrics.outage_metrics(e, w)
             rows.append(_row(drive.name, test, k + 1, RESET, m["max_abs_east"], m["max_abs_north"]))
-    for r in navego_measured(drive.name, checked).itertuples(index=False):
+    for r in navego_measured(drive.name, [(w.start, w.duration) for w in checked]).itertuples(index=False):
         rows.append(_row(drive.name, test, r.outage, NAVEGO_RUN, r.max_east_m, r.max_north_m))
     if test:
         for r in paper.published_values(test).query("method == 'INS'").itertuples(index=False):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import importlib.util
 
 import numpy as np
+import scipy.io
 import pytest
 
 from bgfn.config import PROJECT_ROOT
@@ -34,3 +35,18 @@ def test_the_export_gives_navego_our_imu_errors_our_outages_and_position_only_fi
     ref_v = np.interp(t, drive.reference["time"], drive.reference["v_n"])
     assert np.abs(gnss["vel"][5:-5, 0] - ref_v[5:-5]).max() < 0.2
     assert gnss["larm"].shape == (3, 1) and gnss["larm"][0, 0] == 0.1
+
+
+def test_the_structs_written_for_octave_read_back_equal_the_drive(tmp_path):
+    drive = exact_drive(60.0, imu_errors=error_params("mpu6000"))
+    imu, gnss, _ = navego_check.export(drive, [], nav_config({}), fuse_velocity=True)
+    scipy.io.savemat(tmp_path / "in.mat", {"imu": imu, "gnss": gnss, "att_mode": "quaternion"})
+    back = scipy.io.loadmat(tmp_path / "in.mat", squeeze_me=True, struct_as_record=False)
+    i, g = back["imu"], back["gnss"]
+    rows = drive.imu["time"] >= drive.gnss["time"].iloc[0] - 1e-9
+    np.testing.assert_array_equal(i.t, drive.imu["time"][rows].to_numpy())
+    np.testing.assert_array_equal(i.wb, drive.imu.loc[rows, ["gyro_x", "gyro_y", "gyro_z"]].to_numpy())
+    np.testing.assert_array_equal(i.fb, drive.imu.loc[rows, ["accel_x", "accel_y", "accel_z"]].to_numpy())
+    np.testing.assert_array_equal(g.lat, drive.gnss["lat"].to_numpy())
+    np.testing.assert_array_equal(g.vel, drive.gnss[["v_n", "v_e", "v_d"]].to_numpy())       # the file's own
+    assert str(back["att_mode"]) == "quaternion" and i.ini_align.shape == (3,)

@@ -10,6 +10,7 @@ import pandas as pd
 import pytest
 
 from bgfn.evaluate import nees as N
+from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.profile_schema import load_profile
 from synthetic_drive import demo_drive
 
@@ -70,3 +71,40 @@ def test_the_scan_finds_a_larger_gyro_bias_instability_less_confident():
     assert grid.loc[1.0, "median_nees"] < grid.loc[0.01, "median_nees"]
     assert N.scan_lines(scan)[0].startswith("synthetic: with the profile's gyro bias instability")
     assert N.consistency_scan(cfg, [dataclasses.replace(drive, name="turin-sim-mpu6000")]).empty
+
+
+# ------------------------------------------------------------------------------- the check on a filter's own model
+#: Error terms the filter's model has no state for, switched off so that the drive's errors come from its model.
+UNMODELLED = {k: [0.0, 0.0, 0.0] for k in ("gyro_scale_factor_tol", "accel_scale_factor_tol", "gyro_misalignment_tol",
+                                          "accel_misalignment_tol", "vibration_gyro_std", "vibration_accel_std")}
+BIG_ACCEL_BIAS = {"accel_turn_on_bias_std": [0.05] * 3}
+
+
+def _nees(seeds, overrides=None, told=None):
+    """The horizontal NEES at the end of 20 s outages from two starts of synthetic drives (one per seed) whose IMU
+    errors are drawn from the Ekinox-D model; ``told``: what the filter is told instead (its ``meta``)."""
+    out = []
+    for seed in seeds:
+        d = demo_drive("syn", 200.0, 5.0, seed, imu="ekinox-d", overrides={**UNMODELLED, **(overrides or {})})
+        if told:
+            d = dataclasses.replace(d, meta={**d.meta, "imu_errors": {**d.meta["imu_errors"], **told}})
+        t0 = float(d.reference["time"].iloc[0])
+        ctx = navigation_context(d, NAV, [t0 + 100.0, t0 + 140.0])
+        runs = run_outages(ctx, [(t0 + 100.0, 20.0), (t0 + 140.0, 20.0)], None, "INS", None, {})
+        out += [window_metrics(r.errors, r.start, 20.0, r.sd)["nees_h"] for r in runs]
+    return np.array(out)
+
+
+def test_nees_of_a_drive_drawn_from_the_filters_own_model_averages_two():
+    nees = _nees(range(30))                               # 60 outages; chi-square(2): mean 2, std 2
+    sem = 2.0 / np.sqrt(nees.size)
+    assert abs(nees.mean() - 2.0) < 3.0 * sem, (nees.mean(), sem)
+    assert N.verdict(float(np.median(nees))) == "consistent"
+
+
+def test_an_underestimated_accelerometer_bias_makes_the_check_fail():
+    honest = _nees(range(12), BIG_ACCEL_BIAS)
+    told_small = _nees(range(12), BIG_ACCEL_BIAS, told={"p0_accel_bias_std": [5e-4] * 3,
+                                                        "accel_bias_instability": [1e-6] * 3})
+    assert N.verdict(float(np.median(honest))) == "consistent"
+    assert N.verdict(float(np.median(told_small))) == "overconfident" and told_small.mean() > 5 * honest.mean()

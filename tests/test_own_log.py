@@ -453,3 +453,21 @@ def test_a_margin_too_long_for_a_short_log_is_named_as_the_cause(tmp_path, monke
     with pytest.raises(DataError) as err:
         check_with_drives("mine")
     assert err.value.field == "train.margin_s" and "set train.margin_s to at most" in str(err.value)
+
+
+def test_jittery_gnss_stamps_go_onto_their_grid_or_fail_at_load(tmp_path, truth):
+    log = _write_log(tmp_path / "run", truth)
+    plain = load_drive(log)
+    gnss = pd.read_csv(log / "gnss.csv")
+    rng = np.random.default_rng(1)
+    gnss.assign(time=gnss["time"] + rng.uniform(0.0, 0.06, len(gnss))).to_csv(log / "gnss.csv", index=False)
+    d = load_drive(log)                                           # arrival jitter of up to 60 ms at 1 Hz
+    assert 0.0 < d.meta["gnss_regridded_max_s"] <= 0.1
+    steps = np.diff(d.gnss["time"].to_numpy())
+    np.testing.assert_allclose(steps, 1.0, atol=1e-9)            # a rate that divides: 1 Hz exactly
+    n = min(len(d.gnss), len(plain.gnss))                        # a fix moved past the IMU's end is cropped
+    assert np.abs(d.gnss["time"].to_numpy()[:n] - plain.gnss["time"].to_numpy()[:n]).max() < 0.06
+    gnss.assign(time=gnss["time"] + rng.uniform(0.0, 0.4, len(gnss))).to_csv(log / "gnss.csv", index=False)
+    with pytest.raises(DataError) as err:
+        load_drive(log)
+    assert err.value.source == str(log / "gnss.csv") and "arrival jitter" in str(err.value)

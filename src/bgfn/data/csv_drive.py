@@ -17,7 +17,9 @@ Loading (:func:`load_csv_drive`): the raw tables first pass the plausibility che
 each a DataError naming the CSV file and column), then go onto one regular grid (:mod:`bgfn.data.regrid`): the
 IMU resampled by integrating its increments when its steps jitter, the reference interpolated at the IMU epochs
 (position by cubic Hermite segments with the reference's velocities as slopes, velocities and attitude linearly,
-yaw unwrapped). Extra columns are ignored; any defect raises :class:`bgfn.errors.DataError` naming the file and
+yaw unwrapped), the GNSS stamps onto their nominal grid when they jitter (:func:`bgfn.data.regrid.regular_fix_times`),
+after the clocks that ``meta.yaml`` states and the GNSS-IMU offset estimated from the data (:mod:`bgfn.data.time_offset`)
+are checked. Extra columns are ignored; any defect raises :class:`bgfn.errors.DataError` naming the file and
 column.
 """
 
@@ -35,7 +37,7 @@ from bgfn.data.imu_errors import OPTIONAL_VECTOR_KEYS, SCALAR_KEYS, VECTOR_KEYS
 from bgfn.data.names import safe_id
 from bgfn.data.navego import check_time
 from bgfn.data.physics import check_drive
-from bgfn.data.regrid import check_gaps, imu_on_grid, interpolate_reference, median_rate_hz
+from bgfn.data.regrid import check_gaps, imu_on_grid, interpolate_reference, median_rate_hz, regular_fix_times
 from bgfn.data.time_offset import TOLERANCE_S, estimate_gnss_offset
 from bgfn.errors import DataError
 from bgfn.io import atomic_write_csv, atomic_write_text
@@ -225,6 +227,8 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_st
     check_drive(Drive(str(folder), raw["reference"], raw["imu"], gnss), {t: str(p) for t, p in files.items()})
     # then the clocks, on plausible data: a unit mistake is not blamed on a clock offset
     gnss, offset = _on_imu_clock(raw["imu"], gnss, latency == "auto", files, meta_path)
+    fix_times, fix_shift = regular_fix_times(gnss["time"].to_numpy(float), files["gnss"])   # arrival jitter
+    gnss = gnss.assign(time=fix_times)
     for table in ("imu", "reference"):
         check_gaps(raw[table]["time"].to_numpy(float), files[table])
     t_imu, t_ref = raw["imu"]["time"].to_numpy(float), raw["reference"]["time"].to_numpy(float)
@@ -256,6 +260,7 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_st
         "platform": user["platform"],
         "time_shifts_s": {"imu_time_offset_s": user["imu_time_offset_s"], "gnss_latency_s": user["gnss_latency_s"]},
         "gnss_offset": offset,
+        "gnss_regridded_max_s": fix_shift,
         "imu_mounting_deg": user["imu_mounting_deg"],
         "params": {"folder": str(folder), "imu_rate_hz": imu_rate_hz, "t_start": t_start, "t_end": t_end},
     }

@@ -40,6 +40,48 @@ RATE_DIGITS = 4
 TIME_TOL = 1e-6
 
 
+#: GNSS stamps within this fraction of their nominal interval of a regular grid are put on it (arrival jitter).
+FIX_JITTER_TOL = 0.1
+
+
+def regular_fix_times(t: np.ndarray, source="gnss") -> tuple[np.ndarray, float]:
+    """GNSS fix stamps on their nominal grid: a receiver's fixes are valid at regular epochs, but a logger that
+    stamps their arrival adds jitter, and a rate like 0.999475 Hz then divides nothing the evaluation needs.
+
+    The nominal interval is the median step to two significant digits (0.9995 s -> 1 s); each stamp goes to the
+    nearest epoch ``t0 + offset + k interval`` (``offset`` the median deviation), at most
+    :data:`FIX_JITTER_TOL` of an interval away; gaps (missing fixes) stay gaps. A log already on a grid is returned
+    as it is.
+
+    Returns
+    -------
+    times : ndarray
+    shift : float
+        The largest move, s (0: unchanged).
+
+    Raises
+    ------
+    DataError
+        A stamp farther from the grid than the tolerance, or two on one epoch, naming ``source`` and the row.
+    """
+    t = np.asarray(t, dtype=float)
+    if t.size < 3:
+        return t, 0.0
+    nominal = float(f"{median_interval(t):.2g}")
+    k = np.round((t - t[0]) / nominal).astype(np.int64)
+    grid = t[0] + k * nominal
+    grid += float(np.median(t - grid))
+    shift = np.abs(t - grid)
+    worst = int(np.argmax(shift))
+    if np.any(np.diff(k) <= 0) or shift[worst] > FIX_JITTER_TOL * nominal:
+        raise DataError(source, "time", f"fix stamps within {FIX_JITTER_TOL:g} of their nominal interval "
+                        f"({nominal:g} s) of a regular grid (a receiver's arrival jitter), one fix per epoch",
+                        f"{shift[worst]:.3f} s off at data row {worst + 1} (time {t[worst]:.3f} s)")
+    if shift[worst] < TIME_TOL:
+        return t, 0.0
+    return grid, float(shift[worst])
+
+
 def median_interval(t: np.ndarray) -> float:
     """Median step of a time vector, s."""
     return float(np.median(np.diff(np.asarray(t, dtype=float))))

@@ -7,6 +7,7 @@ reference at 5 Hz (not at the IMU epochs), a 1 Hz GNSS with a lever arm, times i
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import shutil
 
@@ -16,16 +17,19 @@ import pytest
 import yaml
 
 from bgfn import config
-from bgfn.data import Drive, load_drive, write_csv_drive
+from bgfn.data import load_drive, write_csv_drive
 from bgfn.data import imu_errors as ie
 from bgfn.data.csv_meta import DEFAULT_IMU_PROFILE, META_KEYS, read_meta
 from bgfn.data.names import data_fingerprint, dataset_folder, dataset_id, profile_datasets, unique_ids
 from bgfn.data.regrid import GAP_SAMPLES, interpolate_reference
 from bgfn.errors import DataError
 from bgfn.nav import earth, sim
-from bgfn.profile_schema import check_with_drives, load_profile, with_overrides
+from bgfn.profile_schema import check_with_drives, load_profile
 
 pytestmark = pytest.mark.usefixtures("repo_untouched")
+_spec = importlib.util.spec_from_file_location("demo_log", config.PROJECT_ROOT / "tools" / "demo_log.py")
+demo_log = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(demo_log)        # the example own log CI runs end to end (tools/, not the package)
 
 T0 = 243000.0                   # GPS time of week of the first epoch, s
 FINE_HZ = 400.0                 # truth rate the jittery IMU intervals are cut from
@@ -33,24 +37,6 @@ DURATION_S = 240.0
 LEVER = [-0.4, 0.0, -1.0]       # antenna in the body frame, m
 OUTAGE = [T0 + 150.0, 30.0]     # one 30 s outage: 120 s of GPS time before it, 60 s after
 REF_EVERY = 80                  # a reference row every 80 fine steps: 5 Hz
-
-
-def _jittery_imu(truth: pd.DataFrame, seed: int) -> pd.DataFrame:
-    """IMU rows over intervals of 3, 4 or 5 fine steps (7.5, 10, 12.5 ms): mean rates = summed increments over
-    the interval (exact), plus Ekinox-grade errors."""
-    fine = sim.imu_from_trajectory(truth)                     # rows for truth.time[1:], 2.5 ms each
-    rng = np.random.default_rng(seed)
-    steps = rng.choice([3, 4, 5], size=len(fine) // 3 + 1, p=[0.25, 0.5, 0.25])
-    ends = np.cumsum(steps)
-    ends = ends[ends <= len(fine)]
-    cols = [c for c in fine.columns if c != "time"]
-    cum = np.vstack([np.zeros(len(cols)), np.cumsum(fine[cols].to_numpy(float), axis=0)])
-    sums = np.diff(cum[np.concatenate([[0], ends])], axis=0)       # equal fine steps: mean = sum / count
-    imu = pd.DataFrame(sums / np.diff(np.concatenate([[0], ends]))[:, None], columns=cols)
-    imu.insert(0, "time", truth["time"].to_numpy(float)[ends])
-    noise = rng.standard_normal((len(imu), 6)) * ([2e-4] * 3 + [2e-3] * 3)       # white noise, rad/s and m/s^2
-    imu[cols] = imu[cols].to_numpy() + noise + [1e-4, -1e-4, 5e-5, 0.01, -0.01, 0.005]
-    return imu
 
 
 @pytest.fixture(scope="module")
@@ -61,15 +47,9 @@ def truth():
 
 
 def _write_log(folder, truth, attitude=True, meta=True):
-    """The drive as a logger writes it: jittery IMU, 5 Hz reference, 1 Hz GNSS; returns the folder."""
-    imu = _jittery_imu(truth, seed=7)
-    gnss = sim.gnss_from_trajectory(truth, 1.0, 0.5, 1.0, LEVER, seed=8)
-    ref = truth.iloc[::REF_EVERY].reset_index(drop=True)
-    # the filter's error model: the white noise above as densities (std x sqrt(0.01 s)), the biases as turn-on
-    errors = ie.error_params("ekinox-d", {"gyro_noise_density": 2e-5, "accel_noise_density": 2e-4,
-                                          "gyro_turn_on_bias_std": 2e-4, "accel_turn_on_bias_std": 0.02})
-    drive = Drive("my-car", ref, imu, gnss, {"lever_arm_m": LEVER, "imu_errors": errors, "source": "test"})
-    write_csv_drive(drive, folder)
+    """The drive as a logger writes it (tools/demo_log.py: jittery IMU, 5 Hz reference, 1 Hz GNSS, the ``truth``
+    of this module); returns the folder."""
+    demo_log.demo_log(folder, name="my-car", source="test")
     if not attitude:
         pd.read_csv(folder / "reference.csv").drop(columns=["roll", "pitch", "yaw"]).to_csv(
             folder / "reference.csv", index=False)

@@ -210,7 +210,7 @@ def answer_odometer(odo: OdometerInputs, durations) -> str:
     q = "Does a learned odometer help?"
     if not odo.measured:
         return f"{q} Not measured: notebook 04's odometer bars have not run for this drive (`evaluate.odometer`)."
-    d_short, d_long = min(durations), max(durations)
+    d_long = max(durations)
     nhc = nhc_label("INS")
 
     def pair(m):

@@ -24,6 +24,7 @@ from bgfn.data.names import data_fingerprint, dataset_folder, dataset_id, profil
 from bgfn.data.regrid import GAP_SAMPLES, interpolate_reference
 from bgfn.errors import DataError
 from bgfn.nav import earth, sim
+from bgfn.nav.transform import dcm_from_euler
 from bgfn.profile_schema import check_with_drives, load_profile
 
 pytestmark = pytest.mark.usefixtures("repo_untouched")
@@ -451,3 +452,23 @@ def test_jittery_gnss_stamps_go_onto_their_grid_or_fail_at_load(tmp_path, truth)
     with pytest.raises(DataError) as err:
         load_drive(log)
     assert err.value.source == str(log / "gnss.csv") and "arrival jitter" in str(err.value)
+
+
+def test_a_reference_given_at_an_antenna_is_moved_to_the_imu(tmp_path, truth):
+    """The reference written 1 m ahead and 1.5 m above the IMU (the body frame's x and -z): with
+    ``reference_lever_arm_m`` it comes back to the IMU's track (at the reference's attitude)."""
+    log = _write_log(tmp_path / "run", truth)
+    plain = load_drive(log)
+    lever = np.array([1.0, 0.0, -1.5])
+    ref = pd.read_csv(log / "reference.csv")
+    c = dcm_from_euler(ref["roll"].to_numpy(), ref["pitch"].to_numpy(), ref["yaw"].to_numpy()).reshape(-1, 3, 3)
+    ned = c @ lever
+    r_m, r_n = earth.curvature_radii(ref["lat"].to_numpy())
+    moved = ref.assign(lat=ref["lat"] + ned[:, 0] / (r_m + ref["h"]),
+                       lon=ref["lon"] + ned[:, 1] / ((r_n + ref["h"]) * np.cos(ref["lat"])), h=ref["h"] - ned[:, 2])
+    moved.to_csv(log / "reference.csv", index=False)
+    meta = yaml.safe_load((log / "meta.yaml").read_text())
+    (log / "meta.yaml").write_text(yaml.safe_dump({**meta, "reference_lever_arm_m": lever.tolist()}))
+    back = load_drive(log)
+    dn = (back.reference["lat"] - plain.reference["lat"]).to_numpy() * 6.37e6
+    assert np.abs(dn).max() < 0.01 and np.abs(back.reference["h"] - plain.reference["h"]).max() < 0.01

@@ -41,6 +41,7 @@ from bgfn.data.regrid import check_gaps, imu_on_grid, interpolate_reference, med
 from bgfn.data.time_offset import TOLERANCE_S, estimate_gnss_offset
 from bgfn.errors import DataError
 from bgfn.io import atomic_write_csv, atomic_write_text
+from bgfn.nav.earth import curvature_radii
 from bgfn.nav.transform import dcm_from_euler
 from bgfn.schema import ACCEL_COLUMNS, GNSS_COLUMNS, GNSS_FIX_COLUMNS, GYRO_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS
 
@@ -165,6 +166,28 @@ def _on_imu_clock(imu: pd.DataFrame, gnss: pd.DataFrame, auto: bool, files: dict
                   "fixes": est.fixes, "line": est.line()}
 
 
+def to_imu_point(reference: pd.DataFrame, lever_arm_m) -> pd.DataFrame:
+    """The reference moved from the point it gives (``lever_arm_m`` in the body frame, m) to the IMU:
+    ``p_imu = p_ref - C_bn l`` in NED, with the reference's attitude, or without one its course (the direction of
+    its velocity) at zero roll and pitch; unchanged for a zero lever arm."""
+    lever = np.asarray(lever_arm_m, dtype=float)
+    if not np.any(lever):
+        return reference
+    ref = reference.copy()
+    if np.isfinite(ref[["roll", "pitch", "yaw"]].to_numpy(float)).all():
+        roll, pitch, yaw = (ref[c].to_numpy(float) for c in ("roll", "pitch", "yaw"))
+    else:
+        roll = pitch = np.zeros(len(ref))
+        yaw = np.arctan2(ref["v_e"].to_numpy(float), ref["v_n"].to_numpy(float))
+    offset = dcm_from_euler(roll, pitch, yaw).reshape(-1, 3, 3) @ lever                    # [n, 3] NED, m
+    lat, h = ref["lat"].to_numpy(float), ref["h"].to_numpy(float)
+    r_m, r_n = curvature_radii(lat)
+    ref["lat"] = lat - offset[:, 0] / (r_m + h)
+    ref["lon"] = ref["lon"].to_numpy(float) - offset[:, 1] / ((r_n + h) * np.cos(lat))
+    ref["h"] = h + offset[:, 2]
+    return ref
+
+
 def rotate_imu(imu: pd.DataFrame, mounting_deg) -> pd.DataFrame:
     """The IMU rows in the body frame: ``x_b = C x_s`` for the rates and specific forces, ``C`` the rotation of the
     IMU's axes in the body frame by ``mounting_deg`` = [roll, pitch, yaw] (deg, ZYX as the attitude); unchanged
@@ -243,7 +266,8 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_st
                         "at least two IMU intervals: the same time base", f"[{t_ref[0]:.3f}, {t_ref[-1]:.3f}] s")
     imu, t_first, resampled = imu_on_grid(raw["imu"], rate, lo, hi)
     epochs = np.concatenate([[t_first], imu["time"].to_numpy(float)])
-    reference = interpolate_reference(raw["reference"], epochs, files["reference"])
+    reference = to_imu_point(interpolate_reference(raw["reference"], epochs, files["reference"]),
+                             user["reference_lever_arm_m"])
     tg = gnss["time"].to_numpy(float)
     gnss = gnss.loc[(tg >= epochs[0]) & (tg <= epochs[-1])].reset_index(drop=True)
     meta = {
@@ -262,6 +286,7 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_st
         "gnss_offset": offset,
         "gnss_regridded_max_s": fix_shift,
         "imu_mounting_deg": user["imu_mounting_deg"],
+        "reference_lever_arm_m": user["reference_lever_arm_m"],
         "params": {"folder": str(folder), "imu_rate_hz": imu_rate_hz, "t_start": t_start, "t_end": t_end},
     }
     return Drive(user["name"] or safe_id(folder.name), reference, imu, gnss, meta)

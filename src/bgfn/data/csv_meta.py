@@ -22,6 +22,8 @@ key                meaning (all optional; the file itself is optional)
                    is an error naming both files
 ``gnss_std_m``     [north, east, down] std of a fix, m, for a ``gnss.csv`` without ``std_n, std_e, std_d``
                    (a receiver that reports no accuracy); no default: such a file needs it
+``reference_lever_arm_m``  the point whose position ``reference.csv`` gives, in the body frame [x, y, z], m
+                   (e.g. the RTK antenna); the reference is moved to the IMU at load; default [0, 0, 0]
 =================  ====================================================================================
 
 Without ``meta.yaml``, or without ``imu_errors``, the filter uses the consumer-MEMS profile
@@ -56,7 +58,7 @@ ID_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 DEFAULT_IMU_PROFILE = "mpu6000"
 #: Top-level keys of ``meta.yaml``.
 META_KEYS: tuple[str, ...] = ("name", "lever_arm_m", "source", "imu_errors", "platform", "imu_mounting_deg",
-                              "imu_time_offset_s", "gnss_latency_s", "gnss_std_m")
+                              "imu_time_offset_s", "gnss_latency_s", "gnss_std_m", "reference_lever_arm_m")
 #: ``platform`` values (the aids of each: :data:`bgfn.nav.constraints.PLATFORM_AIDS`).
 PLATFORMS: tuple[str, ...] = ("car", "walker", "other")
 #: Largest time shift a meta key may state, s: beyond it the log's clocks disagree by more than a delay.
@@ -167,6 +169,8 @@ def read_meta(path: str | Path) -> dict:
     name = _checked_name(path, meta)
     larm = _vector(path, meta, "lever_arm_m", [0.0, 0.0, 0.0], "3 finite numbers [x, y, z], m (antenna in the body "
                    "frame)")
+    ref_lever = _vector(path, meta, "reference_lever_arm_m", [0.0, 0.0, 0.0], "3 finite numbers [x, y, z], m (the "
+                        "reference's point in the body frame)")
     mounting = _vector(path, meta, "imu_mounting_deg", [0.0, 0.0, 0.0], "3 finite numbers [roll, pitch, yaw], deg "
                        "(the IMU's axes in the body frame)")
     if np.any(np.abs(mounting) > 360.0):
@@ -198,7 +202,8 @@ def read_meta(path: str | Path) -> dict:
     imu_errors, origin = imu_errors_from(path, meta.get("imu_errors"))
     return {"name": name, "lever_arm_m": larm.tolist(), "source": source, "imu_errors": imu_errors,
             "imu_errors_source": origin, "platform": platform, "imu_mounting_deg": mounting.tolist(),
-            "gnss_std_m": None if std is None else std.tolist(), **shifts}
+            "gnss_std_m": None if std is None else std.tolist(), "reference_lever_arm_m": ref_lever.tolist(),
+            **shifts}
 
 
 def _vector(path: Path, meta: dict, key: str, default, expected: str) -> np.ndarray:

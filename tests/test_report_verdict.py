@@ -214,3 +214,13 @@ def test_the_ins_rows_carry_the_filters_consistency_and_question_five_says_it():
     five = verdict_sentences(inp, verdict_table(inp))[4]
     assert ("the filter is overconfident: the INS row's median NEES of the horizontal position in the 60 s sweep is "
             "40 (30 % of the runs inside the 95 % bound") in five and "weighted too little" in five
+
+
+def test_the_oracle_speed_row_says_when_the_networks_speed_error_is_beyond_its_grid():
+    odo = _odometer()
+    odo.summary.loc[odo.summary["method"] == "BGFN-ODO", "speed_rmse_mps"] = 3.0       # the grid ends at 1 m/s
+    t = verdict_table(_inputs(odometer=odo)).set_index("row")
+    assert np.isnan(t.loc[ORACLE_ODO_ROW, "sweep 60 s"])
+    assert t.loc[ORACLE_ODO_ROW, "inputs"] == "speed RMSE 3/3 m/s: beyond the oracle's grid where empty"
+    assert verdict_table(_inputs(odometer=_odometer())).set_index("row").loc[ORACLE_ODO_ROW, "inputs"] == \
+        "speed RMSE 0.5/0.5 m/s"

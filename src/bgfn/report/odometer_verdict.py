@@ -144,9 +144,12 @@ def odometer_rows(odo: OdometerInputs, durations) -> list[dict]:
                      **{f"sweep {d:g} s": odo.cell(method, d) for d in durations},
                      **{f"p {d:g} s": odo.cell(method, d, "p_vs_nhc") for d in durations}, "runs": odo.runs(method)})
     if odo.has(SUBJECT_ODO) and odo.has(ORACLE):
-        rows.append({"row": ORACLE_ODO_ROW, "inputs": "-", "protocol": "-", "outage 1": np.nan, "outage 2": np.nan,
-                     **{f"sweep {d:g} s": odo.oracle_at(odo.cell(SUBJECT_ODO, d, "speed_rmse_mps"), d)
-                        for d in durations},
+        at = {d: odo.oracle_at(odo.cell(SUBJECT_ODO, d, "speed_rmse_mps"), d) for d in durations}
+        rmse = "/".join(f"{odo.cell(SUBJECT_ODO, d, 'speed_rmse_mps'):.2g}" for d in durations)
+        rows.append({"row": ORACLE_ODO_ROW, "protocol": "-", "outage 1": np.nan, "outage 2": np.nan,
+                     "inputs": (f"speed RMSE {rmse} m/s" + ("" if all(np.isfinite(list(at.values())))
+                                                            else ": beyond the oracle's grid where empty")),
+                     **{f"sweep {d:g} s": at[d] for d in durations},
                      **{f"p {d:g} s": np.nan for d in durations}, "runs": 0})
     return rows
 

@@ -36,6 +36,7 @@ from bgfn.config import SHARED_TABLES
 from bgfn.data.names import dataset_id
 from bgfn.data.registry import SIMULATED_IMU
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
+from bgfn.evaluate.plots import finish_duration_axes
 from bgfn.evaluate.sweep import profile_sweep_plan
 from bgfn.io import atomic_write_csv, save_figure
 
@@ -115,14 +116,8 @@ def plot_nees(summary: pd.DataFrame, dataset: str):
         ax.plot(h["duration_s"], h["median_nees"], marker="o", label=m)
     ax.axhline(CHI2_MEDIAN, color="grey", ls="--", lw=1, label="consistent: median")
     ax.axhline(CHI2_95, color="grey", ls=":", lw=1, label="consistent: 95 % bound")
-    ax.set_yscale("log")
-    ax.set_xlabel("outage duration (s)")
-    ax.set_ylabel("median horizontal NEES")
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7, ncol=2)
-    ax.set_title(f"{dataset}: the filter's covariance against its errors at the outage end", fontsize=10)
-    fig.tight_layout()
-    return fig
+    return finish_duration_axes(fig, ax, "median horizontal NEES",
+                                f"{dataset}: the filter's covariance against its errors at the outage end")
 
 
 def nees_section(out: str | Path, results: dict, sweep: pd.DataFrame | None) -> list[str]:

@@ -38,6 +38,7 @@ import pandas as pd
 from bgfn.config import SHARED_TABLES
 from bgfn.data import dataset_id, load_drive
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
+from bgfn.evaluate.plots import finish_duration_axes
 from bgfn.evaluate.sweep import profile_sweep_plan, sweep_train_config
 from bgfn.io import atomic_write_csv, save_figure
 from bgfn.learning import odometry as lo
@@ -372,14 +373,8 @@ def plot_error_growth(summary: pd.DataFrame, dataset: str):
             g = g.sort_values("duration_s")
             ax.plot(g["duration_s"], g["max_h_m"], marker="o", lw=2.0 if method == nhc_label("INS") else 1.3,
                     color="black" if method == nhc_label("INS") else None, label=method)
-    ax.set_xlabel("outage duration (s)")
-    ax.set_ylabel("median max horizontal error (m)")
-    ax.set_yscale("log")
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7, ncol=2)
-    ax.set_title(f"{dataset}: error growth over the outage, sweep starts", fontsize=10)
-    fig.tight_layout()
-    return fig
+    return finish_duration_axes(fig, ax, "median max horizontal error (m)",
+                                f"{dataset}: error growth over the outage, sweep starts")
 
 
 def odometer_summary(rows: pd.DataFrame) -> pd.DataFrame:

@@ -19,6 +19,19 @@ def _style(method: str) -> str:
     return "--" if method.endswith(NHC_SUFFIX) else "-"
 
 
+def finish_duration_axes(fig, ax, ylabel: str, title: str):
+    """A figure of a quantity against the outage duration, finished as every such figure of notebook 04 is: log
+    y axis, grid, a two-column legend, the title; returns ``fig``."""
+    ax.set_xlabel("outage duration (s)")
+    ax.set_ylabel(ylabel)
+    ax.set_yscale("log")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7, ncol=2)
+    ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
 def _ned_from_start(traj: pd.DataFrame, ref0) -> np.ndarray:
     return earth.lla_to_ned(traj["lat"].to_numpy(), traj["lon"].to_numpy(), traj["h"].to_numpy(),
                             float(ref0["lat"]), float(ref0["lon"]), float(ref0["h"]))

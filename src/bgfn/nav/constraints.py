@@ -402,19 +402,29 @@ def vehicle_rotation_nb(tan_yaw, tan_pitch, out):
 
 
 @numba.njit(cache=True)
-def nhc_measurement(v, c, r_vb, dz, H):
-    """NHC innovation (vehicle-frame lateral and vertical velocity, m/s) into ``dz`` [2] and ``H`` [2, 15]
-    (module docstring: ``M`` on ``dV``, ``-M [v x]`` on ``phi``)."""
+def vehicle_velocity_rows(v, c, r_vb, axes, dz, H):
+    """Components ``axes`` of the vehicle-frame velocity (m/s) into ``dz`` and their rows of ``H`` [len(axes), 15]
+    (module docstring: ``M = R_vb C_bn^T`` on ``dV``, ``-M [v x]`` on ``phi``): the NHC's lateral and vertical rows,
+    and the learned odometer's forward row (:mod:`bgfn.nav.odometer`)."""
     m = r_vb @ c.T                                   # NED velocity -> vehicle frame
     vv = m @ v
     mv = m @ em.skew_nb(v)
     H[:, :] = 0.0
-    for i in range(2):
-        row = NHC_AXES[i]
+    for i in range(axes.size):
+        row = axes[i]
         dz[i] = vv[row]
         for j in range(3):
             H[i, em.DV_NED[j]] = m[row, j]
             H[i, em.PHI_NED[j]] = -mv[row, j]
+
+
+_NHC_ROWS = np.array(NHC_AXES, dtype=np.int64)
+
+
+@numba.njit(cache=True)
+def nhc_measurement(v, c, r_vb, dz, H):
+    """NHC innovation (vehicle-frame lateral and vertical velocity, m/s) into ``dz`` [2] and ``H`` [2, 15]."""
+    vehicle_velocity_rows(v, c, r_vb, _NHC_ROWS, dz, H)
 
 
 @numba.njit(cache=True)
@@ -471,4 +481,5 @@ class VehicleSchedule:
 __all__ = ["AID_NHC", "AID_NONE", "AID_ZUPT", "ConstraintConfig", "Constraints", "DEFAULT_PLATFORM", "NHC_DEFAULTS",
            "PLATFORM_AIDS", "ZUPT_DEFAULTS",
            "aid_epochs", "build_constraints", "constraint_config", "mounting_track", "nhc_measurement",
+           "vehicle_velocity_rows",
            "rest_noise", "stillness", "vehicle_rotation", "VehicleSchedule", "zupt_measurement"]

@@ -28,7 +28,8 @@ from scipy.stats import chi2
 
 from ..errors import DataError
 from . import error_model as em
-from .constraints import AID_ZUPT, TIME_TOL, Constraints, VehicleSchedule, vehicle_rotation_nb
+from .constraints import (AID_ZUPT, TIME_TOL, Constraints, VehicleSchedule, vehicle_rotation_nb,
+                          vehicle_velocity_rows)
 from .filter import AidMeasurement
 
 #: Default chi-square probability of the forward-speed row's gate (one degree of freedom).
@@ -76,15 +77,17 @@ class SpeedTrack:
         return SpeedTrack(self.time, self.speed, self.std * float(factor))
 
 
+#: The vehicle frame's forward axis (the row of :func:`bgfn.nav.constraints.vehicle_velocity_rows` it measures).
+FORWARD_AXIS = np.array([0], dtype=np.int64)
+
+
 def forward_speed_row(v: np.ndarray, c: np.ndarray, r_vb: np.ndarray) -> tuple[float, np.ndarray]:
-    """The computed forward speed ``(M v)_x`` (m/s) and its row of ``H`` [15] (module docstring)."""
-    m = r_vb @ c.T                                   # NED -> vehicle frame
-    row = np.zeros(em.N_STATES)
-    mv = m @ em.skew_nb(np.ascontiguousarray(v, dtype=float))
-    for j in range(3):
-        row[em.DV_NED[j]] = m[0, j]
-        row[em.PHI_NED[j]] = -mv[0, j]
-    return float(m[0] @ v), row
+    """The computed forward speed ``(M v)_x`` (m/s) and its row of ``H`` [15] (module docstring; the NHC's rows
+    for the other two axes)."""
+    dz, H = np.empty(1), np.empty((1, em.N_STATES))
+    vehicle_velocity_rows(np.ascontiguousarray(v, dtype=float), np.ascontiguousarray(c, dtype=float),
+                          np.ascontiguousarray(r_vb, dtype=float), FORWARD_AXIS, dz, H)
+    return float(dz[0]), H[0]
 
 
 @dataclass(frozen=True)

@@ -40,7 +40,7 @@ from bgfn.config import PROJECT_ROOT, git_commit
 from bgfn.data import load_drive
 from bgfn.io import atomic_write_csv
 from bgfn.nav.baseline import nav_config
-from bgfn.nav.earth import curvature_radii
+from bgfn.nav.earth import curvature_radii, lla_to_ned
 from bgfn.nav.outages import outage_windows
 from bgfn.nav.ins_setups import NAVEGO_CHECK_COLUMNS, NAVEGO_CHECK_FILE
 from bgfn.profile_schema import load_profile
@@ -66,8 +66,8 @@ def export(drive, windows, nav: dict, fuse_velocity: bool) -> tuple[dict, dict, 
     if fuse_velocity and has_vel:
         vel, stdv, setting = g[["v_n", "v_e", "v_d"]].to_numpy(float), np.full(3, 0.1), "velocity fused (file's)"
     else:     # position only: the velocity from the fixes, carrying nothing (std 100 m/s)
-        north, east = (lat - lat[0]) * (r_m + h), (g["lon"].to_numpy(float) - g["lon"].iloc[0]) * (r_n + h) * np.cos(lat)
-        vel = np.column_stack([np.gradient(north, t_fix), np.gradient(east, t_fix), -np.gradient(h, t_fix)])
+        ned = lla_to_ned(lat, g["lon"].to_numpy(float), h, lat[0], g["lon"].iloc[0], h[0])
+        vel = np.column_stack([np.gradient(ned[:, k], t_fix) for k in range(3)])
         stdv, setting = np.full(3, NO_VELOCITY_STD), "position only"
     keep = np.ones(len(g), bool)
     for s, d in windows:                                   # gnss_outage.m: the fixes inside the outages removed

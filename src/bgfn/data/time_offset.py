@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from bgfn.nav.earth import curvature_radii
+from bgfn.nav.earth import lla_to_ned
 from bgfn.schema import GYRO_COLUMNS
 
 #: Lags searched, s (more than the 18 s between GPS time and UTC), and their step, s.
@@ -67,10 +67,8 @@ class OffsetEstimate:
 def course_rate(gnss: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
     """``(time, |course rate|)`` at the midpoints between successive fixes where the platform moves (rad/s)."""
     t = gnss["time"].to_numpy(float)
-    lat, lon = gnss["lat"].to_numpy(float), gnss["lon"].to_numpy(float)
-    r_m, r_n = curvature_radii(lat)
-    north = (lat - lat[0]) * (r_m + gnss["h"].to_numpy(float))
-    east = (lon - lon[0]) * (r_n + gnss["h"].to_numpy(float)) * np.cos(lat)
+    lat, lon, h = (gnss[c].to_numpy(float) for c in ("lat", "lon", "h"))
+    north, east, _ = lla_to_ned(lat, lon, h, lat[0], lon[0], h[0]).T
     dt = np.diff(t)
     v_n, v_e = np.diff(north) / dt, np.diff(east) / dt                 # velocity over each interval
     course = np.unwrap(np.arctan2(v_e, v_n))

@@ -102,6 +102,15 @@ SHARED_TABLES: dict[str, str] = {
 #: one in the ``base:`` chain sets that section's own ``datasets``.
 DATASET_KEYS: tuple[str, ...] = ("data.datasets", "nav.datasets", "train.datasets", "evaluate.datasets",
                                  "evaluate.sweep.datasets")
+
+
+def odometer_datasets(odometer: dict | None, sweep_datasets) -> list[str]:
+    """The drives of the learned-odometer bars: ``evaluate.odometer.datasets``, null meaning the sweep's (one rule
+    for notebook 04, which runs them, and notebook 05, which measures their networks)."""
+    names = (odometer or {}).get("datasets")
+    return list(sweep_datasets or []) if names is None else list(names)
+
+
 #: Keys of earlier versions that now live elsewhere: ``section.key`` -> the key to set instead.
 MOVED_KEYS: dict[str, str] = {
     "nav.outage_starts": "outage_windows",

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from bgfn.config import odometer_datasets
 from bgfn.data import load_drive
 from bgfn.data.registry import recorded_first
 from bgfn.energy.checkpoint import MEASURED, SPIKING, check_trained
@@ -30,16 +31,17 @@ from bgfn.train.checkpoints import card_path, checkpoint_name, odometer_models_d
 
 #: The sweep fold whose odometers are measured (every fold trains the same networks on other windows).
 FOLD = 0
+
+
 def odometer_dataset(cfg: dict) -> str | None:
-    """The dataset whose odometers are measured: the first of ``evaluate.odometer.datasets`` (null: the sweep's),
-    recorded drives first; None when the profile trains no odometer network."""
+    """The dataset whose odometers are measured: the first of the odometer bars' drives
+    (:func:`bgfn.config.odometer_datasets`), recorded drives first; None when the profile trains no odometer
+    network."""
     ecfg = cfg.get("evaluate") or {}
     oc = ecfg.get("odometer") or {}
     if not oc.get("methods"):
         return None
-    names = oc.get("datasets")
-    names = (ecfg.get("sweep") or {}).get("datasets") or [] if names is None else names
-    names = recorded_first(names)
+    names = recorded_first(odometer_datasets(oc, (ecfg.get("sweep") or {}).get("datasets")))
     return names[0] if names else None
 
 

@@ -35,7 +35,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from bgfn.config import SHARED_TABLES
+from bgfn.config import SHARED_TABLES, odometer_datasets
 from bgfn.data import dataset_id, load_drive
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.evaluate.plots import finish_duration_axes
@@ -308,8 +308,7 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
     added to ``timings`` (``odometer_s``)."""
     t0 = time.perf_counter()
     ecfg = setup.config
-    names = ecfg["odometer"]["datasets"]
-    names = list(setup.sweep_datasets) if names is None else list(names)
+    names = odometer_datasets(ecfg["odometer"], setup.sweep_datasets)
     rows, facts = run_odometer_bars(cfg, profile, names, ecfg, runner, report)
     summary = odometer_summary(rows)
     tables = Path(out) / "tables"

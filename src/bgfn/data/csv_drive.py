@@ -33,6 +33,7 @@ import yaml
 
 from bgfn.data.csv_meta import META_FILE, read_meta
 from bgfn.data.drive import Drive
+from bgfn.data.gnss import imu_position
 from bgfn.data.imu_errors import OPTIONAL_VECTOR_KEYS, SCALAR_KEYS, VECTOR_KEYS
 from bgfn.data.names import safe_id
 from bgfn.data.navego import check_time
@@ -41,7 +42,6 @@ from bgfn.data.regrid import check_gaps, imu_on_grid, interpolate_reference, med
 from bgfn.data.time_offset import TOLERANCE_S, estimate_gnss_offset
 from bgfn.errors import DataError
 from bgfn.io import atomic_write_csv, atomic_write_text
-from bgfn.nav.earth import curvature_radii
 from bgfn.nav.transform import dcm_from_euler
 from bgfn.schema import ACCEL_COLUMNS, GNSS_COLUMNS, GNSS_FIX_COLUMNS, GYRO_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS
 
@@ -166,28 +166,6 @@ def _on_imu_clock(imu: pd.DataFrame, gnss: pd.DataFrame, auto: bool, files: dict
                   "fixes": est.fixes, "line": est.line()}
 
 
-def to_imu_point(reference: pd.DataFrame, lever_arm_m) -> pd.DataFrame:
-    """The reference moved from the point it gives (``lever_arm_m`` in the body frame, m) to the IMU:
-    ``p_imu = p_ref - C_bn l`` in NED, with the reference's attitude, or without one its course (the direction of
-    its velocity) at zero roll and pitch; unchanged for a zero lever arm."""
-    lever = np.asarray(lever_arm_m, dtype=float)
-    if not np.any(lever):
-        return reference
-    ref = reference.copy()
-    if np.isfinite(ref[["roll", "pitch", "yaw"]].to_numpy(float)).all():
-        roll, pitch, yaw = (ref[c].to_numpy(float) for c in ("roll", "pitch", "yaw"))
-    else:
-        roll = pitch = np.zeros(len(ref))
-        yaw = np.arctan2(ref["v_e"].to_numpy(float), ref["v_n"].to_numpy(float))
-    offset = dcm_from_euler(roll, pitch, yaw).reshape(-1, 3, 3) @ lever                    # [n, 3] NED, m
-    lat, h = ref["lat"].to_numpy(float), ref["h"].to_numpy(float)
-    r_m, r_n = curvature_radii(lat)
-    ref["lat"] = lat - offset[:, 0] / (r_m + h)
-    ref["lon"] = ref["lon"].to_numpy(float) - offset[:, 1] / ((r_n + h) * np.cos(lat))
-    ref["h"] = h + offset[:, 2]
-    return ref
-
-
 def rotate_imu(imu: pd.DataFrame, mounting_deg) -> pd.DataFrame:
     """The IMU rows in the body frame: ``x_b = C x_s`` for the rates and specific forces, ``C`` the rotation of the
     IMU's axes in the body frame by ``mounting_deg`` = [roll, pitch, yaw] (deg, ZYX as the attitude); unchanged
@@ -266,8 +244,10 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_st
                         "at least two IMU intervals: the same time base", f"[{t_ref[0]:.3f}, {t_ref[-1]:.3f}] s")
     imu, t_first, resampled = imu_on_grid(raw["imu"], rate, lo, hi)
     epochs = np.concatenate([[t_first], imu["time"].to_numpy(float)])
-    reference = to_imu_point(interpolate_reference(raw["reference"], epochs, files["reference"]),
-                             user["reference_lever_arm_m"])
+    reference = interpolate_reference(raw["reference"], epochs, files["reference"])
+    if np.any(user["reference_lever_arm_m"]):       # a reference given at another point (an RTK antenna): to the IMU
+        lat, lon, h = imu_position(reference, user["reference_lever_arm_m"])
+        reference = reference.assign(lat=lat, lon=lon, h=h)
     tg = gnss["time"].to_numpy(float)
     gnss = gnss.loc[(tg >= epochs[0]) & (tg <= epochs[-1])].reset_index(drop=True)
     meta = {

@@ -58,5 +58,11 @@ def test_sentences_put_the_stand_in_beside_the_recorded_drive():
     lines = ev.drift_sentences(summary, stand_in="sim", recorded="real")
     assert lines == ["30 s outages, median max horizontal error over up to 20 starts: INS 10.0 m on the stand-in "
                      "sim, 40.0 m on the recorded drive real (4.0 times); INS+NHC 4.0 m on the stand-in sim, 6.0 m "
-                     "on the recorded drive real (1.5 times)"]
+                     "on the recorded drive real (1.5 times)",
+                     "The stand-in's standalone INS drifts outside a factor 1.5 of the recorded drive's at 30 s (4.00) "
+                     "(recorded over stand-in)."]
     assert ev.drift_sentences(summary, stand_in="sim", recorded="absent") == []
+    # INS 1.4 times (within 1.5): the verdict turns; INS+NHC plays no part in it
+    summary.loc[1, "median_max_h_m"] = 14.0
+    assert ev.drift_sentences(summary, stand_in="sim", recorded="real")[-1] == (
+        "The stand-in's standalone INS drifts within a factor 1.5 of the recorded drive's at every duration.")

@@ -89,6 +89,7 @@ SHARED_TABLES: dict[str, str] = {
     "kf_ins_drift": "kf_ins_drift.csv",         # notebook 02: INS drift over the sweep's starts, drive by drive
     "kf_ins_drift_runs": "kf_ins_drift_runs.csv",
     "kf_nees_scan": "kf_nees_scan.csv",         # notebook 02: INS consistency vs the gyro bias instability
+    "kf_imu_twin": "kf_imu_twin.csv",           # notebook 02: the recorded IMU against its trajectory twin
     "oracle": "outage_oracle.csv",              # notebook 04: the oracle rows (bgfn.evaluate.oracle)
     "oracle_breakeven": "outage_oracle_breakeven.csv",
     "oracle_runs": "outage_oracle_runs.csv",

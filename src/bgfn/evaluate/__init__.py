@@ -63,6 +63,8 @@ Modules, in the order of the protocol:
 - :mod:`bgfn.evaluate.oracle` -- the oracle rows: true increments plus noise, the break-even accuracy;
 - :mod:`bgfn.evaluate.nees` -- the filter's consistency in the outages: NEES of the horizontal position at each
   window's end against its covariance, per method and duration (``tables/outage_nees.csv``);
+- :mod:`bgfn.evaluate.imu_twin` -- is the stand-in's IMU as rough as a real one: the recorded drive against its
+  trajectory twin (the same road with the stand-in's simulated IMU), their effective gyro bias instability;
 - :mod:`bgfn.evaluate.odometers` -- the bars a learned odometer must clear: INS+NHC, the held speed, RIDGE-ODO and
   an oracle speed, fused as a forward-speed measurement (beyond the paper);
 - :mod:`bgfn.evaluate.record` -- ``outage_evaluation.json``, the record notebook 06 reads;
@@ -78,6 +80,8 @@ from bgfn.evaluate.config import (COLORS, EVALUATE_DEFAULTS, FIGURE_METHODS, MET
 from bgfn.evaluate.hybrid import (NavContext, OutageRun, gps_run, navigation_context, pseudo_gps_positions, run_outages,
                                   window_metrics)
 from bgfn.evaluate.increments import AntennaTruth, increment_errors, increment_rmse
+from bgfn.evaluate.imu_twin import (TWIN_COLUMNS, effective_instability, implied_setting, settle_setting,
+                                    twin_check, twin_lines, twin_section)
 from bgfn.evaluate.ins_drift import (DRIFT_COLUMNS, DRIFT_RUN_COLUMNS, drift_sentences, drift_starts, drift_summary,
                                      ins_drift_runs, plot_ins_drift)
 from bgfn.evaluate.networks import ensure_models, load_model
@@ -103,7 +107,8 @@ from bgfn.evaluate.variants import (NO_VARIANT, VARIANT_COLUMNS, VARIANT_METRICS
                                     variant_runs, variant_table)
 
 __all__ = [
-    "NEES_COLUMNS", "consistency_scan", "nees_lines", "nees_section", "nees_summary", "scan_lines", "ODOMETER_COLUMNS", "ODOMETER_METHODS", "OdometerSection", "odometer_lines", "odometer_rows", "odometer_summary",
+    "TWIN_COLUMNS", "effective_instability", "implied_setting", "settle_setting", "twin_check", "twin_lines",
+    "twin_section", "NEES_COLUMNS", "consistency_scan", "nees_lines", "nees_section", "nees_summary", "scan_lines", "ODOMETER_COLUMNS", "ODOMETER_METHODS", "OdometerSection", "odometer_lines", "odometer_rows", "odometer_summary",
     "odometer_table", "run_odometer_bars", "run_odometer_section",
     "DRIFT_COLUMNS", "DRIFT_RUN_COLUMNS", "drift_sentences", "drift_starts", "drift_summary", "ins_drift_runs",
     "plot_ins_drift", "outage_figures",

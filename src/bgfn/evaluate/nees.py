@@ -132,8 +132,9 @@ def nees_section(out: str | Path, results: dict, sweep: pd.DataFrame | None) -> 
     return nees_lines(summary)
 
 
-#: Gyro bias instabilities the scan tries, deg/s (the MPU-6000 profile's 0.01 deg/s up to 0.3 deg/s).
-SCAN_GYRO_BIAS_DPS: tuple[float, ...] = (0.01, 0.03, 0.1, 0.3)
+#: Gyro bias instabilities the scan tries, deg/s (half the MPU-6000 profile's 0.01 deg/s up to 0.3 deg/s; dense where the
+#: recorded drive and its trajectory twin turn consistent, :mod:`bgfn.evaluate.imu_twin`).
+SCAN_GYRO_BIAS_DPS: tuple[float, ...] = (0.005, 0.01, 0.02, 0.03, 0.05, 0.1, 0.2, 0.3)
 #: Columns of ``tables/kf_nees_scan.csv``.
 SCAN_COLUMNS: tuple[str, ...] = ("dataset", "gyro_bias_instability_dps", "profile", "duration_s", "runs",
                                  "median_nees", "inside_95", "median_max_h_m", "verdict")

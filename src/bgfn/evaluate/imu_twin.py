@@ -1,0 +1,210 @@
+"""Is the stand-in's IMU as rough as a real one? The recorded drive against its trajectory twin (notebook 02).
+
+The stand-in ``turin-sim-mpu6000`` simulates a consumer MEMS IMU; its INS drift decides how hard the paper's field
+test is. Measured at rest (:mod:`bgfn.data.imu_roughness`: Allan deviation, the bias between stops) the recorded
+car's IMU is no rougher than the stand-in's error model, yet in outages it drifts several times further. What acts
+only while driving (scale factor and misalignment under turns, vibration rectification, a bias that wanders with
+temperature and load) is not seen at rest; it is seen by the filter.
+
+The measurement: the **effective gyro bias instability** of a drive, the value of the filter's gyro bias
+instability at which its standalone INS is consistent in outages (median NEES = the chi-square median 1.39,
+:mod:`bgfn.evaluate.nees`; log-log interpolated on the scan's grid, :func:`effective_instability`). It lumps every
+unmodelled driving error into the one term that dominates a MEMS INS's drift. Measured on
+
+- the recorded drive (its real IMU), and
+- its **trajectory twin** (:func:`bgfn.data.imu_roughness.trajectory_twin`): the same road, GNSS, starts and
+  filter, with the stand-in's error model simulated on it (several seeds), whose truth is known: even a perfect
+  error model needs some margin (the filter does not model scale factor, misalignment or vibration).
+
+The twin needs more than its simulated instability ``m`` (the terms the filter does not model add ``x``); taking
+the two in quadrature, ``e_twin^2 = m^2 + x^2``, the simulated instability that gives the twin the recorded
+drive's ``e_rec`` is ``sqrt(e_rec^2 - x^2)`` (:func:`implied_setting`). From the MPU-6000 profile's 0.01 deg/s,
+:func:`settle_setting` repeats that step until it moves the setting by less than 10 %; the profile carries the
+result, and notebook 02 checks it on every run (:func:`twin_lines`: the twin's effective instability against the
+recorded drive's, with the profile's setting).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+
+from bgfn.config import SHARED_TABLES
+from bgfn.data.imu_roughness import trajectory_twin
+from bgfn.evaluate.nees import CHI2_MEDIAN, consistency_scan
+from bgfn.io import atomic_write_csv
+from bgfn.paper import test_of
+
+#: Seeds of the twin's simulated IMU.
+TWIN_SEEDS: tuple[int, ...] = (1, 2, 3)
+#: Columns of ``tables/kf_imu_twin.csv``.
+TWIN_COLUMNS: tuple[str, ...] = ("dataset", "imu", "seed", "duration_s", "effective_dps", "model_dps",
+                                 "median_max_h_m")
+
+
+def effective_instability(scan: pd.DataFrame) -> pd.DataFrame:
+    """Per dataset and duration of a :func:`bgfn.evaluate.consistency_scan`: the gyro bias instability at which the
+    median NEES first falls to :data:`CHI2_MEDIAN` (deg/s, log-log interpolated; NaN when it never does, the grid's
+    first value when it already does there).
+
+    Returns
+    -------
+    DataFrame
+        ``dataset, duration_s, effective_dps``.
+    """
+    rows = []
+    for (ds, du), g in scan.groupby(["dataset", "duration_s"], sort=False):
+        g = g.sort_values("gyro_bias_instability_dps")
+        x, y = g["gyro_bias_instability_dps"].to_numpy(float), g["median_nees"].to_numpy(float)
+        below = np.flatnonzero(y <= CHI2_MEDIAN)
+        if below.size == 0:
+            value = np.nan
+        elif below[0] == 0:
+            value = float(x[0])
+        else:
+            k = below[0]
+            w = np.log(y[k - 1] / CHI2_MEDIAN) / np.log(y[k - 1] / y[k])
+            value = float(np.exp(np.log(x[k - 1]) + w * (np.log(x[k]) - np.log(x[k - 1]))))
+        rows.append((ds, float(du), value))
+    return pd.DataFrame(rows, columns=["dataset", "duration_s", "effective_dps"])
+
+
+def _rows(scan: pd.DataFrame, imu: str, seed) -> list[dict]:
+    eff = effective_instability(scan)
+    own = scan[scan["profile"]]
+    out = []
+    for _, r in eff.iterrows():
+        o = own[own["duration_s"] == r["duration_s"]].iloc[0]
+        out.append({"dataset": r["dataset"], "imu": imu, "seed": seed, "duration_s": r["duration_s"],
+                    "effective_dps": r["effective_dps"], "model_dps": float(o["gyro_bias_instability_dps"]),
+                    "median_max_h_m": float(o["median_max_h_m"])})
+    return out
+
+
+def twin_check(cfg: dict, recorded, stand_in, seeds=TWIN_SEEDS, scan: pd.DataFrame | None = None,
+               gyro_dps: float | None = None, report: Callable[[str], None] | None = None) -> pd.DataFrame:
+    """The effective gyro bias instability of the recorded drive and of its trajectory twins (module docstring).
+
+    Parameters
+    ----------
+    cfg : dict
+        The profile (``nav:`` runs the filter, ``evaluate.sweep`` places the starts).
+    recorded, stand_in : bgfn.data.Drive
+        The recorded drive, and the simulated stand-in whose ``meta["imu_errors"]`` the twin simulates.
+    seeds : sequence of int
+        Seeds of the twin's IMU errors.
+    scan : DataFrame, optional
+        The recorded drive's :func:`bgfn.evaluate.consistency_scan` (notebook 02 has run it; default: run here).
+    gyro_dps : float, optional
+        Simulate the twin with this gyro bias instability (deg/s, every axis) instead of the stand-in's.
+    report : callable, optional
+        Called with one line per drive.
+
+    Returns
+    -------
+    DataFrame
+        :data:`TWIN_COLUMNS`: ``imu`` ``recorded`` or ``<stand-in> model``; ``model_dps`` the filter's own setting
+        and ``median_max_h_m`` the INS drift with it (the twin's: the stand-in's model, exact).
+    """
+    scan = consistency_scan(cfg, [recorded]) if scan is None else scan[scan["dataset"] == recorded.name]
+    rows = _rows(scan, "recorded", None)
+    errors = dict(stand_in.meta["imu_errors"])
+    if gyro_dps is not None:
+        errors["gyro_bias_instability"] = [float(np.radians(gyro_dps))] * 3
+    for seed in seeds:
+        twin = trajectory_twin(recorded, errors, seed)
+        rows += _rows(consistency_scan(cfg, [twin]), f"{stand_in.name} model", int(seed))
+    out = pd.DataFrame(rows, columns=list(TWIN_COLUMNS))
+    if report is not None:
+        for imu, g in out.groupby("imu", sort=False):
+            report(f"{recorded.name}, {imu} IMU: effective gyro bias instability "
+                   + ", ".join(f"{v:.3g} deg/s at {d:g} s" for d, v in g.groupby("duration_s")["effective_dps"]
+                               .apply(lambda x: float(np.exp(np.log(x).mean()))).items()))
+    return out
+
+
+def _gmean(x: pd.Series) -> float:
+    x = x.to_numpy(float)
+    return float(np.exp(np.mean(np.log(x)))) if x.size and np.all(np.isfinite(x)) and np.all(x > 0) else np.nan
+
+
+def effective_levels(table: pd.DataFrame) -> tuple[float, float, float]:
+    """``(recorded, twin, twin's simulated)`` gyro bias instability, deg/s: the effective ones as geometric means
+    over durations and seeds."""
+    twin = table[table["imu"] != "recorded"]
+    return (_gmean(table.loc[table["imu"] == "recorded", "effective_dps"]), _gmean(twin["effective_dps"]),
+            float(twin["model_dps"].iloc[0]))
+
+
+def implied_setting(table: pd.DataFrame) -> float:
+    """The simulated gyro bias instability that gives the twin the recorded drive's effective one (module
+    docstring: ``sqrt(e_rec^2 - (e_twin^2 - m^2))``, deg/s; 0 when the twin's unmodelled terms alone exceed it)."""
+    rec, twin, model = effective_levels(table)
+    extra2 = max(twin ** 2 - model ** 2, 0.0)
+    return float(np.sqrt(max(rec ** 2 - extra2, 0.0)))
+
+
+def settle_setting(cfg: dict, recorded, stand_in, start_dps: float, seeds=TWIN_SEEDS, rtol: float = 0.1,
+                   max_steps: int = 5, report: Callable[[str], None] | None = None) -> tuple[float, pd.DataFrame]:
+    """Repeat :func:`implied_setting` from ``start_dps`` until a step changes it by less than ``rtol``.
+
+    Returns
+    -------
+    (float, DataFrame)
+        The settled setting (deg/s) and one row per step (``step, model_dps, recorded_dps, twin_dps,
+        implied_dps``).
+    """
+    scan = consistency_scan(cfg, [recorded])
+    value, steps = float(start_dps), []
+    for step in range(max_steps):
+        table = twin_check(cfg, recorded, stand_in, seeds, scan=scan, gyro_dps=value)
+        rec, twin, _ = effective_levels(table)
+        implied = implied_setting(table)
+        steps.append((step, value, rec, twin, implied))
+        if report is not None:
+            report(f"step {step}: simulated {value:.4g} deg/s -> twin {twin:.4g}, recorded {rec:.4g}, "
+                   f"implied {implied:.4g} deg/s")
+        done = abs(implied - value) <= rtol * value
+        value = implied
+        if done:
+            break
+    return value, pd.DataFrame(steps, columns=["step", "model_dps", "recorded_dps", "twin_dps", "implied_dps"])
+
+
+def twin_lines(table: pd.DataFrame, tolerance: float = 1.25) -> list[str]:
+    """What the check says: the two effective instabilities, the drift on one road, and whether the stand-in's
+    setting holds (the twin within a factor ``tolerance`` of the recorded drive)."""
+    rec_e, twin_e, model = effective_levels(table)
+    rec = table[table["imu"] == "recorded"]
+    twin = table[table["imu"] != "recorded"]
+    drift = ", ".join(f"{du:g} s: {float(rec.loc[rec['duration_s'] == du, 'median_max_h_m'].iloc[0]):.1f} m recorded "
+                      f"against {float(twin.loc[twin['duration_s'] == du, 'median_max_h_m'].median()):.1f} m simulated"
+                      for du in sorted(rec["duration_s"].unique()))
+    if not (np.isfinite(rec_e) and np.isfinite(twin_e)):
+        return [f"The effective gyro bias instability lies outside the scan's grid for one IMU: no comparison ({drift})."]
+    ratio = rec_e / twin_e
+    holds = 1.0 / tolerance <= ratio <= tolerance
+    return [f"Effective gyro bias instability on the recorded drive's road: {rec_e:.3g} deg/s for its real IMU, "
+            f"{twin_e:.3g} deg/s for the stand-in's error model simulated with {model:.3g} deg/s (ratio {ratio:.2f}; "
+            f"median INS drift, each with its filter's own model: {drift}).",
+            ("The stand-in's setting holds: its simulated IMU is as rough as the recorded one within a factor "
+             f"{tolerance:g}." if holds else f"The stand-in's setting does not hold: its simulated IMU is "
+             + ("smoother" if ratio > 1 else "rougher") + f" than the recorded one; the measurement implies "
+             f"{implied_setting(table):.3g} deg/s (evaluate.imu_twin.settle_setting).")]
+
+
+def twin_section(cfg: dict, drives, scan: pd.DataFrame, out: Path,
+                 report: Callable[[str], None] | None = None) -> list[str]:
+    """Notebook 02's check: :func:`twin_check` of the first recorded drive (test ``real``) against the stand-in
+    (test ``field``) among ``drives``, written to ``tables/kf_imu_twin.csv``; its :func:`twin_lines` (empty without
+    such a pair)."""
+    recorded = next((d for d in drives if test_of(d.name) == "real"), None)
+    stand_in = next((d for d in drives if test_of(d.name) == "field"), None)
+    if recorded is None or stand_in is None:
+        return []
+    table = twin_check(cfg, recorded, stand_in, scan=scan, report=report)
+    atomic_write_csv(Path(out) / "tables" / SHARED_TABLES["kf_imu_twin"], table, float_format="%.6g")
+    return twin_lines(table)

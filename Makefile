@@ -59,7 +59,7 @@ PIP := $(PY) -m pip
 LOCK_HASH := $(shell sha256sum requirements.lock | cut -c1-16)
 STAMP := $(VENV)/.installed-$(LOCK_HASH)
 
-NOTEBOOKS := 01_data_prep 02_kf_baseline 03_bgfn_training 04_outage_evaluation 05_energy_estimate 06_results
+NOTEBOOKS := 01_data_prep 02_kf_baseline 03_bgfn_training 04_outage_evaluation 05_energy_estimate 06_results 07_own_logs
 # A profile's notebooks also depend on the profile(s) it builds on (`base:` in its YAML; two levels followed).
 base_of = $(shell sed -n 's/^base:[[:space:]]*\([A-Za-z0-9_.-]*\).*/\1/p' params/$(1).yaml 2>/dev/null)
 BASE1 := $(call base_of,$(PROFILE))
@@ -199,6 +199,9 @@ $(RES)/notebooks/06_results.ipynb: $(RES)/notebooks/05_energy_estimate.ipynb dat
 # `variants`), so a later `make reproduce PROFILE=quick-heading` is picked up by the next `make reproduce`.
 VARIANTS := quick-heading
 $(RES)/notebooks/06_results.ipynb: $(wildcard $(filter-out $(RES)/%,$(VARIANTS:%=results/%/notebooks/05_energy_estimate.ipynb)))
+
+# 07 (the gallery of own logs) needs only the data and the navigation; it runs last, after the results page.
+$(RES)/notebooks/07_own_logs.ipynb: $(RES)/notebooks/06_results.ipynb
 
 _notebooks: $(EXEC)
 

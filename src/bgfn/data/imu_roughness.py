@@ -35,6 +35,7 @@ import pandas as pd
 from scipy.ndimage import uniform_filter1d
 
 from bgfn.data.allan import allan_deviation, bias_change_var, gauss_markov_avar, white_avar
+from bgfn.data.gnss import COURSE_MIN_SPEED_MPS, course_over_ground
 from bgfn.data.imu_errors import apply_imu_errors, error_params
 from bgfn.data.imu_levels import DRIVING_MPS, SENSORS, UNITS, imu_rate_hz, rest_spans
 from bgfn.errors import DataError
@@ -48,8 +49,6 @@ WHITE_TAUS_S: tuple[float, float] = (0.1, 1.0)
 #: Bin of the yaw-rate residual (the reference's rate is noisy at 100 Hz), s; its averaging times, s.
 BIN_S = 1.0
 YAW_TAUS_S: tuple[float, ...] = (1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0)
-#: Below this reference speed the course is undefined and the yaw rate is taken as zero (at rest), m/s.
-COURSE_MIN_MPS = 1.0
 #: Shortest stop whose mean reading counts as a bias sample, s (a car settling on its suspension, or a slow
 #: creep the speed threshold misses, spoils the mean of a stop of a second or two).
 MIN_STOP_S = 5.0
@@ -90,14 +89,10 @@ def noise_densities(allan: pd.DataFrame, taus_s: tuple[float, float] = WHITE_TAU
 
 
 def _course_yaw(reference: pd.DataFrame) -> np.ndarray:
-    """Heading per reference row, rad: the reference's yaw where it has one, else the course over ground
-    (held through stops from the last moving row)."""
+    """Heading per reference row, rad: the reference's yaw where it has one, else the course over ground (held
+    through stops from the last moving row, :func:`bgfn.data.gnss.course_over_ground`)."""
     yaw = reference["yaw"].to_numpy(float)
-    vn, ve = reference["v_n"].to_numpy(float), reference["v_e"].to_numpy(float)
-    course = np.arctan2(ve, vn)
-    moving = np.hypot(vn, ve) >= COURSE_MIN_MPS
-    idx = np.maximum.accumulate(np.where(moving, np.arange(course.size), 0))
-    held = np.where(moving.any(), course[idx], 0.0)
+    held = course_over_ground(reference["v_n"], reference["v_e"])
     return np.where(np.isfinite(yaw), yaw, held)
 
 
@@ -186,7 +181,7 @@ def yaw_residual_allan(drive, taus_s=YAW_TAUS_S, bin_s: float = BIN_S,
     t = ref["time"].to_numpy(float)
     vn, ve = ref["v_n"].to_numpy(float), ref["v_e"].to_numpy(float)
     speed = np.hypot(vn, ve)
-    course_rate = np.where(speed < COURSE_MIN_MPS, 0.0, np.gradient(np.unwrap(np.arctan2(ve, vn)), t))
+    course_rate = np.where(speed < COURSE_MIN_SPEED_MPS, 0.0, np.gradient(np.unwrap(np.arctan2(ve, vn)), t))
     gyro_z = np.interp(t, drive.imu["time"].to_numpy(float), drive.imu["gyro_z"].to_numpy(float))
     k = ((t - t[0]) // bin_s).astype(int)
     starts = np.flatnonzero(np.diff(np.concatenate([[-1], k])))
@@ -307,15 +302,17 @@ def trajectory_twin(recorded, imu_errors: dict, seed: int, smooth_s: float = 0.5
     if not recorded.has_attitude:
         vn, ve, vd = (ref[c].to_numpy(float) for c in ("v_n", "v_e", "v_d"))
         speed = np.hypot(vn, ve)
-        moving = speed >= COURSE_MIN_MPS
-        if not moving.any():
+        if not (speed >= COURSE_MIN_SPEED_MPS).any():
             raise DataError(f"trajectory twin of {recorded.name}", "reference speed",
-                            f"some motion above {COURSE_MIN_MPS} m/s to take a heading from", "none")
-        idx = np.maximum.accumulate(np.where(moving, np.arange(speed.size), 0))
-        idx[:int(np.argmax(moving))] = int(np.argmax(moving))
+                            f"some motion above {COURSE_MIN_SPEED_MPS} m/s to take a heading from", "none")
         n = max(1, int(round(smooth_s * imu_rate_hz(recorded.imu))))
-        course = uniform_filter1d(np.unwrap(np.arctan2(ve, vn)[idx]), n, mode="nearest")
-        climb = uniform_filter1d(np.arctan2(-vd, np.maximum(speed, COURSE_MIN_MPS))[idx], n, mode="nearest")
+        course = uniform_filter1d(np.unwrap(course_over_ground(vn, ve)), n, mode="nearest")
+        # the climb angle, held through slow rows like the course (the same rows are trusted)
+        climb = np.arctan2(-vd, np.maximum(speed, COURSE_MIN_SPEED_MPS))
+        slow = speed < COURSE_MIN_SPEED_MPS
+        idx = np.maximum.accumulate(np.where(~slow, np.arange(speed.size), -1))
+        idx[idx < 0] = int(np.argmax(~slow))
+        climb = uniform_filter1d(climb[idx], n, mode="nearest")
         ref["roll"], ref["pitch"], ref["yaw"] = 0.0, climb, np.angle(np.exp(1j * course))
     params = error_params({k: v for k, v in imu_errors.items()
                            if k not in ("realized", "p0_gyro_bias_std", "p0_accel_bias_std", "note", "file_profile")})

@@ -1,0 +1,110 @@
+"""The gallery of own logs (notebook 07): each log of :data:`bgfn.data.gallery.GALLERY` loaded through the CSV path
+and run through the navigation part of the chain with the profile a user would write for it.
+
+For each log: what the loader decided (the clocks: the GNSS-IMU offset it estimated or applied; the mounting it
+rotated out; the platform), what the filter decided (self-alignment, noise scale, which aids run and why: notebook
+02's sentences, :meth:`bgfn.nav.baseline.Baseline.lines`), the outages its profile's rule picked, and the results:
+the GPS-aided horizontal RMS and max against the reference, the standalone INS and the INS with the platform's aids
+in those outages. The networks' rows of such a log come from ``make reproduce PROFILE=<its profile>`` (the whole
+chain, minutes to tens of minutes); the gallery keeps to what runs in seconds so that every build shows it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from bgfn.data import load_drive
+from bgfn.data.gallery import GalleryLog
+from bgfn.nav.baseline import nav_config, run_baseline
+from bgfn.nav.constraints import DEFAULT_PLATFORM, PLATFORM_AIDS
+from bgfn.nav.outages import describe_windows, outage_windows
+
+#: Columns of ``tables/gallery.csv``.
+GALLERY_COLUMNS: tuple[str, ...] = ("log", "kind", "platform", "duration_s", "imu_rows", "gnss_fixes", "noise_scale",
+                                    "gps_rms_h_m", "gps_max_h_m", "outage", "start_s", "method", "max_h_m")
+
+
+@dataclass
+class GalleryRun:
+    """One log's run: its profile text, ``meta.yaml``, the decisions in words, its rows (:data:`GALLERY_COLUMNS`), and
+    the loaded drive with its outages (for the figures)."""
+
+    log: GalleryLog
+    profile_text: str
+    meta_text: str
+    decisions: list
+    rows: pd.DataFrame
+    drive: object = None
+    windows: list | None = None
+
+
+def run_log(log: GalleryLog, folder: Path, cfg: dict) -> GalleryRun:
+    """Load ``folder`` by its absolute path and run the GPS-aided filter and its outages under ``cfg`` (the loaded
+    profile the log's :meth:`~bgfn.data.gallery.GalleryLog.profile_text` describes)."""
+    folder = Path(folder).resolve()
+    drive = load_drive(folder)
+    windows = outage_windows(cfg, drive, str(folder))
+    b = run_baseline(drive, nav_config(cfg["nav"]), windows)
+    decisions = []
+    if "gnss_offset" in drive.meta:
+        off = drive.meta["gnss_offset"]
+        applied = (f"GNSS latency estimated and applied ({off['applied_latency_s']:.2f} s, gnss_latency_s: auto); "
+                   "what is left: " if off.get("applied_latency_s") else "")
+        decisions.append(f"{drive.name}: {applied}{off['line']}")
+    mounting = drive.meta.get("imu_mounting_deg") or [0.0, 0.0, 0.0]
+    if np.any(mounting):
+        decisions.append(f"{drive.name}: IMU rows rotated into the body frame by the mounting "
+                         f"{[float(x) for x in mounting]} deg (roll, pitch, yaw) of meta.yaml")
+    decisions += describe_windows(cfg, drive, str(folder)) + b.lines()
+    h = b.errors["horizontal"].to_numpy(float)                 # GPS-aided, against the reference, m
+    h = h[np.isfinite(h)]
+    base = {"log": drive.name, "kind": log.kind, "platform": drive.meta.get("platform", DEFAULT_PLATFORM),
+            "duration_s": float(drive.imu["time"].iloc[-1] - drive.imu["time"].iloc[0]), "imu_rows": len(drive.imu),
+            "gnss_fixes": len(drive.gnss), "noise_scale": float(b.setup.noise_scale) if b.setup is not None else 1.0,
+            "gps_rms_h_m": float(np.sqrt(np.mean(h ** 2))) if h.size else np.nan,
+            "gps_max_h_m": float(h.max()) if h.size else np.nan}
+    rows = []
+    aided = _aided_label(base["platform"])
+    for k, (start, _) in enumerate(windows, start=1):
+        for _, r in b.outage_table[b.outage_table["outage"] == f"outage_{k}"].iterrows():
+            rows.append({**base, "outage": k, "start_s": float(start),
+                         "method": "INS" if r["method"] == "INS" else aided, "max_h_m": float(r["max_horizontal"])})
+    meta_text = (folder / "meta.yaml").read_text(encoding="utf-8")
+    return GalleryRun(log, log.profile_text(folder), meta_text, decisions,
+                      pd.DataFrame(rows, columns=list(GALLERY_COLUMNS)), drive, list(windows))
+
+
+def _aided_label(platform: str) -> str:
+    """The aided row's name for a platform: ``INS+NHC`` for a car (the project's name, ZUPT included), else the
+    aids it takes (``INS+ZUPT`` for a walker; ``INS`` again for ``other``, which takes none)."""
+    if platform == "car":
+        return "INS+NHC"
+    aids = [a for a, on in zip(("NHC", "ZUPT"), PLATFORM_AIDS[platform]) if on]
+    return "+".join(["INS"] + aids) if aids else "INS (no aid)"
+
+
+def gallery_table(runs: list[GalleryRun]) -> pd.DataFrame:
+    """All runs' rows, one table (``tables/gallery.csv``)."""
+    return pd.concat([r.rows for r in runs], ignore_index=True) if runs else pd.DataFrame(columns=list(GALLERY_COLUMNS))
+
+
+def gallery_pivot(table: pd.DataFrame) -> pd.DataFrame:
+    """One row per log: its GPS-aided RMS and max, and per outage the max horizontal error of the INS alone and with
+    the platform's aids (``aided row`` names them)."""
+    rows = []
+    for log, g in table.groupby("log", sort=False):
+        first = g.iloc[0]
+        row = {"log": log, "kind": first["kind"], "platform": first["platform"], "noise scale": first["noise_scale"],
+               "GPS/INS RMS (m)": first["gps_rms_h_m"], "GPS/INS max (m)": first["gps_max_h_m"],
+               "aided row": next((m for m in g["method"] if m != "INS"), "-")}
+        for k, go in g.groupby("outage", sort=True):
+            ins = go.loc[go["method"] == "INS", "max_h_m"]
+            aid = go.loc[go["method"] != "INS", "max_h_m"]
+            row[f"outage {k}: INS (m)"] = float(ins.iloc[0]) if len(ins) else np.nan
+            row[f"outage {k}: aided (m)"] = float(aid.iloc[0]) if len(aid) else np.nan
+        rows.append(row)
+    return pd.DataFrame(rows)

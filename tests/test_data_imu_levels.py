@@ -13,7 +13,7 @@ RATE = 100.0
 
 class _Drive:
     def __init__(self, name, imu, reference):
-        self.name, self.imu, self.reference = name, imu, reference
+        self.name, self.imu, self.reference, self.meta = name, imu, reference, {"platform": "car"}
 
 
 def _drive(n=60_000, gyro_nd=1e-3, accel_nd=4e-3, vib_gyro=0.02, vib_accel=0.4, idle=0.25, seed=0):

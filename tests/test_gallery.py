@@ -10,6 +10,7 @@ from synthetic_drive import demo_drive
 
 from bgfn.data import Drive, load_drive
 from bgfn.data import gallery as G
+from bgfn.data import imu_levels
 from bgfn.evaluate import gallery as EG
 from bgfn.nav import sim
 from bgfn.profile_schema import load_profile
@@ -69,3 +70,12 @@ def test_a_walker_runs_with_zupt_alone_and_its_rows_say_so(tmp_path):
     wide = EG.gallery_pivot(run.rows)
     assert wide["aided row"].iloc[0] == "INS+ZUPT" and "outage 2: aided (m)" in wide.columns
     assert EG._aided_label("other") == "INS (no aid)" and EG._aided_label("car") == "INS+NHC"
+
+
+def test_a_walker_is_moving_at_a_walkers_pace_for_notebook_01(tmp_path):
+    """Notebook 01's levels and spectra of a walker: *driving* is the platform's own pace, not a car's 3 m/s."""
+    walk = load_drive(G.walker_log(tmp_path / "walk"))
+    assert imu_levels.moving_speed(walk) < G.WALK_SPEED_MPS < imu_levels.DRIVING_MPS
+    states = imu_levels.motion_states(walk).value_counts()
+    assert states["driving"] > 0.7 * len(walk.imu) and states["still"] > 0
+    assert len(imu_levels.imu_psd(walk)) > 100

@@ -31,13 +31,17 @@ import pandas as pd
 from scipy import signal
 
 from bgfn.errors import DataError
+from bgfn.nav.constraints import DEFAULT_PLATFORM
 
 #: Reference speed below which the vehicle stands still (averaged over SMOOTH_S), m/s ...
 STILL_MPS = 0.1
 #: ... for at least this long, s; TRIM_S cut from both ends of each stop; the averaging span, s.
 MIN_REST_S, TRIM_S, SMOOTH_S = 2.0, 0.5, 1.0
-#: Reference speed above which the vehicle is driving, m/s.
+#: Reference speed above which the vehicle is driving, m/s (a car) ...
 DRIVING_MPS = 3.0
+#: ... and above which each platform of ``meta["platform"]`` (:data:`bgfn.nav.constraints.PLATFORM_AIDS`) is
+#: moving at its own pace: a walker's 1-1.5 m/s never reaches a car's threshold.
+MOVING_MPS: dict[str, float] = {"car": DRIVING_MPS, "walker": 0.5, "other": 0.5}
 #: High-pass corner separating vehicle motion from vibration and noise, Hz.
 HIGHPASS_HZ = 5.0
 #: Minimum samples of a motion state for a level to be reported (5 s at 100 Hz).
@@ -72,8 +76,15 @@ def rest_spans(imu: pd.DataFrame, reference: pd.DataFrame, still_mps: float = ST
             if t[i1 - 1] - t[i0] >= min_rest_s and i1 - i0 > 2 * trim]
 
 
-def motion_states(drive, still_mps: float = STILL_MPS, driving_mps: float = DRIVING_MPS) -> pd.Series:
-    """``'still'``, ``'driving'`` or ``''`` at every IMU row (module docstring)."""
+def moving_speed(drive) -> float:
+    """The speed above which ``drive``'s platform counts as moving (*driving*), m/s (:data:`MOVING_MPS`)."""
+    return MOVING_MPS[drive.meta.get("platform", DEFAULT_PLATFORM)]
+
+
+def motion_states(drive, still_mps: float = STILL_MPS, driving_mps: float | None = None) -> pd.Series:
+    """``'still'``, ``'driving'`` or ``''`` at every IMU row (module docstring; ``driving_mps`` default: the
+    platform's :func:`moving_speed`)."""
+    driving_mps = moving_speed(drive) if driving_mps is None else driving_mps
     t = drive.imu["time"].to_numpy(float)
     out = np.full(t.size, "", dtype=object)
     for i0, i1 in rest_spans(drive.imu, drive.reference, still_mps):
@@ -115,7 +126,7 @@ def noise_band_hz(rate_hz: float, corner_hz: float = HIGHPASS_HZ) -> float:
 
 
 def imu_levels(drive, highpass_hz: float = HIGHPASS_HZ, still_mps: float = STILL_MPS,
-               driving_mps: float = DRIVING_MPS) -> pd.DataFrame:
+               driving_mps: float | None = None) -> pd.DataFrame:
     """Noise and vibration levels of a drive's IMU, per sensor, axis and motion state.
 
     The high pass runs over the whole record (edges of a state's spans see their neighbours; at 5 Hz the
@@ -241,7 +252,7 @@ def stand_in_table(measured, stand_in) -> pd.DataFrame:
 
 
 def imu_psd(drive, state: str = "driving", nperseg: int = 512, still_mps: float = STILL_MPS,
-            driving_mps: float = DRIVING_MPS) -> pd.DataFrame:
+            driving_mps: float | None = None) -> pd.DataFrame:
     """Welch power spectral density of every IMU channel over the rows of one motion state.
 
     The rows of the state are concatenated (the joins add a little broadband power; the spans are long

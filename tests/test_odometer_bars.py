@@ -102,3 +102,30 @@ def test_the_error_growth_figure_has_one_line_per_row_and_the_oracle_at_its_grid
     lines = {ln.get_label(): ln.get_ydata() for ln in fig.axes[0].get_lines()}
     assert set(lines) == {"INS+NHC", "RIDGE-ODO", "BGFN-ODO", "ORACLE-SPEED 0.05 m/s", "ORACLE-SPEED 2 m/s"}
     assert np.allclose(lines["RIDGE-ODO"], [8.0, 24.0, 48.0])
+
+
+def test_the_two_evaluation_outages_are_one_more_fold_at_their_own_duration(monkeypatch, tmp_path):
+    from bgfn import config
+
+    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)
+    drive = demo_drive("synthetic", 150.0, 5.0, 3)
+    cfg = load_profile("smoke")
+    cfg = {**cfg, "nav": NAV, "train": {**cfg["train"], "window": 50, "margin_s": 5.0},
+           "outage_windows": [[110.0, 20.0], [70.0, 15.0]]}           # outage 1 is the later one
+    ecfg = ev.evaluate_config({"sweep": {"n_starts": 2, "folds": 2, "durations_s": [10.0, 30.0], "warmup_s": 30.0},
+                               "odometer": {"sigmas_mps": [0.5], "seeds": [0], "methods": ["mlp"],
+                                            "paper_outages": True}}, cfg["train"])
+    rows, facts = O.odometer_rows(cfg, "t", "synthetic", ecfg, drive=drive)
+    paper = rows[rows["fold"] == O.PAPER_FOLD]
+    assert facts["paper_windows"] == [(110.0, 20.0), (70.0, 15.0)]
+    # one row per outage and method, at the outage's own duration (not the sweep's 10 and 30 s)
+    assert sorted(zip(paper["start_s"], paper["duration_s"])) == sorted([(70.0, 15.0), (110.0, 20.0)] * 5)
+    assert set(paper["method"]) == {"INS+NHC", "INS+NHC+HOLD", "RIDGE-ODO", "MLP-ODO", "ORACLE-SPEED"}
+    assert "MLP-ODO fold -1 seed 0" in facts["networks"]              # its own network, those outages held out
+    table = O.paper_outage_table(paper, {"synthetic": facts["paper_windows"]})
+    assert list(table.columns) == list(O.PAPER_COLUMNS)
+    first = table[table["outage"] == 1]
+    assert (first["start_s"] == 110.0).all() and (first["duration_s"] == 20.0).all()
+    assert first["method"].iloc[0] == "INS+NHC" and (table["runs"] == 1).all()
+    # the sweep's statistics never see them
+    assert not (O.odometer_summary(rows[rows["fold"] != O.PAPER_FOLD])["duration_s"].isin([15.0, 20.0])).any()

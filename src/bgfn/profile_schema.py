@@ -194,7 +194,7 @@ SCHEMA = section(
                       level=_FRACTION, boot_seed=_SEED),
         oracle=section(sigmas_m=seq(_NONNEG), seeds=seq(_SEED, min_len=1), durations_s=seq(_POS)),
         odometer=section(datasets=seq(text(), null=True), methods=seq(text(*METHOD_LABELS)),
-                         network_seeds=seq(_SEED, min_len=1), window_s=number(0.5), sigmas_mps=seq(_POS), walk_mps_per_sqrt_s=_NONNEG,
+                         network_seeds=seq(_SEED, min_len=1), paper_outages=flag(), window_s=number(0.5), sigmas_mps=seq(_POS), walk_mps_per_sqrt_s=_NONNEG,
                          seeds=seq(_SEED, min_len=1), hold_std_mps=_POS, ridge_alpha=_POS,
                          gate_probability=number(0, 1, lo_open=True, hi_open=True, null=True))),
     energy=section(

@@ -19,6 +19,11 @@ on a drive, with the same starts, folds and durations as the sweep (:func:`bgfn.
   ``walk_mps_per_sqrt_s`` > 0): the same plus a random walk the fused std does not know of, the slowly drifting
   error a learned odometer makes between the drive's situations.
 
+With ``paper_outages``, every row also runs in the drive's two evaluation outages (the profile's ``outage_windows``,
+the paper's tables) as one more fold, :data:`PAPER_FOLD`: its networks and its ridge learn outside those outages
++- ``train.margin_s``; its rows (one per outage, at the outage's own duration) go to ``outage_odometer_paper.csv``
+(:func:`paper_outage_table`), never into the sweep's statistics.
+
 Every row is fused at the aid epochs (``nav.nhc.rate_hz``) through the chi-square gate (``gate_probability``).
 Each row also carries the speed error the odometer made inside the outage against the reference's speed
 (``speed_rmse_mps``) and the share of epochs within its own 2 sigma (``coverage_2sigma``).
@@ -43,6 +48,7 @@ from bgfn.evaluate.sweep import profile_sweep_plan, sweep_train_config
 from bgfn.io import atomic_write_csv, save_figure
 from bgfn.learning import odometry as lo
 from bgfn.learning.split import overlaps
+from bgfn.nav.outages import outage_windows
 from bgfn.train.checkpoints import checkpoint_name, odometer_models_dir
 from bgfn.train.objectives import SpeedObjective
 from bgfn.nav import odometer as no
@@ -61,6 +67,11 @@ ODOMETER_COLUMNS: tuple[str, ...] = ("dataset", "start_s", "duration_s", "method
                                      "max_h_m", "rmse_h_m", "final_h_m", "speed_rmse_mps", "coverage_2sigma")
 
 
+#: The fold of the drive's two evaluation outages (module docstring).
+PAPER_FOLD = -1
+#: Columns of ``tables/outage_odometer_paper.csv`` (:func:`paper_outage_table`).
+PAPER_COLUMNS: tuple[str, ...] = ("dataset", "outage", "start_s", "duration_s", "method", "sigma_mps", "max_h_m",
+                                  "speed_rmse_mps", "coverage_2sigma", "runs")
 #: Columns of ``tables/outage_odometer_summary.csv`` (:func:`odometer_summary`).
 SUMMARY_COLUMNS: tuple[str, ...] = ("dataset", "duration_s", "method", "sigma_mps", "max_h_m", "ratio_to_nhc",
                                     "speed_rmse_mps", "coverage_2sigma", "runs", "p_vs_nhc")
@@ -120,7 +131,8 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
     drive = drive if drive is not None else load_drive(dataset, profile=profile)
     plan = profile_sweep_plan(cfg, drive, sw)
     dmax = max(float(d) for d in sw["durations_s"])
-    ctx = navigation_context(drive, cfg.get("nav"), plan["start_s"])
+    paper = [(float(s), float(d)) for s, d in outage_windows(cfg, drive, dataset)] if oc["paper_outages"] else []
+    ctx = navigation_context(drive, cfg.get("nav"), sorted({*map(float, plan["start_s"]), *(s for s, _ in paper)}))
     con = ctx.constraints
     rate = float(con.config.nhc_rate_hz)
     window, imu_rate = lo.window_samples(drive.imu, oc["window_s"])       # the ridge's band energies need 2 s
@@ -136,9 +148,12 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
     val_fraction = float((cfg.get("train") or {}).get("val_fraction", 0.2))
     folds = {int(k): [(float(s), dmax) for s in plan.loc[plan["fold"] == k, "start_s"]]
              for k in sorted(plan["fold"].unique())}
+    if paper:
+        folds[PAPER_FOLD] = paper
     # one honest split per fold: the ridge and the networks learn from the same windows
     data = {k: lo.build_speed_data(ws, fw, margin, val_fraction) for k, fw in folds.items()}
-    runs, tracks, facts = [], {}, {"ridge_std_mps": {}, "epochs": int(len(all_windows))}
+    runs, tracks = [], {}
+    facts = {"ridge_std_mps": {}, "epochs": int(len(all_windows)), "paper_windows": folds.get(PAPER_FOLD, [])}
     honest = {"time": all_windows.t_end, "truth": truth, "outages": [], "tracks": {}}   # each outage: its own fold's
 
     def keep(label: str, track: no.SpeedTrack, inside: np.ndarray) -> None:
@@ -149,9 +164,9 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
     for k, fw in folds.items():
         model, track = fold_ridge(data[k], all_windows, float(oc["ridge_alpha"]), imu_rate)
         facts["ridge_std_mps"][int(k)] = model.std_mps
-        inside = overlaps(all_windows.t_end, all_windows.t_end, np.array([[s, s + d] for s, d in fw]))
-        keep(RIDGE, track, inside)
-        honest["outages"] += fw
+        if k != PAPER_FOLD:             # the speed figure: the sweep's outages (the paper's two overlap them)
+            keep(RIDGE, track, overlaps(all_windows.t_end, all_windows.t_end, np.array([[s, s + d] for s, d in fw])))
+            honest["outages"] += fw
         runs.append(OdometerRun(f"{dataset} fold {k} {RIDGE}", fw, no.Odometer(con, track, gate), RIDGE,
                                 np.nan, 0, int(k)))
         tracks[runs[-1].label] = track
@@ -160,7 +175,7 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
         for s, d in fw:
             v0 = float(np.interp(s, tt, speed))
             held = no.SpeedTrack(epochs, np.full(epochs.size, v0), np.full(epochs.size, float(oc["hold_std_mps"])))
-            runs.append(OdometerRun(f"{dataset} {s:.0f} s {HOLD}", [(s, d)], no.Odometer(con, held, gate), HOLD,
+            runs.append(OdometerRun(f"{dataset} fold {k} {s:.0f} s {HOLD}", [(s, d)], no.Odometer(con, held, gate), HOLD,
                                     np.nan, 0, int(k)))
             tracks[runs[-1].label] = held
         walks = [(ORACLE, 0.0)] + ([(ORACLE_WALK, float(oc["walk_mps_per_sqrt_s"]))]
@@ -177,16 +192,18 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
                                 label, np.nan, seed, k))
         tracks[runs[-1].label] = track
         facts["networks"][f"{label} fold {k} seed {seed}"] = fact
-        if seed == min(oc["network_seeds"]):
+        if seed == min(oc["network_seeds"]) and k != PAPER_FOLD:
             keep(label, track, overlaps(all_windows.t_end, all_windows.t_end,
                                         np.array([[s, s + d] for s, d in folds[k]])))
     results = (runner or Runner()).map(odometer_run, [(ctx, r, ecfg["pseudo_gps"]) for r in runs],
                                        labels=[r.label for r in runs], desc=f"odometer bars {dataset}")
     rows = []
+    paper = dict(paper)
     for run, outs in zip(runs, results):
         track = tracks.get(run.label)
         for r in outs:
-            for du in sw["durations_s"]:
+            # a paper outage at its own duration only; a sweep window at every duration of the sweep
+            for du in (sw["durations_s"] if run.fold != PAPER_FOLD else [paper[r.start]]):
                 m = window_metrics(r.errors, r.start, float(du))
                 rows.append({"dataset": dataset, "start_s": r.start, "duration_s": float(du), "method": run.method,
                              "sigma_mps": run.sigma_mps, "seed": run.seed, "fold": run.fold,
@@ -276,6 +293,7 @@ class OdometerSection:
     lines: list
     facts: dict
     figures: list = field(default_factory=list)
+    paper: pd.DataFrame | None = None
 
     def markdown(self) -> str:
         """The summary at the sweep's durations as a Markdown table (:func:`odometer_table`), then the lines."""
@@ -284,8 +302,34 @@ class OdometerSection:
         wide = odometer_table(self.summary)
         head = "| dataset | method | " + " | ".join(wide.columns) + " |"
         body = [f"| {ds} | {m} | " + " | ".join(f"{v:.1f}" for v in r) + " |" for (ds, m), r in wide.iterrows()]
-        return "\n".join(["Median max horizontal error (m) over the sweep's starts:", "", head,
-                          "|---" * (len(wide.columns) + 2) + "|", *body, ""] + [f"- {s}" for s in self.lines])
+        text = "\n".join(["Median max horizontal error (m) over the sweep's starts:", "", head,
+                           "|---" * (len(wide.columns) + 2) + "|", *body, ""] + [f"- {s}" for s in self.lines])
+        if self.paper is None or self.paper.empty:
+            return text
+        p = self.paper[self.paper["sigma_mps"].isna()]       # the oracle's grid: tables/outage_odometer_paper.csv
+        wide = p.pivot_table(index=["dataset", "method"], columns="outage", values="max_h_m", sort=False)
+        head = "| dataset | method | " + " | ".join(f"outage {c}" for c in wide.columns) + " |"
+        body = [f"| {ds} | {m} | " + " | ".join(f"{v:.1f}" for v in r) + " |" for (ds, m), r in wide.iterrows()]
+        return "\n".join([text, "", "Max horizontal error (m) in each drive's two evaluation outages (the paper's tables; "
+                          "the networks and the ridge trained with those outages +- margin held out, median over "
+                          "seeds):", "", head, "|---" * (len(wide.columns) + 2) + "|", *body])
+
+
+def paper_outage_table(rows: pd.DataFrame, windows: dict) -> pd.DataFrame:
+    """The rows of :data:`PAPER_FOLD` per dataset, outage (numbered as the profile's ``outage_windows``: ``windows``,
+    ``{dataset: [(start, duration), ...]}``), method and sigma: the median over seeds of the max horizontal error,
+    speed RMSE and 2-sigma coverage (:data:`PAPER_COLUMNS`)."""
+    if rows.empty:
+        return pd.DataFrame(columns=list(PAPER_COLUMNS))
+    number = {(ds, float(s)): k for ds, w in windows.items() for k, (s, _) in enumerate(w, start=1)}
+    r = rows.assign(outage=[number[(ds, float(s))] for ds, s in zip(rows["dataset"], rows["start_s"])])
+    order = {m: i for i, m in enumerate(ODOMETER_METHODS)}
+    out = (r.groupby(["dataset", "outage", "start_s", "duration_s", "method", "sigma_mps"], dropna=False, sort=False)
+           .agg(max_h_m=("max_h_m", "median"), speed_rmse_mps=("speed_rmse_mps", "median"),
+                coverage_2sigma=("coverage_2sigma", "median"), runs=("max_h_m", "size")).reset_index())
+    out = out.assign(rank=out["method"].map(order)).sort_values(["dataset", "outage", "rank", "sigma_mps"],
+                                                                kind="stable")
+    return out.drop(columns="rank").reset_index(drop=True)[list(PAPER_COLUMNS)]
 
 
 def odometer_table(summary: pd.DataFrame) -> pd.DataFrame:
@@ -310,10 +354,13 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
     ecfg = setup.config
     names = odometer_datasets(ecfg["odometer"], setup.sweep_datasets)
     rows, facts = run_odometer_bars(cfg, profile, names, ecfg, runner, report)
+    paper = paper_outage_table(rows[rows["fold"] == PAPER_FOLD], {n: f["paper_windows"] for n, f in facts.items()})
+    rows = rows[rows["fold"] != PAPER_FOLD].reset_index(drop=True)
     summary = odometer_summary(rows)
     tables = Path(out) / "tables"
     atomic_write_csv(tables / SHARED_TABLES["odometer"], rows, float_format="%.4f")
     atomic_write_csv(tables / SHARED_TABLES["odometer_summary"], summary, float_format="%.4f")
+    atomic_write_csv(tables / SHARED_TABLES["odometer_paper"], paper, float_format="%.4f")
     figures = []
     for name, f in facts.items():
         for fig, stem in ((plot_speed_series(f["speed_series"], name), "odometer_speed"),
@@ -323,7 +370,7 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
             figures.append(fig)
     if timings is not None:
         timings["odometer_s"] = time.perf_counter() - t0
-    return OdometerSection(rows, summary, odometer_lines(summary) if len(summary) else [], facts, figures)
+    return OdometerSection(rows, summary, odometer_lines(summary) if len(summary) else [], facts, figures, paper)
 
 
 #: Colours of the speed bands (:func:`plot_speed_series`): the ridge, then the networks.

@@ -3,7 +3,7 @@ question ("does a learned odometer help?") and its clause in each dataset's head
 
 Read from notebook 04's odometer tables (:mod:`bgfn.evaluate.odometers`: ``outage_odometer.csv`` with one row per
 start, seed and duration, ``outage_odometer_summary.csv`` with the medians, the ratio to INS+NHC per start and the
-Wilcoxon p against it) and notebook 05's ``energy_odometer.csv`` (:mod:`bgfn.energy.odometer`). Nothing here is
+Wilcoxon p against it, ``outage_odometer_paper.csv`` with the rows in each drive's two evaluation outages) and notebook 05's ``energy_odometer.csv`` (:mod:`bgfn.energy.odometer`). Nothing here is
 typed by hand; a missing table leaves its cells empty and its sentence says so.
 """
 
@@ -42,6 +42,7 @@ class OdometerInputs:
     rows: pd.DataFrame | None       # outage_odometer.csv
     summary: pd.DataFrame | None    # outage_odometer_summary.csv
     energy: pd.DataFrame | None     # energy_odometer.csv (only the dataset notebook 05 measured)
+    paper: pd.DataFrame | None = None   # outage_odometer_paper.csv (the two evaluation outages)
 
     @property
     def measured(self) -> bool:
@@ -54,6 +55,14 @@ class OdometerInputs:
         s = self.summary
         sel = s[(s["method"] == method) & np.isclose(s["duration_s"].astype(float), duration)]
         return float(sel[column].iloc[0]) if len(sel) else float("nan")
+
+    def outage_cell(self, method: str, outage: int) -> float:
+        """Max horizontal error of ``method`` (not the oracle) in evaluation outage ``outage`` (NaN when absent)."""
+        p = self.paper
+        if p is None or p.empty:
+            return float("nan")
+        sel = p[(p["method"] == method) & (p["outage"].astype(int) == outage) & p["sigma_mps"].isna()]
+        return float(sel["max_h_m"].iloc[0]) if len(sel) else float("nan")
 
     def has(self, method: str) -> bool:
         return self.measured and bool((self.summary["method"] == method).any())
@@ -121,18 +130,19 @@ def same_dataset(column: pd.Series, dataset: str) -> pd.Series:
 
 
 def read_odometer_inputs(odometer: pd.DataFrame | None, summary: pd.DataFrame | None,
-                         energy: pd.DataFrame | None, dataset: str) -> OdometerInputs:
+                         energy: pd.DataFrame | None, dataset: str,
+                         paper: pd.DataFrame | None = None) -> OdometerInputs:
     """The tables restricted to ``dataset`` (the energy table only when its ``dataset`` column names it)."""
     def of(df):
         return None if df is None or "dataset" not in df.columns else df[same_dataset(df["dataset"], dataset)]
 
-    return OdometerInputs(of(odometer), of(summary), of(energy))
+    return OdometerInputs(of(odometer), of(summary), of(energy), of(paper))
 
 
 def odometer_rows(odo: OdometerInputs, durations) -> list[dict]:
-    """The verdict table's odometer rows (sweep columns only: the paper's two outages have no odometer run): the
-    held speed, every learned odometer, then the oracle speed at BGFN-ODO's own speed RMSE; ``p``: Wilcoxon of the
-    row against INS+NHC over the starts."""
+    """The verdict table's odometer rows: the held speed, every learned odometer (in the two evaluation outages when
+    notebook 04 ran them there, ``evaluate.odometer.paper_outages``, and in the sweep), then the oracle speed at
+    BGFN-ODO's own speed RMSE (sweep only); ``p``: Wilcoxon of the row against INS+NHC over the starts."""
     if not odo.measured:
         return []
     rows = []
@@ -140,7 +150,8 @@ def odometer_rows(odo: OdometerInputs, durations) -> list[dict]:
         if not odo.has(method):
             continue
         rows.append({"row": method, "inputs": ODOMETER_INPUTS if method != HOLD else "speed at the outage start",
-                     "protocol": "honest" if method != HOLD else "-", "outage 1": np.nan, "outage 2": np.nan,
+                     "protocol": "honest" if method != HOLD else "-", "outage 1": odo.outage_cell(method, 1),
+                     "outage 2": odo.outage_cell(method, 2),
                      **{f"sweep {d:g} s": odo.cell(method, d) for d in durations},
                      **{f"p {d:g} s": odo.cell(method, d, "p_vs_nhc") for d in durations}, "runs": odo.runs(method)})
     if odo.has(SUBJECT_ODO) and odo.has(ORACLE):

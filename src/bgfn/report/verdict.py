@@ -93,7 +93,8 @@ class VerdictInputs:
                    of(read_csv(tables / SHARED_TABLES["training_all_windows"])),
                    read_odometer_inputs(read_csv(tables / SHARED_TABLES["odometer"]),
                                         read_csv(tables / SHARED_TABLES["odometer_summary"]),
-                                        read_csv(tables / SHARED_TABLES["energy_odometer"]), dataset),
+                                        read_csv(tables / SHARED_TABLES["energy_odometer"]), dataset,
+                                        read_csv(tables / SHARED_TABLES["odometer_paper"])),
                    of(read_csv(tables / SHARED_TABLES["nees"])))
 
 

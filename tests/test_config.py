@@ -12,7 +12,7 @@ import yaml
 
 from bgfn import config
 from bgfn.errors import DataError
-from bgfn.profile_schema import load_profile, with_overrides
+from bgfn.profile_schema import load_profile
 
 
 def _section_keys(cfg: dict) -> dict[str, set[str]]:

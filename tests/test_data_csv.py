@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bgfn.data import Drive, acquire, load_csv_drive, load_drive, write_csv_drive
+from bgfn.data import Drive, load_csv_drive, load_drive, write_csv_drive
 from bgfn.data.imu_errors import error_params
 from bgfn.errors import DataError
 from bgfn.nav.sim import demo_trajectory, imu_from_trajectory

@@ -14,7 +14,7 @@ from bgfn.data.imu_errors import OPTIONAL_VECTOR_KEYS, VECTOR_KEYS
 from bgfn.errors import ChecksumError, DataError
 from bgfn.nav.sim import imu_from_trajectory
 from conftest import REQUIRED
-from bgfn.profile_schema import load_profile, with_overrides
+from bgfn.profile_schema import load_profile
 
 pytestmark = pytest.mark.usefixtures("repo_untouched")
 

@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 import scipy.io
 
-from bgfn.data import acquire
 from bgfn.data.navego import read_gnss, read_imu, read_reference, resample_imu
 from bgfn.errors import DataError
 from bgfn.schema import GNSS_COLUMNS, IMU_COLUMNS, REFERENCE_COLUMNS

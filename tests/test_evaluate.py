@@ -24,7 +24,7 @@ from bgfn.nav import earth, metrics
 from bgfn.nav.filter import run_filter, run_outage
 from bgfn.nav.outages import OutageWindow, TablePseudoGps
 from synthetic_drive import demo_drive
-from bgfn.profile_schema import load_profile, with_overrides
+from bgfn.profile_schema import with_overrides
 
 WINDOWS = [(60.0, 20.0), (110.0, 20.0)]
 NAV = {"init": {"position_std_m": 1.0, "height_std_m": 2.0, "velocity_std_mps": 0.1, "level_std_deg": 0.2,

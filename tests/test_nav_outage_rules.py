@@ -155,7 +155,6 @@ def test_the_reader_takes_the_datasets_entry_or_the_default():
 
 
 def test_a_rule_in_a_profile_file_is_checked_with_the_schema(params):
-    from bgfn import config
     from bgfn.profile_schema import OUTAGE_RULE
 
     assert set(OUTAGE_RULE.fields) == {"rule", *R.RULE_DEFAULTS["cruise_and_manoeuvre"]}
@@ -185,7 +184,7 @@ def test_a_rule_in_a_profile_file_is_checked_with_the_schema(params):
 
 
 def test_check_with_drives_applies_the_rule_to_each_drive(params, monkeypatch):
-    from bgfn import config, profile_schema
+    from bgfn import profile_schema
     from bgfn.profile_schema import check_with_drives
 
     monkeypatch.setattr(profile_schema, "load_drive", lambda name, profile=None: SimpleNamespace(
@@ -212,7 +211,7 @@ def test_check_with_drives_applies_the_rule_to_each_drive(params, monkeypatch):
 def test_training_and_evaluation_take_each_datasets_outages():
     from bgfn import evaluate as ev
     from bgfn import train as T
-    from bgfn.profile_schema import load_profile, with_overrides
+    from bgfn.profile_schema import load_profile
 
     smoke = T.TrainingPlan.of(load_profile("smoke"))                   # the shipped mapping: every Turin dataset the default
     default = outages.default_windows(smoke.cfg)

@@ -96,12 +96,6 @@ class Drive:
         meta = dict(self.meta, crop=[t_start, t_end])
         return Drive(self.name, ref, sel_imu(self.imu), sel(self.gnss), meta, sel_imu(self.imu_bias))
 
-    @property
-    def has_attitude(self) -> bool:
-        """True when the reference's ``roll``, ``pitch`` and ``yaw`` are all finite (a drive without a reference
-        attitude, e.g. a user's log, holds them all NaN)."""
-        return bool(np.isfinite(self.reference[["roll", "pitch", "yaw"]].to_numpy(float)).all())
-
     def validate(self, source: str | None = None, files: dict | None = None) -> "Drive":
         """Check columns, strictly increasing times, finite values and physics; return self.
 

@@ -191,7 +191,7 @@ def twin_lines(table: pd.DataFrame, tolerance: float = 1.25) -> list[str]:
             f"{twin_e:.3g} deg/s for the stand-in's error model simulated with {model:.3g} deg/s (ratio {ratio:.2f}; "
             f"median INS drift, each with its filter's own model: {drift}).",
             ("The stand-in's setting holds: its simulated IMU is as rough as the recorded one within a factor "
-             f"{tolerance:g}." if holds else f"The stand-in's setting does not hold: its simulated IMU is "
+             f"{tolerance:g}." if holds else "The stand-in's setting does not hold: its simulated IMU is "
              + ("smoother" if ratio > 1 else "rougher") + f" than the recorded one; the measurement implies "
              f"{implied_setting(table):.3g} deg/s (evaluate.imu_twin.settle_setting).")]
 

@@ -7,8 +7,10 @@ mean NIS) for a clock mistake.
 
 The turn rate is seen by both: the gyros measure it directly, the GNSS course (the direction of the velocity
 from successive fixes) changes with it while the platform moves. :func:`estimate_gnss_offset` cross-correlates
-the magnitude of the course rate from the fixes with the magnitude of the angular rate from the IMU (both
-sign-free, so a mounting or an axis convention does not matter) over lags of +- ``max_lag_s`` and returns the
+the magnitude of the course rate from the fixes with the magnitude of the IMU's angular rate about the vertical
+(the direction of the log's mean specific force: the IMU's own, so a mounting or an axis convention does not
+matter; the roll and pitch rates, which lead or lag the turn in a car's body, would shift the match) over lags of
++- ``max_lag_s`` and returns the
 lag of the best match: the time by which the GNSS stamps are late against the IMU's (positive: the fixes are
 stamped after the motion the IMU saw at that time).
 """
@@ -21,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from bgfn.nav.earth import lla_to_ned
-from bgfn.schema import GYRO_COLUMNS
+from bgfn.schema import ACCEL_COLUMNS, GYRO_COLUMNS
 
 #: Lags searched, s (more than the 18 s between GPS time and UTC), and their step, s.
 MAX_LAG_S, LAG_STEP_S = 30.0, 0.05
@@ -85,7 +87,8 @@ def estimate_gnss_offset(imu: pd.DataFrame, gnss: pd.DataFrame, max_lag_s: float
     if tg.size < MIN_FIXES:
         return OffsetEstimate(float("nan"), float("nan"), int(tg.size))
     ti = imu["time"].to_numpy(float)
-    w = np.linalg.norm(imu[list(GYRO_COLUMNS)].to_numpy(float), axis=1)
+    f = imu[list(ACCEL_COLUMNS)].to_numpy(float).mean(axis=0)             # -g on average: the vertical, body frame
+    w = np.abs(imu[list(GYRO_COLUMNS)].to_numpy(float) @ (f / np.linalg.norm(f)))
     # the IMU's rate averaged over one GNSS interval (what a course difference sees), as a running mean
     dt_g = float(np.median(np.diff(gnss["time"].to_numpy(float))))
     n = max(1, int(round(dt_g / float(np.median(np.diff(ti))))))

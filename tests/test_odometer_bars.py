@@ -129,3 +129,14 @@ def test_the_two_evaluation_outages_are_one_more_fold_at_their_own_duration(monk
     assert first["method"].iloc[0] == "INS+NHC" and (table["runs"] == 1).all()
     # the sweep's statistics never see them
     assert not (O.odometer_summary(rows[rows["fold"] != O.PAPER_FOLD])["duration_s"].isin([15.0, 20.0])).any()
+
+
+def test_a_walker_gets_no_odometer_bars():
+    """The learned odometer is a car's forward speed fused with the NHC rows: a walker's drive is skipped, saying so."""
+    drive = demo_drive("synthetic", 150.0, 5.0, 3)
+    drive.meta["platform"] = "walker"
+    cfg = load_profile("smoke")
+    ecfg = ev.evaluate_config({"sweep": {"n_starts": 2, "folds": 2, "durations_s": [10.0], "warmup_s": 30.0}},
+                              cfg["train"])
+    rows, facts = O.odometer_rows(cfg, "t", "synthetic", ecfg, drive=drive)
+    assert rows.empty and list(rows.columns) == list(O.ODOMETER_COLUMNS) and facts["skipped"] == "walker"

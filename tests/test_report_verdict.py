@@ -76,6 +76,19 @@ def test_answers_say_the_measured_numbers():
     assert "leaky: 3.0 m, 80 % below INS" in prot and "79.7-90 %" in prot            # (15 - 3) / 15
     assert "main), honest: 60.0 m, 4.0 times INS" in prot
     assert headline(inp, t).endswith("INS with non-holonomic constraints 5.0 m.")
+    # a walker's constraint row is its ZUPT alone: the headline says so (the platform from kf_baseline.json)
+    walker = _inputs(platform="walker")
+    assert headline(walker, verdict_table(walker)).endswith("INS with zero-velocity updates (no NHC) 5.0 m.")
+
+
+def test_the_platform_comes_from_notebook_02s_record(tmp_path):
+    import json
+
+    from bgfn.report.verdict import _platform
+    (tmp_path / "kf_baseline.json").write_text(json.dumps(
+        {"datasets": {"/data/my walk": {"constraints": {"platform": "walker"}}, "car": {"constraints": None}}}))
+    assert _platform(tmp_path, "/data/my walk") == "walker" and _platform(tmp_path, "car") == "car"
+    assert _platform(tmp_path / "nowhere", "x") == "car"
 
 
 def test_missing_tables_say_not_measured():

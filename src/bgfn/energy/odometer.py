@@ -25,6 +25,7 @@ from bgfn.energy.checkpoint import MEASURED, SPIKING, check_trained
 from bgfn.energy.counts import layer_counts, mean_rate
 from bgfn.energy.tables import reduction_pct, stack_tables, table_from_counts, total_energy_uj
 from bgfn.learning import odometry as lo
+from bgfn.nav.constraints import DEFAULT_PLATFORM
 from bgfn.paper import odometer_label
 from bgfn.train import load_trained
 from bgfn.train.checkpoints import card_path, checkpoint_name, odometer_models_dir
@@ -33,15 +34,18 @@ from bgfn.train.checkpoints import card_path, checkpoint_name, odometer_models_d
 FOLD = 0
 
 
-def odometer_dataset(cfg: dict) -> str | None:
+def odometer_dataset(cfg: dict, profile: str | None = None) -> str | None:
     """The dataset whose odometers are measured: the first of the odometer bars' drives
-    (:func:`bgfn.config.odometer_datasets`), recorded drives first; None when the profile trains no odometer
-    network."""
+    (:func:`bgfn.config.odometer_datasets`), recorded drives first, that is a car (notebook 04 trains no odometer
+    for another platform; checked on the drive when ``profile`` is given); None when the profile trains no
+    odometer network."""
     ecfg = cfg.get("evaluate") or {}
     oc = ecfg.get("odometer") or {}
     if not oc.get("methods"):
         return None
     names = recorded_first(odometer_datasets(oc, (ecfg.get("sweep") or {}).get("datasets")))
+    if profile is not None:
+        names = [n for n in names if load_drive(n, profile=profile).meta.get("platform", DEFAULT_PLATFORM) == "car"]
     return names[0] if names else None
 
 
@@ -117,7 +121,7 @@ def odometer_energy(profile: str, cfg: dict, e_mac: float, e_ac: float, batch_si
     bgfn.errors.DataError
         BGFN-ODO never improved on its initial weights (unless ``energy.allow_untrained``).
     """
-    dataset = odometer_dataset(cfg)
+    dataset = odometer_dataset(cfg, profile)
     if dataset is None:
         return None
     oc = cfg["evaluate"]["odometer"]

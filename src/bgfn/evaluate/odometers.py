@@ -52,6 +52,7 @@ from bgfn.nav.outages import outage_windows
 from bgfn.train.checkpoints import checkpoint_name, odometer_models_dir
 from bgfn.train.objectives import SpeedObjective
 from bgfn.nav import odometer as no
+from bgfn.nav.constraints import DEFAULT_PLATFORM
 from bgfn import train
 from bgfn.paper import METHOD_LABELS, nhc_label, odometer_label
 from bgfn.parallel import Runner
@@ -129,6 +130,12 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
     t0 = time.perf_counter()
     oc, sw = ecfg["odometer"], ecfg["sweep"]
     drive = drive if drive is not None else load_drive(dataset, profile=profile)
+    platform = drive.meta.get("platform", DEFAULT_PLATFORM)
+    if platform != "car":
+        # a forward speed along the vehicle's x axis, fused with the NHC rows: a car's aid; a walker takes no NHC
+        return pd.DataFrame(columns=list(ODOMETER_COLUMNS)), {
+            "ridge_std_mps": {}, "paper_windows": [], "wall_s": time.perf_counter() - t0, "skipped": platform,
+            "speed_series": None}
     plan = profile_sweep_plan(cfg, drive, sw)
     dmax = max(float(d) for d in sw["durations_s"])
     paper = [(float(s), float(d)) for s, d in outage_windows(cfg, drive, dataset)] if oc["paper_outages"] else []
@@ -276,7 +283,10 @@ def run_odometer_bars(cfg: dict, profile: str, datasets, ecfg: dict, runner: Run
     for name in datasets:
         rows, facts[name] = odometer_rows(cfg, profile, name, ecfg, runner)
         parts.append(rows)
-        if report is not None:
+        if report is not None and facts[name].get("skipped"):
+            report(f"{name}: no odometer bars (platform {facts[name]['skipped']}: the learned odometer is a car's "
+                   "forward speed, fused with the non-holonomic constraints)")
+        elif report is not None:
             report(f"{name}: {len(rows)} odometer rows in {facts[name]['wall_s']:.1f} s; RIDGE-ODO std per fold "
                    + ", ".join(f"{v:.2f} m/s" for v in facts[name]["ridge_std_mps"].values()))
     rows = pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(columns=list(ODOMETER_COLUMNS))
@@ -363,6 +373,8 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
     atomic_write_csv(tables / SHARED_TABLES["odometer_paper"], paper, float_format="%.4f")
     figures = []
     for name, f in facts.items():
+        if f.get("skipped"):
+            continue
         for fig, stem in ((plot_speed_series(f["speed_series"], name), "odometer_speed"),
                           (plot_error_growth(summary[summary["dataset"] == name], name), "odometer_growth")):
             save_figure(fig, Path(out) / "figures" / f"{stem}_{dataset_id(name)}.png")

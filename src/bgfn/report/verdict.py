@@ -28,14 +28,14 @@ import numpy as np
 import pandas as pd
 
 from bgfn import paper
-from bgfn.config import MAIN_VARIANT, SHARED_TABLES
+from bgfn.config import MAIN_VARIANT, RUN_RECORDS, SHARED_TABLES
 from bgfn.data.names import dataset_id
 from bgfn.data.registry import recorded_first
 from bgfn.evaluate.tables import table_paths
 from bgfn.nav.ins_setups import gap_explained
 from bgfn.report.odometer_verdict import (OdometerInputs, answer_odometer, odometer_headline, odometer_rows,
                                           read_odometer_inputs, same_dataset)
-from bgfn.report.reading import read_csv
+from bgfn.report.reading import read_csv, read_json
 
 #: Rows of the verdict table, in order: (label, method label in the tables). The oracle row is built apart.
 METHOD_ROWS: tuple[tuple[str, str], ...] = (
@@ -71,6 +71,7 @@ class VerdictInputs:
     training_all_windows: pd.DataFrame | None = None    # training_all_windows.csv: untrained runs, all windows
     odometer: OdometerInputs | None = None          # outage_odometer*.csv, energy_odometer.csv
     nees: pd.DataFrame | None = None                # outage_nees.csv: the filter's consistency in outages
+    platform: str = "car"                           # kf_baseline.json: what carried the IMU (its aids)
 
     @classmethod
     def read(cls, out: str | Path, dataset: str) -> "VerdictInputs":
@@ -95,7 +96,7 @@ class VerdictInputs:
                                         read_csv(tables / SHARED_TABLES["odometer_summary"]),
                                         read_csv(tables / SHARED_TABLES["energy_odometer"]), dataset,
                                         read_csv(tables / SHARED_TABLES["odometer_paper"])),
-                   of(read_csv(tables / SHARED_TABLES["nees"])))
+                   of(read_csv(tables / SHARED_TABLES["nees"])), _platform(out, dataset))
 
 
 def _outage_value(seeds: pd.DataFrame | None, method: str, outage: int) -> float:
@@ -421,6 +422,20 @@ def verdict_sentences(inp: VerdictInputs, table: pd.DataFrame, claims: dict | No
             answer_ins_tuning(inp), answer_odometer(inp.odometer or OdometerInputs(None, None, None), SWEEP_DURATIONS)]
 
 
+def _platform(out: Path, dataset: str) -> str:
+    """The drive's platform as notebook 02 recorded it (``kf_baseline.json``; ``car`` when it says nothing)."""
+    record = read_json(Path(out) / RUN_RECORDS["kf_baseline"]) or {}
+    for name, facts in (record.get("datasets") or {}).items():
+        if dataset_id(name) == dataset_id(dataset):
+            return str(((facts or {}).get("constraints") or {}).get("platform", "car"))
+    return "car"
+
+
+#: What the ``INS+NHC`` row is on each platform (:data:`bgfn.nav.constraints.PLATFORM_AIDS`), in the headline's words.
+CONSTRAINT_WORDS = {"car": "INS with non-holonomic constraints", "walker": "INS with zero-velocity updates (no NHC)",
+                    "other": "INS with no constraint (platform other)"}
+
+
 def headline(inp: VerdictInputs, table: pd.DataFrame) -> str:
     """One line per test for the book's first page: BGFN against INS and INS+NHC where both were measured."""
     title = paper.TESTS[inp.test]["title"] if inp.test in paper.TESTS else inp.test
@@ -439,7 +454,7 @@ def headline(inp: VerdictInputs, table: pd.DataFrame) -> str:
     odo = odometer_headline(inp.odometer, SWEEP_DURATIONS) if inp.odometer is not None else ""
     return (f"{title} ({inp.dataset}): " + (f"{odo[0].upper()}{odo[1:]}. " if odo else "")
             + f"The paper's design, {where}: BGFN {_m(vals[0])}, {word} standalone INS ({_m(vals[1])}); "
-            f"INS with non-holonomic constraints {_m(vals[2])}.")
+            f"{CONSTRAINT_WORDS.get(inp.platform, CONSTRAINT_WORDS['car'])} {_m(vals[2])}.")
 
 
 def format_table(table: pd.DataFrame):

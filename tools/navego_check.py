@@ -123,7 +123,9 @@ def errors(nav_file: Path, drive, windows) -> list[dict]:
                      "max_north_m": float(np.abs(north[sel]).max())})
     aided = ~out_of & (t > t[0] + 60.0)              # after a minute of convergence
     rms = float(np.sqrt(np.mean(north[aided] ** 2 + east[aided] ** 2)))
-    return [{**r, "aided_rms_h_m": rms} for r in rows]
+    # the filters' bias states step by step: NaveGo's largest gyro-bias estimate against the drive's true biases
+    gyro_est = float(np.degrees(np.abs(np.asarray(m["b"], float)[:, :3]).max())) if "b" in m else float("nan")
+    return [{**r, "aided_rms_h_m": rms, "max_gyro_bias_est_dps": gyro_est} for r in rows]
 
 
 def octave_version(octave: str) -> str:

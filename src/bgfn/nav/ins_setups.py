@@ -18,7 +18,10 @@ Table columns (:data:`COLUMNS`; ``tables/kf_ins_tuning.csv``, ``bgfn.config.SHAR
 ``dataset``, ``test`` (the paper's test or empty), ``outage`` (1, 2, ...), ``setup``, ``max_east_m``,
 ``max_north_m`` (max absolute error in the outage, m, :func:`bgfn.nav.metrics.outage_metrics`), ``aided_rms_h_m``
 (the horizontal RMS of the setup's GPS-aided run over the whole drive, m: the state every outage starts from;
-NaveGo's own from its check; NaN for the paper's row and the reset bound, which shares the ``navego`` run).
+NaveGo's own from its check; NaN for the paper's row and the reset bound, which shares the ``navego`` run),
+``max_gyro_bias_est_dps`` (the largest gyro-bias estimate of that run over the drive, deg/s: the bias states step by
+step, NaveGo's from its check), ``true_gyro_bias_dps`` (the drive's largest true gyro bias, deg/s, a simulated IMU's
+``Drive.imu_bias``; NaN for a recorded one).
 """
 
 from __future__ import annotations
@@ -48,7 +51,8 @@ SETUPS: tuple[str, ...] = navego_setup.INS_TUNINGS + (RESET, NAVEGO_RUN, PAPER)
 NAVEGO_CHECK_FILE = PROJECT_ROOT / "data" / "measured" / "navego_check.csv"
 #: Its columns.
 NAVEGO_CHECK_COLUMNS: tuple[str, ...] = ("dataset", "outage", "start_s", "duration_s", "max_east_m", "max_north_m",
-                                         "aided_rms_h_m", "setting", "navego", "octave", "date", "commit")
+                                         "aided_rms_h_m", "max_gyro_bias_est_dps", "setting", "navego", "octave",
+                                         "date", "commit")
 
 
 def navego_measured(dataset: str, windows, path: Path = NAVEGO_CHECK_FILE) -> pd.DataFrame:
@@ -65,11 +69,22 @@ def navego_measured(dataset: str, windows, path: Path = NAVEGO_CHECK_FILE) -> pd
             rows.append(hit.iloc[0].to_dict() | {"outage": k})
     return pd.DataFrame(rows, columns=list(NAVEGO_CHECK_COLUMNS))
 #: Columns of :func:`ins_tuning_table`.
-COLUMNS: tuple[str, ...] = ("dataset", "test", "outage", "setup", "max_east_m", "max_north_m", "aided_rms_h_m")
+COLUMNS: tuple[str, ...] = ("dataset", "test", "outage", "setup", "max_east_m", "max_north_m", "aided_rms_h_m",
+                            "max_gyro_bias_est_dps", "true_gyro_bias_dps")
 
 
-def _row(dataset, test, outage, setup, east, north, aided=float("nan")) -> dict:
-    return dict(zip(COLUMNS, (dataset, test or "", int(outage), setup, float(east), float(north), float(aided))))
+def _row(dataset, test, outage, setup, east, north, aided=float("nan"), gyro=float("nan"),
+         true=float("nan")) -> dict:
+    return dict(zip(COLUMNS, (dataset, test or "", int(outage), setup, float(east), float(north), float(aided),
+                              float(gyro), float(true))))
+
+
+def _max_gyro_bias_dps(bias: pd.DataFrame | None) -> float:
+    """The largest absolute gyro bias of a bias table (estimates or truth) over the drive, deg/s."""
+    cols = ["gyro_bias_x", "gyro_bias_y", "gyro_bias_z"]
+    if bias is None or not set(cols) <= set(bias.columns):
+        return float("nan")
+    return float(np.degrees(np.nanmax(np.abs(bias[cols].to_numpy(float)))))
 
 
 def _aided_rms(b: Baseline) -> float:
@@ -101,6 +116,7 @@ def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None
     checked = check_windows(windows, float(drive.reference["time"].iloc[0]), float(drive.imu["time"].iloc[-1]),
                             f"{drive.name}: profile outage_windows", sort=False)      # Outage k as in notebook 02
     lever = drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0])
+    true = _max_gyro_bias_dps(drive.imu_bias)           # NaN for a recorded IMU (its biases are unknown)
     rows = []
     for tuning in navego_setup.INS_TUNINGS:
         c = {**cfg, "ins_tuning": tuning}
@@ -109,9 +125,9 @@ def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None
         ins = b.outage_table
         if "method" in ins.columns:                   # the standalone INS only (not the INS+NHC rows)
             ins = ins[ins["method"] == "INS"]
-        aided = _aided_rms(b)
+        aided, gyro = _aided_rms(b), _max_gyro_bias_dps(b.full.bias)
         for k, r in enumerate(ins.itertuples(index=False)):
-            rows.append(_row(drive.name, test, k + 1, tuning, r.max_abs_east, r.max_abs_north, aided))
+            rows.append(_row(drive.name, test, k + 1, tuning, r.max_abs_east, r.max_abs_north, aided, gyro, true))
         if tuning != "navego":
             continue
         imu = filter_imu(drive, c)
@@ -124,7 +140,8 @@ def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None
             m = metrics.outage_metrics(e, w)
             rows.append(_row(drive.name, test, k + 1, RESET, m["max_abs_east"], m["max_abs_north"]))
     for r in navego_measured(drive.name, [(w.start, w.duration) for w in checked]).itertuples(index=False):
-        rows.append(_row(drive.name, test, r.outage, NAVEGO_RUN, r.max_east_m, r.max_north_m, r.aided_rms_h_m))
+        rows.append(_row(drive.name, test, r.outage, NAVEGO_RUN, r.max_east_m, r.max_north_m, r.aided_rms_h_m,
+                         getattr(r, "max_gyro_bias_est_dps", float("nan")), true))
     if test:
         for r in paper.published_values(test).query("method == 'INS'").itertuples(index=False):
             rows.append(_row(drive.name, test, r.outage, PAPER, r.max_east_m, r.max_north_m))
@@ -187,7 +204,9 @@ def gap_explained(table: pd.DataFrame) -> pd.DataFrame:
     DataFrame
         One row per dataset with a paper test and per setup other than ``shipped``: ``dataset``, ``test``,
         ``setup``, ``shipped_m``, ``setup_m``, ``paper_m``, ``explained_pct`` (NaN when there is no gap),
-        ``aided_rms_h_m`` (the setup's GPS-aided horizontal RMS, m; NaN where the table has none).
+        ``aided_rms_h_m`` (the setup's GPS-aided horizontal RMS, m; NaN where the table has none),
+        ``max_gyro_bias_est_dps`` (its largest gyro-bias estimate over the drive, deg/s), ``true_gyro_bias_dps`` (the
+        drive's largest true gyro bias, deg/s; NaN for a recorded IMU).
     """
     rows = []
     for dataset, t in table.groupby("dataset", sort=False):
@@ -198,6 +217,8 @@ def gap_explained(table: pd.DataFrame) -> pd.DataFrame:
         size = {s: float(g[["max_east_m", "max_north_m"]].to_numpy().mean()) for s, g in t.groupby("setup")}
         aided = ({s: float(g["aided_rms_h_m"].iloc[0]) for s, g in t.groupby("setup")} if "aided_rms_h_m" in t.columns
                  else {})
+        gyro = ({s: float(g["max_gyro_bias_est_dps"].iloc[0]) for s, g in t.groupby("setup")}
+                if "max_gyro_bias_est_dps" in t.columns else {})
         gap = size[PAPER] - size["shipped"]
         for s in SETUPS:
             if s in ("shipped", PAPER) or s not in size:
@@ -205,9 +226,11 @@ def gap_explained(table: pd.DataFrame) -> pd.DataFrame:
             pct = 100.0 * (size[s] - size["shipped"]) / gap if abs(gap) > 1e-9 else float("nan")
             rows.append({"dataset": dataset, "test": t["test"].iloc[0], "setup": s, "shipped_m": size["shipped"],
                          "setup_m": size[s], "paper_m": size[PAPER], "explained_pct": pct,
-                         "aided_rms_h_m": aided.get(s, float("nan"))})
+                         "aided_rms_h_m": aided.get(s, float("nan")), "max_gyro_bias_est_dps": gyro.get(s, float("nan")),
+                         "true_gyro_bias_dps": (float(t["true_gyro_bias_dps"].iloc[0])
+                                                if "true_gyro_bias_dps" in t.columns else float("nan"))})
     return pd.DataFrame(rows, columns=["dataset", "test", "setup", "shipped_m", "setup_m", "paper_m",
-                                       "explained_pct", "aided_rms_h_m"])
+                                       "explained_pct", "aided_rms_h_m", "max_gyro_bias_est_dps", "true_gyro_bias_dps"])
 
 
 def _share(pct: float) -> str:
@@ -254,6 +277,14 @@ def _against_navego(gap: pd.DataFrame) -> str:
                  f"{ours:.1f} m for our setup of it"
                  + (" (NaveGo's own filter loses the drive with the GNSS still there)." if theirs > 3 * max(ours, 1.0)
                     else "."))
+    gyro = ({r.setup: r.max_gyro_bias_est_dps for r in gap.itertuples(index=False)}
+            if "max_gyro_bias_est_dps" in gap.columns else {})
+    g_ours, g_theirs = gyro.get("navego", np.nan), gyro.get(NAVEGO_RUN, np.nan)
+    if np.isfinite(g_ours) and np.isfinite(g_theirs):
+        text += (f" Their gyro-bias states, step by step: the largest estimate over the drive is {g_theirs:.3g} deg/s "
+                 f"in NaveGo, {g_ours:.3g} deg/s in our setup of it")
+        true = gap["true_gyro_bias_dps"].iloc[0] if "true_gyro_bias_dps" in gap.columns else np.nan
+        text += (f", against the drive's largest true gyro bias of {true:.3g} deg/s." if np.isfinite(true) else ".")
     return text
 
 

@@ -162,8 +162,10 @@ def _on_imu_clock(imu: pd.DataFrame, gnss: pd.DataFrame, auto: bool, files: dict
                         f"(a known delay: gnss_latency_s or imu_time_offset_s in {meta_path})",
                         f"stamps {est.offset_s:+.2f} s late against the IMU's (the turn rates of both correlate "
                         f"{est.correlation:.2f} at that lag){leap}")
+    line = (f"GNSS latency {applied:.2f} s estimated and taken off (gnss_latency_s: auto); left after it: "
+            f"{est.line()}" if auto else est.line())
     return gnss, {"applied_latency_s": float(applied), "residual_s": est.offset_s, "correlation": est.correlation,
-                  "fixes": est.fixes, "line": est.line()}
+                  "fixes": est.fixes, "line": line}
 
 
 def rotate_imu(imu: pd.DataFrame, mounting_deg) -> pd.DataFrame:

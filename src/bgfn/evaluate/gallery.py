@@ -50,11 +50,8 @@ def run_log(log: GalleryLog, folder: Path, cfg: dict) -> GalleryRun:
     windows = outage_windows(cfg, drive, str(folder))
     b = run_baseline(drive, nav_config(cfg["nav"]), windows)
     decisions = []
-    if "gnss_offset" in drive.meta:
-        off = drive.meta["gnss_offset"]
-        applied = (f"GNSS latency estimated and applied ({off['applied_latency_s']:.2f} s, gnss_latency_s: auto); "
-                   "what is left: " if off.get("applied_latency_s") else "")
-        decisions.append(f"{drive.name}: {applied}{off['line']}")
+    if "gnss_offset" in drive.meta:            # the clocks (with gnss_latency_s: auto, the latency taken off)
+        decisions.append(f"{drive.name}: {drive.meta['gnss_offset']['line']}")
     mounting = drive.meta.get("imu_mounting_deg") or [0.0, 0.0, 0.0]
     if np.any(mounting):
         decisions.append(f"{drive.name}: IMU rows rotated into the body frame by the mounting "

@@ -84,12 +84,15 @@ def course_over_ground(v_n, v_e, min_speed_mps: float = COURSE_MIN_SPEED_MPS) ->
     v_n, v_e = np.asarray(v_n, dtype=float), np.asarray(v_e, dtype=float)
     course = np.arctan2(v_e, v_n)
     fast = np.hypot(v_n, v_e) >= min_speed_mps
-    if not fast.any():
-        return np.zeros_like(course)
-    idx = np.where(fast, np.arange(course.size), -1)
-    idx = np.maximum.accumulate(idx)                 # last trusted epoch at or before each epoch
-    idx[idx < 0] = int(np.argmax(fast))              # before the first: the first trusted one
-    return course[idx]
+    return hold_trusted(course, fast) if fast.any() else np.zeros_like(course)
+
+
+def hold_trusted(values: np.ndarray, trusted: np.ndarray) -> np.ndarray:
+    """``values`` with each untrusted epoch taking the nearest earlier trusted one (the first trusted one before the
+    first); ``trusted`` must hold at least one True."""
+    idx = np.maximum.accumulate(np.where(trusted, np.arange(len(values)), -1))   # last trusted at or before each
+    idx[idx < 0] = int(np.argmax(trusted))
+    return np.asarray(values)[idx]
 
 
 def body_to_nav(truth: pd.DataFrame) -> np.ndarray:

@@ -35,12 +35,13 @@ import pandas as pd
 from scipy.ndimage import uniform_filter1d
 
 from bgfn.data.allan import allan_deviation, bias_change_var, gauss_markov_avar, white_avar
-from bgfn.data.gnss import COURSE_MIN_SPEED_MPS, course_over_ground
+from bgfn.data.gnss import COURSE_MIN_SPEED_MPS, course_over_ground, hold_trusted
 from bgfn.data.imu_errors import apply_imu_errors, error_params
 from bgfn.data.imu_levels import DRIVING_MPS, SENSORS, UNITS, imu_rate_hz, rest_spans
 from bgfn.errors import DataError
 from bgfn.nav.earth import earth_rate_n
 from bgfn.nav.sim import imu_from_trajectory
+from bgfn.nav.transform import dcm_from_euler
 
 #: Averaging times of the Allan deviation at rest, s (a stop lasts seconds to a minute).
 REST_TAUS_S: tuple[float, ...] = (0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0)
@@ -115,9 +116,7 @@ def stop_biases(drive, min_stop_s: float = MIN_STOP_S) -> pd.DataFrame:
     rows = []
     for i0, i1 in rest_spans(imu, ref, min_rest_s=min_stop_s):
         k = int(np.clip(np.searchsorted(rt, 0.5 * (t[i0] + t[i1 - 1])), 0, rt.size - 1))
-        w = earth_rate_n(lat[k])                       # NED, rad/s
-        c, s = np.cos(yaw[k]), np.sin(yaw[k])
-        w_body = np.array([c * w[0] + s * w[1], -s * w[0] + c * w[1], w[2]])
+        w_body = dcm_from_euler(0.0, 0.0, yaw[k]).T @ earth_rate_n(lat[k])     # level IMU along the heading, rad/s
         rows.append([t[i0], t[i1 - 1], 0.5 * (t[i0] + t[i1 - 1]), t[i1 - 1] - t[i0],
                      *(gyro[i0:i1].mean(axis=0) - w_body)])
     return pd.DataFrame(rows, columns=["t0", "t1", "t_mid", "duration_s", "gyro_bias_x", "gyro_bias_y",
@@ -308,11 +307,8 @@ def trajectory_twin(recorded, imu_errors: dict, seed: int, smooth_s: float = 0.5
         n = max(1, int(round(smooth_s * imu_rate_hz(recorded.imu))))
         course = uniform_filter1d(np.unwrap(course_over_ground(vn, ve)), n, mode="nearest")
         # the climb angle, held through slow rows like the course (the same rows are trusted)
-        climb = np.arctan2(-vd, np.maximum(speed, COURSE_MIN_SPEED_MPS))
-        slow = speed < COURSE_MIN_SPEED_MPS
-        idx = np.maximum.accumulate(np.where(~slow, np.arange(speed.size), -1))
-        idx[idx < 0] = int(np.argmax(~slow))
-        climb = uniform_filter1d(climb[idx], n, mode="nearest")
+        climb = hold_trusted(np.arctan2(-vd, np.maximum(speed, COURSE_MIN_SPEED_MPS)), speed >= COURSE_MIN_SPEED_MPS)
+        climb = uniform_filter1d(climb, n, mode="nearest")
         ref["roll"], ref["pitch"], ref["yaw"] = 0.0, climb, np.angle(np.exp(1j * course))
     params = error_params({k: v for k, v in imu_errors.items()
                            if k not in ("realized", "p0_gyro_bias_std", "p0_accel_bias_std", "note", "file_profile")})

@@ -20,7 +20,7 @@ import pandas as pd
 from bgfn.data import load_drive
 from bgfn.data.gallery import GalleryLog
 from bgfn.nav.baseline import nav_config, run_baseline
-from bgfn.nav.constraints import DEFAULT_PLATFORM, PLATFORM_AIDS
+from bgfn.nav.constraints import DEFAULT_PLATFORM, platform_aids
 from bgfn.nav.outages import describe_windows, outage_windows
 
 #: Columns of ``tables/gallery.csv``.
@@ -57,13 +57,11 @@ def run_log(log: GalleryLog, folder: Path, cfg: dict) -> GalleryRun:
         decisions.append(f"{drive.name}: IMU rows rotated into the body frame by the mounting "
                          f"{[float(x) for x in mounting]} deg (roll, pitch, yaw) of meta.yaml")
     decisions += describe_windows(cfg, drive, str(folder)) + b.lines()
-    h = b.errors["horizontal"].to_numpy(float)                 # GPS-aided, against the reference, m
-    h = h[np.isfinite(h)]
     base = {"log": drive.name, "kind": log.kind, "platform": drive.meta.get("platform", DEFAULT_PLATFORM),
             "duration_s": float(drive.imu["time"].iloc[-1] - drive.imu["time"].iloc[0]), "imu_rows": len(drive.imu),
             "gnss_fixes": len(drive.gnss), "noise_scale": float(b.setup.noise_scale) if b.setup is not None else 1.0,
-            "gps_rms_h_m": float(np.sqrt(np.mean(h ** 2))) if h.size else np.nan,
-            "gps_max_h_m": float(h.max()) if h.size else np.nan}
+            "gps_rms_h_m": float(b.rms.loc["horizontal", "rms"]),        # GPS-aided, against the reference, m
+            "gps_max_h_m": float(b.rms.loc["horizontal", "max_abs"])}
     rows = []
     aided = _aided_label(base["platform"])
     for k, (start, _) in enumerate(windows, start=1):
@@ -80,8 +78,8 @@ def _aided_label(platform: str) -> str:
     aids it takes (``INS+ZUPT`` for a walker; ``INS`` again for ``other``, which takes none)."""
     if platform == "car":
         return "INS+NHC"
-    aids = [a for a, on in zip(("NHC", "ZUPT"), PLATFORM_AIDS[platform]) if on]
-    return "+".join(["INS"] + aids) if aids else "INS (no aid)"
+    aids = platform_aids(platform)
+    return "+".join(("INS", *aids)) if aids else "INS (no aid)"
 
 
 def gallery_table(runs: list[GalleryRun]) -> pd.DataFrame:

@@ -205,12 +205,12 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
     results = (runner or Runner()).map(odometer_run, [(ctx, r, ecfg["pseudo_gps"]) for r in runs],
                                        labels=[r.label for r in runs], desc=f"odometer bars {dataset}")
     rows = []
-    paper = dict(paper)
+    paper_duration = dict(paper)                 # start -> the evaluation outage's own duration
     for run, outs in zip(runs, results):
         track = tracks.get(run.label)
         for r in outs:
             # a paper outage at its own duration only; a sweep window at every duration of the sweep
-            for du in (sw["durations_s"] if run.fold != PAPER_FOLD else [paper[r.start]]):
+            for du in (sw["durations_s"] if run.fold != PAPER_FOLD else [paper_duration[r.start]]):
                 m = window_metrics(r.errors, r.start, float(du))
                 rows.append({"dataset": dataset, "start_s": r.start, "duration_s": float(du), "method": run.method,
                              "sigma_mps": run.sigma_mps, "seed": run.seed, "fold": run.fold,

@@ -75,6 +75,11 @@ PLATFORM_AIDS: dict[str, tuple[bool, bool]] = {"car": (True, True), "walker": (F
 DEFAULT_PLATFORM = "car"
 
 
+def platform_aids(platform: str) -> tuple[str, ...]:
+    """The names of the aids ``platform`` takes, in order (``("NHC", "ZUPT")`` for a car; :data:`PLATFORM_AIDS`)."""
+    return tuple(a for a, on in zip(("NHC", "ZUPT"), PLATFORM_AIDS[platform]) if on)
+
+
 @dataclass(frozen=True)
 class ConstraintConfig:
     """Settings of the vehicle constraints (a profile's ``nav.nhc`` and ``nav.zupt``).
@@ -122,7 +127,7 @@ class ConstraintConfig:
 
     def describe(self) -> str:
         """Which aids run, and why (the platform)."""
-        aids = [a for a, on in (("NHC", self.nhc), ("ZUPT", self.zupt)) if on]
+        aids = platform_aids(self.platform)
         return (f"platform {self.platform}: " + (" and ".join(aids) if aids else "no vehicle constraint")
                 + {"car": "", "walker": " (no NHC: a walker steps sideways)",
                    "other": " (neither: no motion model is known)"}[self.platform])

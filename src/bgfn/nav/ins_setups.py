@@ -87,13 +87,6 @@ def _max_gyro_bias_dps(bias: pd.DataFrame | None) -> float:
     return float(np.degrees(np.nanmax(np.abs(bias[cols].to_numpy(float)))))
 
 
-def _aided_rms(b: Baseline) -> float:
-    """Horizontal RMS of a baseline's GPS-aided run against the reference, m."""
-    h = b.errors["horizontal"].to_numpy(float)
-    h = h[np.isfinite(h)]
-    return float(np.sqrt(np.mean(h ** 2))) if h.size else float("nan")
-
-
 def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None) -> pd.DataFrame:
     """The standalone-INS max errors of ``drive`` in each outage under every setup (module docstring).
 
@@ -125,7 +118,7 @@ def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None
         ins = b.outage_table
         if "method" in ins.columns:                   # the standalone INS only (not the INS+NHC rows)
             ins = ins[ins["method"] == "INS"]
-        aided, gyro = _aided_rms(b), _max_gyro_bias_dps(b.full.bias)
+        aided, gyro = float(b.rms.loc["horizontal", "rms"]), _max_gyro_bias_dps(b.full.bias)
         for k, r in enumerate(ins.itertuples(index=False)):
             rows.append(_row(drive.name, test, k + 1, tuning, r.max_abs_east, r.max_abs_north, aided, gyro, true))
         if tuning != "navego":

@@ -4,6 +4,7 @@ removing a static bias, and the table beside the paper's INS row."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -19,7 +20,7 @@ from bgfn.nav import baseline, ins_setups, metrics, sim
 from bgfn.nav import error_model as em
 from bgfn.nav import navego_setup as ns
 from bgfn.nav import state as st
-from bgfn.nav.filter import noise_arrays, run_outage
+from bgfn.nav.filter import noise_arrays, run_filter, run_outage
 from bgfn.nav.outages import OutageWindow
 from synthetic_drive import demo_drive
 
@@ -43,7 +44,7 @@ def drive():
 def test_navego_q_and_p0_are_the_profiles_dynamic_biases():
     errs = ie.error_params("ekinox-d")
     noise = ns.navego_noise(errs)
-    q_g, q_a, q_bg, q_ba, inv_tau_a, inv_tau_g = noise_arrays(noise)
+    q_g, q_a, q_bg, q_ba, inv_tau_a, inv_tau_g, decay_a, decay_g = noise_arrays(noise)
     # NaveGo's Ekinox profile: gb_dyn [8.1e-6, 7.1e-6, 9.8e-6] rad/s, gb_corr 10 s; ab_dyn [8.4e-5, 6.7e-5,
     # 7.4e-5] m/s^2, ab_corr [0.5, 2, 1] s; Q = (gb_dyn / sqrt(gb_corr))^2 (imu_si_errors.m).
     np.testing.assert_allclose(q_bg, [6.561e-12, 5.041e-12, 9.604e-12], rtol=1e-12)
@@ -61,6 +62,9 @@ def test_navego_q_and_p0_are_the_profiles_dynamic_biases():
     shipped = noise_arrays(st.noise_from_imu_errors(errs, "gauss_markov"))
     np.testing.assert_allclose(shipped[2], 2 * q_bg, rtol=1e-12)
     np.testing.assert_allclose(shipped[3], 2 * q_ba, rtol=1e-12)
+    # NaveGo holds its bias estimates between updates (F keeps -1/tau); the shipped filter relaxes them with it
+    assert not decay_a.any() and not decay_g.any()
+    np.testing.assert_array_equal(shipped[6:], shipped[4:6])
     # F: the bias states decay with -1/tau
     F = em.system_matrix([0.78, 0.13, 250.0], [5.0, 2.0, 0.0], np.eye(3), [0.0, 0.0, -9.8],
                          noise.accel_bias_tau, noise.gyro_bias_tau)
@@ -164,6 +168,25 @@ def test_the_evaluation_reads_the_same_setup(drive):
     assert run.errors["east"].abs().max() == pytest.approx(b.outage_table["max_abs_east"].iloc[1], abs=1e-9)
 
 
+def test_navegos_bias_estimates_are_held_through_an_outage_where_the_shipped_ones_relax(drive):
+    # NaveGo corrects every IMU sample with its last estimate (ins_gnss.m lines 251-252): 60 s of standalone INS
+    # end with the estimate it started with; a Gauss-Markov estimate relaxes as exp(-t / tau) toward zero
+    noise = ns.navego_noise(drive.meta["imu_errors"])
+    row = drive.reference.iloc[0]
+    start = st.initial_state(row, st.initial_covariance(row[["lat", "lon", "h"]].to_numpy(float), noise, 1.0, 2.0,
+                                                        0.1, 0.003, 0.01))
+    start.gyro_bias[:], start.accel_bias[:] = [1e-3, -2e-3, 3e-3], [0.05, -0.02, 0.01]
+    imu = drive.imu[drive.imu["time"] <= float(row["time"]) + 60.0]
+    held = run_filter(imu, start, noise).bias.iloc[-1]
+    relaxed = run_filter(imu, start, replace(noise, hold_bias_estimates=False)).bias.iloc[-1]
+    t = float(held["time"]) - float(row["time"])
+    for sensor, b0, tau in (("gyro", start.gyro_bias, noise.gyro_bias_tau), ("accel", start.accel_bias,
+                                                                           noise.accel_bias_tau)):
+        cols = [f"{sensor}_bias_{a}" for a in "xyz"]
+        np.testing.assert_array_equal(held[cols].to_numpy(float), b0)
+        np.testing.assert_allclose(relaxed[cols].to_numpy(float), b0 * np.exp(-t / tau), rtol=1e-9)
+
+
 # ----------------------------------------------------------------------------------------------- the table
 def test_ins_tuning_table_runs_every_setup_beside_the_papers_row(drive, tmp_path):
     cfg = baseline.nav_config(NAV)
@@ -171,7 +194,7 @@ def test_ins_tuning_table_runs_every_setup_beside_the_papers_row(drive, tmp_path
     table = ins_setups.ins_tuning_table(drive, cfg, WINDOWS, baseline=shipped)
     assert list(table.columns) == list(ins_setups.COLUMNS)
     # NaveGo's own run (make navego-check) has no row for this synthetic drive
-    assert table["setup"].tolist() == [s for s in ins_setups.SETUPS if s != ins_setups.NAVEGO_RUN for _ in (1, 2)]
+    assert table["setup"].tolist() == [s for s in ins_setups.SETUPS if "Octave" not in s for _ in (1, 2)]
     assert set(table["test"]) == {"dataset"}
     rows = table.set_index(["setup", "outage"])
     navego = baseline.run_baseline(drive, {**cfg, "ins_tuning": "navego"}, WINDOWS)
@@ -185,7 +208,7 @@ def test_ins_tuning_table_runs_every_setup_beside_the_papers_row(drive, tmp_path
     pd.testing.assert_frame_equal(ins_setups.ins_tuning_table(drive, cfg, WINDOWS), table)
     # a tactical IMU's dynamic-bias estimates are small: clearing them at the start changes little
     reset, nav = (table[table["setup"] == s][["max_east_m", "max_north_m"]].to_numpy() for s in ("navego-reset", "navego"))
-    np.testing.assert_allclose(reset, nav, atol=0.05)
+    np.testing.assert_allclose(reset, nav, rtol=0.05, atol=0.05)
     lay = ins_setups.layout(table, drive.name)
     assert list(lay.index) == ["Outage 1", "Outage 2"]
     assert lay[("paper", "North")].tolist() == [23.2, 19.6]
@@ -224,7 +247,7 @@ def test_the_navego_row_does_not_depend_on_the_static_bias_it_removes():
 
 
 def _table(values):
-    rows = [("turin-sim-ekinox", "dataset", o, s, e, n, 1.0, 0.1, 1.7) for s, o, e, n in values]
+    rows = [("turin-sim-ekinox", "dataset", o, s, e, n, 1.0, 0.1, 1.7, 0.05, 0.8) for s, o, e, n in values]
     return pd.DataFrame(rows, columns=list(ins_setups.COLUMNS))
 
 
@@ -246,12 +269,23 @@ def test_gap_explained_and_its_sentences():
     # NaveGo's own run beside our setup of it: the ratio, and both GPS-aided solutions (NaveGo's far off here)
     own = _table([("shipped", 1, 2.0, 2.0), ("navego", 1, 30.0, 30.0), ("NaveGo (Octave)", 1, 60.0, 60.0),
                   ("paper", 1, 12.0, 12.0)])
-    own.loc[own["setup"] == "NaveGo (Octave)", ["aided_rms_h_m", "max_gyro_bias_est_dps"]] = [190.0, 44.0]
+    own.loc[own["setup"] == "NaveGo (Octave)", ["aided_rms_h_m", "max_gyro_bias_est_dps",
+                                                "max_accel_bias_est_mps2"]] = [190.0, 44.0, 3.1]
     line = ins_setups.sentences(own)[0]
-    assert ("the largest estimate over the drive is 44 deg/s in NaveGo, 0.1 deg/s in our setup of it, against the "
-            "drive's largest true gyro bias of 1.7 deg/s") in line
+    assert ("the largest gyro-bias estimate over the drive is 44 deg/s in NaveGo, 0.1 deg/s in our setup of it, "
+            "against the drive's largest true gyro bias of 1.7 deg/s") in line
+    assert ("the largest accelerometer-bias estimate over the drive is 3.1 m/s^2 in NaveGo, 0.05 m/s^2 in our setup "
+            "of it, against the drive's largest true accelerometer bias of 0.8 m/s^2") in line
     assert "Our setup of NaveGo gives 0.50 times NaveGo's own INS error (more than 30 % apart" in line
     assert "190.0 m horizontal RMS for NaveGo, 1.0 m for our setup of it (NaveGo's own filter loses" in line
+    assert "bias feedback made consistent" not in line          # that run is not in this table
+    # ... and NaveGo with its bias feedback made consistent (make navego-check's diagnostic run): 30 / 25 = 1.2
+    fixed = pd.concat([own, _table([(ins_setups.NAVEGO_CONSISTENT, 1, 25.0, 25.0)])], ignore_index=True)
+    fixed.loc[fixed["setup"] == ins_setups.NAVEGO_CONSISTENT, "aided_rms_h_m"] = 4.2
+    line = ins_setups.sentences(fixed)[0]
+    assert "With NaveGo's bias feedback made consistent" in line
+    assert "our setup gives 1.20 times its INS error (within 30 %); its GPS-aided RMS is 4.2 m" in line
+    assert ins_setups.gap_explained(fixed).set_index("setup").loc[ins_setups.NAVEGO_CONSISTENT, "setup_m"] == 25.0
     # a dataset that stands for no paper test has no gap to explain
     assert ins_setups.gap_explained(over.assign(dataset="synthetic").query("setup != 'paper'")).empty
 
@@ -269,3 +303,10 @@ def test_navegos_own_rows_are_read_for_the_profiles_outages_only(tmp_path):
     assert got[["outage", "max_east_m"]].values.tolist() == [[1, 7.0]]
     assert ins_setups.navego_measured("other", [(300.0, 30.0)], path).empty
     assert ins_setups.navego_measured("d", [(300.0, 30.0)], tmp_path / "missing.csv").empty
+    # a file with both of make navego-check's runs: each variant reads its own rows (no column: the released one)
+    both = pd.read_csv(path).assign(variant="as released")
+    both = pd.concat([both, both.assign(variant="bias feedback consistent", max_east_m=[1.0, 2.0])])
+    both.to_csv(path, index=False)
+    assert ins_setups.navego_measured("d", [(300.0, 30.0)], path)["max_east_m"].tolist() == [7.0]
+    assert ins_setups.navego_measured("d", [(300.0, 30.0)], path,
+                                      variant="bias feedback consistent")["max_east_m"].tolist() == [2.0]

@@ -50,3 +50,22 @@ def test_the_structs_written_for_octave_read_back_equal_the_drive(tmp_path):
     np.testing.assert_array_equal(g.lat, drive.gnss["lat"].to_numpy())
     np.testing.assert_array_equal(g.vel, drive.gnss[["v_n", "v_e", "v_d"]].to_numpy())       # the file's own
     assert str(back["att_mode"]) == "quaternion" and i.ini_align.shape == (3,)
+
+
+def test_the_diagnostic_copy_changes_navegos_bias_feedback_and_nothing_else(tmp_path):
+    # a stand-in for NaveGo's tree: the three lines of ins_gnss.m Version 011 the diagnostic changes, and another file
+    src = tmp_path / "navego"
+    (src / "ins-gnss").mkdir(parents=True)
+    lines = ["kf.xp(1:9) = 0.0;           % states 1 to 9", "gb_dyn   = -kf.xp(10:12);", "ab_dyn   = -kf.xp(13:15);"]
+    (src / navego_check.PATCHED_FILE).write_text("\n".join(["x = 1;", *lines, "y = 2;"]) + "\n")
+    (src / "ins-gnss" / "F_update.m").write_text("F = 0;\n")
+    out = navego_check.patched_navego(src, tmp_path / "run")
+    got = (out / navego_check.PATCHED_FILE).read_text().splitlines()
+    assert got == ["x = 1;", "kf.xp(1:15) = 0.0;           % states 1 to 9", "gb_dyn   = gb_dyn - kf.xp(10:12);",
+                   "ab_dyn   = ab_dyn + kf.xp(13:15);", "y = 2;"]
+    assert (out / "ins-gnss" / "F_update.m").read_text() == "F = 0;\n"
+    assert (src / navego_check.PATCHED_FILE).read_text().splitlines()[1:4] == lines      # the source untouched
+    # another NaveGo version (a line not there): one error naming the file and the line, no run
+    (src / navego_check.PATCHED_FILE).write_text("gb_dyn = 0;\n")
+    with pytest.raises(ValueError, match=r"ins_gnss.m: expected the line `kf.xp\(1:9\) = 0.0;` exactly once"):
+        navego_check.patched_navego(src, tmp_path / "again")

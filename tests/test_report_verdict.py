@@ -237,3 +237,19 @@ def test_the_oracle_speed_row_says_when_the_networks_speed_error_is_beyond_its_g
     assert t.loc[ORACLE_ODO_ROW, "inputs"] == "speed RMSE 3/3 m/s: beyond the oracle's grid where empty"
     assert verdict_table(_inputs(odometer=_odometer())).set_index("row").loc[ORACLE_ODO_ROW, "inputs"] == \
         "speed RMSE 0.5/0.5 m/s"
+
+
+def test_the_ins_answer_puts_navego_itself_beside_our_setup_of_it():
+    from bgfn.nav import ins_setups
+    from bgfn.report.verdict import answer_ins_tuning
+
+    rows = [("turin-sim-mpu6000", "field", o, s, e, e, 1.0, 0.1, 1.7, 0.05, 0.8)
+            for s, e in (("shipped", 20.0), ("navego", 40.0), (ins_setups.NAVEGO_RUN, 400.0),
+                         (ins_setups.NAVEGO_CONSISTENT, 42.0), ("paper", 300.0)) for o in (1, 2)]
+    table = pd.DataFrame(rows, columns=list(ins_setups.COLUMNS))
+    line = answer_ins_tuning(_inputs(ins_tuning=table))
+    assert ("20.0 m with our filter, 40.0 m with NaveGo v1.4's bias modelling, 400.0 m with NaveGo v1.4 itself under "
+            "Octave (42.0 m with its bias feedback made consistent), 300.0 m in the paper") in line
+    # without make navego-check's rows: our two setups and the paper's only
+    line = answer_ins_tuning(_inputs(ins_tuning=table[~table["setup"].str.contains("Octave")]))
+    assert "40.0 m with NaveGo v1.4's bias modelling, 300.0 m in the paper" in line

@@ -6,7 +6,8 @@ function navego_check(in_file, out_file, navego_dir)
 % in_file:    a MAT file (-v7) holding the structs imu and gnss in NaveGo's layout (ins_gnss.m's header), the
 %             GNSS fixes inside the outages already removed, and att_mode.
 % out_file:   where nav_e.t, nav_e.lat, nav_e.lon, nav_e.h, nav_e.tg and nav_e.b are written (MAT -v7).
-% navego_dir: NaveGo's source (../shared/navego-v1.4): read from there at run time, never copied here.
+% navego_dir: NaveGo's source (../shared/navego-v1.4): read from there at run time, never copied here (the
+%             diagnostic run reads a temporary copy with three lines changed: navego_check.py, BIAS_FEEDBACK_PATCH).
 %
 % This file is ours (MIT); NaveGo (LGPL-3.0) is only called.
 

@@ -20,6 +20,18 @@ Settings, each chosen to compare like with like (listed in the CSV's ``setting``
   one;
 - the initial attitude is the reference's at the first fix, its std the profile's ``nav.init``; ZUPT off
   (``zupt_th = 0``: our INS row has none).
+
+Two runs per drive (the CSV's ``variant`` column, :data:`VARIANTS`):
+
+- ``as released``: NaveGo v1.4 as mirrored;
+- ``bias feedback consistent``: a diagnostic. v1.4's ``ins_gnss.m`` (Version 011) zeroes only the error states 1-9
+  before an update (line 363) and takes the *negative* of the carried bias states as the whole bias estimate (lines
+  408-409), while its prediction ``xi = A xp`` counts those states once more. The innovation then holds the whole
+  true bias at every fix, whatever has been estimated: the accelerometer states integrate it without bound, and
+  the gyro states settle at about half of it. This run copies NaveGo into a temporary folder, applies
+  :data:`BIAS_FEEDBACK_PATCH` there (all 15 states zeroed before an update, the estimates corrected by the states
+  with the signs of NaveGo's own ``F``: gyro ``gb -= x``, accelerometer ``ab += x``, since ``F_update.m`` drives
+  the velocity error with ``+C_bn x_a``) and runs that copy. Nothing of NaveGo is written into this project.
 """
 
 from __future__ import annotations
@@ -46,6 +58,15 @@ from bgfn.nav.ins_setups import NAVEGO_CHECK_COLUMNS, NAVEGO_CHECK_FILE
 from bgfn.profile_schema import load_profile
 
 NAVEGO_DIR = PROJECT_ROOT.parent / "shared" / "navego-v1.4"
+#: The file the diagnostic variant changes, and its three lines: (as in v1.4, as run). Each must occur exactly once.
+PATCHED_FILE = Path("ins-gnss") / "ins_gnss.m"
+BIAS_FEEDBACK_PATCH: tuple[tuple[str, str], ...] = (
+    ("kf.xp(1:9) = 0.0;", "kf.xp(1:15) = 0.0;"),                     # line 363: every error state starts at zero
+    ("gb_dyn   = -kf.xp(10:12);", "gb_dyn   = gb_dyn - kf.xp(10:12);"),   # line 408: the estimate corrected
+    ("ab_dyn   = -kf.xp(13:15);", "ab_dyn   = ab_dyn + kf.xp(13:15);"),   # line 409: +, the sign of F's C_bn x_a
+)
+#: NaveGo's runs per drive: as released, and with its bias feedback made consistent (module docstring).
+VARIANTS: tuple[str, ...] = ("as released", "bias feedback consistent")
 DATASETS = ("turin-sim-ekinox", "turin-sim-mpu6000")
 #: The velocity std that makes NaveGo's velocity rows carry nothing (position-only, as our filter), m/s.
 NO_VELOCITY_STD = 100.0
@@ -53,6 +74,25 @@ NO_VELOCITY_STD = 100.0
 
 def _vec(x) -> np.ndarray:
     return np.broadcast_to(np.asarray(x, dtype=float), (3,)).astype(float)
+
+
+def patched_navego(navego: Path, into: Path) -> Path:
+    """A copy of NaveGo's source ``navego`` under ``into`` with :data:`BIAS_FEEDBACK_PATCH` applied; its path.
+
+    Raises ``ValueError`` naming the file and the line when a line to change is not there exactly once (another
+    NaveGo version): the diagnostic then says nothing rather than run something else.
+    """
+    dst = Path(into) / "navego-bias-feedback"
+    shutil.copytree(navego, dst)
+    f = dst / PATCHED_FILE
+    text = f.read_text(encoding="utf-8")
+    for old, new in BIAS_FEEDBACK_PATCH:
+        if text.count(old) != 1:
+            raise ValueError(f"{Path(navego) / PATCHED_FILE}: expected the line `{old}` exactly once (NaveGo v1.4, "
+                             f"ins_gnss.m Version 011), found it {text.count(old)} times")
+        text = text.replace(old, new)
+    f.write_text(text, encoding="utf-8")
+    return dst
 
 
 def export(drive, windows, nav: dict, fuse_velocity: bool) -> tuple[dict, dict, str]:
@@ -123,9 +163,11 @@ def errors(nav_file: Path, drive, windows) -> list[dict]:
                      "max_north_m": float(np.abs(north[sel]).max())})
     aided = ~out_of & (t > t[0] + 60.0)              # after a minute of convergence
     rms = float(np.sqrt(np.mean(north[aided] ** 2 + east[aided] ** 2)))
-    # the filters' bias states step by step: NaveGo's largest gyro-bias estimate against the drive's true biases
-    gyro_est = float(np.degrees(np.abs(np.asarray(m["b"], float)[:, :3]).max())) if "b" in m else float("nan")
-    return [{**r, "aided_rms_h_m": rms, "max_gyro_bias_est_dps": gyro_est} for r in rows]
+    # the filters' bias states step by step: NaveGo's largest bias estimates against the drive's true biases
+    b = np.abs(np.asarray(m["b"], float)) if "b" in m else np.full((1, 6), np.nan)
+    gyro_est, accel_est = float(np.degrees(b[:, :3].max())), float(b[:, 3:].max())
+    return [{**r, "aided_rms_h_m": rms, "max_gyro_bias_est_dps": gyro_est, "max_accel_bias_est_mps2": accel_est}
+            for r in rows]
 
 
 def octave_version(octave: str) -> str:
@@ -140,6 +182,7 @@ def main(argv=None) -> int:
     p.add_argument("--octave", default="octave")
     p.add_argument("--navego", default=str(NAVEGO_DIR), help="NaveGo's source (default ../shared/navego-v1.4)")
     p.add_argument("--fuse-velocity", action="store_true", help="NaveGo fuses the file's velocity (its own way)")
+    p.add_argument("--variants", nargs="*", default=list(VARIANTS), choices=list(VARIANTS))
     p.add_argument("--out", default=str(NAVEGO_CHECK_FILE))
     a = p.parse_args(argv)
     octave = shutil.which(a.octave)
@@ -157,21 +200,26 @@ def main(argv=None) -> int:
         drive = load_drive(name, profile=a.profile)
         windows = outage_windows(cfg, drive, name)
         imu_s, gnss_s, setting = export(drive, windows, nav, a.fuse_velocity)
-        with tempfile.TemporaryDirectory() as tmp:
-            tmp = Path(tmp)
-            scipy.io.savemat(tmp / "in.mat", {"imu": imu_s, "gnss": gnss_s, "att_mode": "quaternion"})
-            print(f"==> {name}: NaveGo's ins_gnss under {version} ({len(imu_s['t'])} IMU rows, "
-                  f"{len(gnss_s['t'])} fixes, {setting})", flush=True)
-            cmd = [octave, "--no-gui", "--quiet", "--no-window-system", "--eval",
-                   f"addpath('{PROJECT_ROOT / 'tools'}'); navego_check('{tmp / 'in.mat'}', '{tmp / 'out.mat'}', "
-                   f"'{Path(a.navego).resolve()}')"]
-            subprocess.run(cmd, check=True)
-            for r in errors(tmp / "out.mat", drive, windows):
-                rows.append({"dataset": name, **r, "setting": setting, "navego": "v1.4 (ins_gnss.m Version 011)",
-                             "octave": version, "date": datetime.date.today().isoformat(),
-                             "commit": git_commit() or "unknown"})
-                print(f"    outage {r['outage']}: max |E| {r['max_east_m']:.2f} m, max |N| {r['max_north_m']:.2f} m; "
-                      f"GPS-aided RMS {r['aided_rms_h_m']:.2f} m")
+        for variant in a.variants:
+            with tempfile.TemporaryDirectory() as tmp:
+                tmp = Path(tmp)
+                navego = Path(a.navego).resolve()
+                if variant != VARIANTS[0]:
+                    navego = patched_navego(navego, tmp)
+                scipy.io.savemat(tmp / "in.mat", {"imu": imu_s, "gnss": gnss_s, "att_mode": "quaternion"})
+                print(f"==> {name}: NaveGo's ins_gnss ({variant}) under {version} ({len(imu_s['t'])} IMU rows, "
+                      f"{len(gnss_s['t'])} fixes, {setting})", flush=True)
+                cmd = [octave, "--no-gui", "--quiet", "--no-window-system", "--eval",
+                       f"addpath('{PROJECT_ROOT / 'tools'}'); navego_check('{tmp / 'in.mat'}', '{tmp / 'out.mat'}', "
+                       f"'{navego}')"]
+                subprocess.run(cmd, check=True)
+                for r in errors(tmp / "out.mat", drive, windows):
+                    rows.append({"dataset": name, **r, "setting": setting, "navego": "v1.4 (ins_gnss.m Version 011)",
+                                 "variant": variant, "octave": version, "date": datetime.date.today().isoformat(),
+                                 "commit": git_commit() or "unknown"})
+                    print(f"    outage {r['outage']}: max |E| {r['max_east_m']:.2f} m, max |N| {r['max_north_m']:.2f} "
+                          f"m; GPS-aided RMS {r['aided_rms_h_m']:.2f} m; largest bias estimates "
+                          f"{r['max_gyro_bias_est_dps']:.3g} deg/s, {r['max_accel_bias_est_mps2']:.3g} m/s^2")
     table = pd.DataFrame(rows, columns=list(NAVEGO_CHECK_COLUMNS))
     atomic_write_csv(a.out, table, float_format="%.4f")
     print(f"wrote {a.out}")

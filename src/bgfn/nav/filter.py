@@ -49,8 +49,9 @@ PSEUDO_RATE_HZ = 1.0
 # ---------------------------------------------------------------------------------------------------
 @numba.njit(cache=True)
 def propagate_steps(i0, i1, dt, gyro, accel, pos, v, c, ba, bg, P, q_g, q_a, q_bg, q_ba, inv_tau_a,
-                  inv_tau_g, out_pos, out_v, out_c, out_sd):
-    """Steps i0..i1-1 (IMU rows); output row k+1 holds the state after step k."""
+                  inv_tau_g, decay_a, decay_g, out_pos, out_v, out_c, out_sd):
+    """Steps i0..i1-1 (IMU rows); output row k+1 holds the state after step k. ``inv_tau_*``: the bias model's
+    inverse correlation times (in F); ``decay_*``: those the bias estimates relax with (0: held)."""
     n = P.shape[0]
     F = np.empty((n, n))
     Q = np.empty((n, n))
@@ -71,10 +72,10 @@ def propagate_steps(i0, i1, dt, gyro, accel, pos, v, c, ba, bg, P, q_g, q_a, q_b
             phi[r, r] += 1.0
         P[:, :] = phi @ P @ phi.T + Q
         step_inplace(pos, v, c, wb, fb, h)
-        # Gauss-Markov bias estimates decay with their model (inv_tau = 0: random walk, constant).
+        # Gauss-Markov bias estimates decay with their model (decay = 0: random walk, or held as NaveGo does).
         for a in range(3):
-            ba[a] *= np.exp(-h * inv_tau_a[a])
-            bg[a] *= np.exp(-h * inv_tau_g[a])
+            ba[a] *= np.exp(-h * decay_a[a])
+            bg[a] *= np.exp(-h * decay_g[a])
         out_pos[k + 1] = pos
         out_v[k + 1] = v
         out_c[k + 1] = c
@@ -325,12 +326,14 @@ class FilterResult:
 
 
 def noise_arrays(noise: FilterNoise):
-    """Process-noise arrays in the order :func:`propagate_steps` takes them (PSDs, inverse correlation times)."""
+    """Process-noise arrays in the order :func:`propagate_steps` takes them (PSDs, inverse correlation times of the
+    model, then of the estimates' decay: zero when ``noise.hold_bias_estimates``)."""
     inv = [np.where(np.isfinite(t), 1.0 / np.asarray(t, float), 0.0) for t in
            (noise.accel_bias_tau, noise.gyro_bias_tau)]
+    decay = [np.zeros(3) if noise.hold_bias_estimates else i for i in inv]
     return (np.asarray(noise.gyro_noise, float) ** 2, np.asarray(noise.accel_noise, float) ** 2,
             np.asarray(noise.gyro_bias_walk, float) ** 2, np.asarray(noise.accel_bias_walk, float) ** 2,
-            inv[0], inv[1])
+            inv[0], inv[1], decay[0], decay[1])
 
 
 def gate_thresholds(probability: float | None, source: str = "nav") -> np.ndarray:
@@ -507,10 +510,11 @@ def run_filter(imu: pd.DataFrame, initial: FilterState, noise: FilterNoise, gnss
         order = np.lexsort((np.r_[np.zeros(aided.size), np.ones(len(bias_rows))], np.r_[aided, bias_rows]))
         bias_rows = list(np.r_[aided, bias_rows][order])
         bias_vals = list(np.concatenate([out_bias_aid[aided], np.array(bias_vals)])[order])
-    # Bias estimates are piecewise constant between updates (random walk) or decay (Gauss-Markov).
+    # Bias estimates are piecewise constant between updates (random walk, or held) or decay (Gauss-Markov), as
+    # propagate_steps applies them: with the estimates' decay (noise_arrays' last two), not the model's.
     idx = np.searchsorted(np.array(bias_rows), np.arange(n_rows), side="right") - 1
     bias = np.array(bias_vals)[idx]
-    inv_a, inv_g = q[4], q[5]
+    inv_a, inv_g = q[6], q[7]
     if np.any(inv_a > 0) or np.any(inv_g > 0):
         age = times - times[np.array(bias_rows)[idx]]
         bias = bias * np.exp(-age[:, None] * np.concatenate([inv_a, inv_g])[None, :])

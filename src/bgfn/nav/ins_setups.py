@@ -11,6 +11,12 @@ starts from the GPS-aided filter's state, so its drift depends on how that filte
   only the profile's static biases are removed: a bound for a filter that keeps no accumulated bias estimate
   (a later ``ins_gnss.m``, Version 012; v1.4 as mirrored, Version 011, accumulates them as ours does:
   :mod:`bgfn.nav.navego_setup`, "Not reproduced");
+- ``NaveGo (Octave)``: NaveGo v1.4 itself on the same drive and outages, as released (``make navego-check``,
+  ``data/measured/navego_check.csv``);
+- ``NaveGo, bias feedback consistent (Octave)``: the same with NaveGo's bias feedback made consistent, a diagnostic
+  of why the released one diverges on a rough IMU (``tools/navego_check.py``: v1.4 carries its bias states from
+  update to update and takes their negative as the estimate, so its accelerometer-bias states integrate the true
+  bias without bound);
 - ``paper``: the paper's INS row (:func:`bgfn.paper.published_values`: the field test's beside the real drive),
   only for a dataset that stands for one of its tests.
 
@@ -21,7 +27,8 @@ Table columns (:data:`COLUMNS`; ``tables/kf_ins_tuning.csv``, ``bgfn.config.SHAR
 NaveGo's own from its check; NaN for the paper's row and the reset bound, which shares the ``navego`` run),
 ``max_gyro_bias_est_dps`` (the largest gyro-bias estimate of that run over the drive, deg/s: the bias states step by
 step, NaveGo's from its check), ``true_gyro_bias_dps`` (the drive's largest true gyro bias, deg/s, a simulated IMU's
-``Drive.imu_bias``; NaN for a recorded one).
+``Drive.imu_bias``; NaN for a recorded one), ``max_accel_bias_est_mps2`` and ``true_accel_bias_mps2`` (the same for
+the accelerometers, m/s^2).
 """
 
 from __future__ import annotations
@@ -45,23 +52,30 @@ RESET = "navego-reset"
 PAPER = "paper"
 #: Label of NaveGo v1.4 itself, run under GNU Octave on the same drive and outages (``make navego-check``).
 NAVEGO_RUN = "NaveGo (Octave)"
-#: Row order of the table: our setups, NaveGo's own run, then the paper's.
-SETUPS: tuple[str, ...] = navego_setup.INS_TUNINGS + (RESET, NAVEGO_RUN, PAPER)
+#: Label of NaveGo v1.4 with its bias feedback made consistent (``make navego-check``'s diagnostic run).
+NAVEGO_CONSISTENT = "NaveGo, bias feedback consistent (Octave)"
+#: ``variant`` of ``data/measured/navego_check.csv`` -> the table's setup label (``tools/navego_check.py``'s VARIANTS).
+NAVEGO_VARIANTS: dict[str, str] = {"as released": NAVEGO_RUN, "bias feedback consistent": NAVEGO_CONSISTENT}
+#: Row order of the table: our setups, NaveGo's own runs, then the paper's.
+SETUPS: tuple[str, ...] = navego_setup.INS_TUNINGS + (RESET, NAVEGO_RUN, NAVEGO_CONSISTENT, PAPER)
 #: What ``tools/navego_check.py`` measured (NaveGo's INS-only errors in the outages), with date and commit.
 NAVEGO_CHECK_FILE = PROJECT_ROOT / "data" / "measured" / "navego_check.csv"
 #: Its columns.
 NAVEGO_CHECK_COLUMNS: tuple[str, ...] = ("dataset", "outage", "start_s", "duration_s", "max_east_m", "max_north_m",
-                                         "aided_rms_h_m", "max_gyro_bias_est_dps", "setting", "navego", "octave",
-                                         "date", "commit")
+                                         "aided_rms_h_m", "max_gyro_bias_est_dps", "max_accel_bias_est_mps2",
+                                         "setting", "navego", "variant", "octave", "date", "commit")
 
 
-def navego_measured(dataset: str, windows, path: Path = NAVEGO_CHECK_FILE) -> pd.DataFrame:
-    """NaveGo's own rows of ``dataset`` from ``path`` whose outage matches one of ``windows`` (same start and
+def navego_measured(dataset: str, windows, path: Path = NAVEGO_CHECK_FILE,
+                    variant: str = "as released") -> pd.DataFrame:
+    """NaveGo's own rows of ``dataset`` and ``variant`` (a key of :data:`NAVEGO_VARIANTS`; a file without the
+    column holds the released one only) from ``path`` whose outage matches one of ``windows`` (same start and
     duration; the profile's ``Outage k`` numbering); empty when the check has not run for them."""
     if not Path(path).is_file():
         return pd.DataFrame(columns=list(NAVEGO_CHECK_COLUMNS))
     t = pd.read_csv(path)
-    t = t[t["dataset"] == dataset]
+    variants = t["variant"] if "variant" in t.columns else pd.Series("as released", index=t.index)
+    t = t[(t["dataset"] == dataset) & (variants == variant)]
     rows = []
     for k, (s, d) in enumerate(windows, 1):
         hit = t[np.isclose(t["start_s"], s) & np.isclose(t["duration_s"], d)]
@@ -70,21 +84,25 @@ def navego_measured(dataset: str, windows, path: Path = NAVEGO_CHECK_FILE) -> pd
     return pd.DataFrame(rows, columns=list(NAVEGO_CHECK_COLUMNS))
 #: Columns of :func:`ins_tuning_table`.
 COLUMNS: tuple[str, ...] = ("dataset", "test", "outage", "setup", "max_east_m", "max_north_m", "aided_rms_h_m",
-                            "max_gyro_bias_est_dps", "true_gyro_bias_dps")
+                            "max_gyro_bias_est_dps", "true_gyro_bias_dps", "max_accel_bias_est_mps2",
+                            "true_accel_bias_mps2")
+_NAN = float("nan")
 
 
-def _row(dataset, test, outage, setup, east, north, aided=float("nan"), gyro=float("nan"),
-         true=float("nan")) -> dict:
+def _row(dataset, test, outage, setup, east, north, aided=_NAN, gyro=_NAN, true=_NAN, accel=_NAN,
+         true_accel=_NAN) -> dict:
     return dict(zip(COLUMNS, (dataset, test or "", int(outage), setup, float(east), float(north), float(aided),
-                              float(gyro), float(true))))
+                              float(gyro), float(true), float(accel), float(true_accel))))
 
 
-def _max_gyro_bias_dps(bias: pd.DataFrame | None) -> float:
-    """The largest absolute gyro bias of a bias table (estimates or truth) over the drive, deg/s."""
-    cols = ["gyro_bias_x", "gyro_bias_y", "gyro_bias_z"]
+def _max_bias(bias: pd.DataFrame | None, sensor: str) -> float:
+    """The largest absolute ``sensor`` ('gyro', deg/s; 'accel', m/s^2) bias of a bias table (estimates or truth)
+    over the drive."""
+    cols = [f"{sensor}_bias_{a}" for a in "xyz"]
     if bias is None or not set(cols) <= set(bias.columns):
         return float("nan")
-    return float(np.degrees(np.nanmax(np.abs(bias[cols].to_numpy(float)))))
+    top = float(np.nanmax(np.abs(bias[cols].to_numpy(float))))
+    return float(np.degrees(top)) if sensor == "gyro" else top
 
 
 def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None) -> pd.DataFrame:
@@ -109,7 +127,8 @@ def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None
     checked = check_windows(windows, float(drive.reference["time"].iloc[0]), float(drive.imu["time"].iloc[-1]),
                             f"{drive.name}: profile outage_windows", sort=False)      # Outage k as in notebook 02
     lever = drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0])
-    true = _max_gyro_bias_dps(drive.imu_bias)           # NaN for a recorded IMU (its biases are unknown)
+    true = _max_bias(drive.imu_bias, "gyro")            # NaN for a recorded IMU (its biases are unknown)
+    true_accel = _max_bias(drive.imu_bias, "accel")
     rows = []
     for tuning in navego_setup.INS_TUNINGS:
         c = {**cfg, "ins_tuning": tuning}
@@ -118,9 +137,11 @@ def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None
         ins = b.outage_table
         if "method" in ins.columns:                   # the standalone INS only (not the INS+NHC rows)
             ins = ins[ins["method"] == "INS"]
-        aided, gyro = float(b.rms.loc["horizontal", "rms"]), _max_gyro_bias_dps(b.full.bias)
+        aided, gyro, accel = (float(b.rms.loc["horizontal", "rms"]), _max_bias(b.full.bias, "gyro"),
+                              _max_bias(b.full.bias, "accel"))
         for k, r in enumerate(ins.itertuples(index=False)):
-            rows.append(_row(drive.name, test, k + 1, tuning, r.max_abs_east, r.max_abs_north, aided, gyro, true))
+            rows.append(_row(drive.name, test, k + 1, tuning, r.max_abs_east, r.max_abs_north, aided, gyro, true,
+                             accel, true_accel))
         if tuning != "navego":
             continue
         imu = filter_imu(drive, c)
@@ -132,9 +153,12 @@ def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None
                                           drive.reference, drive.meta)
             m = metrics.outage_metrics(e, w)
             rows.append(_row(drive.name, test, k + 1, RESET, m["max_abs_east"], m["max_abs_north"]))
-    for r in navego_measured(drive.name, [(w.start, w.duration) for w in checked]).itertuples(index=False):
-        rows.append(_row(drive.name, test, r.outage, NAVEGO_RUN, r.max_east_m, r.max_north_m, r.aided_rms_h_m,
-                         getattr(r, "max_gyro_bias_est_dps", float("nan")), true))
+    for variant, setup in NAVEGO_VARIANTS.items():
+        for r in navego_measured(drive.name, [(w.start, w.duration) for w in checked],
+                                 variant=variant).itertuples(index=False):
+            rows.append(_row(drive.name, test, r.outage, setup, r.max_east_m, r.max_north_m, r.aided_rms_h_m,
+                             getattr(r, "max_gyro_bias_est_dps", _NAN), true,
+                             getattr(r, "max_accel_bias_est_mps2", _NAN), true_accel))
     if test:
         for r in paper.published_values(test).query("method == 'INS'").itertuples(index=False):
             rows.append(_row(drive.name, test, r.outage, PAPER, r.max_east_m, r.max_north_m))
@@ -185,6 +209,11 @@ def layout(table: pd.DataFrame, dataset: str) -> pd.DataFrame:
                         columns=pd.MultiIndex.from_tuples(list(data), names=["setup", "axis"]))
 
 
+#: Columns of a setup's GPS-aided run (one value per drive) and of the drive's truth, carried by :func:`gap_explained`.
+_RUN_COLUMNS = ("aided_rms_h_m", "max_gyro_bias_est_dps", "max_accel_bias_est_mps2")
+_TRUE_COLUMNS = ("true_gyro_bias_dps", "true_accel_bias_mps2")
+
+
 def gap_explained(table: pd.DataFrame) -> pd.DataFrame:
     """How much of the gap between our INS row and the paper's each setup closes, per dataset.
 
@@ -198,8 +227,9 @@ def gap_explained(table: pd.DataFrame) -> pd.DataFrame:
         One row per dataset with a paper test and per setup other than ``shipped``: ``dataset``, ``test``,
         ``setup``, ``shipped_m``, ``setup_m``, ``paper_m``, ``explained_pct`` (NaN when there is no gap),
         ``aided_rms_h_m`` (the setup's GPS-aided horizontal RMS, m; NaN where the table has none),
-        ``max_gyro_bias_est_dps`` (its largest gyro-bias estimate over the drive, deg/s), ``true_gyro_bias_dps`` (the
-        drive's largest true gyro bias, deg/s; NaN for a recorded IMU).
+        ``max_gyro_bias_est_dps`` (its largest gyro-bias estimate over the drive, deg/s), ``max_accel_bias_est_mps2``
+        (the same for the accelerometers, m/s^2), ``true_gyro_bias_dps``, ``true_accel_bias_mps2`` (the drive's
+        largest true biases; NaN for a recorded IMU).
     """
     rows = []
     for dataset, t in table.groupby("dataset", sort=False):
@@ -208,10 +238,9 @@ def gap_explained(table: pd.DataFrame) -> pd.DataFrame:
             continue
         t = t[t["outage"].isin(on)]
         size = {s: float(g[["max_east_m", "max_north_m"]].to_numpy().mean()) for s, g in t.groupby("setup")}
-        aided = ({s: float(g["aided_rms_h_m"].iloc[0]) for s, g in t.groupby("setup")} if "aided_rms_h_m" in t.columns
-                 else {})
-        gyro = ({s: float(g["max_gyro_bias_est_dps"].iloc[0]) for s, g in t.groupby("setup")}
-                if "max_gyro_bias_est_dps" in t.columns else {})
+        # per setup: its run's values (one per drive, repeated on every outage row); the truth: the drive's
+        per_setup = {c: {s: float(g[c].iloc[0]) for s, g in t.groupby("setup")} for c in _RUN_COLUMNS if c in t.columns}
+        truth = {c: float(t[c].iloc[0]) if c in t.columns else _NAN for c in _TRUE_COLUMNS}
         gap = size[PAPER] - size["shipped"]
         for s in SETUPS:
             if s in ("shipped", PAPER) or s not in size:
@@ -219,11 +248,9 @@ def gap_explained(table: pd.DataFrame) -> pd.DataFrame:
             pct = 100.0 * (size[s] - size["shipped"]) / gap if abs(gap) > 1e-9 else float("nan")
             rows.append({"dataset": dataset, "test": t["test"].iloc[0], "setup": s, "shipped_m": size["shipped"],
                          "setup_m": size[s], "paper_m": size[PAPER], "explained_pct": pct,
-                         "aided_rms_h_m": aided.get(s, float("nan")), "max_gyro_bias_est_dps": gyro.get(s, float("nan")),
-                         "true_gyro_bias_dps": (float(t["true_gyro_bias_dps"].iloc[0])
-                                                if "true_gyro_bias_dps" in t.columns else float("nan"))})
+                         **{c: per_setup.get(c, {}).get(s, _NAN) for c in _RUN_COLUMNS}, **truth})
     return pd.DataFrame(rows, columns=["dataset", "test", "setup", "shipped_m", "setup_m", "paper_m",
-                                       "explained_pct", "aided_rms_h_m", "max_gyro_bias_est_dps", "true_gyro_bias_dps"])
+                                       "explained_pct", *_RUN_COLUMNS, *_TRUE_COLUMNS])
 
 
 def _share(pct: float) -> str:
@@ -253,31 +280,65 @@ def sentences(table: pd.DataFrame) -> list[str]:
     return out
 
 
+#: How far our ``navego`` setup's INS error may lie from NaveGo's own (issue 26), as a ratio.
+NAVEGO_TOLERANCE = 0.3
+
+
+def _within(ratio: float, why: str = "") -> str:
+    """``(within 30 %)`` or ``(more than 30 % apart<why>)`` for a ratio of INS errors."""
+    return ("(within 30 %)" if abs(ratio - 1.0) <= NAVEGO_TOLERANCE else f"(more than 30 % apart{why})")
+
+
+def _bias_states(row, ours, true: dict) -> str:
+    """The largest gyro- and accelerometer-bias estimates of NaveGo's run ``row`` and of our setup ``ours``,
+    against the drive's largest true biases (``true``), in words; empty where they are not measured."""
+    parts = []
+    for col, true_col, unit, fmt in (("max_gyro_bias_est_dps", "true_gyro_bias_dps", "deg/s", ".3g"),
+                                     ("max_accel_bias_est_mps2", "true_accel_bias_mps2", "m/s^2", ".2g")):
+        theirs, mine = getattr(row, col, _NAN), getattr(ours, col, _NAN)
+        if not (np.isfinite(theirs) and np.isfinite(mine)):
+            continue
+        sensor = "gyro" if "gyro" in col else "accelerometer"
+        text = f"the largest {sensor}-bias estimate over the drive is {theirs:{fmt}} {unit} in NaveGo, {mine:{fmt}} {unit} in our setup of it"
+        t = true.get(true_col, _NAN)
+        parts.append(text + (f", against the drive's largest true {sensor} bias of {t:{fmt}} {unit}" if np.isfinite(t) else ""))
+    return "; ".join(parts)
+
+
 def _against_navego(gap: pd.DataFrame) -> str:
-    """Our ``navego`` setup against NaveGo's own run (issue 26: within 30 % of it?), when both are there; with both
-    GPS-aided solutions' horizontal RMS: outages that start from far different states cannot agree."""
-    by = {r.setup: r.setup_m for r in gap.itertuples(index=False)}
-    if "navego" not in by or NAVEGO_RUN not in by or not by[NAVEGO_RUN] > 0:
+    """Our ``navego`` setup against NaveGo's own runs (issue 26: within 30 % of it?), when both are there: the INS
+    ratio, both GPS-aided solutions' horizontal RMS (outages that start from far different states cannot agree) and
+    the bias states step by step; then the same against NaveGo with its bias feedback made consistent."""
+    rows = {r.setup: r for r in gap.itertuples(index=False)}
+    ours = rows.get("navego")
+    if ours is None:
         return ""
-    ratio = by["navego"] / by[NAVEGO_RUN]
-    text = (f" Our setup of NaveGo gives {ratio:.2f} times NaveGo's own INS error "
-            + ("(within 30 %)." if abs(ratio - 1.0) <= 0.3 else "(more than 30 % apart: methods page, 'NaveGo run "
-                                                                  "beside us', lists the differences)."))
-    aided = {r.setup: r.aided_rms_h_m for r in gap.itertuples(index=False)} if "aided_rms_h_m" in gap.columns else {}
-    ours, theirs = aided.get("navego", np.nan), aided.get(NAVEGO_RUN, np.nan)
-    if np.isfinite(ours) and np.isfinite(theirs):
-        text += (f" Their GPS-aided solutions, from which every outage starts: {theirs:.1f} m horizontal RMS for NaveGo, "
-                 f"{ours:.1f} m for our setup of it"
-                 + (" (NaveGo's own filter loses the drive with the GNSS still there)." if theirs > 3 * max(ours, 1.0)
-                    else "."))
-    gyro = ({r.setup: r.max_gyro_bias_est_dps for r in gap.itertuples(index=False)}
-            if "max_gyro_bias_est_dps" in gap.columns else {})
-    g_ours, g_theirs = gyro.get("navego", np.nan), gyro.get(NAVEGO_RUN, np.nan)
-    if np.isfinite(g_ours) and np.isfinite(g_theirs):
-        text += (f" Their gyro-bias states, step by step: the largest estimate over the drive is {g_theirs:.3g} deg/s "
-                 f"in NaveGo, {g_ours:.3g} deg/s in our setup of it")
-        true = gap["true_gyro_bias_dps"].iloc[0] if "true_gyro_bias_dps" in gap.columns else np.nan
-        text += (f", against the drive's largest true gyro bias of {true:.3g} deg/s." if np.isfinite(true) else ".")
+    true = {c: float(gap[c].iloc[0]) if c in gap.columns else _NAN for c in _TRUE_COLUMNS}
+    text = ""
+    released = rows.get(NAVEGO_RUN)
+    if released is not None and released.setup_m > 0:
+        ratio = ours.setup_m / released.setup_m
+        text += (f" Our setup of NaveGo gives {ratio:.2f} times NaveGo's own INS error "
+                 f"{_within(ratio, ': methods page, NaveGo run beside us, lists the differences')}.")
+        a_ours, a_theirs = getattr(ours, "aided_rms_h_m", _NAN), getattr(released, "aided_rms_h_m", _NAN)
+        if np.isfinite(a_ours) and np.isfinite(a_theirs):
+            text += (f" Their GPS-aided solutions, from which every outage starts: {a_theirs:.1f} m horizontal RMS for "
+                     f"NaveGo, {a_ours:.1f} m for our setup of it"
+                     + (" (NaveGo's own filter loses the drive with the GNSS still there)." if a_theirs > 3 * max(a_ours, 1.0)
+                        else "."))
+        states = _bias_states(released, ours, true)
+        text += f" Their bias states, step by step: {states}." if states else ""
+    fixed = rows.get(NAVEGO_CONSISTENT)
+    if fixed is not None and fixed.setup_m > 0:
+        ratio = ours.setup_m / fixed.setup_m
+        text += (" With NaveGo's bias feedback made consistent (every error state zeroed before an update and the "
+                 "bias estimates corrected by the states with the signs of its own F, where v1.4 carries the bias "
+                 f"states and takes their negative as the estimate), our setup gives {ratio:.2f} times its INS error "
+                 f"{_within(ratio)}")
+        a_fixed = getattr(fixed, "aided_rms_h_m", _NAN)
+        text += f"; its GPS-aided RMS is {a_fixed:.1f} m" if np.isfinite(a_fixed) else ""
+        states = _bias_states(fixed, ours, true)
+        text += (f"; {states}." if states else ".")
     return text
 
 
@@ -292,6 +353,6 @@ def read_table(out) -> pd.DataFrame | None:
     return pd.read_csv(path) if path.exists() else None
 
 
-__all__ = ["COLUMNS", "NAVEGO_CHECK_COLUMNS", "NAVEGO_CHECK_FILE", "NAVEGO_RUN", "PAPER", "RESET", "SETUPS",
+__all__ = ["COLUMNS", "NAVEGO_CHECK_COLUMNS", "NAVEGO_CHECK_FILE", "NAVEGO_CONSISTENT", "NAVEGO_RUN", "NAVEGO_VARIANTS", "PAPER", "RESET", "SETUPS",
            "navego_measured", "gap_explained", "ins_tuning_table", "ins_tuning_tables", "layout",
            "layouts", "read_table", "save_table", "sentences"]

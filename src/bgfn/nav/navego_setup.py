@@ -28,6 +28,11 @@ Version 011 of 2022-04, ``ins-gnss/F_update.m`` Version 010, ``ins-gnss/kf_predi
    ``sigma / sqrt(2)``.
 6. Discretization ``A = expm(F dt)``, ``Q_d = G Q G^T dt`` at the GNSS epochs (``ins-gnss/kf_prediction.m``
    Version 001, lines 49 and 51).
+7. *Bias estimates held between updates.* Every IMU sample is corrected with the last update's ``gb_dyn`` and
+   ``ab_dyn`` (lines 251-252); nothing relaxes them between fixes or through an outage, although ``F`` models
+   the biases as Gauss-Markov. (Our shipped filter lets a Gauss-Markov estimate relax as ``exp(-dt/tau)``; with
+   the MPU-6000's ``tau`` of 100 s that took a quarter of the bias correction away within a 30 s outage and made
+   this setup's INS row many times NaveGo's: found by running the two side by side, ``make navego-check``.)
 
 How this module maps it onto our filter, per sensor (our keys of :mod:`bgfn.data.imu_errors`; for NaveGo's
 own files :mod:`bgfn.data.drives` maps ``gb_sta -> gyro_bias_fixed``, ``gb_dyn -> gyro_bias_instability``,
@@ -43,13 +48,18 @@ bias model (4)              Gauss-Markov, ``tau = *_bias_corr_time``        rand
 driving PSD (5)             ``instability^2 / corr_time``                   ``2 instability^2 / tau``
 white noise                 ``*_noise_density`` (``arw``, ``vrw``) x        the same
                             ``nav.noise_scale``
+estimates between updates   held (7; ``FilterNoise.hold_bias_estimates``)   relax with the model
 ==========================  ==============================================  ======================
 
 Not reproduced (our filter stays the paper's, Eqs. eq3/eq4): NaveGo also fuses the GNSS velocity, propagates
 P only at the GNSS epochs, starts from the first fix and ``ini_align``, and corrects with a ZUPT heuristic
 (lines 280-315). Before each update it zeroes the error states 1-9 only (``kf.xp(1:9) = 0.0``, line 363): the
 bias states 10-15 are carried from update to update (``xi = A xp``, ``kf_prediction.m`` line 54), and
-``gb_dyn = -kf.xp(10:12)`` (lines 408-409) is the accumulated estimate, as in our closed-loop filter. (An earlier
+``gb_dyn = -kf.xp(10:12)`` (lines 408-409) is the accumulated estimate. That feedback is not reproduced: its
+prediction ``xi = A xp`` counts the carried bias states once more, and with the negative sign its accelerometer-bias
+states integrate the true bias without bound (``tools/navego_check.py`` explains it and runs NaveGo a second time
+with the feedback made consistent, all 15 states zeroed and the estimates corrected by them: our closed-loop
+filter's scheme, and the run this setup is compared with on a rough IMU). (An earlier
 reading of a later ``ins_gnss.m``, Version 012, which zeroes the whole state and so does not accumulate them, is
 why :func:`bgfn.nav.ins_setups.ins_tuning_table` also shows a run whose bias estimates are cleared at the outage
 start; v1.4 as mirrored here is Version 011.)
@@ -108,7 +118,8 @@ def navego_noise(imu_errors: dict, noise_scale: float = 1.0, source: str = "meta
         out[f"{s}_bias_walk"] = sigma / np.sqrt(tau)          # imu_si_errors.m lines 95, 101: gb_dyn/sqrt(gb_corr)
         out[f"{s}_bias_tau"] = tau                            # F_update.m lines 164, 171: -1/gb_corr
         out[f"{s}_bias_std"] = sigma                          # ins_gnss.m line 200: P0 = gb_dyn^2
-    return FilterNoise(**out)
+    # item 7: the estimates are held between updates (lines 251-252 correct every sample with the last gb_dyn)
+    return FilterNoise(**out, hold_bias_estimates=True)
 
 
 def static_biases(imu_errors: dict, source: str = "meta['imu_errors']") -> tuple[np.ndarray, np.ndarray]:

@@ -93,6 +93,11 @@ class FilterNoise:
         Prior std of the gyro bias (P0), rad/s.
     accel_bias_std : ndarray
         Prior std of the accelerometer bias (P0), m/s^2.
+    hold_bias_estimates : bool
+        False (default): between updates the bias *estimates* follow their model's mean, ``b <- exp(-dt/tau) b``
+        (a Gauss-Markov estimate relaxes toward zero); True: they are held until the next update, as NaveGo v1.4
+        does (it corrects the IMU with its estimate unchanged between fixes and through an outage;
+        :mod:`bgfn.nav.navego_setup`). The covariance follows the model either way.
     """
 
     gyro_noise: np.ndarray
@@ -103,6 +108,7 @@ class FilterNoise:
     accel_bias_tau: np.ndarray
     gyro_bias_std: np.ndarray
     accel_bias_std: np.ndarray
+    hold_bias_estimates: bool = False
 
 
 def _vec3(d, key, source):

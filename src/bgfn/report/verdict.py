@@ -32,7 +32,7 @@ from bgfn.config import MAIN_VARIANT, RUN_RECORDS, SHARED_TABLES
 from bgfn.data.names import dataset_id
 from bgfn.data.registry import recorded_first
 from bgfn.evaluate.tables import table_paths
-from bgfn.nav.ins_setups import gap_explained
+from bgfn.nav.ins_setups import NAVEGO_CONSISTENT, NAVEGO_RUN, gap_explained
 from bgfn.report.odometer_verdict import (OdometerInputs, answer_odometer, odometer_headline, odometer_rows,
                                           read_odometer_inputs, same_dataset)
 from bgfn.report.reading import read_csv, read_json
@@ -397,9 +397,13 @@ def answer_ins_tuning(inp: VerdictInputs) -> str:
         return "Is the INS row comparable? The paper has no INS row for this drive's test."
     r = g.iloc[0]
     whose = "" if paper.has_own_values(inp.test) else " (its field test: it has no table of this drive)"
+    own = dict(zip(gap["setup"], gap["setup_m"]))
+    navego = ("" if NAVEGO_RUN not in own else f", {_m(own[NAVEGO_RUN])} with NaveGo v1.4 itself under Octave"
+              + ("" if NAVEGO_CONSISTENT not in own else
+                 f" ({_m(own[NAVEGO_CONSISTENT])} with its bias feedback made consistent)"))
     return (f"Is the INS row comparable? Mean of the INS row's max east and north errors: {_m(r['shipped_m'])} with "
-            f"our filter, {_m(r['setup_m'])} with NaveGo v1.4's bias modelling, {_m(r['paper_m'])} in the paper"
-            f"{whose}." + consistency_sentence(inp))
+            f"our filter, {_m(r['setup_m'])} with NaveGo v1.4's bias modelling{navego}, {_m(r['paper_m'])} in the "
+            f"paper{whose}." + consistency_sentence(inp))
 
 
 def consistency_sentence(inp: VerdictInputs) -> str:

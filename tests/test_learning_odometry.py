@@ -121,3 +121,26 @@ def test_a_network_odometer_learns_speed_and_its_uncertainty(tmp_path):
     assert "val_rmse_mps" in card and "val_rmse_m" not in card
     assert card["val_rmse_mps"] < 0.5 * card["val_rmse_mean_mps"]        # far better than the mean speed
     assert card["best_epoch"] >= 1 and card["history"][0]["val_rmse_mps"] > card["val_rmse_mps"]
+
+
+def test_the_odometers_learning_rate_search_tunes_inside_the_training_windows(tmp_path):
+    from bgfn import train as T
+
+    imu, t, speed = _vibrating_drive()
+    epochs = np.arange(5.0, 595.0, 1.0)
+    data = od.build_speed_data(od.speed_windows(imu, epochs, 200, np.interp(epochs, t, speed)), [(300.0, 30.0)],
+                               margin_s=10.0)
+    inner = od.inner_speed_split(data, 0.25)
+    # the tuning split lies inside the training windows: the calibration block (data.val) chooses nothing
+    assert set(inner.train.t_end) | set(inner.val.t_end) <= set(data.train.t_end)
+    assert not set(inner.val.t_end) & set(data.val.t_end)
+    assert len(inner.val) == round(0.25 * len(data.train)) and inner.options["objective"] == "speed"
+    assert inner.norm.y_mean[0] == pytest.approx(inner.train.speed.mean())       # refit on the inner windows
+    # the search of the increments, on the speed objective: the same grid and budget, its error in m/s
+    cfg = {"optimizer": {"epochs": 6, "batch_size": 16, "patience": 50},
+           "lr_search": {"grid": [1e-5, 3e-3], "fraction": 0.25, "seed": 0, "extend": 0},
+           "sizes": {"mlp": {"smoke": {"n_recent": 200, "hidden": 16}}}, "size": "smoke"}
+    table = T.search_profile_rates({"drive fold 0": (data, tmp_path)}, ["mlp"], cfg, split=od.inner_speed_split)
+    assert table["lr"].tolist() == [1e-5, 3e-3] and table["dataset"].eq("drive fold 0").all()
+    assert table.loc[table["selected"], "lr"].tolist() == [3e-3]       # 6 epochs at 1e-5 barely move the network
+    assert (table["tuning_rmse_m"] > 0).all() and table["tuning_rmse_m"].iloc[1] < table["tuning_rmse_m"].iloc[0]

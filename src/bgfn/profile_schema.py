@@ -196,7 +196,7 @@ SCHEMA = section(
         odometer=section(datasets=seq(text(), null=True), methods=seq(text(*METHOD_LABELS)),
                          network_seeds=seq(_SEED, min_len=1), paper_outages=flag(), window_s=number(0.5), sigmas_mps=seq(_POS), walk_mps_per_sqrt_s=_NONNEG,
                          seeds=seq(_SEED, min_len=1), hold_std_mps=_POS, ridge_alpha=_POS,
-                         gate_probability=number(0, 1, lo_open=True, hi_open=True, null=True))),
+                         gate_probability=number(0, 1, lo_open=True, hi_open=True, null=True), lr_search=flag())),
     energy=section(
         e_mac_pj=_POS, e_ac_pj=_POS, dataset=text(null=True), seed=integer(0, null=True), allow_untrained=flag(),
         max_windows=integer(1, null=True), batch_size=integer(1), sweep_time_steps=seq(integer(1), min_len=1),

@@ -41,6 +41,7 @@ import numpy as np
 import pandas as pd
 
 from bgfn.config import SHARED_TABLES, odometer_datasets
+from bgfn.errors import DataError
 from bgfn.data import dataset_id, load_drive
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.evaluate.plots import finish_duration_axes
@@ -233,17 +234,20 @@ def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, data: d
     oc = ecfg["odometer"]
     if not oc["methods"]:
         return {}
-    # the same learning rate for every network (train.lr): notebook 03's search tuned the rates for the increments,
-    # another target, and one of its picks (e.g. 0.27 for BGFN on the real drive) can cripple a speed network
+    # notebook 03's search tuned the rates for the increments, another target, and one of its picks (e.g. 0.27 for
+    # BGFN on the real drive) can cripple a speed network: the same train.lr for every network, or with
+    # lr_search the rate of each network chosen per fold by train.lr_search's grid on the speed objective
     tc = sweep_train_config(cfg["train"], ecfg["sweep"])
+    search = speed_lr_search(cfg, profile, dataset, ecfg, data, runner) if oc["lr_search"] else None
     runs, keys = [], []
     for k in sorted(data):
         out = odometer_models_dir(profile, dataset, int(k))
+        tk = train.with_selected_lr(tc, None if search is None else search[search["dataset"] == fold_name(dataset, k)])
         for m in oc["methods"]:
             for seed in oc["network_seeds"]:
                 label = odometer_label(m)
                 runs.append(train.TrainingRun(f"{dataset} fold {k} {label} seed {seed}", m, data[int(k)],
-                                              train.size_config(tc, m), tc, int(seed), out, None,
+                                              train.size_config(tk, m), tk, int(seed), out, None,
                                               {"dataset": dataset, "profile": profile, "fold": int(k),
                                                "objective": "speed"}))
                 keys.append((label, int(k), int(seed)))
@@ -256,8 +260,38 @@ def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, data: d
         factor = lo.calibration_factor(speed_val - run.data.val.speed, std_val)
         speed, std = obj.to_units(train.predict_normalized(net.model, net.norm.x(all_windows.x)))
         tracks[key] = (no.SpeedTrack(all_windows.t_end, np.maximum(speed, 0.0), std * factor),
-                       {"calibration": factor, "val_rmse_mps": card["val_rmse_mps"], "epochs": card["epochs_run"]})
+                       {"calibration": factor, "val_rmse_mps": card["val_rmse_mps"], "epochs": card["epochs_run"],
+                        "lr": train.method_lr(run.train_cfg, run.method)})
     return tracks
+
+
+def fold_name(dataset: str, fold: int) -> str:
+    """``<dataset> fold <k>``: a fold's name in the odometers' learning-rate search and its progress lines."""
+    return f"{dataset} fold {int(fold)}"
+
+
+def speed_lr_search(cfg: dict, profile: str, dataset: str, ecfg: dict, data: dict[int, lo.SpeedData],
+                    runner: Runner | None = None) -> pd.DataFrame:
+    """The learning rate of every odometer network per fold (``evaluate.odometer.lr_search``): the grid, extension
+    and budget of ``train.lr_search`` (:func:`bgfn.train.search_profile_rates`, the same for every network), on a
+    tuning split inside each fold's training windows (:func:`bgfn.learning.odometry.inner_speed_split`), so that
+    neither the fold's outages nor its calibration block choose it; the sweep's model sizes.
+
+    Returns
+    -------
+    DataFrame
+        :data:`bgfn.train.LR_SEARCH_COLUMNS` with ``dataset`` = :func:`fold_name` and ``tuning_rmse_m`` the tuning
+        speed RMSE (m/s); ``selected`` marks each network's rate per fold.
+    """
+    tc = {**sweep_train_config(cfg["train"], ecfg["sweep"]), "lr_search": (cfg.get("train") or {}).get("lr_search")}
+    if not train.lr_search_options(tc)["grid"]:
+        raise DataError("evaluate.odometer", "lr_search", "a train.lr_search.grid to search (or lr_search: false)",
+                        "no grid")
+    learning = {fold_name(dataset, k): (d, odometer_models_dir(profile, dataset, int(k)) / "lr_search")
+                for k, d in sorted(data.items())}
+    table = train.search_profile_rates(learning, ecfg["odometer"]["methods"], tc, runner, split=lo.inner_speed_split,
+                                       extra_card={"dataset": dataset, "profile": profile, "objective": "speed"})
+    return table[list(train.LR_SEARCH_COLUMNS)]
 
 
 def speed_errors(track: no.SpeedTrack | None, t: np.ndarray, truth: np.ndarray, start: float,

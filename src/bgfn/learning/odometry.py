@@ -144,6 +144,15 @@ def build_speed_data(ws: SpeedWindows, outage_windows=(), margin_s: float = 30.0
                                              "n_outage_excluded": int(ws.x.shape[0] - idx.size)})
 
 
+def inner_speed_split(data: SpeedData, fraction: float = 0.2) -> SpeedData:
+    """A tuning split inside ``data.train`` (the speed twin of :func:`bgfn.learning.inner_split`): its middle
+    ``fraction`` becomes the validation block, training windows touching it are dropped, the normalizer is refit.
+    A learning rate chosen on it never sees ``data.val``, the block the odometer's std is calibrated on."""
+    inner = build_speed_data(data.train, (), 0.0, fraction)
+    return SpeedData(inner.train, inner.val, inner.norm, {**data.options, **{"val_fraction": float(fraction)}},
+                     {**inner.info, "inner_of": "train"})
+
+
 def window_samples(imu: pd.DataFrame, window_s: float) -> tuple[int, float]:
     """(IMU samples in a window of ``window_s`` seconds, the IMU rate in Hz) of a drive's IMU table: the odometer's
     window (``evaluate.odometer.window_s``), the same for the ridge, the networks and the energy audit."""

@@ -13,7 +13,7 @@ Notebook 03 runs the search per dataset (:func:`search_profile_learning_rates`) 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import pandas as pd
 
@@ -70,17 +70,22 @@ def search_learning_rates(data: LearningData, methods, train_cfg: dict, out_dir:
     return table.drop(columns="dataset").reset_index(drop=True)
 
 
-def search_profile_rates(learning: dict, methods, train_cfg: dict, runner: Runner | None = None) -> pd.DataFrame:
+def search_profile_rates(learning: dict, methods, train_cfg: dict, runner: Runner | None = None,
+                         split: Callable = inner_split, extra_card: dict | None = None) -> pd.DataFrame:
     """The search of :func:`search_learning_rates` for several datasets at once (``{dataset: (LearningData,
     out_dir)}``), in rounds of independent runs spread over ``runner``: the grid, then each ``extend`` step (a
-    rate beyond a grid's edge depends on the rates tried before it). Rows: dataset, method, rate (sorted)."""
+    rate beyond a grid's edge depends on the rates tried before it). Rows: dataset, method, rate (sorted).
+
+    ``split(data, fraction)`` makes the tuning split (default :func:`bgfn.learning.inner_split`; a learned
+    odometer's: :func:`bgfn.learning.odometry.inner_speed_split`); ``tuning_rmse_m`` holds the objective's error
+    (m for increments, m/s for a speed); ``extra_card`` is added to every run's card."""
     ls = lr_search_options(train_cfg)
     grid = [float(v) for v in (ls["grid"] or [])]
     if not grid:
         raise DataError("train.lr_search", "grid", "a non-empty list of learning rates", repr(ls["grid"]))
     grid = sorted(set(grid))
     budget = search_train_config(train_cfg)
-    inner = {name: inner_split(data, float(ls["fraction"])) for name, (data, _) in learning.items()}
+    inner = {name: split(data, float(ls["fraction"])) for name, (data, _) in learning.items()}
     tried: dict[tuple, list[dict]] = {(name, m): [] for name in learning for m in methods}
 
     def run(name, method: str, lr: float) -> TrainingRun:
@@ -88,7 +93,8 @@ def search_profile_rates(learning: dict, methods, train_cfg: dict, runner: Runne
         out_dir = learning[name][1]
         sub = Path(out_dir) / f"lr{lr:g}" if out_dir is not None else None
         label = f"{'' if name is None else name + ' '}{method} lr {lr:g}"
-        return TrainingRun(label, method, inner[name], size_config(train_cfg, method), cfg, int(ls["seed"]), sub)
+        return TrainingRun(label, method, inner[name], size_config(train_cfg, method), cfg, int(ls["seed"]), sub,
+                           None, extra_card)
 
     pending = [(key, lr) for key in tried for lr in grid]
     for step in range(int(ls["extend"]) + 1):
@@ -96,7 +102,8 @@ def search_profile_rates(learning: dict, methods, train_cfg: dict, runner: Runne
             break
         cards = train_runs([run(*key, lr) for key, lr in pending], runner, desc="lr search" + (f" +{step}" if step else ""))
         for (key, lr), card in zip(pending, cards):
-            tried[key].append({"dataset": key[0], "method": key[1], "lr": lr, "tuning_rmse_m": card["val_rmse_m"],
+            error = card["val_rmse_m"] if "val_rmse_m" in card else card["val_rmse_mps"]
+            tried[key].append({"dataset": key[0], "method": key[1], "lr": lr, "tuning_rmse_m": error,
                                "tuning_loss": card["best_val_loss"], "epochs_run": card["epochs_run"]})
         pending = [(key, nxt) for key, rows in tried.items()
                    if (nxt := next_learning_rate([r["lr"] for r in rows],

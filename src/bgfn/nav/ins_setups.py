@@ -268,7 +268,8 @@ def sentences(table: pd.DataFrame) -> list[str]:
     paper's, and the share of the gap each setup explains."""
     gap = gap_explained(table)
     names = {"navego": "NaveGo v1.4's setup", RESET: "that setup with the bias estimates cleared at the outage start",
-             NAVEGO_RUN: "NaveGo v1.4 itself, run under Octave on the same drive and outages"}
+             NAVEGO_RUN: "NaveGo v1.4 itself, run under Octave on the same drive and outages",
+             NAVEGO_CONSISTENT: "the same with its bias feedback made consistent"}
     out = []
     for dataset, g in gap.groupby("dataset", sort=False):
         first = g.iloc[0]

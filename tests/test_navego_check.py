@@ -5,10 +5,12 @@ from __future__ import annotations
 import importlib.util
 
 import numpy as np
+import pandas as pd
 import scipy.io
 import pytest
 
 from bgfn.config import PROJECT_ROOT
+from bgfn.data import Drive
 from bgfn.data.imu_errors import error_params
 from bgfn.nav.baseline import nav_config
 from synthetic_drive import exact_drive
@@ -69,3 +71,34 @@ def test_the_diagnostic_copy_changes_navegos_bias_feedback_and_nothing_else(tmp_
     (src / navego_check.PATCHED_FILE).write_text("gb_dyn = 0;\n")
     with pytest.raises(ValueError, match=r"ins_gnss.m: expected the line `kf.xp\(1:9\) = 0.0;` exactly once"):
         navego_check.patched_navego(src, tmp_path / "again")
+
+
+def test_the_bias_trace_holds_navegos_estimates_ours_and_the_truth_at_the_same_fixes(tmp_path):
+    # NaveGo's nav_e.b at its fixes (rad/s, m/s^2) -> deg/s and m/s^2 from the first fix, the first trace_s seconds
+    tg = np.arange(1000.0, 1010.0)
+    b = np.column_stack([np.full(10, np.radians(1.5)), np.zeros((10, 4)), np.linspace(0.0, 0.9, 10)])
+    scipy.io.savemat(tmp_path / "out.mat", {"tg": tg[:, None], "b": b})
+    rows = navego_check.navego_trace(tmp_path / "out.mat", "d", "as released", trace_s=4.0)
+    assert [r["time_s"] for r in rows] == [0.0, 1.0, 2.0, 3.0, 4.0]
+    assert rows[0]["source"] == "NaveGo, as released" and rows[0]["gyro_bias_x_dps"] == pytest.approx(1.5)
+    assert rows[4]["accel_bias_z_mps2"] == pytest.approx(0.4)
+    # ours under NaveGo's setup and the simulated truth, at the same fixes
+    drive = exact_drive(60.0, imu_errors=error_params("mpu6000"))
+    assert [r["source"] for r in navego_check.our_trace(drive, {}, drive.gnss["time"].to_numpy(float)[:2])] == [
+        navego_check.OURS] * 2                                                  # a drive without a truth
+    t_imu = drive.imu["time"].to_numpy(float)
+    truth = pd.DataFrame({"time": t_imu, **{c: 1e-3 * (k + 1) + 1e-5 * (t_imu - t_imu[0]) for k, c in
+                                            enumerate(navego_check._BIAS)}})
+    drive = Drive(drive.name, drive.reference, drive.imu, drive.gnss, drive.meta, truth)
+    t = drive.gnss["time"].to_numpy(float)[:5]
+    ours = navego_check.our_trace(drive, {}, t)
+    assert [r["source"] for r in ours] == [navego_check.OURS] * 5 + [navego_check.TRUTH] * 5
+    assert [r["time_s"] for r in ours[:5]] == list(t - t[0])
+    assert ours[7]["gyro_bias_y_dps"] == pytest.approx(np.degrees(2e-3 + 1e-5 * (t[2] - t_imu[0])))
+    assert ours[9]["accel_bias_z_mps2"] == pytest.approx(6e-3 + 1e-5 * (t[4] - t_imu[0]))
+    assert abs(ours[0]["gyro_bias_x_dps"]) < 1.0                               # ours: an estimate, in deg/s
+    # a run of some drives keeps the other drives' rows
+    path = tmp_path / "trace.csv"
+    pd.DataFrame({"dataset": ["a", "b"], "x": [1, 2]}).to_csv(path, index=False)
+    both = navego_check.merged(path, pd.DataFrame({"dataset": ["b"], "x": [3]}), ["b"])
+    assert both.values.tolist() == [["a", 1], ["b", 3]]

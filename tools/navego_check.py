@@ -32,6 +32,10 @@ Two runs per drive (the CSV's ``variant`` column, :data:`VARIANTS`):
   :data:`BIAS_FEEDBACK_PATCH` there (all 15 states zeroed before an update, the estimates corrected by the states
   with the signs of NaveGo's own ``F``: gyro ``gb -= x``, accelerometer ``ab += x``, since ``F_update.m`` drives
   the velocity error with ``+C_bn x_a``) and runs that copy. Nothing of NaveGo is written into this project.
+
+The bias states step by step go to ``data/measured/navego_bias_trace.csv`` (:data:`TRACE_COLUMNS`): every run's bias
+estimates at its fixes of the first :data:`TRACE_S` seconds, beside our filter under NaveGo's setup and the drive's
+true biases at the same fixes. ``--datasets`` runs some drives and keeps the others' rows in both files.
 """
 
 from __future__ import annotations
@@ -51,7 +55,7 @@ import scipy.io
 from bgfn.config import PROJECT_ROOT, git_commit
 from bgfn.data import load_drive
 from bgfn.io import atomic_write_csv
-from bgfn.nav.baseline import nav_config
+from bgfn.nav.baseline import nav_config, run_drive
 from bgfn.nav.earth import curvature_radii, lla_to_ned
 from bgfn.nav.outages import outage_windows
 from bgfn.nav.ins_setups import NAVEGO_CHECK_COLUMNS, NAVEGO_CHECK_FILE
@@ -67,6 +71,15 @@ BIAS_FEEDBACK_PATCH: tuple[tuple[str, str], ...] = (
 )
 #: NaveGo's runs per drive: as released, and with its bias feedback made consistent (module docstring).
 VARIANTS: tuple[str, ...] = ("as released", "bias feedback consistent")
+#: The bias states step by step (issue 26): NaveGo's estimates at every fix of each run's first TRACE_S seconds,
+#: beside our filter under NaveGo's setup and the drive's true biases (a simulated drive's), at the same fixes.
+TRACE_FILE = PROJECT_ROOT / "data" / "measured" / "navego_bias_trace.csv"
+TRACE_S = 120.0
+OURS = "ours, navego setup"
+TRUTH = "truth"
+_BIAS = ("gyro_bias_x", "gyro_bias_y", "gyro_bias_z", "accel_bias_x", "accel_bias_y", "accel_bias_z")
+TRACE_COLUMNS: tuple[str, ...] = ("dataset", "source", "time_s", *(c + ("_dps" if c.startswith("gyro") else "_mps2")
+                                                                  for c in _BIAS), "date", "commit")
 DATASETS = ("turin-sim-ekinox", "turin-sim-mpu6000")
 #: The velocity std that makes NaveGo's velocity rows carry nothing (position-only, as our filter), m/s.
 NO_VELOCITY_STD = 100.0
@@ -170,6 +183,46 @@ def errors(nav_file: Path, drive, windows) -> list[dict]:
             for r in rows]
 
 
+def _trace_rows(name: str, source: str, t: np.ndarray, t0: float, bias: np.ndarray) -> list[dict]:
+    """Rows of :data:`TRACE_COLUMNS` (without date and commit): ``bias`` [n, 6] rad/s and m/s^2 at times ``t``."""
+    b = np.asarray(bias, float).copy()
+    b[:, :3] = np.degrees(b[:, :3])
+    return [{"dataset": name, "source": source, "time_s": float(ti - t0), **dict(zip(TRACE_COLUMNS[3:9], map(float, r)))}
+            for ti, r in zip(t, b)]
+
+
+def navego_trace(nav_file: Path, name: str, variant: str, trace_s: float = TRACE_S) -> list[dict]:
+    """NaveGo's bias estimates (``nav_e.b``) at its fixes of the first ``trace_s`` seconds, as trace rows."""
+    m = scipy.io.loadmat(nav_file)
+    tg, b = np.asarray(m["tg"], float).ravel(), np.asarray(m["b"], float)
+    keep = tg <= tg[0] + trace_s
+    return _trace_rows(name, f"NaveGo, {variant}", tg[keep], tg[0], b[keep])
+
+
+def our_trace(drive, nav_section: dict, times: np.ndarray) -> list[dict]:
+    """Our filter under NaveGo's setup (``nav.ins_tuning: navego``) and the drive's true biases at ``times`` (s;
+    the first is the trace's zero), as trace rows; the truth only where the drive has one (a simulated IMU)."""
+    t0 = float(times[0])
+    est = run_drive(drive, {**(nav_section or {}), "ins_tuning": "navego"}).bias
+    rows = _trace_rows(drive.name, OURS, times, t0, np.column_stack(
+        [np.interp(times, est["time"].to_numpy(float), est[c].to_numpy(float)) for c in _BIAS]))
+    if drive.imu_bias is not None:
+        tb = drive.imu_bias
+        rows += _trace_rows(drive.name, TRUTH, times, t0, np.column_stack(
+            [np.interp(times, tb["time"].to_numpy(float), tb[c].to_numpy(float)) for c in _BIAS]))
+    return rows
+
+
+def merged(path: Path, new: pd.DataFrame, datasets) -> pd.DataFrame:
+    """``new`` after the rows of ``path`` (when it exists) whose dataset was not run now: a run of some drives keeps
+    the others' measurements."""
+    if not Path(path).is_file():
+        return new
+    old = pd.read_csv(path)
+    old = old[~old["dataset"].isin(list(datasets))]
+    return pd.concat([old.reindex(columns=new.columns), new], ignore_index=True)
+
+
 def octave_version(octave: str) -> str:
     out = subprocess.run([octave, "--version"], capture_output=True, text=True, timeout=60).stdout
     return out.splitlines()[0].strip() if out else "unknown"
@@ -184,6 +237,8 @@ def main(argv=None) -> int:
     p.add_argument("--fuse-velocity", action="store_true", help="NaveGo fuses the file's velocity (its own way)")
     p.add_argument("--variants", nargs="*", default=list(VARIANTS), choices=list(VARIANTS))
     p.add_argument("--out", default=str(NAVEGO_CHECK_FILE))
+    p.add_argument("--trace-out", default=str(TRACE_FILE))
+    p.add_argument("--trace-s", type=float, default=TRACE_S, help="seconds of the bias trace from the first fix")
     a = p.parse_args(argv)
     octave = shutil.which(a.octave)
     if octave is None:
@@ -195,7 +250,8 @@ def main(argv=None) -> int:
         return 2
     cfg = load_profile(a.profile)
     nav = nav_config(cfg["nav"])
-    rows, version = [], octave_version(octave)
+    rows, trace, version = [], [], octave_version(octave)
+    stamp = {"date": datetime.date.today().isoformat(), "commit": git_commit() or "unknown"}
     for name in a.datasets:
         drive = load_drive(name, profile=a.profile)
         windows = outage_windows(cfg, drive, name)
@@ -213,16 +269,21 @@ def main(argv=None) -> int:
                        f"addpath('{PROJECT_ROOT / 'tools'}'); navego_check('{tmp / 'in.mat'}', '{tmp / 'out.mat'}', "
                        f"'{navego}')"]
                 subprocess.run(cmd, check=True)
+                trace += navego_trace(tmp / "out.mat", name, variant, a.trace_s)
                 for r in errors(tmp / "out.mat", drive, windows):
                     rows.append({"dataset": name, **r, "setting": setting, "navego": "v1.4 (ins_gnss.m Version 011)",
-                                 "variant": variant, "octave": version, "date": datetime.date.today().isoformat(),
-                                 "commit": git_commit() or "unknown"})
+                                 "variant": variant, "octave": version, **stamp})
                     print(f"    outage {r['outage']}: max |E| {r['max_east_m']:.2f} m, max |N| {r['max_north_m']:.2f} "
                           f"m; GPS-aided RMS {r['aided_rms_h_m']:.2f} m; largest bias estimates "
                           f"{r['max_gyro_bias_est_dps']:.3g} deg/s, {r['max_accel_bias_est_mps2']:.3g} m/s^2")
-    table = pd.DataFrame(rows, columns=list(NAVEGO_CHECK_COLUMNS))
+        fixes = np.array(sorted({r["time_s"] for r in trace if r["dataset"] == name}))
+        trace += our_trace(drive, cfg["nav"], fixes + float(gnss_s["t"][0, 0]))
+    table = merged(a.out, pd.DataFrame(rows, columns=list(NAVEGO_CHECK_COLUMNS)), a.datasets)
     atomic_write_csv(a.out, table, float_format="%.4f")
     print(f"wrote {a.out}")
+    steps = merged(a.trace_out, pd.DataFrame([{**r, **stamp} for r in trace], columns=list(TRACE_COLUMNS)), a.datasets)
+    atomic_write_csv(a.trace_out, steps, float_format="%.6g")
+    print(f"wrote {a.trace_out}")
     return 0
 
 

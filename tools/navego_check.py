@@ -268,7 +268,7 @@ def main(argv=None) -> int:
                 cmd = [octave, "--no-gui", "--quiet", "--no-window-system", "--eval",
                        f"addpath('{PROJECT_ROOT / 'tools'}'); navego_check('{tmp / 'in.mat'}', '{tmp / 'out.mat'}', "
                        f"'{navego}')"]
-                subprocess.run(cmd, check=True)
+                subprocess.run(cmd, check=True, cwd=tmp)     # Octave writes a crash dump (octave-workspace) where it runs
                 trace += navego_trace(tmp / "out.mat", name, variant, a.trace_s)
                 for r in errors(tmp / "out.mat", drive, windows):
                     rows.append({"dataset": name, **r, "setting": setting, "navego": "v1.4 (ins_gnss.m Version 011)",

@@ -58,7 +58,7 @@ from bgfn.io import atomic_write_csv
 from bgfn.nav.baseline import nav_config, run_drive
 from bgfn.nav.earth import curvature_radii, lla_to_ned
 from bgfn.nav.outages import outage_windows
-from bgfn.nav.ins_setups import NAVEGO_CHECK_COLUMNS, NAVEGO_CHECK_FILE
+from bgfn.nav.ins_setups import NAVEGO_CHECK_COLUMNS, NAVEGO_CHECK_FILE, NAVEGO_VARIANTS
 from bgfn.profile_schema import load_profile
 
 NAVEGO_DIR = PROJECT_ROOT.parent / "shared" / "navego-v1.4"
@@ -70,7 +70,7 @@ BIAS_FEEDBACK_PATCH: tuple[tuple[str, str], ...] = (
     ("ab_dyn   = -kf.xp(13:15);", "ab_dyn   = ab_dyn + kf.xp(13:15);"),   # line 409: +, the sign of F's C_bn x_a
 )
 #: NaveGo's runs per drive: as released, and with its bias feedback made consistent (module docstring).
-VARIANTS: tuple[str, ...] = ("as released", "bias feedback consistent")
+VARIANTS: tuple[str, ...] = tuple(NAVEGO_VARIANTS)      # the CSV's variant column, read by bgfn.nav.ins_setups
 #: The bias states step by step (issue 26): NaveGo's estimates at every fix of each run's first TRACE_S seconds,
 #: beside our filter under NaveGo's setup and the drive's true biases (a simulated drive's), at the same fixes.
 TRACE_FILE = PROJECT_ROOT / "data" / "measured" / "navego_bias_trace.csv"

@@ -238,7 +238,7 @@ def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, data: d
     # BGFN on the real drive) can cripple a speed network: the same train.lr for every network, or with
     # lr_search the rate of each network chosen per fold by train.lr_search's grid on the speed objective
     tc = sweep_train_config(cfg["train"], ecfg["sweep"])
-    search = speed_lr_search(cfg, profile, dataset, ecfg, data, runner) if oc["lr_search"] else None
+    search = speed_lr_search(tc, profile, dataset, oc["methods"], data, runner) if oc["lr_search"] else None
     runs, keys = [], []
     for k in sorted(data):
         out = odometer_models_dir(profile, dataset, int(k))
@@ -270,12 +270,13 @@ def fold_name(dataset: str, fold: int) -> str:
     return f"{dataset} fold {int(fold)}"
 
 
-def speed_lr_search(cfg: dict, profile: str, dataset: str, ecfg: dict, data: dict[int, lo.SpeedData],
+def speed_lr_search(tc: dict, profile: str, dataset: str, methods, data: dict[int, lo.SpeedData],
                     runner: Runner | None = None) -> pd.DataFrame:
-    """The learning rate of every odometer network per fold (``evaluate.odometer.lr_search``): the grid, extension
-    and budget of ``train.lr_search`` (:func:`bgfn.train.search_profile_rates`, the same for every network), on a
-    tuning split inside each fold's training windows (:func:`bgfn.learning.odometry.inner_speed_split`), so that
-    neither the fold's outages nor its calibration block choose it; the sweep's model sizes.
+    """The learning rate of every odometer network ``methods`` per fold (``evaluate.odometer.lr_search``): the grid,
+    extension and budget of ``tc``'s ``lr_search`` (``tc``: the sweep's ``train:`` section,
+    :func:`bgfn.evaluate.sweep.sweep_train_config`; :func:`bgfn.train.search_profile_rates`, the same for every
+    network), on a tuning split inside each fold's training windows (:func:`bgfn.learning.odometry.inner_speed_split`),
+    so that neither the fold's outages nor its calibration block choose it; the sweep's model sizes.
 
     Returns
     -------
@@ -283,13 +284,12 @@ def speed_lr_search(cfg: dict, profile: str, dataset: str, ecfg: dict, data: dic
         :data:`bgfn.train.LR_SEARCH_COLUMNS` with ``dataset`` = :func:`fold_name` and ``tuning_rmse_m`` the tuning
         speed RMSE (m/s); ``selected`` marks each network's rate per fold.
     """
-    tc = {**sweep_train_config(cfg["train"], ecfg["sweep"]), "lr_search": (cfg.get("train") or {}).get("lr_search")}
     if not train.lr_search_options(tc)["grid"]:
         raise DataError("evaluate.odometer", "lr_search", "a train.lr_search.grid to search (or lr_search: false)",
                         "no grid")
     learning = {fold_name(dataset, k): (d, odometer_models_dir(profile, dataset, int(k)) / "lr_search")
                 for k, d in sorted(data.items())}
-    table = train.search_profile_rates(learning, ecfg["odometer"]["methods"], tc, runner, split=lo.inner_speed_split,
+    table = train.search_profile_rates(learning, methods, tc, runner, split=lo.inner_speed_split,
                                        extra_card={"dataset": dataset, "profile": profile, "objective": "speed"})
     return table[list(train.LR_SEARCH_COLUMNS)]
 

@@ -55,7 +55,8 @@ NAVEGO_RUN = "NaveGo (Octave)"
 #: Label of NaveGo v1.4 with its bias feedback made consistent (``make navego-check``'s diagnostic run).
 NAVEGO_CONSISTENT = "NaveGo, bias feedback consistent (Octave)"
 #: ``variant`` of ``data/measured/navego_check.csv`` -> the table's setup label (``tools/navego_check.py``'s VARIANTS).
-NAVEGO_VARIANTS: dict[str, str] = {"as released": NAVEGO_RUN, "bias feedback consistent": NAVEGO_CONSISTENT}
+RELEASED, CONSISTENT = "as released", "bias feedback consistent"
+NAVEGO_VARIANTS: dict[str, str] = {RELEASED: NAVEGO_RUN, CONSISTENT: NAVEGO_CONSISTENT}
 #: Row order of the table: our setups, NaveGo's own runs, then the paper's.
 SETUPS: tuple[str, ...] = navego_setup.INS_TUNINGS + (RESET, NAVEGO_RUN, NAVEGO_CONSISTENT, PAPER)
 #: What ``tools/navego_check.py`` measured (NaveGo's INS-only errors in the outages), with date and commit.
@@ -67,14 +68,14 @@ NAVEGO_CHECK_COLUMNS: tuple[str, ...] = ("dataset", "outage", "start_s", "durati
 
 
 def navego_measured(dataset: str, windows, path: Path = NAVEGO_CHECK_FILE,
-                    variant: str = "as released") -> pd.DataFrame:
+                    variant: str = RELEASED) -> pd.DataFrame:
     """NaveGo's own rows of ``dataset`` and ``variant`` (a key of :data:`NAVEGO_VARIANTS`; a file without the
     column holds the released one only) from ``path`` whose outage matches one of ``windows`` (same start and
     duration; the profile's ``Outage k`` numbering); empty when the check has not run for them."""
     if not Path(path).is_file():
         return pd.DataFrame(columns=list(NAVEGO_CHECK_COLUMNS))
     t = pd.read_csv(path)
-    variants = t["variant"] if "variant" in t.columns else pd.Series("as released", index=t.index)
+    variants = t["variant"] if "variant" in t.columns else pd.Series(RELEASED, index=t.index)
     t = t[(t["dataset"] == dataset) & (variants == variant)]
     rows = []
     for k, (s, d) in enumerate(windows, 1):

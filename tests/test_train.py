@@ -503,3 +503,18 @@ def test_runs_that_never_improved_are_trained_again_on_all_windows_only_when_the
     assert lines[1] == f"  toy mlp seed 0: {n // 4} -> {n} windows, best epoch 0 -> {pair['all']['best_epoch']}"
     assert T.recheck_lines(table.iloc[:0], tc)[0].startswith("no run to recheck")
     assert T.recheck_lines(table, {})[0] == "not rechecked (train.recheck_all_windows is false)"
+
+
+def test_recheck_runs_first_keeps_the_lowest_seed_of_each_dataset_and_method():
+    def card(dataset, method, seed):
+        return {"dataset": dataset, "method": method, "seed": seed, "best_epoch": 0}
+
+    cards = [card("a", "mlp", 2), card("a", "mlp", 1), card("a", "bgfn", 1), card("b", "mlp", 0), card("a", "mlp", 0)]
+    # a/mlp: seed 0 (the last card), a/bgfn: its only run, b/mlp: its only run; in the cards' order
+    assert T.first_per_method(cards) == [cards[2], cards[3], cards[4]]
+    lines = T.recheck_lines(pd.DataFrame({"dataset": ["a"], "method": ["mlp"], "seed": [0], "n_train": [10],
+                                          "n_train_all": [40], "best_epoch": [0], "best_epoch_all": [2],
+                                          "train_loss_min_all": [0.5]}), {"recheck_all_windows": True,
+                                                                          "recheck_runs": "first"})
+    assert "the first of each dataset and method" in lines[0] and lines[0].startswith(
+        "trained again on all their training windows, 1 of 1 runs")

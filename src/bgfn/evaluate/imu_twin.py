@@ -37,6 +37,7 @@ from bgfn.data.imu_roughness import trajectory_twin
 from bgfn.evaluate.nees import CHI2_MEDIAN, consistency_scan
 from bgfn.io import atomic_write_csv
 from bgfn.paper import test_of
+from bgfn.parallel import Runner
 
 #: Seeds of the twin's simulated IMU.
 TWIN_SEEDS: tuple[int, ...] = (1, 2, 3)
@@ -85,7 +86,8 @@ def _rows(scan: pd.DataFrame, imu: str, seed) -> list[dict]:
 
 
 def twin_check(cfg: dict, recorded, stand_in, seeds=TWIN_SEEDS, scan: pd.DataFrame | None = None,
-               gyro_dps: float | None = None, report: Callable[[str], None] | None = None) -> pd.DataFrame:
+               gyro_dps: float | None = None, report: Callable[[str], None] | None = None,
+               runner: Runner | None = None) -> pd.DataFrame:
     """The effective gyro bias instability of the recorded drive and of its trajectory twins (module docstring).
 
     Parameters
@@ -102,6 +104,8 @@ def twin_check(cfg: dict, recorded, stand_in, seeds=TWIN_SEEDS, scan: pd.DataFra
         Simulate the twin with this gyro bias instability (deg/s, every axis) instead of the stand-in's.
     report : callable, optional
         Called with one line per drive.
+    runner : bgfn.parallel.Runner, optional
+        Where the scans' points run (default: one after the other).
 
     Returns
     -------
@@ -109,14 +113,20 @@ def twin_check(cfg: dict, recorded, stand_in, seeds=TWIN_SEEDS, scan: pd.DataFra
         :data:`TWIN_COLUMNS`: ``imu`` ``recorded`` or ``<stand-in> model``; ``model_dps`` the filter's own setting
         and ``median_max_h_m`` the INS drift with it (the twin's: the stand-in's model, exact).
     """
-    scan = consistency_scan(cfg, [recorded]) if scan is None else scan[scan["dataset"] == recorded.name]
+    scan = (consistency_scan(cfg, [recorded], runner=runner) if scan is None
+            else scan[scan["dataset"] == recorded.name])
     rows = _rows(scan, "recorded", None)
     errors = dict(stand_in.meta["imu_errors"])
     if gyro_dps is not None:
         errors["gyro_bias_instability"] = [float(np.radians(gyro_dps))] * 3
-    for seed in seeds:
-        twin = trajectory_twin(recorded, errors, seed)
-        rows += _rows(consistency_scan(cfg, [twin]), f"{stand_in.name} model", int(seed))
+    twins = [trajectory_twin(recorded, errors, seed) for seed in seeds]
+    # every twin's scan in one map: its points spread over the runner's jobs together
+    # (the twins carry the recorded drive's name, so its settings apply: their rows come back twin by twin, each
+    # twin the same number of them)
+    twin_scan = consistency_scan(cfg, twins, runner=runner)
+    per_twin = len(twin_scan) // max(len(twins), 1)
+    for k, seed in enumerate(seeds):
+        rows += _rows(twin_scan.iloc[k * per_twin:(k + 1) * per_twin], f"{stand_in.name} model", int(seed))
     out = pd.DataFrame(rows, columns=list(TWIN_COLUMNS))
     if report is not None:
         for imu, g in out.groupby("imu", sort=False):
@@ -197,7 +207,7 @@ def twin_lines(table: pd.DataFrame, tolerance: float = 1.25) -> list[str]:
 
 
 def twin_section(cfg: dict, drives, scan: pd.DataFrame, out: Path,
-                 report: Callable[[str], None] | None = None) -> list[str]:
+                 report: Callable[[str], None] | None = None, runner: Runner | None = None) -> list[str]:
     """Notebook 02's check: :func:`twin_check` of the first recorded drive (test ``real``) against the stand-in
     (test ``field``) among ``drives``, written to ``tables/kf_imu_twin.csv``; its :func:`twin_lines` (empty without
     such a pair)."""
@@ -205,6 +215,6 @@ def twin_section(cfg: dict, drives, scan: pd.DataFrame, out: Path,
     stand_in = next((d for d in drives if test_of(d.name) == "field"), None)
     if recorded is None or stand_in is None:
         return []
-    table = twin_check(cfg, recorded, stand_in, scan=scan, report=report)
+    table = twin_check(cfg, recorded, stand_in, scan=scan, report=report, runner=runner)
     atomic_write_csv(Path(out) / "tables" / SHARED_TABLES["kf_imu_twin"], table, float_format="%.6g")
     return twin_lines(table)

@@ -38,6 +38,7 @@ from bgfn.data.registry import SIMULATED_IMU
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.evaluate.plots import finish_duration_axes
 from bgfn.evaluate.sweep import profile_sweep_plan
+from bgfn.parallel import Runner
 from bgfn.io import atomic_write_csv, save_figure
 
 #: chi-square with 2 degrees of freedom: its median (2 ln 2) and its 95 % quantile (-2 ln 0.05).
@@ -140,12 +141,34 @@ SCAN_COLUMNS: tuple[str, ...] = ("dataset", "gyro_bias_instability_dps", "profil
                                  "median_nees", "inside_95", "median_max_h_m", "verdict")
 
 
+def scan_point(cfg: dict, drive, value_dps: float, own: bool, starts: list[float], durations) -> list[dict]:
+    """One point of :func:`consistency_scan`: the standalone INS of ``drive`` from ``starts`` with the gyro bias
+    instability ``value_dps`` (deg/s, every axis), one row per duration (:data:`SCAN_COLUMNS`)."""
+    errors = {**drive.meta["imu_errors"], "gyro_bias_instability": [float(np.radians(value_dps))] * 3}
+    d = dataclasses.replace(drive, meta={**drive.meta, "imu_errors": errors})
+    ctx = navigation_context(d, cfg.get("nav"), starts)
+    runs = run_outages(ctx, [(s, max(durations)) for s in starts], None, "INS", None, cfg["evaluate"]["pseudo_gps"])
+    rows = []
+    for du in durations:
+        m = [window_metrics(r.errors, r.start, du, r.sd) for r in runs]
+        nees = np.array([x["nees_h"] for x in m])
+        rows.append({"dataset": drive.name, "gyro_bias_instability_dps": float(f"{value_dps:.4g}"), "profile": own,
+                     "duration_s": du, "runs": len(m), "median_nees": float(np.median(nees)),
+                     "inside_95": float(np.mean(nees <= CHI2_95)),
+                     "median_max_h_m": float(np.median([x["max_h_m"] for x in m])),
+                     "verdict": verdict(float(np.median(nees)))})
+    return rows
+
+
 def consistency_scan(cfg: dict, drives, durations=(30.0, 60.0), values_dps=SCAN_GYRO_BIAS_DPS,
-                     report: Callable[[str], None] | None = None) -> pd.DataFrame:
+                     report: Callable[[str], None] | None = None, runner: Runner | None = None) -> pd.DataFrame:
     """The INS NEES of every recorded drive among ``drives`` from the sweep's starts (``evaluate.sweep``) with the
     filter's gyro bias instability set to each of ``values_dps`` (deg/s, every axis) and to the profile's own
-    (``profile`` True): median NEES, share inside the 95 % bound, median max horizontal error, per duration."""
-    rows = []
+    (``profile`` True): median NEES, share inside the 95 % bound, median max horizontal error, per duration.
+
+    The points are independent runs (:func:`scan_point`), spread over ``runner`` (default: one after the other);
+    the rows come back in the grid's order whatever the number of jobs."""
+    tasks, labels = [], []
     for drive in drives:
         if drive.name in SIMULATED_IMU:
             continue
@@ -153,23 +176,15 @@ def consistency_scan(cfg: dict, drives, durations=(30.0, 60.0), values_dps=SCAN_
         own = float(np.degrees(np.mean(drive.meta["imu_errors"]["gyro_bias_instability"])))
         grid = [float(v) for v in values_dps if not np.isclose(v, own, rtol=1e-3)]   # the profile's own once
         for value in sorted(grid + [own]):
-            errors = {**drive.meta["imu_errors"], "gyro_bias_instability": [float(np.radians(value))] * 3}
-            d = dataclasses.replace(drive, meta={**drive.meta, "imu_errors": errors})
-            ctx = navigation_context(d, cfg.get("nav"), starts)
-            runs = run_outages(ctx, [(s, max(durations)) for s in starts], None, "INS", None,
-                               cfg["evaluate"]["pseudo_gps"])
-            for du in durations:
-                m = [window_metrics(r.errors, r.start, du, r.sd) for r in runs]
-                nees = np.array([x["nees_h"] for x in m])
-                rows.append({"dataset": drive.name, "gyro_bias_instability_dps": float(f"{value:.4g}"),
-                             "profile": bool(value == own), "duration_s": du, "runs": len(m),
-                             "median_nees": float(np.median(nees)), "inside_95": float(np.mean(nees <= CHI2_95)),
-                             "median_max_h_m": float(np.median([x["max_h_m"] for x in m])),
-                             "verdict": verdict(float(np.median(nees)))})
-            if report is not None:
-                report(f"{drive.name}: gyro bias instability {value:g} deg/s -> INS median NEES "
-                       + ", ".join(f"{r['median_nees']:.3g} at {r['duration_s']:g} s" for r in rows[-len(durations):]))
-    return pd.DataFrame(rows, columns=list(SCAN_COLUMNS))
+            tasks.append((cfg, drive, value, bool(value == own), starts, tuple(durations)))
+            labels.append(f"{drive.name} gyro bias instability {value:g} deg/s")
+
+    def line(rows: list[dict]) -> str:
+        return "INS median NEES " + ", ".join(f"{r['median_nees']:.3g} at {r['duration_s']:g} s" for r in rows)
+
+    done = (runner or Runner()).map(scan_point, tasks, labels=labels, summary=line, desc="NEES scan",
+                                    echo=report, bar=False)
+    return pd.DataFrame([row for rows in done for row in rows], columns=list(SCAN_COLUMNS))
 
 
 def scan_lines(scan: pd.DataFrame) -> list[str]:

@@ -41,7 +41,8 @@ from bgfn.train.plots import plot_motion_coverage, plot_training_curves, plot_va
 from bgfn.train.profile import (TrainingDataset, TrainingPlan, ins_attitude, prepare_datasets, prepare_learning_data,
                                 train_dataset, train_datasets, training_runs, val_position_table,
                                 val_position_tables)
-from bgfn.train.recheck import RECHECK_COLUMNS, capped_runs, recheck_all_windows, recheck_lines, recheck_table
+from bgfn.train.recheck import (RECHECK_COLUMNS, capped_runs, first_per_method, recheck_all_windows, recheck_lines,
+                                recheck_table)
 from bgfn.train.runs import train_profile
 from bgfn.train.tables import (TIMING_COLUMNS, card_line, cards_table, learning_check, summary_table, timing_table,
                                training_metrics, windows_table, without_timing)
@@ -72,7 +73,7 @@ __all__ = [
     "timing_table", "windows_table", "card_line", "training_metrics", "plot_training_curves",
     "plot_val_predictions", "plot_motion_coverage",
     # runs that never learned, trained again on all windows
-    "RECHECK_COLUMNS", "capped_runs", "recheck_all_windows", "recheck_table", "recheck_lines",
+    "RECHECK_COLUMNS", "capped_runs", "first_per_method", "recheck_all_windows", "recheck_table", "recheck_lines",
     # input and protocol variants
     "VARIANT_RUN_DEFAULTS", "VariantPlan", "describe_options", "variant_train_section", "variant_learning_data",
     "train_variants", "variant_runs", "variant_cards_table", "wall_time_by_variant",

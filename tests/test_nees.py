@@ -11,6 +11,7 @@ import pytest
 
 from bgfn.evaluate import nees as N
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
+from bgfn.parallel import Runner
 from bgfn.profile_schema import load_profile
 from synthetic_drive import demo_drive
 
@@ -58,7 +59,7 @@ def test_the_summary_finds_the_consistent_and_the_overconfident_filter(tmp_path)
     assert (tmp_path / "tables" / "outage_nees.csv").is_file() and (tmp_path / "figures" / "outage_nees_d.png").is_file()
 
 
-def test_the_scan_finds_a_larger_gyro_bias_instability_less_confident():
+def test_the_scan_finds_a_larger_gyro_bias_instability_less_confident(monkeypatch):
     """A synthetic drive with biased gyros the filter's error model under-states: the larger the bias
     instability the filter is told, the smaller its NEES; the profile's value is marked; simulated drives skipped."""
     drive = demo_drive("synthetic", 150.0, 5.0, 3)
@@ -71,6 +72,13 @@ def test_the_scan_finds_a_larger_gyro_bias_instability_less_confident():
     assert grid.loc[1.0, "median_nees"] < grid.loc[0.01, "median_nees"]
     assert N.scan_lines(scan)[0].startswith("synthetic: with the profile's gyro bias instability")
     assert N.consistency_scan(cfg, [dataclasses.replace(drive, name="turin-sim-mpu6000")]).empty
+    # the points are independent runs: spread over 2 processes, the same table, row for row
+    monkeypatch.delenv("BGFN_PROGRESS_LOG", raising=False)      # the progress lines come to `report`
+    lines = []
+    spread = N.consistency_scan(cfg, [drive], durations=(10.0,), values_dps=(0.01, 1.0), report=lines.append,
+                                runner=Runner(jobs=2))
+    pd.testing.assert_frame_equal(spread, scan)
+    assert len(lines) == 3 and all(line.startswith("[NEES scan] synthetic gyro bias instability") for line in lines)
 
 
 # ------------------------------------------------------------------------------- the check on a filter's own model

@@ -38,8 +38,8 @@ from bgfn.data.registry import SIMULATED_IMU
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.evaluate.plots import finish_duration_axes
 from bgfn.evaluate.sweep import profile_sweep_plan
-from bgfn.parallel import Runner
 from bgfn.io import atomic_write_csv, save_figure
+from bgfn.parallel import Runner
 
 #: chi-square with 2 degrees of freedom: its median (2 ln 2) and its 95 % quantile (-2 ln 0.05).
 CHI2_MEDIAN, CHI2_95 = 2.0 * np.log(2.0), -2.0 * np.log(0.05)
@@ -183,7 +183,7 @@ def consistency_scan(cfg: dict, drives, durations=(30.0, 60.0), values_dps=SCAN_
         return "INS median NEES " + ", ".join(f"{r['median_nees']:.3g} at {r['duration_s']:g} s" for r in rows)
 
     done = (runner or Runner()).map(scan_point, tasks, labels=labels, summary=line, desc="NEES scan",
-                                    echo=report, bar=False)
+                                    echo=report if report is not None else (lambda _line: None), bar=False)
     return pd.DataFrame([row for rows in done for row in rows], columns=list(SCAN_COLUMNS))
 
 

@@ -59,7 +59,7 @@ RESULTS_ROOT: Path = PROJECT_ROOT / "results"
 DATA_DIR: Path = PROJECT_ROOT / "data"
 
 #: Profiles shipped with the artifact (users may add their own ``params/<name>.yaml``).
-PROFILES: tuple[str, ...] = ("smoke", "quick", "paper")
+PROFILES: tuple[str, ...] = ("smoke", "quick", "full", "paper")
 #: Top-level keys every profile file must define (``outage_windows``: the evaluation outages, one list or per
 #: dataset a list or a rule, read by :func:`bgfn.nav.outages.outage_windows`, shared by notebooks 01-04).
 SCALAR_KEYS: tuple[str, ...] = ("profile", "description", "seed", "outage_windows")

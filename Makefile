@@ -117,16 +117,21 @@ $(STAMP): requirements.lock
 	  "$(PYTHON)" -m venv "$(VENV)"; \
 	else echo "    $(VENV) exists: checking it against the lock (already satisfied = nothing to do)"; fi
 	@# --no-deps everywhere: the lock is complete; pip must never resolve (spikingjelly declares
-	@# torchvision/torchaudio, which would pull CUDA builds of torch). --no-compile: byte-compiling every installed
-	@# module took 90 of the 150 s on a 2-core machine; Python compiles what it imports on first use instead.
+	@# torchvision/torchaudio, which would pull CUDA builds of torch). --no-compile, then compileall on every core:
+	@# pip byte-compiles on one core (90 of its 150 s on a 2-core machine), and without the .pyc files every
+	@# notebook kernel and worker would compile what it imports again where PYTHONDONTWRITEBYTECODE is set.
 	@echo "    pip install --no-deps -r requirements.lock ($$(grep -vc '^#' requirements.lock) packages)"
 	@$(PIP) install -q --no-compile $(PIP_FLAGS) --no-deps -r requirements.lock 2>&1 | { grep -v "$(PIP_NOISE)" || true; }
 	@echo "    pip install --no-deps spikingjelly==2.0.0"
-	@$(PIP) install -q $(PIP_FLAGS) --no-deps spikingjelly==2.0.0 2>&1 | { grep -v "$(PIP_NOISE)" || true; }
+	@$(PIP) install -q --no-compile $(PIP_FLAGS) --no-deps spikingjelly==2.0.0 2>&1 | { grep -v "$(PIP_NOISE)" || true; }
 	@if $(PY) -c 'import bgfn, pathlib, sys; sys.exit(pathlib.Path(bgfn.__file__).resolve().parents[1] != pathlib.Path("src").resolve())' 2>/dev/null; \
 	then echo "    bgfn already installed (editable) from ./src"; \
 	else echo "    pip install --no-deps -e ."; \
 	  $(PIP) install -q $(PIP_FLAGS) --no-deps -e . 2>&1 | { grep -v "$(PIP_NOISE)" || true; }; fi
+	@echo "    byte-compile the environment (compileall, every core)"
+	@# a file written for a newer Python (torch's py312_intrinsics.py) fails to compile here, as it does under pip's
+	@# own byte-compilation, which skips it: the exit status is not a verdict, the import check below is
+	@$(PY) -m compileall -q -j 0 "$$($(PY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')" src >/dev/null 2>&1 || true
 	@$(PY) -c 'import bgfn, torch, spikingjelly.activation_based, papermill, ipykernel, jupyter_book; \
 	  assert torch.version.cuda is None, "a CUDA build of torch is installed: expected the +cpu wheel"; \
 	  print("    ok: torch", torch.__version__, "| bgfn from", bgfn.__file__)'

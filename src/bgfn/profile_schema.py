@@ -126,7 +126,8 @@ TRAIN = section(
     target_screen_sigma=number(0, lo_open=True, null=True),
     optimizer=OPTIMIZER, lr=mapping(_POS),
     lr_search=section(grid=seq(_POS, null=True), fraction=_FRACTION, seed=_SEED, extend=integer(0),
-                      epochs=integer(1, null=True), patience=integer(1, null=True)),
+                      epochs=integer(1, null=True), patience=integer(1, null=True),
+                      max_train_windows=integer(1, null=True)),
     recheck_all_windows=flag(), recheck_runs=text("first", "all"), size=text(), sizes=mapping(mapping(mapping(ANY))))
 
 #: The parameters of the real car drive ``rtklib-drive0708`` (``data.rtklib-drive0708``; the defaults and the

@@ -131,6 +131,21 @@ def test_the_two_evaluation_outages_are_one_more_fold_at_their_own_duration(monk
     assert not (O.odometer_summary(rows[rows["fold"] != O.PAPER_FOLD])["duration_s"].isin([15.0, 20.0])).any()
 
 
+def test_a_drive_left_out_of_network_datasets_gets_the_bars_but_no_network(monkeypatch, tmp_path):
+    from bgfn import config
+
+    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)
+    drive = demo_drive("synthetic", 150.0, 5.0, 3)
+    cfg = load_profile("smoke")
+    cfg = {**cfg, "nav": NAV, "train": {**cfg["train"], "window": 50, "margin_s": 5.0}}
+    ecfg = ev.evaluate_config({"sweep": {"n_starts": 2, "folds": 2, "durations_s": [10.0], "warmup_s": 30.0},
+                               "odometer": {"sigmas_mps": [0.5], "seeds": [0], "methods": ["mlp"],
+                                            "network_datasets": ["another-drive"]}}, cfg["train"])
+    rows, facts = O.odometer_rows(cfg, "t", "synthetic", ecfg, drive=drive)
+    assert set(rows["method"]) == {"INS+NHC", "INS+NHC+HOLD", "RIDGE-ODO", "ORACLE-SPEED"}
+    assert facts["networks"] == {} and not (tmp_path / "t").exists()     # nothing trained, nothing written
+
+
 def test_a_walker_gets_no_odometer_bars():
     """The learned odometer is a car's forward speed fused with the NHC rows: a walker's drive is skipped, saying so."""
     drive = demo_drive("synthetic", 150.0, 5.0, 3)

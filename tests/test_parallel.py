@@ -9,7 +9,7 @@ import pytest
 
 from bgfn import learning as L, train as T
 from bgfn.errors import DataError
-from bgfn.parallel import PROGRESS_ENV, Runner, RunProgress
+from bgfn.parallel import PROGRESS_ENV, Runner, RunProgress, dispatch_order
 from bgfn.profile_schema import load_profile
 
 
@@ -66,6 +66,25 @@ def test_results_come_back_in_the_order_of_the_runs(jobs):
         assert lines[-1].startswith("[squares] a | got 9")
     assert [line.split(" | ")[3] for line in lines[:2]] == ["2 left", "1 left"]
     assert lines[-1].split(" | ")[-1].startswith("all 3 in ")
+
+
+def _start_time(x: int, delay: float) -> tuple[int, float]:
+    t = time.time()
+    time.sleep(delay)
+    return x, t
+
+
+def test_the_costliest_runs_start_first_and_the_results_keep_their_order():
+    assert dispatch_order([1.0, 3.0, 2.0, 3.0], 4) == [1, 3, 2, 0]          # costliest first, ties in task order
+    assert dispatch_order(None, 3) == [0, 1, 2]
+    with pytest.raises(ValueError, match="2 entries for 3 tasks"):
+        dispatch_order([1.0, 2.0], 3)
+    # the last task is the long one: with its cost given, a 2-process pool starts it among the first two
+    tasks = [(0, 0.3), (1, 0.3), (2, 0.3), (3, 1.0)]
+    out = Runner(2).map(_start_time, tasks, cost=[0.3, 0.3, 0.3, 1.0], bar=False, echo=lambda line: None)
+    assert [x for x, _ in out] == [0, 1, 2, 3]
+    started = sorted(range(4), key=lambda i: out[i][1])
+    assert 3 in started[:2]
 
 
 def test_progress_lines_carry_the_seconds_runs_left_and_an_eta():

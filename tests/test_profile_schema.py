@@ -63,12 +63,32 @@ def test_a_bad_variant_names_its_file_the_key_and_the_value(params, case):
     assert err.value.field == key and words in str(err.value), str(err.value)
 
 
-def test_an_inherited_variant_list_naming_a_drive_not_trained_names_the_base_that_set_it(params):
+def test_a_top_level_drive_list_covers_the_variants_and_the_odometers_too(params):
+    # quick (smoke's base) names its own drives for the variants and the network odometers: one's own list wins
     (params / "mine.yaml").write_text("profile: mine\nbase: smoke\ndescription: v\ndatasets: [rtklib-drive0708]\n")
+    cfg = load_profile("mine")
+    assert cfg["variant_runs"]["datasets"] == ["rtklib-drive0708"] == cfg["evaluate"]["sweep"]["datasets"]
+    assert cfg["evaluate"]["odometer"]["datasets"] == cfg["evaluate"]["odometer"]["network_datasets"] == [
+        "rtklib-drive0708"]
+
+
+def test_a_variant_list_naming_a_drive_not_trained_names_the_file_that_set_it(params):
+    (params / "mine.yaml").write_text("profile: mine\nbase: smoke\ndescription: v\n"
+                                      "train: {datasets: [turin-sim-mpu6000]}\n"
+                                      "variant_runs: {datasets: [rtklib-drive0708]}\n")
     with pytest.raises(DataError) as err:
         load_profile("mine")
-    assert err.value.source == str(params / "smoke.yaml") and err.value.field == "variant_runs.datasets"
+    assert err.value.source == str(params / "mine.yaml") and err.value.field == "variant_runs.datasets"
     assert "['turin-sim-mpu6000']" in str(err.value) and "variant_runs: {datasets: null}" in str(err.value)
+
+
+def test_network_odometers_on_a_drive_without_odometer_bars_fail_by_name(params):
+    (params / "mine.yaml").write_text("profile: mine\nbase: quick\ndescription: v\n"
+                                      "evaluate: {odometer: {network_datasets: [rtklib-drive0780]}}\n")   # misspelt
+    with pytest.raises(DataError) as err:
+        load_profile("mine")
+    assert err.value.source == str(params / "mine.yaml")
+    assert err.value.field == "evaluate.odometer.network_datasets" and "rtklib-drive0780" in str(err.value)
 
 
 def test_noise_scale_auto_and_alignment_options_are_accepted(params):

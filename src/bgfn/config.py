@@ -100,10 +100,11 @@ SHARED_TABLES: dict[str, str] = {
     "variants": "outage_variants.csv",          # notebook 03: the learning-problem variants in the two outages
     "energy_odometer": "energy_odometer.csv",   # notebook 05: the learned odometers' energy (bgfn.energy.odometer)
 }
-#: Where a top-level ``datasets:`` puts its list (the datasets of every notebook), unless the same file or a later
-#: one in the ``base:`` chain sets that section's own ``datasets``.
+#: Where a top-level ``datasets:`` puts its list (the datasets of every notebook, their variants and odometers),
+#: unless the same file or a later one in the ``base:`` chain sets that section's own ``datasets``.
 DATASET_KEYS: tuple[str, ...] = ("data.datasets", "nav.datasets", "train.datasets", "evaluate.datasets",
-                                 "evaluate.sweep.datasets")
+                                 "evaluate.sweep.datasets", "variant_runs.datasets", "evaluate.odometer.datasets",
+                                 "evaluate.odometer.network_datasets")
 
 
 def odometer_datasets(odometer: dict | None, sweep_datasets) -> list[str]:

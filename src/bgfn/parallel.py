@@ -89,7 +89,7 @@ class Runner:
 
     def map(self, fn: Callable, tasks: Sequence[tuple], labels: Sequence[str] | None = None,
             summary: Callable[[Any], str] | None = None, desc: str = "runs", echo: Callable[[str], Any] | None = None,
-            bar: bool = True) -> list:
+            bar: bool = True, cost: Sequence[float] | None = None) -> list:
         """``[fn(*task) for task in tasks]``, the tasks spread over the runner's jobs; results in task order.
 
         Parameters
@@ -108,20 +108,25 @@ class Runner:
             Where the lines go without ``BGFN_PROGRESS_LOG`` (default: printed above the bar).
         bar : bool
             Show a tqdm bar over the runs.
+        cost : sequence of float, optional
+            Each task's expected cost, in any unit: with more than one job the pool gets the costliest first
+            (:func:`dispatch_order`), so that no long run starts last while the other jobs idle. Only the order
+            in which the runs start changes; their results, and their order here, do not.
         """
         tasks = list(tasks)
         labels = list(labels) if labels is not None else [f"{desc} {i + 1}" for i in range(len(tasks))]
         progress = RunProgress(len(tasks), desc, echo=echo, bar=bar)
         results: list = [None] * len(tasks)
         try:
-            for i, result, seconds in self._unordered(fn, tasks):
+            for i, result, seconds in self._unordered(fn, tasks, cost):
                 results[i] = result
                 progress.done(labels[i], seconds, summary(result) if summary is not None else "")
         finally:
             progress.close()
         return results
 
-    def _unordered(self, fn: Callable, tasks: list[tuple]) -> Iterable[tuple[int, Any, float]]:
+    def _unordered(self, fn: Callable, tasks: list[tuple], cost: Sequence[float] | None = None
+                   ) -> Iterable[tuple[int, Any, float]]:
         """``(index, result, seconds)`` of every task as it finishes."""
         if not tasks:
             return
@@ -129,12 +134,25 @@ class Runner:
             for i, task in enumerate(tasks):        # in this process: nothing to pickle, the same numbers
                 yield _timed(i, fn, task)
             return
+        order = dispatch_order(cost, len(tasks))
         jobs = min(self.jobs, len(tasks)) if self.backend == "loky" else -1
         config = ({"backend": "dask", "scheduler_host": self.scheduler} if self.backend == "dask"
                   else {"backend": "loky", "inner_max_num_threads": 1})
         with parallel_config(**config):
             yield from Parallel(n_jobs=jobs, return_as="generator_unordered")(
-                delayed(_timed)(i, fn, task) for i, task in enumerate(tasks))
+                delayed(_timed)(i, fn, tasks[i]) for i in order)
+
+
+def dispatch_order(cost: Sequence[float] | None, n: int) -> list[int]:
+    """The order in which a pool starts ``n`` tasks: the costliest first (longest-processing-time first, ties in
+    task order), or the task order without ``cost``. A pool that takes the next task whenever a job frees up then
+    ends its last runs close together instead of waiting for one long run that started last."""
+    if cost is None:
+        return list(range(n))
+    cost = list(cost)
+    if len(cost) != n:
+        raise ValueError(f"cost has {len(cost)} entries for {n} tasks")
+    return sorted(range(n), key=lambda i: -float(cost[i]))
 
 
 def _timed(i: int, fn: Callable, task: tuple) -> tuple[int, Any, float]:

@@ -26,8 +26,8 @@ import sys
 from dataclasses import dataclass, field
 from typing import Any
 
-from bgfn.config import (MAIN_VARIANT, VARIANT_NAME, VARIANT_RUN_KEYS, file_setting, profile_chain, read_profile,
-                         set_keys, variant_config)
+from bgfn.config import (MAIN_VARIANT, VARIANT_NAME, VARIANT_RUN_KEYS, file_setting, odometer_datasets,
+                         profile_chain, read_profile, set_keys, variant_config)
 from bgfn.data import load_drive
 from bgfn.data.names import profile_datasets, unique_ids
 from bgfn.errors import DataError
@@ -195,6 +195,7 @@ SCHEMA = section(
                       level=_FRACTION, boot_seed=_SEED),
         oracle=section(sigmas_m=seq(_NONNEG), seeds=seq(_SEED, min_len=1), durations_s=seq(_POS)),
         odometer=section(datasets=seq(text(), null=True), methods=seq(text(*METHOD_LABELS)),
+                         network_datasets=seq(text(), null=True),
                          network_seeds=seq(_SEED, min_len=1), paper_outages=flag(), window_s=number(0.5), sigmas_mps=seq(_POS), walk_mps_per_sqrt_s=_NONNEG,
                          seeds=seq(_SEED, min_len=1), hold_std_mps=_POS, ridge_alpha=_POS,
                          gate_probability=number(0, 1, lo_open=True, hi_open=True, null=True), lr_search=flag())),
@@ -393,6 +394,12 @@ def cross_check(cfg: dict) -> None:
     if o_dur and max(o_dur) > max(s_dur):
         raise ProfileError("evaluate.oracle.durations_s", f"durations up to evaluate.sweep.durations_s's longest "
                            f"{max(s_dur):g} s (the sweep's starts leave room for no more)", _fmt(o_dur))
+    od = ev.get("odometer") or {}
+    bars = odometer_datasets(od, sw.get("datasets"))
+    bad = [d for d in od.get("network_datasets") or [] if d not in bars]
+    if bad:
+        raise ProfileError("evaluate.odometer.network_datasets", f"drives among the odometer bars' {bars} "
+                           "(evaluate.odometer.datasets; null: every one of them)", _fmt(bad))
     en = cfg.get("energy") or {}
     if en.get("dataset") is not None and en["dataset"] not in (tr.get("datasets") or []):
         raise ProfileError("energy.dataset", f"one of train.datasets {tr.get('datasets')} (its networks are "

@@ -232,7 +232,7 @@ def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, data: d
     Returns ``{(label, fold, seed): (SpeedTrack, facts)}``.
     """
     oc = ecfg["odometer"]
-    if not oc["methods"]:
+    if not oc["methods"] or (oc["network_datasets"] is not None and dataset not in oc["network_datasets"]):
         return {}
     # notebook 03's search tuned the rates for the increments, another target, and one of its picks (e.g. 0.27 for
     # BGFN on the real drive) can cripple a speed network: the same train.lr for every network, or with

@@ -213,7 +213,8 @@ def run_sweep(cfg: dict, profile: str, dataset: str, drive=None, ecfg: dict | No
     sweep = _Sweep(cfg, profile, dataset, drive, ecfg)
     return sweep.finish((runner or Runner()).map(sweep_run, [(r,) for r in sweep.runs],
                                                  labels=[r.label for r in sweep.runs], summary=_sweep_summary,
-                                                 desc=f"sweep {dataset}"))
+                                                 desc=f"sweep {dataset}",
+                                                 cost=[train.expected_cost(r.training) for r in sweep.runs]))
 
 
 def sweep_summary(sweep: pd.DataFrame, n_boot: int = 2000, level: float = 0.95, seed: int = 0,
@@ -333,7 +334,8 @@ def run_sweeps(cfg: dict, profile: str, datasets, ecfg: dict, runner: Runner | N
     sweeps = [_Sweep(cfg, profile, name, None, ecfg) for name in datasets]
     runs = [r for sw in sweeps for r in sw.runs]
     results = (runner or Runner()).map(sweep_run, [(r,) for r in runs], labels=[r.label for r in runs],
-                                       summary=_sweep_summary, desc="sweep")
+                                       summary=_sweep_summary, desc="sweep",
+                                       cost=[train.expected_cost(r.training) for r in runs])
     parts, info, timings, i = [], {}, {}, 0
     for sw in sweeps:
         name = sw.dataset

@@ -46,7 +46,7 @@ from bgfn.train.recheck import (RECHECK_COLUMNS, capped_runs, first_per_method, 
 from bgfn.train.runs import train_profile
 from bgfn.train.tables import (TIMING_COLUMNS, card_line, cards_table, learning_check, summary_table, timing_table,
                                training_metrics, windows_table, without_timing)
-from bgfn.train.tasks import TrainingRun, run_summary, train_run, train_runs
+from bgfn.train.tasks import TrainingRun, expected_cost, run_summary, train_run, train_runs
 from bgfn.train.trained import TrainedModel, checkpoint_predictions, load_trained, pick_device, predict_normalized
 from bgfn.train.variants import (VARIANT_RUN_DEFAULTS, VariantPlan, describe_options, train_variants,
                                  variant_cards_table, variant_learning_data, variant_runs, variant_train_section,
@@ -64,7 +64,7 @@ __all__ = [
     "next_learning_rate", "search_train_config", "with_selected_lr", "tuned_train_config", "search_profile_learning_rates",
     "selected_train_configs", "chosen_learning_rates", "search_profile_rates",
     # independent runs
-    "TrainingRun", "train_run", "train_runs", "run_summary",
+    "TrainingRun", "train_run", "train_runs", "run_summary", "expected_cost",
     # a profile's training
     "TrainingPlan", "TrainingDataset", "prepare_datasets", "prepare_learning_data", "ins_attitude",
     "val_position_table", "val_position_tables", "train_dataset", "train_datasets", "training_runs", "train_profile",

@@ -126,8 +126,10 @@ def test_variant_plan_takes_variant_runs_and_describes_each_variant():
     plan = T.TrainingPlan.of(with_overrides(load_profile("quick"), {"train.methods": ["mlp", "bgfn"]}))
     vplan = T.VariantPlan.of(plan)
     assert vplan.names == ["velocity", "leaky", "velocity-leaky"]
-    # variant_runs' own order (quick: bgfn, at_lstm, mlp), cut to the plan's methods
-    assert vplan.methods == ["bgfn", "mlp"] and vplan.seeds == [0] and vplan.datasets == plan.datasets
+    # variant_runs' own order (quick: bgfn, at_lstm, mlp), cut to the plan's methods; quick's drive list: the real one
+    assert vplan.methods == ["bgfn", "mlp"] and vplan.seeds == [0] and vplan.datasets == ["rtklib-drive0708"]
+    full = T.VariantPlan.of(T.TrainingPlan.of(load_profile("full")))        # null: every drive trained
+    assert full.datasets == T.TrainingPlan.of(load_profile("full")).datasets and len(full.datasets) == 3
     # variant_runs' own lists are cut to what notebook 03 trains (its parameters may narrow train:)
     smoke = T.VariantPlan.of(T.TrainingPlan.of(with_overrides(load_profile("smoke"), {"train.methods": ["mlp", "at_lstm"]})))
     assert (smoke.methods, smoke.datasets) == (["mlp"], ["turin-sim-mpu6000"])

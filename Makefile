@@ -81,6 +81,11 @@ export JUPYTER_PATH := $(VENV_ABS)/share/jupyter
 export MPLBACKEND := Agg
 export PYDEVD_DISABLE_FILE_VALIDATION := 1
 export PYTHONHASHSEED := 0
+# Python writes the bytecode of what it imports into .venv (and the gitignored src/**/__pycache__) on first use,
+# even where the shell sets PYTHONDONTWRITEBYTECODE: else every notebook kernel and pool worker compiles torch &c.
+# again. pip installs without byte-compiling (--no-compile): it compiles every file, most never imported, on one
+# core (90 of its 150 s on a 2-core machine).
+export PYTHONDONTWRITEBYTECODE :=
 export BGFN_JOBS := $(JOBS)
 export DASK_SCHEDULER
 # the venv's IPython kernel configuration (tools/ipython_kernel_config.py, installed by `make venv`)
@@ -117,9 +122,7 @@ $(STAMP): requirements.lock
 	  "$(PYTHON)" -m venv "$(VENV)"; \
 	else echo "    $(VENV) exists: checking it against the lock (already satisfied = nothing to do)"; fi
 	@# --no-deps everywhere: the lock is complete; pip must never resolve (spikingjelly declares
-	@# torchvision/torchaudio, which would pull CUDA builds of torch). --no-compile, then compileall on every core:
-	@# pip byte-compiles on one core (90 of its 150 s on a 2-core machine), and without the .pyc files every
-	@# notebook kernel and worker would compile what it imports again where PYTHONDONTWRITEBYTECODE is set.
+	@# torchvision/torchaudio, which would pull CUDA builds of torch). --no-compile: see PYTHONDONTWRITEBYTECODE above.
 	@echo "    pip install --no-deps -r requirements.lock ($$(grep -vc '^#' requirements.lock) packages)"
 	@$(PIP) install -q --no-compile $(PIP_FLAGS) --no-deps -r requirements.lock 2>&1 | { grep -v "$(PIP_NOISE)" || true; }
 	@echo "    pip install --no-deps spikingjelly==2.0.0"
@@ -128,10 +131,6 @@ $(STAMP): requirements.lock
 	then echo "    bgfn already installed (editable) from ./src"; \
 	else echo "    pip install --no-deps -e ."; \
 	  $(PIP) install -q $(PIP_FLAGS) --no-deps -e . 2>&1 | { grep -v "$(PIP_NOISE)" || true; }; fi
-	@echo "    byte-compile the environment (compileall, every core)"
-	@# a file written for a newer Python (torch's py312_intrinsics.py) fails to compile here, as it does under pip's
-	@# own byte-compilation, which skips it: the exit status is not a verdict, the import check below is
-	@$(PY) -m compileall -q -j 0 "$$($(PY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')" src >/dev/null 2>&1 || true
 	@$(PY) -c 'import bgfn, torch, spikingjelly.activation_based, papermill, ipykernel, jupyter_book; \
 	  assert torch.version.cuda is None, "a CUDA build of torch is installed: expected the +cpu wheel"; \
 	  print("    ok: torch", torch.__version__, "| bgfn from", bgfn.__file__)'

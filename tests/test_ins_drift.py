@@ -66,3 +66,14 @@ def test_sentences_put_the_stand_in_beside_the_recorded_drive():
     summary.loc[1, "median_max_h_m"] = 14.0
     assert ev.drift_sentences(summary, stand_in="sim", recorded="real")[-1] == (
         "The stand-in's standalone INS drifts within a factor 1.5 of the recorded drive's at every duration.")
+
+
+def test_the_drives_give_the_same_rows_spread_over_two_processes(cfg, runs):
+    from bgfn.parallel import Runner
+
+    lines = []
+    two = ev.ins_drift_runs(cfg, [_drive("calm", "ekinox-d"), _drive("rough", "mpu6000")], report=lines.append,
+                            runner=Runner(2))
+    assert two.to_csv(index=False) == runs.to_csv(index=False)            # row for row, the drives' order kept
+    assert len(lines) == 2 and all(line.startswith("[INS drift] ") and "3 starts x 2 durations" in line
+                                   for line in lines)

@@ -25,6 +25,7 @@ from bgfn.evaluate.config import evaluate_config
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.evaluate.sweep import profile_sweep_plan
 from bgfn.paper import nhc_label, test_of
+from bgfn.parallel import Runner
 
 #: The stand-in drifts "as a real MEMS IMU does" when its median INS drift lies within this factor of the recorded
 #: drive's at every duration (notebook 02; the stand-in's error model: :mod:`bgfn.evaluate.imu_twin`).
@@ -43,7 +44,7 @@ def drift_starts(cfg: dict, drive) -> list[float]:
 
 
 def ins_drift_runs(cfg: dict, drives: list, durations=None, nhc: bool = True,
-                   report: Callable[[str], None] | None = None) -> pd.DataFrame:
+                   report: Callable[[str], None] | None = None, runner: Runner | None = None) -> pd.DataFrame:
     """INS (and ``INS+NHC``) from every sweep start of every drive.
 
     Parameters
@@ -57,6 +58,8 @@ def ins_drift_runs(cfg: dict, drives: list, durations=None, nhc: bool = True,
         Also the INS with the vehicle constraints (``INS+NHC``).
     report : callable, optional
         Called with one line per drive.
+    runner : bgfn.parallel.Runner, optional
+        Where the drives run (default: one after the other); the rows come back in the drives' order.
 
     Returns
     -------
@@ -65,25 +68,29 @@ def ins_drift_runs(cfg: dict, drives: list, durations=None, nhc: bool = True,
     """
     ecfg = evaluate_config(cfg.get("evaluate"), cfg.get("train"))
     durations = sorted(float(d) for d in (durations or ecfg["sweep"]["durations_s"]))
+    done = (runner or Runner()).map(drive_drift_rows, [(cfg, drive, durations, nhc) for drive in drives],
+                                    labels=[drive.name for drive in drives], summary=lambda rows: rows[1],
+                                    desc="INS drift", echo=report or (lambda line: None), bar=False)
+    return pd.DataFrame([row for rows, _ in done for row in rows], columns=list(DRIFT_RUN_COLUMNS))
+
+
+def drive_drift_rows(cfg: dict, drive, durations: list[float], nhc: bool = True) -> tuple[list[dict], str]:
+    """One drive of :func:`ins_drift_runs` (an independent run): its rows and what its progress line says."""
+    ecfg = evaluate_config(cfg.get("evaluate"), cfg.get("train"))
+    starts = drift_starts(cfg, drive)
+    ctx = navigation_context(drive, cfg.get("nav"), starts)
+    windows = [(s, durations[-1]) for s in starts]
+    runs = run_outages(ctx, windows, None, "INS", None, ecfg["pseudo_gps"])
+    if nhc and ctx.constraints is not None:
+        runs += run_outages(ctx, windows, None, nhc_label("INS"), None, ecfg["pseudo_gps"],
+                            constraints=ctx.constraints)
     rows = []
-    for drive in drives:
-        starts = drift_starts(cfg, drive)
-        ctx = navigation_context(drive, cfg.get("nav"), starts)
-        windows = [(s, durations[-1]) for s in starts]
-        runs = run_outages(ctx, windows, None, "INS", None, ecfg["pseudo_gps"])
-        if nhc and ctx.constraints is not None:
-            runs += run_outages(ctx, windows, None, nhc_label("INS"), None, ecfg["pseudo_gps"],
-                                constraints=ctx.constraints)
-        for r in runs:
-            for du in durations:
-                m = window_metrics(r.errors, r.start, du)
-                rows.append({"dataset": drive.name, "test": test_of(drive.name) or "", "start_s": r.start,
-                             "duration_s": du, "method": r.method, "max_h_m": m["max_h_m"],
-                             "final_h_m": m["final_h_m"]})
-        if report is not None:
-            report(f"{drive.name}: {len(starts)} starts x {len(durations)} durations, "
-                   f"{len(runs)} standalone runs")
-    return pd.DataFrame(rows, columns=list(DRIFT_RUN_COLUMNS))
+    for r in runs:
+        for du in durations:
+            m = window_metrics(r.errors, r.start, du)
+            rows.append({"dataset": drive.name, "test": test_of(drive.name) or "", "start_s": r.start,
+                         "duration_s": du, "method": r.method, "max_h_m": m["max_h_m"], "final_h_m": m["final_h_m"]})
+    return rows, f"{len(starts)} starts x {len(durations)} durations, {len(runs)} standalone runs"
 
 
 def drift_summary(runs: pd.DataFrame) -> pd.DataFrame:

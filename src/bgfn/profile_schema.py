@@ -395,7 +395,7 @@ def cross_check(cfg: dict) -> None:
         raise ProfileError("evaluate.oracle.durations_s", f"durations up to evaluate.sweep.durations_s's longest "
                            f"{max(s_dur):g} s (the sweep's starts leave room for no more)", _fmt(o_dur))
     od = ev.get("odometer") or {}
-    bars = odometer_datasets(od, sw.get("datasets"))
+    bars = odometer_datasets(od, sw.get("datasets", EVALUATE_DEFAULTS["sweep"]["datasets"]))
     bad = [d for d in od.get("network_datasets") or [] if d not in bars]
     if bad:
         raise ProfileError("evaluate.odometer.network_datasets", f"drives among the odometer bars' {bars} "

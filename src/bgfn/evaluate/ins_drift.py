@@ -57,7 +57,8 @@ def ins_drift_runs(cfg: dict, drives: list, durations=None, nhc: bool = True,
     nhc : bool
         Also the INS with the vehicle constraints (``INS+NHC``).
     report : callable, optional
-        Called with one line per drive.
+        Called with one progress line per drive (under ``make reproduce`` the lines go to its log instead,
+        :class:`bgfn.parallel.RunProgress`).
     runner : bgfn.parallel.Runner, optional
         Where the drives run (default: one after the other); the rows come back in the drives' order.
 

@@ -87,6 +87,26 @@ def test_the_costliest_runs_start_first_and_the_results_keep_their_order():
     assert 3 in started[:2]
 
 
+def _pid_and_module(x: int) -> tuple[int, int, bool]:
+    import os
+    import sys
+    return x, os.getpid(), "colorsys" in sys.modules
+
+
+def test_workers_started_ahead_are_the_ones_the_runs_use():
+    import os
+    from bgfn import parallel
+    runner = Runner(2)
+    # this module too: loky restarts a worker whose memory grew by 300 MB after its first task (torch's import)
+    assert runner.start("colorsys", __name__) is runner and parallel._STARTING   # returns at once, starts behind
+    out = runner.map(_pid_and_module, [(i,) for i in range(6)], bar=False, echo=lambda line: None)
+    assert not parallel._STARTING                                           # the map waited for it
+    assert [x for x, _, _ in out] == list(range(6))
+    assert all(pid != os.getpid() for _, pid, _ in out)
+    assert all(imported for _, _, imported in out)                          # the started workers imported it
+    assert Runner(1).start("colorsys") is not None and not parallel._STARTING   # one job: no pool to start
+
+
 def test_progress_lines_carry_the_seconds_runs_left_and_an_eta():
     p = RunProgress(4, "training", echo=lambda line: None, bar=False)
     p.t0 -= 10.0                                    # 10 s ago

@@ -2,6 +2,9 @@
 learning rates its search selected once it has run). A command line is an edge of the package: it checks the
 profile and its options (:func:`bgfn.profile_schema.with_overrides`) before anything runs.
 
+``python -m bgfn kernels``: compile the navigation's numba kernels into numba's cache (:mod:`bgfn.evaluate.kernels`;
+``make reproduce`` runs it in the background while notebook 01 prepares the data).
+
 ``python -m bgfn walltimes``: the wall-time section of the book's "Reproduce it" page
 (:mod:`bgfn.report.walltimes`; ``make book`` writes it), or ``--record JOBS`` to add the notebooks of a finished
 run to the measured runs.
@@ -20,6 +23,7 @@ import argparse
 import sys
 
 from bgfn.errors import DataError
+from bgfn.evaluate.kernels import compile_kernels
 from bgfn.io import atomic_write_text
 from bgfn.parallel import Runner
 from bgfn.profile_schema import load_profile, with_overrides
@@ -51,12 +55,29 @@ def walltimes(argv) -> int:
     return 0
 
 
+def kernels(argv) -> int:
+    """``kernels [--profile P]``: the notebooks' navigation paths once on a synthetic drive, with the profile's
+    ``nav:`` section; prints the wall time."""
+    p = argparse.ArgumentParser(prog="python -m bgfn kernels", description="Compile the numba kernels into the cache.")
+    p.add_argument("--profile", default="quick")
+    a = p.parse_args(argv)
+    try:
+        cfg = load_profile(a.profile)
+    except DataError as exc:
+        print(f"error: profile {a.profile!r}: {exc}", file=sys.stderr)
+        return 2
+    print(f"numba kernels compiled or loaded from the cache in {compile_kernels(cfg['nav']):.1f} s")
+    return 0
+
+
 def main(argv=None) -> int:
     """Parse ``--profile``, ``--dataset``, ``--method``, ``--seed`` (each repeatable), ``--device``, ``--jobs`` and
     ``--variants``; train and print one line per finished run (:class:`bgfn.parallel.RunProgress`)."""
     argv = sys.argv[1:] if argv is None else list(argv)
     if argv[:1] == ["walltimes"]:
         return walltimes(argv[1:])
+    if argv[:1] == ["kernels"]:
+        return kernels(argv[1:])
     p = argparse.ArgumentParser(prog="python -m bgfn", description="Train BGFN and baselines for a profile.")
     p.add_argument("command", choices=["train"])
     p.add_argument("--profile", default="quick")

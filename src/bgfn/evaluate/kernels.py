@@ -1,0 +1,59 @@
+"""Compile the navigation's numba kernels into numba's cache before the notebooks call them.
+
+Every kernel of the filter engine and its aids (:mod:`bgfn.nav.strapdown`, :mod:`bgfn.nav.filter`,
+:mod:`bgfn.nav.error_model`, :mod:`bgfn.nav.constraints`, ...) is ``numba.njit(cache=True)``: numba compiles it on
+its first call and writes the machine code beside the source (``__pycache__``), where every later process, the
+parallel runner's workers included, loads it in a fraction of a second. On a fresh clone that first call came in
+notebook 02 and compiled for about 40 s on one core of the 2-core machine while the other idled.
+
+:func:`compile_kernels` calls every path of the notebooks once on a short synthetic drive (the GPS-aided filter
+with the vehicle constraints, the standalone INS, INS+NHC and an odometer in one outage), so that numba compiles
+the same functions for the same argument types. ``make reproduce`` runs it in the background
+(``python -m bgfn kernels``) while notebook 01 prepares the data, which does not need them. Nothing here changes
+a result: a kernel missing from the cache is compiled where it is first called, as before, and one that two
+processes compile at the same time is written to the cache atomically by numba.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from bgfn.data import Drive
+from bgfn.data import imu_errors as ie
+from bgfn.evaluate.hybrid import navigation_context, run_outages
+from bgfn.nav import baseline, sim
+from bgfn.nav import odometer as no
+
+#: The synthetic drive: length, s; rest at its start, s (ZUPT and the at-rest alignment see a still IMU); the
+#: outage (start, duration), s after its first row.
+DRIVE_S, REST_S, OUTAGE = 120.0, 20.0, (70.0, 20.0)
+
+
+def warmup_drive(imu: str = "mpu6000") -> Drive:
+    """A 120 s car drive of :func:`bgfn.nav.sim.demo_trajectory` (20 s at rest first) with the ``imu`` error
+    profile and 1 Hz GNSS fixes (seeded), in the schema of every drive."""
+    ref = sim.demo_trajectory(DRIVE_S, rest_s=REST_S)
+    params = ie.error_params(imu)
+    speed = np.hypot(ref["v_n"], ref["v_e"]).to_numpy()[1:]
+    imu_table, errs, _ = ie.apply_imu_errors(sim.imu_from_trajectory(ref), params, seed=0, speed=speed)
+    gnss = sim.gnss_from_trajectory(ref, 1.0, 1.0, 2.0, seed=1)
+    meta = {"lever_arm_m": [0.0, 0.0, 0.0], "imu_errors": errs, "gnss_rate_hz": 1.0, "imu_rate_hz": 100.0,
+            "platform": "car"}
+    return Drive("kernel-warmup", ref, imu_table, gnss, meta)
+
+
+def compile_kernels(nav_section: dict | None = None) -> float:
+    """Run the notebooks' navigation paths once on :func:`warmup_drive` (with the profile's ``nav:`` section, so
+    that the same aids run) and return the wall time, s. The numbers are thrown away."""
+    t0 = time.perf_counter()
+    drive = warmup_drive()
+    start = float(drive.imu["time"].iloc[0]) + OUTAGE[0]
+    window = [(start, OUTAGE[1])]
+    baseline.run_baseline(drive, baseline.nav_config(nav_section), window)    # GPS/INS, INS and INS+NHC
+    ctx = navigation_context(drive, nav_section, [start])                     # the evaluation's context
+    epochs = np.arange(start - 5.0, start + OUTAGE[1] + 5.0, 1.0)
+    track = no.SpeedTrack(epochs, np.full(epochs.size, 8.0), np.full(epochs.size, 0.5))
+    run_outages(ctx, window, None, "INS", None, None, constraints=no.Odometer(ctx.constraints, track))
+    return time.perf_counter() - t0

@@ -180,17 +180,18 @@ $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(PARAMS) $(SRC) $(STAMP) | data $(K
 # The profile is checked before the first notebook runs: its schema (every notebook's load_profile checks that
 # too) and the facts that need the data (outages inside the drives, window, outage sweep). A bad profile fails
 # here, naming its file and key, before hours of training.
-# Then the navigation's numba kernels are compiled into numba's cache in the background while notebook 01 runs
+# Beside it the navigation's numba kernels are compiled into numba's cache, in the background while notebook 01 runs
 # (python -m bgfn kernels, bgfn.evaluate.kernels): on a fresh clone notebook 02 would otherwise compile them for
 # about 40 s on one core. Its output goes to $(RES)/logs/kernels.log; it changes no result, and what it has not
 # cached yet when a notebook needs it is compiled there as before. (A changed src/bgfn file reruns this rule, and
 # numba recompiles the kernels of a changed file.)
 $(RES)/.profile-checked: $(PARAMS) $(SRC) $(STAMP) | data
-	@echo "==> [$(PROFILE)] check params/$(PROFILE).yaml"
-	@$(PY) -m bgfn.profile_schema $(PROFILE)
-	@mkdir -p $(@D) $(RES)/logs && touch $@
+	@mkdir -p $(@D) $(RES)/logs
 	@echo "==> [$(PROFILE)] numba kernels into the cache, in the background ($(RES)/logs/kernels.log)"
 	@$(PY) -m bgfn kernels --profile $(PROFILE) > $(RES)/logs/kernels.log 2>&1 < /dev/null &
+	@echo "==> [$(PROFILE)] check params/$(PROFILE).yaml"
+	@$(PY) -m bgfn.profile_schema $(PROFILE)
+	@touch $@
 $(RES)/notebooks/01_data_prep.ipynb: $(RES)/.profile-checked $(RES)/.data-fingerprint
 
 # The profile's own CSV drives (a folder in `datasets:`): their files' sizes and times, rewritten only when they

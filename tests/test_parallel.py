@@ -107,6 +107,30 @@ def test_workers_started_ahead_are_the_ones_the_runs_use():
     assert Runner(1).start("colorsys") is not None and not parallel._STARTING   # one job: no pool to start
 
 
+_HELD: list = []
+
+
+def _hold_memory(mb: int) -> int:
+    import os
+
+    import numpy as np
+    _HELD[:] = [np.ones(mb * 2**20, dtype=np.uint8)]          # data a run keeps on purpose (a drive, networks)
+    time.sleep(1.1)                                          # loky checks a worker's memory at most once a second
+    return os.getpid()
+
+
+def test_a_started_worker_is_not_replaced_when_its_runs_hold_memory():
+    # loky replaces a worker grown 300 MB past its memory after its first task; after a start task that is the bare
+    # imports, so without Runner.start's care every run holding a drive would cost a new worker and a warning
+    import warnings
+    runner = Runner(2).start(__name__)
+    with warnings.catch_warnings(record=True) as caught:     # loky warns from its manager thread
+        warnings.simplefilter("always")
+        pids = runner.map(_hold_memory, [(320,)] * 6, bar=False, echo=lambda line: None)
+    assert not [w for w in caught if "worker stopped" in str(w.message)]
+    assert len(set(pids)) <= 2
+
+
 def test_progress_lines_carry_the_seconds_runs_left_and_an_eta():
     p = RunProgress(4, "training", echo=lambda line: None, bar=False)
     p.t0 -= 10.0                                    # 10 s ago

@@ -36,6 +36,7 @@ from pathlib import Path
 from typing import Any, Callable, Iterable, Sequence
 
 from joblib import Parallel, delayed, parallel_config
+from joblib.externals.loky import process_executor
 from tqdm import tqdm
 
 from bgfn.errors import DataError
@@ -193,6 +194,12 @@ def _import_modules(modules: Sequence[str], rendezvous: str, jobs: int) -> int:
     while another is still starting; its process id comes back."""
     for name in modules:
         importlib.import_module(name)
+    # loky takes a worker's memory after its first task as its reference and replaces the worker once it has grown
+    # by 300 MB (a guard against leaking tasks). After this start task the reference is the bare imports, and the
+    # drive, filter context and networks that a run holds on purpose would pass the mark: the worker would be
+    # replaced in the middle of a map (a warning in the notebook and a new worker's start). So the guard is off in
+    # the workers started here; a worker loky starts later takes its reference after a real run, as before.
+    process_executor._USE_PSUTIL = False
     pid = os.getpid()
     Path(rendezvous, str(pid)).touch()
     deadline = time.monotonic() + START_WAIT_S

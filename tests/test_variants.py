@@ -230,10 +230,15 @@ def test_search_budget_caps_epochs_and_patience_for_every_method():
     capped = T.search_train_config(tc)
     assert capped["optimizer"] == {"epochs": 15, "patience": 4, "lr": 1e-3}
     assert tc["optimizer"]["epochs"] == 25                                 # not modified
-    # the window cap of a tuning run replaces the optimizer's (quick: 400 against 1000 for the reported networks)
-    few = T.search_train_config({**tc, "optimizer": {**tc["optimizer"], "max_train_windows": 1000},
-                                 "lr_search": {**tc["lr_search"], "max_train_windows": 400}})
-    assert few["optimizer"]["max_train_windows"] == 400 and few["optimizer"]["epochs"] == 15
+    # the window caps of a tuning run replace the optimizer's (quick: 250 and 200 against 1000 and 400 for the reported
+    # networks); a cap the search leaves unset stays the optimizer's
+    opt = {**tc["optimizer"], "max_train_windows": 1000, "max_val_windows": 400}
+    few = T.search_train_config({**tc, "optimizer": opt,
+                                 "lr_search": {**tc["lr_search"], "max_train_windows": 250, "max_val_windows": 200}})
+    assert few["optimizer"]["max_train_windows"] == 250 and few["optimizer"]["max_val_windows"] == 200
+    assert few["optimizer"]["epochs"] == 15
+    some = T.search_train_config({**tc, "optimizer": opt, "lr_search": {**tc["lr_search"], "max_train_windows": 250}})
+    assert some["optimizer"]["max_val_windows"] == 400
     assert T.search_train_config({**tc, "lr_search": {"grid": [1e-3]}}) == {**tc, "lr_search": {"grid": [1e-3]}}
 
 

@@ -127,7 +127,7 @@ TRAIN = section(
     optimizer=OPTIMIZER, lr=mapping(_POS),
     lr_search=section(grid=seq(_POS, null=True), fraction=_FRACTION, seed=_SEED, extend=integer(0),
                       epochs=integer(1, null=True), patience=integer(1, null=True),
-                      max_train_windows=integer(1, null=True)),
+                      max_train_windows=integer(1, null=True), max_val_windows=integer(1, null=True)),
     recheck_all_windows=flag(), recheck_runs=text("first", "all"), size=text(), sizes=mapping(mapping(mapping(ANY))))
 
 #: The parameters of the real car drive ``rtklib-drive0708`` (``data.rtklib-drive0708``; the defaults and the

@@ -1,8 +1,8 @@
 """The learning rate of every method, chosen the same way: one grid, one budget, one seed, on a tuning split
 inside the training windows (:func:`bgfn.learning.inner_split`); the validation block is never used.
 
-The budget of one tuning run is the profile's optimizer with ``train.lr_search.epochs``, ``patience`` and
-``max_train_windows`` laid over its ``epochs``, early-stopping ``patience`` and window cap
+The budget of one tuning run is the profile's optimizer with ``train.lr_search.epochs``, ``patience``,
+``max_train_windows`` and ``max_val_windows`` laid over its ``epochs``, early-stopping ``patience`` and window caps
 (:func:`search_train_config`): the same smaller budget for every method and rate, so that the search costs less
 than training every rate to the end on every window.
 
@@ -29,12 +29,12 @@ from bgfn.train.tasks import TrainingRun, train_runs
 #: ``train.lr_search``: learning rates tried for every method on :func:`bgfn.learning.inner_split` (null: none).
 #: ``extend``: when a method's best rate is the grid's smallest or largest, up to this many further rates are
 #: tried beyond it, one grid step (the ratio of the two rates at that end) at a time, so no method's choice
-#: is cut off by the grid's ends. ``epochs``, ``patience``, ``max_train_windows``: the budget of one tuning run
-#: (null: the optimizer's ``epochs`` / ``patience`` / ``max_train_windows``), the same for every method and rate.
+#: is cut off by the grid's ends. ``epochs``, ``patience``, ``max_train_windows``, ``max_val_windows``: the budget of
+#: one tuning run (null: the optimizer's), the same for every method and rate.
 LR_SEARCH_DEFAULTS: dict[str, Any] = {"grid": None, "fraction": 0.2, "seed": 0, "extend": 0, "epochs": None,
-                                      "patience": None, "max_train_windows": None}
+                                      "patience": None, "max_train_windows": None, "max_val_windows": None}
 #: The keys of ``train.lr_search`` that replace the optimizer's in a tuning run.
-SEARCH_BUDGET_KEYS: tuple[str, ...] = ("epochs", "patience", "max_train_windows")
+SEARCH_BUDGET_KEYS: tuple[str, ...] = ("epochs", "patience", "max_train_windows", "max_val_windows")
 #: The saved search of notebook 03 (``results/<profile>/tables/``): one row per dataset, method and rate.
 LR_SEARCH_FILE = "lr_search.csv"
 LR_SEARCH_COLUMNS = ("dataset", "method", "lr", "tuning_rmse_m", "tuning_loss", "epochs_run", "selected")
@@ -46,10 +46,10 @@ def lr_search_options(train_cfg: dict | None) -> dict:
 
 
 def search_train_config(train_cfg: dict) -> dict:
-    """The ``train:`` section one tuning run trains with: ``train.lr_search.epochs``, ``patience`` and
-    ``max_train_windows`` (when set) replace the optimizer's ``epochs``, early-stopping ``patience`` and cap on the
-    training windows (an evenly spaced subsample, :func:`bgfn.train.even_subset`); everything else as the
-    profile's."""
+    """The ``train:`` section one tuning run trains with: ``train.lr_search.epochs``, ``patience``,
+    ``max_train_windows`` and ``max_val_windows`` (when set) replace the optimizer's ``epochs``, early-stopping
+    ``patience`` and caps on the training and the tuning windows (evenly spaced subsamples,
+    :func:`bgfn.train.even_subset`); everything else as the profile's."""
     ls = lr_search_options(train_cfg)
     budget = {k: int(ls[k]) for k in SEARCH_BUDGET_KEYS if ls[k] is not None}
     if not budget:

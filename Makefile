@@ -123,16 +123,14 @@ $(STAMP): requirements.lock
 	else echo "    $(VENV) exists: checking it against the lock (already satisfied = nothing to do)"; fi
 	@# --no-deps everywhere: the lock is complete; pip must never resolve (spikingjelly declares
 	@# torchvision/torchaudio, which would pull CUDA builds of torch). --no-compile: see PYTHONDONTWRITEBYTECODE above.
-	@# --no-build-isolation: the package is built with the venv's own setuptools (pyproject.toml: >= 64; Python 3.11's
-	@# venv brings 65), not with a copy pip would first install into a temporary environment (14 s of 76 here).
 	@echo "    pip install --no-deps -r requirements.lock ($$(grep -vc '^#' requirements.lock) packages)"
 	@$(PIP) install -q --no-compile $(PIP_FLAGS) --no-deps -r requirements.lock 2>&1 | { grep -v "$(PIP_NOISE)" || true; }
 	@echo "    pip install --no-deps spikingjelly==2.0.0"
 	@$(PIP) install -q --no-compile $(PIP_FLAGS) --no-deps spikingjelly==2.0.0 2>&1 | { grep -v "$(PIP_NOISE)" || true; }
 	@if $(PY) -c 'import bgfn, pathlib, sys; sys.exit(pathlib.Path(bgfn.__file__).resolve().parents[1] != pathlib.Path("src").resolve())' 2>/dev/null; \
 	then echo "    bgfn already installed (editable) from ./src"; \
-	else echo "    pip install --no-deps --no-build-isolation -e ."; \
-	  $(PIP) install -q $(PIP_FLAGS) --no-deps --no-build-isolation -e . 2>&1 | { grep -v "$(PIP_NOISE)" || true; }; fi
+	else echo "    pip install --no-deps -e ."; \
+	  $(PIP) install -q $(PIP_FLAGS) --no-deps -e . 2>&1 | { grep -v "$(PIP_NOISE)" || true; }; fi
 	@$(PY) -c 'import bgfn, torch, spikingjelly.activation_based, papermill, ipykernel, jupyter_book; \
 	  assert torch.version.cuda is None, "a CUDA build of torch is installed: expected the +cpu wheel"; \
 	  print("    ok: torch", torch.__version__, "| bgfn from", bgfn.__file__)'

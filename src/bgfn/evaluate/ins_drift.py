@@ -69,21 +69,23 @@ def ins_drift_runs(cfg: dict, drives: list, durations=None, nhc: bool = True,
     """
     ecfg = evaluate_config(cfg.get("evaluate"), cfg.get("train"))
     durations = sorted(float(d) for d in (durations or ecfg["sweep"]["durations_s"]))
-    done = (runner or Runner()).map(drive_drift_rows, [(cfg, drive, durations, nhc) for drive in drives],
+    tasks = [(cfg, drive, durations, ecfg["pseudo_gps"], nhc) for drive in drives]
+    done = (runner or Runner()).map(drive_drift_rows, tasks,
                                     labels=[drive.name for drive in drives], summary=lambda rows: rows[1],
                                     desc="INS drift", echo=report or (lambda line: None), bar=False)
     return pd.DataFrame([row for rows, _ in done for row in rows], columns=list(DRIFT_RUN_COLUMNS))
 
 
-def drive_drift_rows(cfg: dict, drive, durations: list[float], nhc: bool = True) -> tuple[list[dict], str]:
-    """One drive of :func:`ins_drift_runs` (an independent run): its rows and what its progress line says."""
-    ecfg = evaluate_config(cfg.get("evaluate"), cfg.get("train"))
+def drive_drift_rows(cfg: dict, drive, durations: list[float], pseudo: dict,
+                     nhc: bool = True) -> tuple[list[dict], str]:
+    """One drive of :func:`ins_drift_runs` (an independent run, ``pseudo`` the evaluation's ``pseudo_gps``): its rows
+    and what its progress line says."""
     starts = drift_starts(cfg, drive)
     ctx = navigation_context(drive, cfg.get("nav"), starts)
     windows = [(s, durations[-1]) for s in starts]
-    runs = run_outages(ctx, windows, None, "INS", None, ecfg["pseudo_gps"])
+    runs = run_outages(ctx, windows, None, "INS", None, pseudo)
     if nhc and ctx.constraints is not None:
-        runs += run_outages(ctx, windows, None, nhc_label("INS"), None, ecfg["pseudo_gps"],
+        runs += run_outages(ctx, windows, None, nhc_label("INS"), None, pseudo,
                             constraints=ctx.constraints)
     rows = []
     for r in runs:

@@ -51,6 +51,21 @@ def test_summary_takes_the_median_ratio_to_ins_nhc_start_by_start():
     assert np.isnan(s.loc["INS+NHC", "p_vs_nhc"])                            # no non-zero difference
 
 
+def test_summary_coverage_is_the_share_of_all_the_outages_epochs():
+    # five outages of one duration (the same epochs each): four wholly inside 2 sigma, one with none inside. The
+    # median of the shares would read 100 %; 4 of every 5 epochs were inside.
+    rows = pd.DataFrame([
+        {"dataset": "d", "start_s": float(s), "duration_s": 30.0, "method": m, "sigma_mps": np.nan, "seed": 0,
+         "fold": 0, "max_h_m": 1.0, "rmse_h_m": 0.0, "final_h_m": 0.0, "speed_rmse_mps": np.nan if m == "INS+NHC"
+         else 1.0, "coverage_2sigma": np.nan if m == "INS+NHC" else (0.0 if s == 4 else 1.0)}
+        for s in range(5) for m in ("INS+NHC", "BGFN-ODO")])
+    s = O.odometer_summary(rows).set_index("method")
+    assert s.loc["BGFN-ODO", "coverage_2sigma"] == pytest.approx(0.8)
+    assert np.isnan(s.loc["INS+NHC", "coverage_2sigma"])
+    paper = O.paper_outage_table(rows.assign(start_s=0.0, seed=range(10)), {"d": [(0.0, 30.0)]})
+    assert paper.set_index("method").loc["BGFN-ODO", "coverage_2sigma"] == pytest.approx(0.8)   # over the seeds
+
+
 def test_rows_of_a_synthetic_drive(monkeypatch, tmp_path):
     from bgfn import config
 

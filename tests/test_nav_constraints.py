@@ -329,3 +329,11 @@ def test_the_platform_decides_which_aids_run():
         assert (m is None) if expect is None else (len(m.dz) == expect)
     with pytest.raises(DataError, match="platform"):
         cn.build_constraints(imu, EKINOX, _body_frame(), platform="boat")
+
+
+def test_the_aided_rows_words_name_exactly_the_platforms_aids():
+    for platform in cn.PLATFORM_AIDS:
+        words = cn.aided_ins_words(platform)
+        assert [a for a in cn.AID_WORDS if cn.AID_WORDS[a] in words] == list(cn.platform_aids(platform))
+    assert cn.aided_ins_words("car") == "INS with non-holonomic constraints and zero-velocity updates"
+    assert cn.aided_ins_words("a unicycle") == cn.aided_ins_words("car")          # unknown: read as the default platform

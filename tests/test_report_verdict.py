@@ -75,10 +75,11 @@ def test_answers_say_the_measured_numbers():
     prot = answer_protocol(t, {"bgfn_reduction_vs_ins_pct": {"a": {"east": 79.7}, "b": {"north": 90.0}}})
     assert "leaky: 3.0 m, 80 % below INS" in prot and "79.7-90 %" in prot            # (15 - 3) / 15
     assert "main), honest: 60.0 m, 4.0 times INS" in prot
-    assert headline(inp, t).endswith("INS with non-holonomic constraints 5.0 m.")
+    assert headline(inp, t).endswith("INS with non-holonomic constraints and zero-velocity updates 5.0 m.")
     # a walker's constraint row is its ZUPT alone: the headline says so (the platform from kf_baseline.json)
     walker = _inputs(platform="walker")
-    assert headline(walker, verdict_table(walker)).endswith("INS with zero-velocity updates (no NHC) 5.0 m.")
+    assert headline(walker, verdict_table(walker)).endswith(
+        "INS with zero-velocity updates (no NHC: a walker steps sideways) 5.0 m.")
 
 
 def test_the_platform_comes_from_notebook_02s_record(tmp_path):

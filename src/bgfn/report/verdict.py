@@ -32,6 +32,7 @@ from bgfn.config import MAIN_VARIANT, RUN_RECORDS, SHARED_TABLES
 from bgfn.data.names import dataset_id
 from bgfn.data.registry import recorded_first
 from bgfn.evaluate.tables import table_paths
+from bgfn.nav.constraints import aided_ins_words
 from bgfn.nav.ins_setups import NAVEGO_CONSISTENT, NAVEGO_RUN, gap_explained
 from bgfn.report.odometer_verdict import (OdometerInputs, answer_odometer, odometer_headline, odometer_rows,
                                           read_odometer_inputs, same_dataset)
@@ -435,11 +436,6 @@ def _platform(out: Path, dataset: str) -> str:
     return "car"
 
 
-#: What the ``INS+NHC`` row is on each platform (:data:`bgfn.nav.constraints.PLATFORM_AIDS`), in the headline's words.
-CONSTRAINT_WORDS = {"car": "INS with non-holonomic constraints", "walker": "INS with zero-velocity updates (no NHC)",
-                    "other": "INS with no constraint (platform other)"}
-
-
 def headline(inp: VerdictInputs, table: pd.DataFrame) -> str:
     """One line per test for the book's first page: BGFN against INS and INS+NHC where both were measured."""
     title = paper.TESTS[inp.test]["title"] if inp.test in paper.TESTS else inp.test
@@ -458,7 +454,7 @@ def headline(inp: VerdictInputs, table: pd.DataFrame) -> str:
     odo = odometer_headline(inp.odometer, SWEEP_DURATIONS) if inp.odometer is not None else ""
     return (f"{title} ({inp.dataset}): " + (f"{odo[0].upper()}{odo[1:]}. " if odo else "")
             + f"The paper's design, {where}: BGFN {_m(vals[0])}, {word} standalone INS ({_m(vals[1])}); "
-            f"{CONSTRAINT_WORDS.get(inp.platform, CONSTRAINT_WORDS['car'])} {_m(vals[2])}.")
+            f"{aided_ins_words(inp.platform)} {_m(vals[2])}.")
 
 
 def format_table(table: pd.DataFrame):

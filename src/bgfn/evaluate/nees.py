@@ -58,13 +58,22 @@ def verdict(median: float) -> str:
             else "consistent")
 
 
+def nees_stats(nees) -> dict:
+    """``runs``, ``median_nees``, ``inside_95`` (share at most :data:`CHI2_95`) and ``verdict`` of the horizontal
+    NEES of some runs; non-finite values are left out (NaN statistics when none is left)."""
+    v = np.asarray(nees, dtype=float)
+    v = v[np.isfinite(v)]
+    median = float(np.median(v)) if v.size else float("nan")
+    return {"runs": int(v.size), "median_nees": median,
+            "inside_95": float(np.mean(v <= CHI2_95)) if v.size else float("nan"), "verdict": verdict(median)}
+
+
 def _summarize(rows: pd.DataFrame, keys: list[str]) -> pd.DataFrame:
+    """:func:`nees_stats` of ``rows['nees_h']`` per group of ``keys`` (groups with a finite NEES only)."""
     ok = rows[np.isfinite(rows["nees_h"].astype(float))]
-    out = ok.groupby(keys, sort=False).agg(runs=("nees_h", "size"), median_nees=("nees_h", "median"),
-                                            inside_95=("nees_h", lambda x: float(np.mean(x <= CHI2_95))))
-    out = out.reset_index()
-    out["verdict"] = out["median_nees"].map(verdict)
-    return out
+    out = [{**dict(zip(keys, k if isinstance(k, tuple) else (k,))), **nees_stats(g["nees_h"])}
+           for k, g in ok.groupby(keys, sort=False)]
+    return pd.DataFrame(out, columns=[*keys, "runs", "median_nees", "inside_95", "verdict"])
 
 
 def nees_summary(sweep: pd.DataFrame | None, results: dict | None = None) -> pd.DataFrame:
@@ -151,12 +160,9 @@ def scan_point(cfg: dict, drive, value_dps: float, own: bool, starts: list[float
     rows = []
     for du in durations:
         m = [window_metrics(r.errors, r.start, du, r.sd) for r in runs]
-        nees = np.array([x["nees_h"] for x in m])
         rows.append({"dataset": drive.name, "gyro_bias_instability_dps": float(f"{value_dps:.4g}"), "profile": own,
-                     "duration_s": du, "runs": len(m), "median_nees": float(np.median(nees)),
-                     "inside_95": float(np.mean(nees <= CHI2_95)),
-                     "median_max_h_m": float(np.median([x["max_h_m"] for x in m])),
-                     "verdict": verdict(float(np.median(nees)))})
+                     "duration_s": du, **nees_stats([x["nees_h"] for x in m]),
+                     "median_max_h_m": float(np.median([x["max_h_m"] for x in m]))})
     return rows
 
 

@@ -129,7 +129,8 @@ $(STAMP): requirements.lock
 	@# pip's configuration) are handed to it, with pip's choice among indexes (the best match over all of them);
 	@# where uv cannot be installed or fails, pip installs the same pins.
 	@echo "    $(UV_PIN) (pinned in the lock) installs the lock, spikingjelly==2.0.0 and -e . with --no-deps"
-	@$(PIP) install -q --no-compile $(PIP_FLAGS) --no-deps "$(UV_PIN)" 2>&1 | { grep -v "$(PIP_NOISE)" || true; }
+	@{ [ -n "$(UV_PIN)" ] && $(PIP) install -q --no-compile $(PIP_FLAGS) --no-deps "$(UV_PIN)" 2>&1 | \
+	  { grep -v "$(PIP_NOISE)" || true; }; } || echo "    uv could not be installed (no uv== line in the lock, or pip failed)"
 	@pipcfg() { printenv "PIP_$$1" || $(PIP) config get "global.$$2" 2>/dev/null || true; }; \
 	for kv in "UV_DEFAULT_INDEX INDEX_URL index-url" "UV_EXTRA_INDEX_URL EXTRA_INDEX_URL extra-index-url" \
 	          "UV_FIND_LINKS FIND_LINKS find-links"; do \

@@ -170,3 +170,25 @@ def test_a_walker_gets_no_odometer_bars():
                               cfg["train"])
     rows, facts = O.odometer_rows(cfg, "t", "synthetic", ecfg, drive=drive)
     assert rows.empty and list(rows.columns) == list(O.ODOMETER_COLUMNS) and facts["skipped"] == "walker"
+
+
+def test_network_table_sets_each_networks_validation_beside_its_own_folds_outages():
+    # one network of fold 0, seed 1: its outages at the longest duration (60 s) have speed RMSE 3 and 4 m/s
+    rows = pd.DataFrame([
+        {"dataset": "d", "start_s": s, "duration_s": du, "method": "BGFN-ODO", "sigma_mps": np.nan, "seed": seed,
+         "fold": fold, "max_h_m": 1.0, "rmse_h_m": 0.0, "final_h_m": 0.0, "speed_rmse_mps": v, "coverage_2sigma": c}
+        for s, du, seed, fold, v, c in ((1.0, 60.0, 1, 0, 3.0, 0.5), (2.0, 60.0, 1, 0, 4.0, 1.0),
+                                       (1.0, 30.0, 1, 0, 9.0, 0.0),            # a shorter duration: not read
+                                       (1.0, 60.0, 0, 0, 9.0, 0.0),            # another seed
+                                       (3.0, 60.0, 1, 1, 9.0, 0.0))])          # another fold
+    net = {"method": "BGFN-ODO", "fold": 0, "seed": 1, "lr": 1e-3, "epochs": 20, "val_rmse_mps": 0.8,
+           "calibration": 1.5}
+    paper = {**net, "fold": O.PAPER_FOLD}
+    t = O.network_table(rows, {"d": {"networks": {"a": net, "b": paper}}, "walker": {"skipped": "walker"}})
+    assert list(t.columns) == list(O.NETWORK_COLUMNS) and len(t) == 1          # the paper fold is not a sweep fold
+    row = t.iloc[0]
+    assert row["outage_speed_rmse_mps"] == pytest.approx(np.sqrt((9 + 16) / 2))  # RMS over the starts
+    assert row["outage_coverage_2sigma"] == pytest.approx(0.75) and row["val_rmse_mps"] == 0.8
+    line, = O.network_lines(t)
+    assert line.startswith("d, fold 0:") and "BGFN-ODO 0.80, then 3.54 m/s (75 % of outage epochs within" in line
+    assert O.network_lines(None) == [] and O.network_lines(t.iloc[:0]) == []

@@ -96,6 +96,7 @@ SHARED_TABLES: dict[str, str] = {
     "odometer": "outage_odometer.csv",          # notebook 04: the bars of a learned odometer (bgfn.evaluate.odometers)
     "odometer_summary": "outage_odometer_summary.csv",
     "odometer_paper": "outage_odometer_paper.csv",  # ... and in each drive's two evaluation outages
+    "odometer_networks": "outage_odometer_networks.csv",  # ... each network odometer: validation against outages
     "nees": "outage_nees.csv",                  # notebook 04: the filter's consistency in outages (bgfn.evaluate.nees)
     "variants": "outage_variants.csv",          # notebook 03: the learning-problem variants in the two outages
     "energy_odometer": "energy_odometer.csv",   # notebook 05: the learned odometers' energy (bgfn.energy.odometer)

@@ -74,6 +74,9 @@ PAPER_FOLD = -1
 #: Columns of ``tables/outage_odometer_paper.csv`` (:func:`paper_outage_table`).
 PAPER_COLUMNS: tuple[str, ...] = ("dataset", "outage", "start_s", "duration_s", "method", "sigma_mps", "max_h_m",
                                   "speed_rmse_mps", "coverage_2sigma", "runs")
+#: Columns of ``tables/outage_odometer_networks.csv`` (:func:`network_table`).
+NETWORK_COLUMNS: tuple[str, ...] = ("dataset", "method", "fold", "seed", "lr", "epochs", "val_rmse_mps", "calibration",
+                                    "outage_speed_rmse_mps", "outage_coverage_2sigma")
 #: Columns of ``tables/outage_odometer_summary.csv`` (:func:`odometer_summary`).
 SUMMARY_COLUMNS: tuple[str, ...] = ("dataset", "duration_s", "method", "sigma_mps", "max_h_m", "ratio_to_nhc",
                                     "speed_rmse_mps", "coverage_2sigma", "runs", "p_vs_nhc")
@@ -199,7 +202,8 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
         runs.append(OdometerRun(f"{dataset} fold {k} {label} seed {seed}", folds[k], no.Odometer(con, track, gate),
                                 label, np.nan, seed, k))
         tracks[runs[-1].label] = track
-        facts["networks"][f"{label} fold {k} seed {seed}"] = fact
+        facts["networks"][f"{label} fold {k} seed {seed}"] = {**fact, "method": label, "fold": int(k),
+                                                               "seed": int(seed)}
         if seed == min(oc["network_seeds"]) and k != PAPER_FOLD:
             keep(label, track, overlaps(all_windows.t_end, all_windows.t_end,
                                         np.array([[s, s + d] for s, d in folds[k]])))
@@ -338,6 +342,7 @@ class OdometerSection:
     facts: dict
     figures: list = field(default_factory=list)
     paper: pd.DataFrame | None = None
+    networks: pd.DataFrame | None = None
 
     def markdown(self) -> str:
         """The summary at the sweep's durations as a Markdown table (:func:`odometer_table`), then the lines."""
@@ -347,7 +352,8 @@ class OdometerSection:
         head = "| dataset | method | " + " | ".join(wide.columns) + " |"
         body = [f"| {ds} | {m} | " + " | ".join(f"{v:.1f}" for v in r) + " |" for (ds, m), r in wide.iterrows()]
         text = "\n".join(["Median max horizontal error (m) over the sweep's starts:", "", head,
-                           "|---" * (len(wide.columns) + 2) + "|", *body, ""] + [f"- {s}" for s in self.lines])
+                           "|---" * (len(wide.columns) + 2) + "|", *body, ""] + [f"- {s}" for s in self.lines]
+                          + [f"- {s}" for s in network_lines(self.networks)])
         if self.paper is None or self.paper.empty:
             return text
         p = self.paper[self.paper["sigma_mps"].isna()]       # the oracle's grid: tables/outage_odometer_paper.csv
@@ -401,7 +407,9 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
     paper = paper_outage_table(rows[rows["fold"] == PAPER_FOLD], {n: f["paper_windows"] for n, f in facts.items()})
     rows = rows[rows["fold"] != PAPER_FOLD].reset_index(drop=True)
     summary = odometer_summary(rows)
+    networks = network_table(rows, facts)
     tables = Path(out) / "tables"
+    atomic_write_csv(tables / SHARED_TABLES["odometer_networks"], networks, float_format="%.4f")
     atomic_write_csv(tables / SHARED_TABLES["odometer"], rows, float_format="%.4f")
     atomic_write_csv(tables / SHARED_TABLES["odometer_summary"], summary, float_format="%.4f")
     atomic_write_csv(tables / SHARED_TABLES["odometer_paper"], paper, float_format="%.4f")
@@ -416,7 +424,49 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
             figures.append(fig)
     if timings is not None:
         timings["odometer_s"] = time.perf_counter() - t0
-    return OdometerSection(rows, summary, odometer_lines(summary) if len(summary) else [], facts, figures, paper)
+    return OdometerSection(rows, summary, odometer_lines(summary) if len(summary) else [], facts, figures, paper,
+                           networks)
+
+
+def network_table(rows: pd.DataFrame, facts: dict) -> pd.DataFrame:
+    """Every network odometer of the sweep's folds (dataset, method, fold, seed): its learning rate and epochs, its
+    speed RMSE on the validation block its std was calibrated on and the calibration factor, and in its own fold's
+    outages at the sweep's longest duration its speed RMSE (the RMS over the starts: each holds the same epochs)
+    and the share of epochs within its +-2 sigma (:data:`NETWORK_COLUMNS`). Where the outage RMSE is far above
+    the validation RMSE, the validation block did not represent the outages, and the calibrated std is too small
+    there."""
+    out = []
+    for name, f in facts.items():
+        for net in (f.get("networks") or {}).values():
+            if net["fold"] == PAPER_FOLD:
+                continue
+            r = rows[(rows["dataset"] == name) & (rows["method"] == net["method"]) & (rows["fold"] == net["fold"])
+                     & (rows["seed"] == net["seed"])]
+            r = r[r["duration_s"] == r["duration_s"].max()] if len(r) else r
+            out.append({"dataset": name, **{k: net[k] for k in ("method", "fold", "seed", "lr", "epochs")},
+                        "val_rmse_mps": net["val_rmse_mps"], "calibration": net["calibration"],
+                        "outage_speed_rmse_mps": float(np.sqrt(np.mean(r["speed_rmse_mps"] ** 2))) if len(r)
+                        else np.nan,
+                        "outage_coverage_2sigma": float(r["coverage_2sigma"].mean()) if len(r) else np.nan})
+    return pd.DataFrame(out, columns=list(NETWORK_COLUMNS))
+
+
+def network_lines(networks: pd.DataFrame | None) -> list[str]:
+    """Per dataset and fold: each network odometer's speed RMSE on its validation block against its own fold's
+    outages, with its share of outage epochs within +-2 sigma (medians over seeds, :func:`network_table`). A fold
+    whose validation block is easier than its outages gets too small a std there (the calibration shrinks it)."""
+    if networks is None or networks.empty:
+        return []
+    lines = []
+    cols = ["val_rmse_mps", "outage_speed_rmse_mps", "outage_coverage_2sigma"]
+    for (ds, fold), g in networks.groupby(["dataset", "fold"], sort=False):
+        med = g.groupby("method", sort=False)[cols].median()
+        lines.append(f"{ds}, fold {fold}: the network odometers' speed RMSE on the validation block their std was "
+                     "calibrated on, then in the fold's outages (median over seeds): "
+                     + "; ".join(f"{m} {r['val_rmse_mps']:.2f}, then {r['outage_speed_rmse_mps']:.2f} m/s "
+                                 f"({100 * r['outage_coverage_2sigma']:.0f} % of outage epochs within +-2 sigma)"
+                                 for m, r in med.iterrows()) + ".")
+    return lines
 
 
 #: Colours of the speed bands (:func:`plot_speed_series`): the ridge, then the networks.

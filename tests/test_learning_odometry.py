@@ -38,6 +38,34 @@ def test_band_energies_put_a_sine_in_its_band():
         od.band_energies(x[:, :20], RATE)                  # 0.2 s: no bin below 5 Hz
 
 
+def test_band_frames_follow_a_sine_that_starts_mid_window_and_keep_each_axis_mean():
+    t = np.arange(200) / RATE
+    x = np.zeros((1, 200, 6))
+    x[0, 100:, 0] = np.sin(2 * np.pi * 15.0 * t[100:])    # 15 Hz on accel_x from 1 s on: band 2 (11.2-23.6 Hz)
+    x[0, :, 2] = -9.81                                     # gravity on accel_z: a mean, no power
+    f = od.band_frames(x, RATE)
+    bands = od.frame_bands(RATE)
+    assert bands[0][0] == pytest.approx(2.5) and bands[-1][1] == pytest.approx(50.0) and len(bands) == 4
+    assert f.shape == (1, 9, 6 * (1 + 4)) and f.dtype == np.float32   # 0.4 s frames every 0.2 s of 2 s
+    power = f[0, :, 6:].reshape(9, 4, 6)                   # [T, B, C]
+    # frames 0-2 end before 1 s: silent; frames 5-8 lie wholly after it: the power sits in band 2
+    assert power[:3, :, 0].max() < -20 and (power[5:, :, 0].argmax(axis=1) == 2).all()
+    assert f[0, :, 2] == pytest.approx(np.full(9, -9.81))  # the mean column of accel_z
+    assert power[:, :, 2].max() < -20
+    with pytest.raises(DataError, match="inputs"):
+        od.band_frames(x[:, :30], RATE)                    # 0.3 s: shorter than one frame
+
+
+def test_network_inputs_keep_the_windows_and_name_a_bad_choice():
+    imu, t, speed = _vibrating_drive(duration=30.0)
+    ws = od.speed_windows(imu, [5.0, 6.0], 200, [1.0, 2.0])
+    assert od.network_inputs(ws, "imu", RATE) is ws
+    fr = od.network_inputs(ws, "band_frames", RATE)
+    assert fr.x.shape == (2, 9, 30) and fr.speed.tolist() == [1.0, 2.0] and fr.t_end.tolist() == [5.0, 6.0]
+    with pytest.raises(DataError, match="inputs"):
+        od.network_inputs(ws, "spectrogram", RATE)
+
+
 def _vibrating_drive(seed=0, duration=600.0):
     """IMU whose vibration (10-30 Hz) grows in amplitude with a slowly varying speed, and that speed."""
     rng = np.random.default_rng(seed)
@@ -107,6 +135,24 @@ def test_speed_data_split_is_honest():
         not ((data.train.t_end >= data.val.t_start.min()) & (data.train.t_start <= data.val.t_end.max())).any()
     assert data.norm.y_mean[0] == pytest.approx(data.train.speed.mean())
     assert data.options["objective"] == "speed" and data.train.y.shape == (len(data.train), 1)
+
+
+def test_validation_blocks_spread_over_the_drive_and_keep_away_from_training():
+    imu, t, speed = _vibrating_drive()
+    epochs = np.arange(5.0, 595.0, 1.0)
+    ws = od.speed_windows(imu, epochs, 200, np.interp(epochs, t, speed))
+    one = od.build_speed_data(ws, [(300.0, 30.0)], margin_s=10.0, val_fraction=0.2)
+    four = od.build_speed_data(ws, [(300.0, 30.0)], margin_s=10.0, val_fraction=0.2, val_blocks=4)
+    assert len(four.val) == len(one.val)                   # the same share of the windows
+    # four runs of consecutive epochs, one in each quarter of the remaining windows (the outage splits none)
+    runs = np.split(four.val.t_end, np.flatnonzero(np.diff(four.val.t_end) > 1.5) + 1)
+    assert len(runs) == 4 and [round(float(np.mean(r)) // 150) for r in runs] == [0, 1, 2, 3]
+    # one block: the middle of the drive only (around the outage, which it skips)
+    assert one.val.t_end.min() > 150 and one.val.t_end.max() < 450
+    for data in (one, four):                               # no training window touches a validation window
+        lo_, hi_ = data.val.t_start, data.val.t_end
+        assert not ((data.train.t_start[:, None] <= hi_[None]) & (lo_[None] <= data.train.t_end[:, None])).any()
+        assert not ((data.val.t_end > 290.0) & (data.val.t_start < 340.0)).any()
 
 
 def test_a_network_odometer_learns_speed_and_its_uncertainty(tmp_path):

@@ -26,6 +26,16 @@ def test_oracle_speed_is_the_truth_plus_seeded_white_noise_and_a_walk():
     assert np.std(np.diff(walk.speed)) == pytest.approx(0.1, rel=0.03)       # 0.1 m/s per sqrt(s) at 1 Hz
 
 
+def test_the_odometers_budget_lies_over_the_sweeps_key_by_key():
+    ev_cfg = {"sweep": {"train": {"size": "smoke", "optimizer": {"epochs": 20, "patience": 5}}},
+              "odometer": {"train": {"optimizer": {"epochs": 60}}}}
+    tc = O.odometer_train_config({"optimizer": {"epochs": 25, "batch_size": 32, "patience": 6}}, ev_cfg)
+    assert tc["size"] == "smoke" and tc["optimizer"] == {"epochs": 60, "batch_size": 32, "patience": 5}
+    ev_cfg["odometer"]["train"] = None                     # null: the sweep's budget as it is
+    tc = O.odometer_train_config({"optimizer": {"epochs": 25, "batch_size": 32, "patience": 6}}, ev_cfg)
+    assert tc["optimizer"] == {"epochs": 20, "batch_size": 32, "patience": 5}
+
+
 def test_speed_errors_by_hand():
     t = np.arange(0.0, 11.0)
     truth = np.full(t.size, 10.0)

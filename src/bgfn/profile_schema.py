@@ -33,6 +33,7 @@ from bgfn.data.names import profile_datasets, unique_ids
 from bgfn.errors import DataError
 from bgfn.evaluate import EVALUATE_DEFAULTS, evaluate_config, sweep_plan
 from bgfn.learning import learning_options
+from bgfn.learning.odometry import ODOMETER_INPUTS
 from bgfn.nav.baseline import filter_start
 from bgfn.nav.outages import DEFAULT_KEY, check_windows, is_rule, outage_entry, picked_outages
 from bgfn.paper import METHOD_LABELS
@@ -198,7 +199,9 @@ SCHEMA = section(
                          network_datasets=seq(text(), null=True),
                          network_seeds=seq(_SEED, min_len=1), paper_outages=flag(), window_s=number(0.5), sigmas_mps=seq(_POS), walk_mps_per_sqrt_s=_NONNEG,
                          seeds=seq(_SEED, min_len=1), hold_std_mps=_POS, ridge_alpha=_POS,
-                         gate_probability=number(0, 1, lo_open=True, hi_open=True, null=True), lr_search=flag())),
+                         gate_probability=number(0, 1, lo_open=True, hi_open=True, null=True), lr_search=flag(),
+                         inputs=text(*ODOMETER_INPUTS), val_blocks=integer(1),
+                         train=Spec("section", null=True, fields=TRAIN.fields))),
     energy=section(
         e_mac_pj=_POS, e_ac_pj=_POS, dataset=text(null=True), seed=integer(0, null=True), allow_untrained=flag(),
         max_windows=integer(1, null=True), batch_size=integer(1), sweep_time_steps=seq(integer(1), min_len=1),

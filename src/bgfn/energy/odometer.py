@@ -5,8 +5,10 @@ Which networks: the odometers that notebook 04 trained (:mod:`bgfn.evaluate.odom
 ``evaluate.odometer.datasets`` (null: the sweep's), recorded drives first, in sweep fold 0, with the first of
 ``evaluate.odometer.network_seeds``. Which windows: ``energy.max_windows`` IMU windows of the odometer's length
 (``evaluate.odometer.window_s``) evenly spaced over that drive: an odometer reads the raw body-frame IMU only, so
-every stretch of the drive is an input it meets in an outage. Each network reads them with its own training
-normalization.
+every stretch of the drive is an input it meets in an outage. Each network reads them through the odometers'
+front end (``evaluate.odometer.inputs``, :func:`bgfn.learning.odometry.network_inputs`) with its own training
+normalization. The front end (band powers of short frames, the same for both networks and for ``RIDGE-ODO``)
+is preprocessing, not counted.
 """
 
 from __future__ import annotations
@@ -137,10 +139,10 @@ def odometer_energy(profile: str, cfg: dict, e_mac: float, e_ac: float, batch_si
         check_trained(json.loads(card_path(paths[m]).read_text()), card_path(paths[m]), allow)
     trained = {m: load_trained(p, device="cpu") for m, p in paths.items()}
     drive = load_drive(dataset, profile=profile)
-    window, _ = lo.window_samples(drive.imu, oc["window_s"])
+    window, rate = lo.window_samples(drive.imu, oc["window_s"])
     t = drive.imu["time"].to_numpy(float)
     n = int((cfg.get("energy") or {}).get("max_windows") or 128)
-    ws = lo.speed_windows(drive.imu, np.linspace(t[window], t[-1], n), window)
+    ws = lo.network_inputs(lo.speed_windows(drive.imu, np.linspace(t[window], t[-1], n), window), oc["inputs"], rate)
     counts = {m: layer_counts(tm.model.eval(), tm.norm.x(ws.x).astype(np.float32), batch_size)
               for m, tm in trained.items()}
     tables = {m: table_from_counts(c, odometer_label(m), e_mac, e_ac) for m, c in counts.items()}

@@ -10,10 +10,12 @@ on a drive, with the same starts, folds and durations as the sweep (:func:`bgfn.
   trained per fold on the GPS-aided solution's forward speed outside that fold's outages (+- ``train.margin_s``),
   its std the RMS of its residuals on a held-out block in the middle of the remaining windows;
 - ``BGFN-ODO``, ``Transformer-ODO``, ``AT-LSTM-ODO``, ``MLP-ODO`` (``methods``): the networks as learned odometers,
-  the forward speed and its log-variance from the same IMU-only windows, trained per fold with beta-NLL
-  (:class:`bgfn.train.objectives.SpeedObjective`) with the sweep's budget and the profile's ``train.lr`` (the same
-  for every network: notebook 03's search tuned its rates for the increments), their std calibrated on their validation
-  windows (NIS = 1) (:func:`network_odometers`);
+  the forward speed and its log-variance from the same IMU-only windows through the networks' front end
+  (``inputs``, :func:`bgfn.learning.odometry.network_inputs`), trained per fold with beta-NLL
+  (:class:`bgfn.train.objectives.SpeedObjective`) with the sweep's budget and ``train`` laid over it
+  (:func:`odometer_train_config`) and the profile's ``train.lr`` (the same for every network: notebook 03's search
+  tuned its rates for the increments), their std calibrated on their validation windows (NIS = 1; ``val_blocks``
+  blocks spread over the drive) (:func:`network_odometers`);
 - ``ORACLE-SPEED``: the reference's horizontal speed plus white noise of std ``sigma`` (the grid ``sigmas_mps``),
   fused with std ``sigma``: how accurate a speed must be to help; ``ORACLE-SPEED+WALK`` (when
   ``walk_mps_per_sqrt_s`` > 0): the same plus a random walk the fused std does not know of, the slowly drifting
@@ -32,7 +34,7 @@ Each row also carries the speed error the odometer made inside the outage agains
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Callable
 
@@ -161,8 +163,14 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
              for k in sorted(plan["fold"].unique())}
     if paper:
         folds[PAPER_FOLD] = paper
-    # one honest split per fold: the ridge and the networks learn from the same windows
-    data = {k: lo.build_speed_data(ws, fw, margin, val_fraction) for k, fw in folds.items()}
+    # one honest split per fold: the ridge and the networks learn from the same windows, the networks through
+    # their front end (evaluate.odometer.inputs)
+    blocks = int(oc["val_blocks"])
+    data = {k: lo.build_speed_data(ws, fw, margin, val_fraction, blocks) for k, fw in folds.items()}
+    net_ws = lo.network_inputs(ws, oc["inputs"], imu_rate)
+    net_data = {k: replace(d, options={**d.options, "inputs": oc["inputs"]})       # the card says what it read
+                for k, d in ((k, lo.build_speed_data(net_ws, fw, margin, val_fraction, blocks))
+                             for k, fw in folds.items())}
     runs, tracks = [], {}
     facts = {"ridge_std_mps": {}, "epochs": int(len(all_windows)), "paper_windows": folds.get(PAPER_FOLD, [])}
     honest = {"time": all_windows.t_end, "truth": truth, "outages": [], "tracks": {}}   # each outage: its own fold's
@@ -196,7 +204,8 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
             runs.append(OdometerRun(f"{dataset} fold {k} {method} {sigma:g} m/s seed {seed}", fw,
                                     no.Odometer(con, track, gate), method, float(sigma), int(seed), int(k)))
             tracks[runs[-1].label] = track
-    nets = network_odometers(cfg, profile, dataset, ecfg, data, all_windows, runner)
+    nets = network_odometers(cfg, profile, dataset, ecfg, net_data,
+                             lo.network_inputs(all_windows, oc["inputs"], imu_rate), runner)
     facts["networks"] = {}
     for (label, k, seed), (track, fact) in nets.items():
         runs.append(OdometerRun(f"{dataset} fold {k} {label} seed {seed}", folds[k], no.Odometer(con, track, gate),
@@ -229,9 +238,9 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
 def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, data: dict[int, lo.SpeedData],
                       all_windows: lo.SpeedWindows, runner: Runner | None = None) -> dict:
     """The learned odometers of ``evaluate.odometer.methods`` (``BGFN-ODO`` ...), per sweep fold and seed: each
-    trained on that fold's honest speed data (``data``, :func:`bgfn.learning.odometry.build_speed_data`) with the sweep's
-    budget and the profile's ``train.lr`` (not the increments' search), its std calibrated on its validation
-    windows (:func:`bgfn.learning.odometry.calibration_factor`, NIS = 1), and its speed over every epoch.
+    trained on that fold's honest speed data (``data``, :func:`bgfn.learning.odometry.build_speed_data`, its windows
+    through the front end) with the odometers' budget (:func:`odometer_train_config`) and the profile's
+    ``train.lr`` (not the increments' search), its std calibrated on its validation windows (:func:`bgfn.learning.odometry.calibration_factor`, NIS = 1), and its speed over every epoch.
 
     Returns ``{(label, fold, seed): (SpeedTrack, facts)}``.
     """
@@ -241,7 +250,7 @@ def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, data: d
     # notebook 03's search tuned the rates for the increments, another target, and one of its picks (e.g. 0.27 for
     # BGFN on the real drive) can cripple a speed network: the same train.lr for every network, or with
     # lr_search the rate of each network chosen per fold by train.lr_search's grid on the speed objective
-    tc = sweep_train_config(cfg["train"], ecfg["sweep"])
+    tc = odometer_train_config(cfg["train"], ecfg)
     search = speed_lr_search(tc, profile, dataset, oc["methods"], data, runner) if oc["lr_search"] else None
     runs, keys = [], []
     for k in sorted(data):
@@ -269,6 +278,12 @@ def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, data: d
     return tracks
 
 
+def odometer_train_config(train_section: dict, ecfg: dict) -> dict:
+    """The odometer networks' ``train:`` section: the sweep's (:func:`bgfn.evaluate.sweep.sweep_train_config`)
+    with ``evaluate.odometer.train`` laid over it the same way (null: the sweep's budget as it is)."""
+    return sweep_train_config(sweep_train_config(train_section, ecfg["sweep"]), {"train": ecfg["odometer"]["train"]})
+
+
 def fold_name(dataset: str, fold: int) -> str:
     """``<dataset> fold <k>``: a fold's name in the odometers' learning-rate search and its progress lines."""
     return f"{dataset} fold {int(fold)}"
@@ -277,8 +292,8 @@ def fold_name(dataset: str, fold: int) -> str:
 def speed_lr_search(tc: dict, profile: str, dataset: str, methods, data: dict[int, lo.SpeedData],
                     runner: Runner | None = None) -> pd.DataFrame:
     """The learning rate of every odometer network ``methods`` per fold (``evaluate.odometer.lr_search``): the grid,
-    extension and budget of ``tc``'s ``lr_search`` (``tc``: the sweep's ``train:`` section,
-    :func:`bgfn.evaluate.sweep.sweep_train_config`; :func:`bgfn.train.search_profile_rates`, the same for every
+    extension and budget of ``tc``'s ``lr_search`` (``tc``: the odometers' ``train:`` section,
+    :func:`odometer_train_config`; :func:`bgfn.train.search_profile_rates`, the same for every
     network), on a tuning split inside each fold's training windows (:func:`bgfn.learning.odometry.inner_speed_split`),
     so that neither the fold's outages nor its calibration block choose it; the sweep's model sizes.
 

@@ -13,6 +13,13 @@ The simple learned odometer (``RIDGE-ODO``, the bar a network must clear to just
 on the log energies of each IMU axis in :data:`BANDS_HZ` (:func:`band_energies`), standardized on the training
 windows; its std is the RMS of its residuals on the validation windows (:class:`RidgeOdometer`).
 
+The networks read either the raw windows or, by default, the same kind of features over time
+(:func:`network_inputs`, ``evaluate.odometer.inputs: band_frames``): each 0.4 s frame's per-axis mean (gravity,
+centripetal acceleration, yaw rate) and log band powers (the vibration of rolling), 9 frames of a 2 s window. On
+a drive of a few hundred training windows a network that must first learn to square and log its raw inputs
+learned less than the ridge on those features (deviations page); the front end gives every network the ridge's
+features, ordered in time, so what a network adds over the ridge is its own.
+
 For the networks that predict a speed and its log-variance: the beta-NLL loss (:func:`beta_nll`, so the variance
 cannot swallow the error) and the one calibration factor on their std fitted on held-out windows so that the
 normalized residuals have unit mean square (:func:`calibration_factor`, NIS = 1).
@@ -37,6 +44,13 @@ ODOMETER_CHANNELS: tuple[str, ...] = ACCEL_COLUMNS + GYRO_COLUMNS
 #: Frequency bands of :func:`band_energies`, Hz: five log-spaced bands from 0.5 Hz to 50 Hz (the Nyquist
 #: frequency of a 100 Hz IMU).
 BANDS_HZ: tuple[tuple[float, float], ...] = tuple(zip(np.geomspace(0.5, 50.0, 6)[:-1], np.geomspace(0.5, 50.0, 6)[1:]))
+
+#: What the odometer networks read (:func:`network_inputs`; ``evaluate.odometer.inputs``).
+ODOMETER_INPUTS: tuple[str, ...] = ("imu", "band_frames")
+#: Frames of :func:`band_frames`, s: 0.4 s (a 2.5 Hz resolution) every 0.2 s, 9 frames of a 2 s window.
+FRAME_S, HOP_S = 0.4, 0.2
+#: Bands per frame of :func:`band_frames` (:func:`frame_bands`).
+FRAME_N_BANDS = 4
 
 
 def forward_speed(solution: pd.DataFrame, mount: np.ndarray | None = None) -> np.ndarray:
@@ -121,18 +135,27 @@ class SpeedData:
 
 
 def build_speed_data(ws: SpeedWindows, outage_windows=(), margin_s: float = 30.0,
-                     val_fraction: float = 0.2) -> SpeedData:
+                     val_fraction: float = 0.2, val_blocks: int = 1) -> SpeedData:
     """The honest split of speed windows ``ws`` (sorted by time): windows touching an outage +- ``margin_s`` are
-    dropped, the middle ``val_fraction`` of the rest is the validation block, and training windows touching that
-    block are dropped too; the normalizer is fitted on the training windows."""
+    dropped, ``val_fraction`` of the rest is validation, and training windows touching it are dropped too; the
+    normalizer is fitted on the training windows.
+
+    The validation windows form ``val_blocks`` equal blocks, centred at the ``(k + 1/2) / val_blocks`` quantiles of
+    the remaining windows (1: the middle block, as the increments' split). The odometer's std is calibrated on
+    them (:func:`calibration_factor`), so several blocks spread over the drive are meant to hold its situations
+    (cruise, turns, stops) rather than one stretch of it, which may be all cruise."""
     lo_, hi_ = ws.span
     idx = np.flatnonzero(~overlaps(lo_, hi_, forbidden_intervals(outage_windows, margin_s)) & np.isfinite(ws.speed))
     n_val = max(1, int(round(val_fraction * idx.size)))
-    val = idx[(idx.size - n_val) // 2:(idx.size - n_val) // 2 + n_val]
+    # val_blocks blocks of n_val / val_blocks windows each, centred at the (k + 1/2) / val_blocks quantiles
+    sizes = np.diff(np.round(np.linspace(0, n_val, val_blocks + 1)).astype(int))
+    centres = ((np.arange(val_blocks) + 0.5) / val_blocks * idx.size).astype(int)
+    parts = [idx[max(0, min(c - n // 2, idx.size - n)):][:n] for c, n in zip(centres, sizes) if n > 0]
+    val = np.unique(np.concatenate(parts))
     if val.size == 0 or idx.size - val.size < 2:
         raise DataError("train", "windows", "at least 2 training and 1 validation speed window outside the outages",
                         f"{idx.size} in all")
-    block = np.array([[ws.t_start[val].min(), ws.t_end[val].max()]])
+    block = np.array([[ws.t_start[p].min(), ws.t_end[p].max()] for p in parts])
     train = idx[~overlaps(lo_[idx], hi_[idx], block)]
     tr, va = ws.subset(train), ws.subset(val)
     x = tr.x.reshape(-1, tr.x.shape[-1]).astype(np.float64)
@@ -142,6 +165,49 @@ def build_speed_data(ws: SpeedWindows, outage_windows=(), margin_s: float = 30.0
                "objective": "speed"}
     return SpeedData(tr, va, norm, options, {"n_train": int(train.size), "n_val": int(val.size),
                                              "n_outage_excluded": int(ws.x.shape[0] - idx.size)})
+
+
+def frame_bands(rate_hz: float, frame_s: float = FRAME_S, n_bands: int = FRAME_N_BANDS) -> tuple:
+    """The bands of :func:`band_frames`, Hz: ``n_bands`` log-spaced from a frame's frequency resolution
+    ``1 / frame_s`` to the Nyquist frequency ``rate_hz / 2``."""
+    edges = np.geomspace(1.0 / frame_s, rate_hz / 2.0, n_bands + 1)
+    return tuple(zip(edges[:-1], edges[1:]))
+
+
+def band_frames(x: np.ndarray, rate_hz: float, frame_s: float = FRAME_S, hop_s: float = HOP_S,
+                bands=None) -> np.ndarray:
+    """The odometer networks' front end (``evaluate.odometer.inputs: band_frames``): each window ``x`` [M, N, C]
+    cut into frames of ``frame_s`` every ``hop_s`` seconds, and per frame each channel's mean and its log mean
+    power in each band (:func:`frame_bands`; :func:`band_energies` on the frame).
+
+    Returns
+    -------
+    ndarray [M, T, C * (1 + B)] float32
+        T frames in time order; per frame the C means, then the C log powers of each band in turn.
+    """
+    x = np.asarray(x, dtype=float)
+    frame, hop = int(round(frame_s * rate_hz)), max(1, int(round(hop_s * rate_hz)))
+    if frame < 2 or frame > x.shape[1]:
+        raise DataError("odometer", "inputs", f"frames of 2 to {x.shape[1]} IMU samples (band_frames, "
+                        f"{frame_s:g} s at {rate_hz:g} Hz)", f"{frame} samples")
+    starts = np.arange(0, x.shape[1] - frame + 1, hop)
+    frames = np.stack([x[:, s:s + frame, :] for s in starts], axis=1)                      # [M, T, F, C]
+    m, t, f, c = frames.shape
+    power = band_energies(frames.reshape(m * t, f, c), rate_hz,
+                          bands or frame_bands(rate_hz, frame_s)).reshape(m, t, c, -1)       # [M, T, C, B]
+    means = frames.mean(axis=2)                                                             # [M, T, C]
+    return np.concatenate([means, power.transpose(0, 1, 3, 2).reshape(m, t, -1)], axis=-1).astype(np.float32)
+
+
+def network_inputs(ws: SpeedWindows, inputs: str, rate_hz: float) -> SpeedWindows:
+    """The windows as the odometer networks read them (``evaluate.odometer.inputs``): ``imu``, the raw body-frame
+    samples [M, N, 6]; ``band_frames``, :func:`band_frames` of them [M, T, 30]. The same for every network, for
+    training, the outages and the energy audit."""
+    if inputs == "imu":
+        return ws
+    if inputs == "band_frames":
+        return SpeedWindows(band_frames(ws.x, rate_hz), ws.speed, ws.t_end, ws.t_start)
+    raise DataError("evaluate.odometer", "inputs", f"one of {ODOMETER_INPUTS}", repr(inputs))
 
 
 def inner_speed_split(data: SpeedData, fraction: float = 0.2) -> SpeedData:

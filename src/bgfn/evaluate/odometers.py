@@ -54,6 +54,8 @@ from bgfn.learning.split import overlaps
 from bgfn.nav.outages import outage_windows
 from bgfn.train.checkpoints import checkpoint_name, odometer_models_dir
 from bgfn.train.objectives import SpeedObjective
+from bgfn.train.options import optimizer_options
+from bgfn.train.speed import torch_threads
 from bgfn.nav import odometer as no
 from bgfn.nav.constraints import DEFAULT_PLATFORM
 from bgfn import train
@@ -266,16 +268,26 @@ def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, data: d
                 keys.append((label, int(k), int(seed)))
     cards = train.train_runs(runs, runner, desc=f"odometer networks {dataset}")
     tracks = {}
-    for key, run, card in zip(keys, runs, cards):
-        net = train.load_trained(Path(run.out_dir) / checkpoint_name(run.method, run.seed), device="cpu")
-        obj = SpeedObjective(run.data)
-        speed_val, std_val = obj.to_units(train.predict_normalized(net.model, net.norm.x(run.data.val.x)))
-        factor = lo.calibration_factor(speed_val - run.data.val.speed, std_val)
-        speed, std = obj.to_units(train.predict_normalized(net.model, net.norm.x(all_windows.x)))
-        tracks[key] = (no.SpeedTrack(all_windows.t_end, np.maximum(speed, 0.0), std * factor),
-                       {"calibration": factor, "val_rmse_mps": card["val_rmse_mps"], "epochs": card["epochs_run"],
-                        "lr": train.method_lr(run.train_cfg, run.method)})
+    # a run sets its process's torch threads to train.optimizer.num_threads: with 1 job the runs ran here and left
+    # that count, with several this process kept its own; predicting under the runs' count gives the same tracks
+    # either way (a thread count changes the order of floating-point sums; measured: a few 1e-4 m in 120 s outages)
+    with torch_threads(optimizer_options(tc)["num_threads"]):
+        for key, run, card in zip(keys, runs, cards):
+            tracks[key] = calibrated_track(run, card, all_windows)
     return tracks
+
+
+def calibrated_track(run: train.TrainingRun, card: dict, all_windows: lo.SpeedWindows) -> tuple:
+    """One trained odometer network's :class:`bgfn.nav.odometer.SpeedTrack` over ``all_windows``, its std calibrated
+    on its validation windows (:func:`bgfn.learning.odometry.calibration_factor`), and its facts."""
+    net = train.load_trained(Path(run.out_dir) / checkpoint_name(run.method, run.seed), device="cpu")
+    obj = SpeedObjective(run.data)
+    speed_val, std_val = obj.to_units(train.predict_normalized(net.model, net.norm.x(run.data.val.x)))
+    factor = lo.calibration_factor(speed_val - run.data.val.speed, std_val)
+    speed, std = obj.to_units(train.predict_normalized(net.model, net.norm.x(all_windows.x)))
+    return (no.SpeedTrack(all_windows.t_end, np.maximum(speed, 0.0), std * factor),
+            {"calibration": factor, "val_rmse_mps": card["val_rmse_mps"], "epochs": card["epochs_run"],
+             "lr": train.method_lr(run.train_cfg, run.method)})
 
 
 def odometer_train_config(train_section: dict, ecfg: dict) -> dict:

@@ -34,7 +34,7 @@ Each row also carries the speed error the odometer made inside the outage agains
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
@@ -167,12 +167,8 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
         folds[PAPER_FOLD] = paper
     # one honest split per fold: the ridge and the networks learn from the same windows, the networks through
     # their front end (evaluate.odometer.inputs)
-    blocks = int(oc["val_blocks"])
-    data = {k: lo.build_speed_data(ws, fw, margin, val_fraction, blocks) for k, fw in folds.items()}
-    net_ws = lo.network_inputs(ws, oc["inputs"], imu_rate)
-    net_data = {k: replace(d, options={**d.options, "inputs": oc["inputs"]})       # the card says what it read
-                for k, d in ((k, lo.build_speed_data(net_ws, fw, margin, val_fraction, blocks))
-                             for k, fw in folds.items())}
+    data = {k: lo.build_speed_data(ws, fw, margin, val_fraction, int(oc["val_blocks"])) for k, fw in folds.items()}
+    net_data = {k: lo.with_inputs(d, oc["inputs"], imu_rate) for k, d in data.items()}
     runs, tracks = [], {}
     facts = {"ridge_std_mps": {}, "epochs": int(len(all_windows)), "paper_windows": folds.get(PAPER_FOLD, [])}
     honest = {"time": all_windows.t_end, "truth": truth, "outages": [], "tracks": {}}   # each outage: its own fold's
@@ -242,7 +238,8 @@ def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, data: d
     """The learned odometers of ``evaluate.odometer.methods`` (``BGFN-ODO`` ...), per sweep fold and seed: each
     trained on that fold's honest speed data (``data``, :func:`bgfn.learning.odometry.build_speed_data`, its windows
     through the front end) with the odometers' budget (:func:`odometer_train_config`) and the profile's
-    ``train.lr`` (not the increments' search), its std calibrated on its validation windows (:func:`bgfn.learning.odometry.calibration_factor`, NIS = 1), and its speed over every epoch.
+    ``train.lr`` (not the increments' search), its std calibrated on its validation windows
+    (:func:`bgfn.learning.odometry.calibration_factor`, NIS = 1), and its speed over every epoch.
 
     Returns ``{(label, fold, seed): (SpeedTrack, facts)}``.
     """

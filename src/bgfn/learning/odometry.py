@@ -158,9 +158,7 @@ def build_speed_data(ws: SpeedWindows, outage_windows=(), margin_s: float = 30.0
     block = np.array([[ws.t_start[p].min(), ws.t_end[p].max()] for p in parts])
     train = idx[~overlaps(lo_[idx], hi_[idx], block)]
     tr, va = ws.subset(train), ws.subset(val)
-    x = tr.x.reshape(-1, tr.x.shape[-1]).astype(np.float64)
-    norm = Normalizer(x.mean(0), np.maximum(x.std(0), 1e-8), np.array([tr.speed.mean()]),
-                      np.array([max(float(tr.speed.std()), 1e-8)]))
+    norm = speed_normalizer(tr)
     options = {"window": int(ws.x.shape[1]), "margin_s": float(margin_s), "val_fraction": float(val_fraction),
                "objective": "speed"}
     return SpeedData(tr, va, norm, options, {"n_train": int(train.size), "n_val": int(val.size),
@@ -208,6 +206,20 @@ def network_inputs(ws: SpeedWindows, inputs: str, rate_hz: float) -> SpeedWindow
     if inputs == "band_frames":
         return SpeedWindows(band_frames(ws.x, rate_hz), ws.speed, ws.t_end, ws.t_start)
     raise DataError("evaluate.odometer", "inputs", f"one of {ODOMETER_INPUTS}", repr(inputs))
+
+
+def speed_normalizer(train: SpeedWindows) -> Normalizer:
+    """Per-channel input and speed standardization fitted on the training windows ``train``."""
+    x = train.x.reshape(-1, train.x.shape[-1]).astype(np.float64)
+    return Normalizer(x.mean(0), np.maximum(x.std(0), 1e-8), np.array([train.speed.mean()]),
+                      np.array([max(float(train.speed.std()), 1e-8)]))
+
+
+def with_inputs(data: SpeedData, inputs: str, rate_hz: float) -> SpeedData:
+    """``data``'s split as the odometer networks read it (:func:`network_inputs`): the same training and validation
+    windows through the front end, the input standardization refit on them, ``options['inputs']`` set."""
+    tr, va = network_inputs(data.train, inputs, rate_hz), network_inputs(data.val, inputs, rate_hz)
+    return SpeedData(tr, va, speed_normalizer(tr), {**data.options, "inputs": inputs}, data.info)
 
 
 def inner_speed_split(data: SpeedData, fraction: float = 0.2) -> SpeedData:

@@ -200,7 +200,7 @@ SCHEMA = section(
                          network_seeds=seq(_SEED, min_len=1), paper_outages=flag(), window_s=number(0.5), sigmas_mps=seq(_POS), walk_mps_per_sqrt_s=_NONNEG,
                          seeds=seq(_SEED, min_len=1), hold_std_mps=_POS, ridge_alpha=_POS,
                          gate_probability=number(0, 1, lo_open=True, hi_open=True, null=True), lr_search=flag(),
-                         inputs=text(*ODOMETER_INPUTS), val_blocks=integer(1),
+                         inputs=text(*ODOMETER_INPUTS), val_blocks=integer(1), curve_folds=seq(integer(1)),
                          train=Spec("section", null=True, fields=TRAIN.fields))),
     energy=section(
         e_mac_pj=_POS, e_ac_pj=_POS, dataset=text(null=True), seed=integer(0, null=True), allow_untrained=flag(),

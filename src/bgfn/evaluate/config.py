@@ -69,12 +69,14 @@ EVALUATE_DEFAULTS: dict[str, Any] = {
     # the sweep's), the IMU window of the ridge odometer, the oracle speed's noise grid and random walk, the held speed's std, the ridge penalty, the gate;
     # paper_outages: also in each drive's two evaluation outages (the profile's outage_windows), as one more fold;
     # lr_search: each odometer network's learning rate per fold from train.lr_search's grid (false: train.lr);
-    # network_datasets: the drives whose networks train as odometers (null: every drive of the bars)
+    # network_datasets: the drives whose networks train as odometers (null: every drive of the bars);
+    # curve_folds: the ridge refitted with the sweep's starts in each of these numbers of folds (bgfn.evaluate.ridge_curve;
+    # more than the starts: one per start)
     "odometer": {"datasets": None, "methods": ["bgfn", "transformer", "at_lstm", "mlp"], "network_seeds": [0],
                  "network_datasets": None,
                  "paper_outages": False, "window_s": 2.0, "sigmas_mps": [0.05, 0.1, 0.2, 0.5, 1.0, 2.0], "walk_mps_per_sqrt_s": 0.0,
                  "seeds": [0], "hold_std_mps": 1.0, "ridge_alpha": 1.0, "gate_probability": 0.999,
-                 "lr_search": False, "inputs": "band_frames", "val_blocks": 4, "train": None},
+                 "lr_search": False, "inputs": "band_frames", "val_blocks": 4, "curve_folds": [], "train": None},
 }
 
 

@@ -26,6 +26,10 @@ the paper's tables) as one more fold, :data:`PAPER_FOLD`: its networks and its r
 +- ``train.margin_s``; its rows (one per outage, at the outage's own duration) go to ``outage_odometer_paper.csv``
 (:func:`paper_outage_table`), never into the sweep's statistics.
 
+With ``curve_folds``, the ridge is also refitted with the sweep's starts split into each of those numbers of folds:
+its speed error against its training windows per fold (:mod:`bgfn.evaluate.ridge_curve`,
+``outage_odometer_curve.csv``).
+
 Every row is fused at the aid epochs (``nav.nhc.rate_hz``) through the chi-square gate (``gate_probability``).
 Each row also carries the speed error the odometer made inside the outage against the reference's speed
 (``speed_rmse_mps``) and the share of epochs within its own 2 sigma (``coverage_2sigma``).
@@ -47,6 +51,7 @@ from bgfn.errors import DataError
 from bgfn.data import dataset_id, load_drive
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.evaluate.plots import finish_duration_axes
+from bgfn.evaluate.ridge_curve import CURVE_COLUMNS, curve_lines, fold_ridge, ridge_curve, speed_errors
 from bgfn.evaluate.sweep import profile_sweep_plan, sweep_train_config
 from bgfn.io import atomic_write_csv, save_figure
 from bgfn.learning import odometry as lo
@@ -120,15 +125,6 @@ def oracle_track(epochs: np.ndarray, truth: np.ndarray, sigma: float, walk: floa
     drift = np.cumsum(rng.standard_normal(epochs.size)) * walk / np.sqrt(rate_hz)
     return no.SpeedTrack(epochs, truth + sigma * rng.standard_normal(epochs.size) + drift, np.full(epochs.size,
                                                                                                     float(sigma)))
-
-
-def fold_ridge(data: lo.SpeedData, all_windows: lo.SpeedWindows, alpha: float,
-               rate_hz: float) -> tuple[lo.RidgeOdometer, no.SpeedTrack]:
-    """The ridge odometer of one fold, fitted on the fold's honest split (:func:`bgfn.learning.odometry.
-    build_speed_data`), its std from the validation block; its track over ``all_windows``."""
-    model = lo.RidgeOdometer.fit(data.train, data.val, rate_hz, alpha)
-    pred = model.predict(all_windows)
-    return model, no.SpeedTrack(all_windows.t_end, pred, np.full(pred.size, model.std_mps))
 
 
 def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Runner | None = None,
@@ -228,6 +224,12 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
                              "sigma_mps": run.sigma_mps, "seed": run.seed, "fold": run.fold,
                              **{c: m[c] for c in ("max_h_m", "rmse_h_m", "final_h_m")},
                              **speed_errors(track, all_windows.t_end, truth, r.start, float(du))})
+    # the ridge's speed error as more folds hold out less of the drive (bgfn.evaluate.ridge_curve)
+    n_starts = int(plan["fold"].size)                                       # more folds than starts: one per start
+    plans = {n: profile_sweep_plan(cfg, drive, {**sw, "folds": n})
+             for n in sorted({min(int(n), n_starts) for n in oc["curve_folds"]})}
+    facts["curve"] = ridge_curve(dataset, plans, ws, all_windows, truth, dmax, margin, val_fraction,
+                                 int(oc["val_blocks"]), float(oc["ridge_alpha"]), imu_rate)
     facts["wall_s"] = time.perf_counter() - t0
     facts["speed_series"] = honest
     return pd.DataFrame(rows, columns=list(ODOMETER_COLUMNS)), facts
@@ -322,22 +324,6 @@ def speed_lr_search(tc: dict, profile: str, dataset: str, methods, data: dict[in
     return table[list(train.LR_SEARCH_COLUMNS)]
 
 
-def speed_errors(track: no.SpeedTrack | None, t: np.ndarray, truth: np.ndarray, start: float,
-                 duration: float) -> dict:
-    """``speed_rmse_mps`` and ``coverage_2sigma`` of a track against the true speed inside an outage (NaN
-    without a track)."""
-    if track is None:
-        return {"speed_rmse_mps": np.nan, "coverage_2sigma": np.nan}
-    m = (t > start) & (t <= start + duration + 1e-6)
-    speed, std = track.at(t[m])
-    ok = np.isfinite(speed)
-    if not ok.any():
-        return {"speed_rmse_mps": np.nan, "coverage_2sigma": np.nan}
-    err = speed[ok] - truth[m][ok]
-    return {"speed_rmse_mps": float(np.sqrt(np.mean(err ** 2))),
-            "coverage_2sigma": float(np.mean(np.abs(err) <= 2 * std[ok]))}
-
-
 def run_odometer_bars(cfg: dict, profile: str, datasets, ecfg: dict, runner: Runner | None = None,
                       report: Callable[[str], None] | None = None) -> tuple[pd.DataFrame, dict]:
     """:func:`odometer_rows` of every dataset (notebook 04); the rows in dataset order and the facts."""
@@ -367,6 +353,7 @@ class OdometerSection:
     figures: list = field(default_factory=list)
     paper: pd.DataFrame | None = None
     networks: pd.DataFrame | None = None
+    curve: pd.DataFrame | None = None
 
     def markdown(self) -> str:
         """The summary at the sweep's durations as a Markdown table (:func:`odometer_table`), then the lines."""
@@ -377,7 +364,9 @@ class OdometerSection:
         body = [f"| {ds} | {m} | " + " | ".join(f"{v:.1f}" for v in r) + " |" for (ds, m), r in wide.iterrows()]
         text = "\n".join(["Median max horizontal error (m) over the sweep's starts:", "", head,
                            "|---" * (len(wide.columns) + 2) + "|", *body, ""] + [f"- {s}" for s in self.lines]
-                          + [f"- {s}" for s in network_lines(self.networks)])
+                          + [f"- {s}" for s in network_lines(self.networks)]
+                          + [f"- {s}" for s in curve_lines(self.curve if self.curve is not None
+                                                           else pd.DataFrame(columns=list(CURVE_COLUMNS)))])
         if self.paper is None or self.paper.empty:
             return text
         p = self.paper[self.paper["sigma_mps"].isna()]       # the oracle's grid: tables/outage_odometer_paper.csv
@@ -432,7 +421,10 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
     rows = rows[rows["fold"] != PAPER_FOLD].reset_index(drop=True)
     summary = odometer_summary(rows)
     networks = network_table(rows, facts)
+    curves = [f["curve"] for f in facts.values() if f.get("curve") is not None and len(f["curve"])]
+    curve = pd.concat(curves, ignore_index=True) if curves else pd.DataFrame(columns=list(CURVE_COLUMNS))
     tables = Path(out) / "tables"
+    atomic_write_csv(tables / SHARED_TABLES["odometer_curve"], curve, float_format="%.4f")
     atomic_write_csv(tables / SHARED_TABLES["odometer_networks"], networks, float_format="%.4f")
     atomic_write_csv(tables / SHARED_TABLES["odometer"], rows, float_format="%.4f")
     atomic_write_csv(tables / SHARED_TABLES["odometer_summary"], summary, float_format="%.4f")
@@ -449,7 +441,7 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
     if timings is not None:
         timings["odometer_s"] = time.perf_counter() - t0
     return OdometerSection(rows, summary, odometer_lines(summary) if len(summary) else [], facts, figures, paper,
-                           networks)
+                           networks, curve)
 
 
 def network_table(rows: pd.DataFrame, facts: dict) -> pd.DataFrame:

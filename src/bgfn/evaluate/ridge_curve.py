@@ -1,0 +1,121 @@
+"""How the simple learned odometer's speed error falls with its training windows (beyond the paper; issue 24).
+
+The learned odometers of :mod:`bgfn.evaluate.odometers` train per fold of the sweep's outage starts, outside that
+fold's outages +- ``train.margin_s``. On a short drive a fold holds out much of it: with 2 folds each odometer
+learns from a few minutes of driving. Whether that is why its speed is too coarse to help the filter is a question
+the drive itself can answer: split the same starts into more folds (``evaluate.odometer.curve_folds``; as many
+folds as starts leaves one start out), so that each fold holds out less of the drive, and refit ``RIDGE-ODO`` (the
+ridge on band energies, closed form, so the whole curve costs seconds) on each fold's honest split
+(:func:`bgfn.learning.odometry.build_speed_data`, the same margin, validation blocks and window as the bars).
+
+Each start is predicted by the ridge of its own fold. The table (:data:`CURVE_COLUMNS`, ``tables/
+outage_odometer_curve.csv``) gives per number of folds the training windows per fold, the ridge's validation std
+and its speed RMSE and +-2 sigma coverage in the outages. If the speed RMSE barely falls while the training windows
+grow, the drive's length is not what limits the learned speed: the situations of the outages that the training
+windows do not cover, or what an IMU window can tell of the speed, are.
+
+Also the two pieces the odometer bars share with the curve: :func:`fold_ridge` (one fold's ridge and its track)
+and :func:`speed_errors` (a track's speed error inside one outage).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from bgfn.errors import DataError
+from bgfn.learning import odometry as lo
+from bgfn.nav import odometer as no
+
+#: Columns of ``tables/outage_odometer_curve.csv`` (:func:`ridge_curve`).
+CURVE_COLUMNS: tuple[str, ...] = ("dataset", "folds", "n_train", "val_std_mps", "duration_s",
+                                  "outage_speed_rmse_mps", "outage_coverage_2sigma", "starts")
+
+
+def fold_ridge(data: lo.SpeedData, all_windows: lo.SpeedWindows, alpha: float,
+               rate_hz: float) -> tuple[lo.RidgeOdometer, no.SpeedTrack]:
+    """The ridge odometer of one fold, fitted on the fold's honest split (:func:`bgfn.learning.odometry.
+    build_speed_data`), its std from the validation windows; its track over ``all_windows``."""
+    model = lo.RidgeOdometer.fit(data.train, data.val, rate_hz, alpha)
+    pred = model.predict(all_windows)
+    return model, no.SpeedTrack(all_windows.t_end, pred, np.full(pred.size, model.std_mps))
+
+
+def speed_errors(track: no.SpeedTrack | None, t: np.ndarray, truth: np.ndarray, start: float,
+                 duration: float) -> dict:
+    """``speed_rmse_mps`` and ``coverage_2sigma`` of a track against the true speed inside an outage (NaN
+    without a track)."""
+    if track is None:
+        return {"speed_rmse_mps": np.nan, "coverage_2sigma": np.nan}
+    m = (t > start) & (t <= start + duration + 1e-6)
+    speed, std = track.at(t[m])
+    ok = np.isfinite(speed)
+    if not ok.any():
+        return {"speed_rmse_mps": np.nan, "coverage_2sigma": np.nan}
+    err = speed[ok] - truth[m][ok]
+    return {"speed_rmse_mps": float(np.sqrt(np.mean(err ** 2))),
+            "coverage_2sigma": float(np.mean(np.abs(err) <= 2 * std[ok]))}
+
+
+def ridge_curve(dataset: str, plans: dict[int, pd.DataFrame], ws: lo.SpeedWindows, all_windows: lo.SpeedWindows,
+                truth: np.ndarray, duration_s: float, margin_s: float, val_fraction: float, val_blocks: int,
+                alpha: float, rate_hz: float) -> pd.DataFrame:
+    """``RIDGE-ODO``'s speed error against its training windows (module docstring).
+
+    Parameters
+    ----------
+    dataset : str
+    plans : dict
+        Number of folds -> the sweep's starts split into that many folds (``start_s``, ``fold``;
+        :func:`bgfn.evaluate.sweep.sweep_plan`).
+    ws : SpeedWindows
+        The windows with the GPS-aided solution's forward speed (the training targets).
+    all_windows : SpeedWindows
+        Every aid epoch's window (what the odometer predicts).
+    truth : ndarray
+        The reference's speed at ``all_windows.t_end``, m/s.
+    duration_s : float
+        Each start's held-out outage (the sweep's longest), s; the speed errors are taken over it.
+    margin_s, val_fraction, val_blocks, alpha, rate_hz
+        As the odometer bars' (:func:`bgfn.learning.odometry.build_speed_data`, :class:`~bgfn.learning.odometry.
+        RidgeOdometer`).
+
+    Returns
+    -------
+    DataFrame
+        :data:`CURVE_COLUMNS`, a row per number of folds: ``n_train`` the median training windows of a fold,
+        ``val_std_mps`` the median of the folds' ridge std, ``outage_speed_rmse_mps`` the RMS over the starts (each
+        holds the same epochs) and ``outage_coverage_2sigma`` the share of their epochs within +-2 sigma.
+    """
+    rows = []
+    for n_folds, plan in sorted(plans.items()):
+        if plan.empty:
+            raise DataError("evaluate.odometer", "curve_folds", "folds of a sweep with starts", "no start")
+        n_train, stds, errs = [], [], []
+        for _, starts in plan.groupby("fold", sort=True):
+            held = [(float(s), float(duration_s)) for s in starts["start_s"]]
+            data = lo.build_speed_data(ws, held, margin_s, val_fraction, val_blocks)
+            model, track = fold_ridge(data, all_windows, alpha, rate_hz)
+            n_train.append(data.info["n_train"])
+            stds.append(model.std_mps)
+            errs += [speed_errors(track, all_windows.t_end, truth, s, d) for s, d in held]
+        rmse = np.array([e["speed_rmse_mps"] for e in errs])
+        cover = np.array([e["coverage_2sigma"] for e in errs])
+        rows.append({"dataset": dataset, "folds": int(n_folds), "n_train": float(np.median(n_train)),
+                     "val_std_mps": float(np.median(stds)), "duration_s": float(duration_s),
+                     "outage_speed_rmse_mps": float(np.sqrt(np.nanmean(rmse ** 2))),
+                     "outage_coverage_2sigma": float(np.nanmean(cover)), "starts": int(len(errs))})
+    return pd.DataFrame(rows, columns=list(CURVE_COLUMNS))
+
+
+def curve_lines(curve: pd.DataFrame) -> list[str]:
+    """One sentence per dataset: the ridge's speed error in its outages as its training windows per fold grow."""
+    lines = []
+    for ds, g in curve.groupby("dataset", sort=False):
+        g = g.sort_values("folds")
+        lines.append(f"{ds}: RIDGE-ODO's speed RMSE in its own fold's {g['duration_s'].iloc[0]:g} s outages as the "
+                     "sweep's starts are split into more folds (each holding out less of the drive): "
+                     + "; ".join(f"{r.folds} folds, {r.n_train:.0f} training windows per fold: "
+                                 f"{r.outage_speed_rmse_mps:.2f} m/s ({100 * r.outage_coverage_2sigma:.0f} % "
+                                 "within +-2 sigma)" for r in g.itertuples()) + ".")
+    return lines

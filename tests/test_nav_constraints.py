@@ -123,6 +123,32 @@ def test_mounting_track_recovers_an_imu_mounted_off_the_direction_of_travel():
     assert cn.mounting_track(body, cn.ConstraintConfig(mounting="none"))[1].size == 0
 
 
+def test_mounting_weighted_by_heading_variance_ignores_a_heading_still_converging():
+    """A solution whose heading is 15 deg off for its first minute (a self-aligned filter finding its heading, std
+    20 deg) and right afterwards (std 0.5 deg): the heading error enters v^b_y / v^b_x one for one, so the equal
+    mean still holds a share of the 15 deg at the end, while the inverse-variance weights leave the true 1 deg."""
+    ref = sim.demo_trajectory(300.0)
+    t = ref["time"].to_numpy(float)
+    early = t < t[0] + 60.0
+    c_v = transform.dcm_from_euler(ref["roll"].to_numpy(), ref["pitch"].to_numpy(), ref["yaw"].to_numpy())
+    r_bv = transform.dcm_from_euler(0.0, 0.0, np.radians(1.0))                   # body -> vehicle: 1 deg yaw
+    roll, pitch, yaw = transform.euler_from_dcm(c_v @ r_bv)
+    body = ref.assign(roll=roll, pitch=pitch, yaw=yaw + np.where(early, np.radians(15.0), 0.0))
+    std = np.where(early, np.radians(20.0), np.radians(0.5))
+    truth = np.tan(np.radians(-1.0))                                             # vehicle x in the body frame
+    heading = cn.ConstraintConfig(mounting_min_speed_mps=5.0)                    # mounting_weight: heading
+    equal = cn.ConstraintConfig(mounting_min_speed_mps=5.0, mounting_weight="equal")
+    weighted = cn.mounting_track(body, heading, std)[1][-1, 0]
+    plain = cn.mounting_track(body, equal, std)[1][-1, 0]
+    assert abs(np.degrees(np.arctan(weighted) - np.arctan(truth))) < 0.05
+    assert abs(np.degrees(np.arctan(plain) - np.arctan(truth))) > 1.0
+    np.testing.assert_array_equal(cn.mounting_track(body, heading)[1], cn.mounting_track(body, equal, std)[1])
+    with pytest.raises(DataError, match="heading_std"):
+        cn.mounting_track(body, heading, std[:-1])
+    with pytest.raises(DataError, match="mounting_weight"):
+        cn.constraint_config({"nhc": {"mounting_weight": "speed"}})
+
+
 # ----------------------------------------------------------------------------------------------- detector
 @pytest.mark.parametrize("model", ["ekinox-d", "mpu6000"])
 def test_detector_fires_on_a_still_span_and_not_while_driving(model):
@@ -287,7 +313,7 @@ def test_baseline_has_the_ins_nhc_row_beside_the_ins_row():
     cfg = baseline.nav_config({})
     b = baseline.run_baseline(drive, cfg, windows)
     assert list(b.outage_table["method"]) == ["INS", "INS", "INS+NHC", "INS+NHC"]
-    con = baseline.outage_constraints(drive, cfg, b.full.trajectory)
+    con = baseline.outage_constraints(drive, cfg, b.full)
     again = run_outage(drive.imu, b.states["outage_2"], windows[1], b.noise, drive.meta["lever_arm_m"],
                        aid=con)
     e = b.outage_errors["outage_2"]

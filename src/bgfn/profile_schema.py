@@ -181,7 +181,8 @@ SCHEMA = section(
         innovation_gate=number(0, 1, lo_open=True, hi_open=True, null=True),
         ins_tuning=text("shipped", "navego"),
         # the vehicle constraints of the +NHC rows (bgfn.nav.constraints)
-        nhc=section(std_mps=_POS, rate_hz=_POS, mounting=text("estimate", "none"), mounting_min_speed_mps=_NONNEG),
+        nhc=section(std_mps=_POS, rate_hz=_POS, mounting=text("estimate", "none"), mounting_min_speed_mps=_NONNEG,
+                    mounting_weight=text("heading", "equal")),
         zupt=section(std_mps=_POS, window_s=_POS, accel_ratio=_NONNEG, gyro_ratio=_NONNEG, max_speed_mps=_NONNEG),
         constraints_in_gps_run=flag()),
     train=TRAIN,

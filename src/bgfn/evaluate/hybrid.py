@@ -154,7 +154,7 @@ def navigation_context(drive, nav_section: dict | None, starts: Sequence[float])
         static[ANGULAR_RATE_CHANNELS], static[SPECIFIC_FORCE_CHANNELS] = navego_setup.static_biases(
             drive.meta["imu_errors"], f"{drive.name} meta['imu_errors']")
     return NavContext(drive, full, noise, lever, states, imu_time, imu, nav_at_imu, interval, std, static,
-                      baseline.outage_constraints(drive, cfg, full.trajectory))
+                      baseline.outage_constraints(drive, cfg, full))
 
 
 # ----------------------------------------------------------------------------------------------- outage runs

@@ -38,6 +38,7 @@ from ..io import atomic_write_csv
 from . import constraints as cn, metrics, navego_setup
 from .alignment import ALIGNMENT_DEFAULTS, MODES, Alignment, align
 from .consistency import nis_line, nis_summary
+from .error_model import PHI_D, STATE_NAMES
 from .filter import FilterResult, gate_thresholds, run_filter, run_outage
 from .outages import check_windows, epochs_before
 from .state import FilterNoise, FilterState, initial_covariance, initial_state, noise_from_imu_errors, save_states
@@ -117,14 +118,17 @@ def gps_constraints(drive, cfg: dict, initial: FilterState, noise: FilterNoise):
         return None
     first = run_filter(filter_imu(drive, cfg), initial, noise, drive.gnss, drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0]),
                        gate_probability=cfg["innovation_gate"], source=drive.name)
-    return outage_constraints(drive, cfg, first.trajectory)
+    return outage_constraints(drive, cfg, first)
 
 
-def outage_constraints(drive, cfg: dict, trajectory: pd.DataFrame):
+def outage_constraints(drive, cfg: dict, solution: FilterResult):
     """The vehicle constraints of the ``INS+NHC`` runs of ``drive``: the stillness detector over its IMU and the
-    vehicle frame from the GPS-aided ``trajectory`` (:func:`bgfn.nav.constraints.build_constraints`)."""
-    return cn.build_constraints(drive.imu, drive.meta["imu_errors"], cn.constraint_config(cfg), trajectory,
-                                source=drive.name, platform=drive.meta.get("platform", cn.DEFAULT_PLATFORM))
+    vehicle frame from the GPS-aided ``solution``'s trajectory, each epoch weighted by its heading std
+    (:func:`bgfn.nav.constraints.build_constraints`, ``nav.nhc.mounting_weight``)."""
+    heading_std = solution.sd[STATE_NAMES[PHI_D]].to_numpy(float)
+    return cn.build_constraints(drive.imu, drive.meta["imu_errors"], cn.constraint_config(cfg), solution.trajectory,
+                                source=drive.name, platform=drive.meta.get("platform", cn.DEFAULT_PLATFORM),
+                                heading_std=heading_std)
 
 
 def run_drive(drive, section: dict | None = None, snapshots: dict | None = None) -> FilterResult:
@@ -396,7 +400,7 @@ def run_baseline(drive, cfg: dict, windows) -> Baseline:
                       gate_probability=cfg["innovation_gate"], source=drive.name,
                       aid=gps_constraints(drive, cfg, initial, noise))
     errors = metrics.navigation_errors(full.trajectory, drive.reference, drive.meta)
-    aids = outage_constraints(drive, cfg, full.trajectory)
+    aids = outage_constraints(drive, cfg, full)
     rows, outage_errors = [], {}
     for n, w in zip(names, windows):
         parts = []

@@ -35,7 +35,10 @@ falsely.
 Vehicle frame (:func:`mounting_track`): the IMU body frame need not be the vehicle's (the Turin reference's
 body frame is about a degree off the direction of travel in yaw and pitch). The vehicle x axis is estimated,
 causally, from the GPS-aided solution: the running mean of ``v^b_y / v^b_x`` and ``v^b_z / v^b_x`` over the
-epochs with forward speed above ``mounting_min_speed_mps`` up to the epoch (``mounting: none``: the body frame).
+epochs with forward speed above ``mounting_min_speed_mps`` up to the epoch (``mounting: none``: the body frame),
+each weighted by the inverse variance of the solution's heading (``mounting_weight: heading``; ``equal``: the same
+weight): a heading error turns the body-frame velocity with it, and a self-aligned filter's first minute would
+otherwise set the vehicle frame by its own unconverged heading.
 Inside an outage no fix updates it: it is held at its value at the outage start (:meth:`Constraints.frozen`).
 """
 
@@ -62,11 +65,15 @@ NHC_AXES = (1, 2)
 TIME_TOL = 1e-6
 
 #: Defaults of the ``nav.nhc`` and ``nav.zupt`` profile sections (keys of :class:`ConstraintConfig`).
-NHC_DEFAULTS: dict = {"std_mps": 0.1, "rate_hz": 1.0, "mounting": "estimate", "mounting_min_speed_mps": 5.0}
+NHC_DEFAULTS: dict = {"std_mps": 0.1, "rate_hz": 1.0, "mounting": "estimate", "mounting_min_speed_mps": 5.0,
+                     "mounting_weight": "heading"}
 ZUPT_DEFAULTS: dict = {"std_mps": 0.05, "window_s": 2.0, "accel_ratio": 1.5, "gyro_ratio": 1.5,
                        "max_speed_mps": 2.0}
 #: Mounting choices: the vehicle frame estimated from the GPS-aided solution, or the IMU body frame.
 MOUNTINGS = ("estimate", "none")
+#: Weights of the epochs in the mounting estimate (:func:`mounting_track`): the inverse variance of the GPS-aided
+#: solution's heading, or equal.
+MOUNTING_WEIGHTS = ("heading", "equal")
 #: What moves the IMU (a drive's ``meta["platform"]``, ``meta.yaml``'s ``platform``) -> (NHC, ZUPT): a car rolls
 #: without slipping sideways or leaving the road, so both; a walker stops and stands but steps sideways, so ZUPT
 #: alone; anything else (a drone, a cart of unknown kind) neither.
@@ -110,6 +117,9 @@ class ConstraintConfig:
         Vehicle frame from the GPS-aided solution (module docstring), or the IMU body frame.
     mounting_min_speed_mps : float
         Forward speed above which an epoch enters the mounting estimate, m/s.
+    mounting_weight : {"heading", "equal"}
+        Each epoch of the mounting estimate weighted by the inverse variance of the solution's heading, or equally
+        (:func:`mounting_track`).
     zupt_std_mps : float
         Std of the zero-velocity measurement per NED axis, m/s.
     window_s : float
@@ -130,6 +140,7 @@ class ConstraintConfig:
     gyro_ratio: float = ZUPT_DEFAULTS["gyro_ratio"]
     zupt_max_speed_mps: float = ZUPT_DEFAULTS["max_speed_mps"]
     platform: str = DEFAULT_PLATFORM
+    mounting_weight: str = NHC_DEFAULTS["mounting_weight"]
 
     @property
     def nhc(self) -> bool:
@@ -166,9 +177,12 @@ def constraint_config(nav_cfg: dict) -> ConstraintConfig:
     """:class:`ConstraintConfig` of a ``nav:`` section (:func:`bgfn.nav.baseline.nav_config`, defaults filled)."""
     nhc = {**NHC_DEFAULTS, **(nav_cfg.get("nhc") or {})}
     zupt = {**ZUPT_DEFAULTS, **(nav_cfg.get("zupt") or {})}
+    if nhc["mounting_weight"] not in MOUNTING_WEIGHTS:
+        raise DataError("params nav.nhc", "mounting_weight", f"one of {MOUNTING_WEIGHTS}", repr(nhc["mounting_weight"]))
     return ConstraintConfig(float(nhc["std_mps"]), float(nhc["rate_hz"]), str(nhc["mounting"]),
                             float(nhc["mounting_min_speed_mps"]), float(zupt["std_mps"]), float(zupt["window_s"]),
-                            float(zupt["accel_ratio"]), float(zupt["gyro_ratio"]), float(zupt["max_speed_mps"]))
+                            float(zupt["accel_ratio"]), float(zupt["gyro_ratio"]), float(zupt["max_speed_mps"]),
+                            mounting_weight=str(nhc["mounting_weight"]))
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -268,24 +282,43 @@ def vehicle_velocity_ratios(trajectory: pd.DataFrame) -> tuple[np.ndarray, np.nd
     return ratios, vb[:, 0]
 
 
-def mounting_track(trajectory: pd.DataFrame | None, config: ConstraintConfig) -> tuple[np.ndarray, np.ndarray]:
+def mounting_track(trajectory: pd.DataFrame | None, config: ConstraintConfig,
+                   heading_std: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The causal estimate of the vehicle x axis in the body frame after each epoch of a GPS-aided solution.
+
+    Parameters
+    ----------
+    trajectory : DataFrame or None
+        The GPS-aided solution (reference schema).
+    config : ConstraintConfig
+    heading_std : ndarray [T], optional
+        The solution's heading std at each of its epochs, rad (the filter's ``phi_D``). With ``mounting_weight:
+        heading`` each epoch weighs ``1 / heading_std^2``: a heading error of the solution turns ``v^b`` by the same
+        angle, so ``v^b_y / v^b_x`` holds it one for one, and while the filter is still finding its heading (a
+        self-aligned start: tens of degrees of std for the first minute of the real drive) those epochs would
+        otherwise pull the estimate by as much. None (or ``equal``): every epoch weighs the same.
 
     Returns
     -------
     time : ndarray [T]
         Epochs of ``trajectory``, s (empty without a trajectory or with ``mounting: none``).
     tangents : ndarray [T, 2]
-        Running mean of ``v^b_y / v^b_x`` and ``v^b_z / v^b_x`` over the epochs up to each one with forward speed
-        above ``mounting_min_speed_mps`` (0 before the first: the body frame).
+        Weighted running mean of ``v^b_y / v^b_x`` and ``v^b_z / v^b_x`` over the epochs up to each one with
+        forward speed above ``mounting_min_speed_mps`` (0 before the first: the body frame).
     """
     if trajectory is None or config.mounting == "none" or len(trajectory) == 0:
         return np.empty(0), np.empty((0, 2))
     ratios, forward = vehicle_velocity_ratios(trajectory)
-    use = forward > config.mounting_min_speed_mps
-    sums = np.cumsum(np.where(use[:, None], ratios, 0.0), axis=0)
-    count = np.cumsum(use)[:, None]
-    tangents = np.divide(sums, count, out=np.zeros_like(sums), where=count > 0)
+    weight = (forward > config.mounting_min_speed_mps).astype(float)
+    if heading_std is not None and config.mounting_weight == "heading":
+        std = np.asarray(heading_std, dtype=float)
+        if std.shape != weight.shape or not np.all(np.isfinite(std) & (std > 0)):
+            raise DataError("mounting estimate", "heading_std", f"{weight.size} positive heading stds, rad",
+                            f"shape {std.shape}, min {np.nanmin(std) if std.size else 'none'}")
+        weight /= std ** 2
+    sums = np.cumsum(weight[:, None] * ratios, axis=0)
+    total = np.cumsum(weight)[:, None]
+    tangents = np.divide(sums, total, out=np.zeros_like(sums), where=total > 0)
     return trajectory["time"].to_numpy(float), tangents
 
 
@@ -377,7 +410,7 @@ class Constraints:
 
 def build_constraints(imu: pd.DataFrame, imu_errors: dict, config: ConstraintConfig,
                       trajectory: pd.DataFrame | None = None, source: str = "drive",
-                      platform: str = DEFAULT_PLATFORM) -> Constraints:
+                      platform: str = DEFAULT_PLATFORM, heading_std: np.ndarray | None = None) -> Constraints:
     """Detector, aid schedule and vehicle frame of a drive.
 
     Parameters
@@ -393,6 +426,8 @@ def build_constraints(imu: pd.DataFrame, imu_errors: dict, config: ConstraintCon
         Name used in error messages.
     platform : str
         What moves the IMU (:data:`PLATFORM_AIDS`): which aids apply; the vehicle frame is estimated for a car only.
+    heading_std : ndarray, optional
+        ``trajectory``'s heading std at each of its rows, rad (:func:`mounting_track`).
     """
     config = replace(config, platform=platform)
     t = imu["time"].to_numpy(float)
@@ -400,7 +435,7 @@ def build_constraints(imu: pd.DataFrame, imu_errors: dict, config: ConstraintCon
     epochs = aid_epochs(t, config.nhc_rate_hz)
     moving = AID_NHC if config.nhc else AID_NONE
     aid = np.where(epochs, np.where(still & config.zupt, AID_ZUPT, moving), AID_NONE).astype(np.int8)
-    mount_time, mount = mounting_track(trajectory if config.nhc else None, config)
+    mount_time, mount = mounting_track(trajectory if config.nhc else None, config, heading_std)
     return Constraints(config, t, aid, still, mount_time, mount)
 
 

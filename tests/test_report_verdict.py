@@ -195,6 +195,20 @@ def test_odometer_rows_answer_and_headline_read_the_odometer_tables():
     assert "better than its ANN twin" in answer and "(overconfident" in answer
 
 
+def test_the_odometer_answer_says_whether_more_training_windows_made_the_speed_finer():
+    odo = _odometer()
+    assert "Would more of this drive help?" not in verdict_sentences(_inputs(odometer=odo),
+                                                                      verdict_table(_inputs(odometer=odo)))[5]
+    odo.curve = pd.DataFrame({"dataset": "d", "folds": [20, 2, 4], "n_train": [250.0, 125.0, 180.0],
+                              "val_std_mps": 2.0, "duration_s": 120.0, "outage_speed_rmse_mps": [2.2, 2.3, 2.4],
+                              "outage_coverage_2sigma": 0.9, "starts": 20})
+    inp = _inputs(odometer=odo)
+    assert verdict_sentences(inp, verdict_table(inp))[5].endswith(
+        " Would more of this drive help? RIDGE-ODO refitted with the starts in 20 folds instead of 2 learns from 250 "
+        "windows per fold instead of 125 (2.0 times as many), and its speed RMSE in its 120 s outages goes from 2.30 "
+        "to 2.20 m/s (notebook 04's learning curve).")
+
+
 def test_odometer_answer_without_its_tables_says_not_measured():
     inp = _inputs()
     assert verdict_sentences(inp, verdict_table(inp))[5].endswith("have not run for this drive (`evaluate.odometer`).")

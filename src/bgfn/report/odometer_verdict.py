@@ -3,7 +3,8 @@ question ("does a learned odometer help?") and its clause in each dataset's head
 
 Read from notebook 04's odometer tables (:mod:`bgfn.evaluate.odometers`: ``outage_odometer.csv`` with one row per
 start, seed and duration, ``outage_odometer_summary.csv`` with the medians, the ratio to INS+NHC per start and the
-Wilcoxon p against it, ``outage_odometer_paper.csv`` with the rows in each drive's two evaluation outages) and notebook 05's ``energy_odometer.csv`` (:mod:`bgfn.energy.odometer`). Nothing here is
+Wilcoxon p against it, ``outage_odometer_paper.csv`` with the rows in each drive's two evaluation outages, ``outage_odometer_curve.csv`` with
+RIDGE-ODO's speed error against its training windows) and notebook 05's ``energy_odometer.csv`` (:mod:`bgfn.energy.odometer`). Nothing here is
 typed by hand; a missing table leaves its cells empty and its sentence says so.
 """
 
@@ -43,6 +44,7 @@ class OdometerInputs:
     summary: pd.DataFrame | None    # outage_odometer_summary.csv
     energy: pd.DataFrame | None     # energy_odometer.csv (only the dataset notebook 05 measured)
     paper: pd.DataFrame | None = None   # outage_odometer_paper.csv (the two evaluation outages)
+    curve: pd.DataFrame | None = None   # outage_odometer_curve.csv (RIDGE-ODO against its training windows)
 
     @property
     def measured(self) -> bool:
@@ -131,12 +133,27 @@ def same_dataset(column: pd.Series, dataset: str) -> pd.Series:
 
 def read_odometer_inputs(odometer: pd.DataFrame | None, summary: pd.DataFrame | None,
                          energy: pd.DataFrame | None, dataset: str,
-                         paper: pd.DataFrame | None = None) -> OdometerInputs:
+                         paper: pd.DataFrame | None = None, curve: pd.DataFrame | None = None) -> OdometerInputs:
     """The tables restricted to ``dataset`` (the energy table only when its ``dataset`` column names it)."""
     def of(df):
         return None if df is None or "dataset" not in df.columns else df[same_dataset(df["dataset"], dataset)]
 
-    return OdometerInputs(of(odometer), of(summary), of(energy), of(paper))
+    return OdometerInputs(of(odometer), of(summary), of(energy), of(paper), of(curve))
+
+
+def curve_sentence(odo: OdometerInputs) -> str:
+    """Whether more training windows of this drive made the learned speed finer: RIDGE-ODO's speed RMSE in its
+    outages with the fewest and the most folds of ``outage_odometer_curve.csv`` (empty without two points)."""
+    c = odo.curve
+    if c is None or len(c) < 2:
+        return ""
+    c = c.sort_values("folds")
+    lo, hi = c.iloc[0], c.iloc[-1]
+    return (f" Would more of this drive help? {RIDGE} refitted with the starts in {int(hi['folds'])} folds instead "
+            f"of {int(lo['folds'])} learns from {hi['n_train']:.0f} windows per fold instead of {lo['n_train']:.0f} "
+            f"({hi['n_train'] / lo['n_train']:.1f} times as many), and its speed RMSE in its "
+            f"{hi['duration_s']:g} s outages goes from {lo['outage_speed_rmse_mps']:.2f} to "
+            f"{hi['outage_speed_rmse_mps']:.2f} m/s (notebook 04's learning curve).")
 
 
 def odometer_rows(odo: OdometerInputs, durations) -> list[dict]:
@@ -260,7 +277,7 @@ def answer_odometer(odo: OdometerInputs, durations) -> str:
                 + (f"up to a noise of {be:g} m/s" if np.isfinite(be) else "at no noise level of its grid")
                 + (f"; at {SUBJECT_ODO}'s speed error it reaches {_m(at)}" if np.isfinite(at) else "")
                 + " (how accurate a speed must be, and what better learning could give with this filter).")
-    return out
+    return out + curve_sentence(odo)
 
 
 def odometer_headline(odo: OdometerInputs, durations) -> str:

@@ -96,7 +96,8 @@ class VerdictInputs:
                    read_odometer_inputs(read_csv(tables / SHARED_TABLES["odometer"]),
                                         read_csv(tables / SHARED_TABLES["odometer_summary"]),
                                         read_csv(tables / SHARED_TABLES["energy_odometer"]), dataset,
-                                        read_csv(tables / SHARED_TABLES["odometer_paper"])),
+                                        read_csv(tables / SHARED_TABLES["odometer_paper"]),
+                                        read_csv(tables / SHARED_TABLES["odometer_curve"])),
                    of(read_csv(tables / SHARED_TABLES["nees"])), _platform(out, dataset))
 
 

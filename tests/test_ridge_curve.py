@@ -76,3 +76,15 @@ def test_lines_name_the_folds_and_windows():
     with pytest.raises(Exception):
         RC.ridge_curve("synthetic", {2: pd.DataFrame(columns=["start_s", "fold"])}, ws, ws, ws.speed, 30.0, 5.0,
                        0.2, 2, 1.0, RATE)
+
+
+def test_the_curve_figure_draws_each_drive_against_its_training_windows():
+    curve = pd.DataFrame({"dataset": ["a", "a", "b", "b"], "folds": [20, 2, 2, 20], "n_train": [250.0, 125.0, 400, 800],
+                          "val_std_mps": [2.0, 1.9, 3.0, 3.1], "duration_s": 120.0,
+                          "outage_speed_rmse_mps": [2.2, 2.3, 3.5, 2.9], "outage_coverage_2sigma": 0.9, "starts": 20})
+    fig = RC.plot_curve(curve)
+    lines = fig.axes[0].get_lines()
+    assert len(lines) == 4                                               # per drive: outages and validation std
+    np.testing.assert_array_equal(lines[0].get_xdata(), [125.0, 250.0])  # sorted by training windows
+    np.testing.assert_array_equal(lines[0].get_ydata(), [2.3, 2.2])
+    np.testing.assert_array_equal(lines[3].get_ydata(), [3.0, 3.1])

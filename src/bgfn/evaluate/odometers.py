@@ -51,7 +51,8 @@ from bgfn.errors import DataError
 from bgfn.data import dataset_id, load_drive
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.evaluate.plots import finish_duration_axes
-from bgfn.evaluate.ridge_curve import CURVE_COLUMNS, curve_lines, fold_ridge, ridge_curve, speed_errors
+from bgfn.evaluate.ridge_curve import (CURVE_COLUMNS, curve_lines, fold_ridge, plot_curve, ridge_curve,
+                                       speed_errors)
 from bgfn.evaluate.sweep import profile_sweep_plan, sweep_train_config
 from bgfn.io import atomic_write_csv, save_figure
 from bgfn.learning import odometry as lo
@@ -438,6 +439,11 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
             save_figure(fig, Path(out) / "figures" / f"{stem}_{dataset_id(name)}.png")
             plt.close(fig)
             figures.append(fig)
+    if len(curve):
+        fig = plot_curve(curve)
+        save_figure(fig, Path(out) / "figures" / "odometer_curve.png")
+        plt.close(fig)
+        figures.append(fig)
     if timings is not None:
         timings["odometer_s"] = time.perf_counter() - t0
     return OdometerSection(rows, summary, odometer_lines(summary) if len(summary) else [], facts, figures, paper,

@@ -20,6 +20,7 @@ and :func:`speed_errors` (a track's speed error inside one outage).
 
 from __future__ import annotations
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
@@ -119,3 +120,25 @@ def curve_lines(curve: pd.DataFrame) -> list[str]:
                                  f"{r.outage_speed_rmse_mps:.2f} m/s ({100 * r.outage_coverage_2sigma:.0f} % "
                                  "within +-2 sigma)" for r in g.itertuples()) + ".")
     return lines
+
+
+def plot_curve(curve: pd.DataFrame):
+    """RIDGE-ODO's speed RMSE in its outages (solid) and its validation std (dashed) against its training windows
+    per fold, one colour per drive, each point labelled with its number of folds."""
+    fig, ax = plt.subplots(figsize=(6.4, 3.6))
+    for ds, g in curve.groupby("dataset", sort=False):
+        g = g.sort_values("n_train")
+        line, = ax.plot(g["n_train"], g["outage_speed_rmse_mps"], marker="o", label=f"{ds}: in its outages")
+        ax.plot(g["n_train"], g["val_std_mps"], ls="--", marker=".", color=line.get_color(),
+                label=f"{ds}: validation std")
+        for r in g.itertuples():
+            ax.annotate(f"{r.folds}", (r.n_train, r.outage_speed_rmse_mps), textcoords="offset points",
+                        xytext=(3, 4), fontsize=7)
+    ax.set_xlabel("training windows per fold (median; the numbers: folds)")
+    ax.set_ylabel("forward speed error (m/s)")
+    ax.set_ylim(bottom=0.0)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    ax.set_title("RIDGE-ODO: speed error against its training windows", fontsize=10)
+    fig.tight_layout()
+    return fig

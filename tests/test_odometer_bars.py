@@ -6,7 +6,7 @@ import pandas as pd
 import pytest
 
 from bgfn import evaluate as ev
-from bgfn.evaluate import odometers as O, ridge_curve as RC
+from bgfn.evaluate import odometers as O
 from bgfn.nav import odometer as no
 from bgfn.profile_schema import load_profile
 from synthetic_drive import demo_drive
@@ -40,10 +40,10 @@ def test_speed_errors_by_hand():
     t = np.arange(0.0, 11.0)
     truth = np.full(t.size, 10.0)
     track = no.SpeedTrack(t, truth + np.array([0, 1, -1, 1, -1, 3, 0, 0, 0, 0, 0.0]), np.full(t.size, 0.6))
-    e = RC.speed_errors(track, t, truth, start=0.0, duration=5.0)            # epochs 1..5: errors 1,-1,1,-1,3
+    e = no.speed_errors(track, t, truth, start=0.0, duration=5.0)            # epochs 1..5: errors 1,-1,1,-1,3
     assert e["speed_rmse_mps"] == pytest.approx(np.sqrt((4 + 9) / 5))
     assert e["coverage_2sigma"] == pytest.approx(4 / 5)                       # |3| > 1.2
-    assert np.isnan(RC.speed_errors(None, t, truth, 0.0, 5.0)["speed_rmse_mps"])
+    assert np.isnan(no.speed_errors(None, t, truth, 0.0, 5.0)["speed_rmse_mps"])
 
 
 def test_summary_takes_the_median_ratio_to_ins_nhc_start_by_start():

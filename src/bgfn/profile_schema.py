@@ -35,6 +35,7 @@ from bgfn.evaluate import EVALUATE_DEFAULTS, evaluate_config, sweep_plan
 from bgfn.learning import learning_options
 from bgfn.learning.odometry import ODOMETER_INPUTS
 from bgfn.nav.baseline import filter_start
+from bgfn.nav.constraints import MOUNTING_WEIGHTS, MOUNTINGS
 from bgfn.nav.outages import DEFAULT_KEY, check_windows, is_rule, outage_entry, picked_outages
 from bgfn.paper import METHOD_LABELS
 from bgfn.parallel import BACKENDS, SCHEDULER_ENV
@@ -181,8 +182,8 @@ SCHEMA = section(
         innovation_gate=number(0, 1, lo_open=True, hi_open=True, null=True),
         ins_tuning=text("shipped", "navego"),
         # the vehicle constraints of the +NHC rows (bgfn.nav.constraints)
-        nhc=section(std_mps=_POS, rate_hz=_POS, mounting=text("estimate", "none"), mounting_min_speed_mps=_NONNEG,
-                    mounting_weight=text("heading", "equal")),
+        nhc=section(std_mps=_POS, rate_hz=_POS, mounting=text(*MOUNTINGS), mounting_min_speed_mps=_NONNEG,
+                    mounting_weight=text(*MOUNTING_WEIGHTS)),
         zupt=section(std_mps=_POS, window_s=_POS, accel_ratio=_NONNEG, gyro_ratio=_NONNEG, max_speed_mps=_NONNEG),
         constraints_in_gps_run=flag()),
     train=TRAIN,

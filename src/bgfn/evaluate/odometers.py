@@ -51,8 +51,7 @@ from bgfn.errors import DataError
 from bgfn.data import dataset_id, load_drive
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.evaluate.plots import finish_duration_axes
-from bgfn.evaluate.ridge_curve import (CURVE_COLUMNS, curve_lines, fold_ridge, plot_curve, ridge_curve,
-                                       speed_errors)
+from bgfn.evaluate.ridge_curve import CURVE_COLUMNS, curve_lines, plot_curve, ridge_curve
 from bgfn.evaluate.sweep import profile_sweep_plan, sweep_train_config
 from bgfn.io import atomic_write_csv, save_figure
 from bgfn.learning import odometry as lo
@@ -176,7 +175,8 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
         speed[inside], std[inside] = track.at(all_windows.t_end[inside])
 
     for k, fw in folds.items():
-        model, track = fold_ridge(data[k], all_windows, float(oc["ridge_alpha"]), imu_rate)
+        model = lo.RidgeOdometer.fit(data[k].train, data[k].val, imu_rate, float(oc["ridge_alpha"]))
+        track = model.track(all_windows)
         facts["ridge_std_mps"][int(k)] = model.std_mps
         if k != PAPER_FOLD:             # the speed figure: the sweep's outages (the paper's two overlap them)
             keep(RIDGE, track, overlaps(all_windows.t_end, all_windows.t_end, np.array([[s, s + d] for s, d in fw])))
@@ -224,7 +224,7 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
                 rows.append({"dataset": dataset, "start_s": r.start, "duration_s": float(du), "method": run.method,
                              "sigma_mps": run.sigma_mps, "seed": run.seed, "fold": run.fold,
                              **{c: m[c] for c in ("max_h_m", "rmse_h_m", "final_h_m")},
-                             **speed_errors(track, all_windows.t_end, truth, r.start, float(du))})
+                             **no.speed_errors(track, all_windows.t_end, truth, r.start, float(du))})
     # the ridge's speed error as more folds hold out less of the drive (bgfn.evaluate.ridge_curve)
     n_starts = int(plan["fold"].size)                                       # more folds than starts: one per start
     plans = {n: profile_sweep_plan(cfg, drive, {**sw, "folds": n})

@@ -13,9 +13,6 @@ outage_odometer_curve.csv``) gives per number of folds the training windows per 
 and its speed RMSE and +-2 sigma coverage in the outages. If the speed RMSE barely falls while the training windows
 grow, the drive's length is not what limits the learned speed: the situations of the outages that the training
 windows do not cover, or what an IMU window can tell of the speed, are.
-
-Also the two pieces the odometer bars share with the curve: :func:`fold_ridge` (one fold's ridge and its track)
-and :func:`speed_errors` (a track's speed error inside one outage).
 """
 
 from __future__ import annotations
@@ -31,31 +28,6 @@ from bgfn.nav import odometer as no
 #: Columns of ``tables/outage_odometer_curve.csv`` (:func:`ridge_curve`).
 CURVE_COLUMNS: tuple[str, ...] = ("dataset", "folds", "n_train", "val_std_mps", "duration_s",
                                   "outage_speed_rmse_mps", "outage_coverage_2sigma", "starts")
-
-
-def fold_ridge(data: lo.SpeedData, all_windows: lo.SpeedWindows, alpha: float,
-               rate_hz: float) -> tuple[lo.RidgeOdometer, no.SpeedTrack]:
-    """The ridge odometer of one fold, fitted on the fold's honest split (:func:`bgfn.learning.odometry.
-    build_speed_data`), its std from the validation windows; its track over ``all_windows``."""
-    model = lo.RidgeOdometer.fit(data.train, data.val, rate_hz, alpha)
-    pred = model.predict(all_windows)
-    return model, no.SpeedTrack(all_windows.t_end, pred, np.full(pred.size, model.std_mps))
-
-
-def speed_errors(track: no.SpeedTrack | None, t: np.ndarray, truth: np.ndarray, start: float,
-                 duration: float) -> dict:
-    """``speed_rmse_mps`` and ``coverage_2sigma`` of a track against the true speed inside an outage (NaN
-    without a track)."""
-    if track is None:
-        return {"speed_rmse_mps": np.nan, "coverage_2sigma": np.nan}
-    m = (t > start) & (t <= start + duration + 1e-6)
-    speed, std = track.at(t[m])
-    ok = np.isfinite(speed)
-    if not ok.any():
-        return {"speed_rmse_mps": np.nan, "coverage_2sigma": np.nan}
-    err = speed[ok] - truth[m][ok]
-    return {"speed_rmse_mps": float(np.sqrt(np.mean(err ** 2))),
-            "coverage_2sigma": float(np.mean(np.abs(err) <= 2 * std[ok]))}
 
 
 def ridge_curve(dataset: str, plans: dict[int, pd.DataFrame], ws: lo.SpeedWindows, all_windows: lo.SpeedWindows,
@@ -96,10 +68,11 @@ def ridge_curve(dataset: str, plans: dict[int, pd.DataFrame], ws: lo.SpeedWindow
         for _, starts in plan.groupby("fold", sort=True):
             held = [(float(s), float(duration_s)) for s in starts["start_s"]]
             data = lo.build_speed_data(ws, held, margin_s, val_fraction, val_blocks)
-            model, track = fold_ridge(data, all_windows, alpha, rate_hz)
+            model = lo.RidgeOdometer.fit(data.train, data.val, rate_hz, alpha)
+            track = model.track(all_windows)
             n_train.append(data.info["n_train"])
             stds.append(model.std_mps)
-            errs += [speed_errors(track, all_windows.t_end, truth, s, d) for s, d in held]
+            errs += [no.speed_errors(track, all_windows.t_end, truth, s, d) for s, d in held]
         rmse = np.array([e["speed_rmse_mps"] for e in errs])
         cover = np.array([e["coverage_2sigma"] for e in errs])
         rows.append({"dataset": dataset, "folds": int(n_folds), "n_train": float(np.median(n_train)),

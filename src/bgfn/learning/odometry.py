@@ -36,6 +36,7 @@ from bgfn.errors import DataError
 from bgfn.learning.normalize import Normalizer
 from bgfn.learning.split import forbidden_intervals, overlaps
 from bgfn.learning.windows import gather_windows, windows_ending_at
+from bgfn.nav.odometer import SpeedTrack
 from bgfn.nav.transform import dcm_from_euler
 from bgfn.schema import ACCEL_COLUMNS, GYRO_COLUMNS
 
@@ -316,6 +317,11 @@ class RidgeOdometer:
         """Forward speed of each window, m/s (never negative: a car's odometer)."""
         z = (band_energies(ws.x, self.rate_hz) - self.mean) / self.scale
         return np.maximum(z @ self.coef + self.intercept, 0.0)
+
+    def track(self, ws: SpeedWindows) -> SpeedTrack:
+        """The prediction of each window at the epoch it ends at, each with the validation std (a filter's aid)."""
+        pred = self.predict(ws)
+        return SpeedTrack(ws.t_end, pred, np.full(pred.size, self.std_mps))
 
 
 def beta_nll(mean, log_var, target, beta: float = 0.5):

@@ -16,7 +16,8 @@ The speed and its std come from a :class:`SpeedTrack` (a learned odometer's pred
 speed held from the outage start, an oracle ...): at an epoch, the track's last value at or before it, no older
 than ``max_age_s``. A row whose normalized innovation squared exceeds the ``gate_probability`` quantile of
 chi-square with one degree of freedom is left out (:attr:`bgfn.nav.filter.AidMeasurement.gate`), so one wild
-prediction cannot pull the solution away.
+prediction cannot pull the solution away. :func:`speed_errors` scores a track against the true speed inside an
+outage (its RMSE and the share of epochs within its +-2 sigma).
 """
 
 from __future__ import annotations
@@ -75,6 +76,22 @@ class SpeedTrack:
         if not (np.isfinite(factor) and factor > 0):
             raise DataError("speed track", "calibration", "a positive factor", repr(factor))
         return SpeedTrack(self.time, self.speed, self.std * float(factor))
+
+
+def speed_errors(track: SpeedTrack | None, t: np.ndarray, truth: np.ndarray, start: float,
+                 duration: float) -> dict:
+    """``speed_rmse_mps`` and ``coverage_2sigma`` of a track against the true speed ``truth`` at epochs ``t`` (s)
+    inside the outage ``(start, start + duration]`` (NaN without a track)."""
+    if track is None:
+        return {"speed_rmse_mps": np.nan, "coverage_2sigma": np.nan}
+    m = (t > start) & (t <= start + duration + 1e-6)
+    speed, std = track.at(t[m])
+    ok = np.isfinite(speed)
+    if not ok.any():
+        return {"speed_rmse_mps": np.nan, "coverage_2sigma": np.nan}
+    err = speed[ok] - truth[m][ok]
+    return {"speed_rmse_mps": float(np.sqrt(np.mean(err ** 2))),
+            "coverage_2sigma": float(np.mean(np.abs(err) <= 2 * std[ok]))}
 
 
 #: The vehicle frame's forward axis (the row of :func:`bgfn.nav.constraints.vehicle_velocity_rows` it measures).

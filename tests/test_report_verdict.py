@@ -268,3 +268,25 @@ def test_the_ins_answer_puts_navego_itself_beside_our_setup_of_it():
     # without make navego-check's rows: our two setups and the paper's only
     line = answer_ins_tuning(_inputs(ins_tuning=table[~table["setup"].str.contains("Octave")]))
     assert "40.0 m with NaveGo v1.4's bias modelling, 300.0 m in the paper" in line
+
+
+def test_headline_says_when_the_two_outages_rank_the_aided_ins_behind_ins_but_the_drives_starts_do_not():
+    seeds = _seeds()
+    seeds.loc[seeds["method"] == "INS+NHC", "max_h_m"] *= 5.0           # 20 m and 40 m against INS's 10 and 20 m
+    drift = pd.DataFrame([{"dataset": "d", "test": "field", "duration_s": du, "method": m, "n_starts": 20,
+                           "median_max_h_m": v, "q25_max_h_m": v, "q75_max_h_m": v}
+                          for du, m, v in ((30.0, "INS", 70.4), (30.0, "INS+NHC", 6.5), (60.0, "INS", 300.0),
+                                           (60.0, "INS+NHC", 12.0))])
+    inp = _inputs(seeds=seeds, sweep_summary=None, sweep_pairs=None, breakeven=None, ins_drift=drift)
+    line = headline(inp, verdict_table(inp))
+    assert "zero-velocity updates 30.0 m, worse than standalone INS in these two outages though not over" in line
+    assert "from notebook 02's 20 starts it is 6.5 m against INS's 70.4 m (median max error, 30 s)." in line
+    # where the starts agree with the two outages, or the aid is the better one there, nothing is added
+    worse = drift.assign(median_max_h_m=lambda d: np.where(d["method"] == "INS+NHC", 99.0, d["median_max_h_m"]))
+    assert headline(_inputs(seeds=seeds, sweep_summary=None, sweep_pairs=None, breakeven=None, ins_drift=worse),
+                    verdict_table(inp)).endswith("zero-velocity updates 30.0 m.")
+    better = _inputs(sweep_summary=None, sweep_pairs=None, breakeven=None, ins_drift=drift)   # 4 m against 10 m
+    assert headline(better, verdict_table(better)).endswith("zero-velocity updates 6.0 m.")
+    free = answer_free_aids(verdict_table(inp), drift)
+    assert "INS+NHC 30.0 m, worse than standalone INS in these two outages though not over the drive" in free
+    assert "(median max error, 30 s); BGFN 60.0 m" in free

@@ -9,10 +9,12 @@ Adds to ``results/bench.json``:
   measured interleaved (twin step, BGFN step, twin, BGFN, ... in one process, a warm-up round discarded) and
   taken round by round, so a busy neighbour slows both alike; ``train_ratio_spread.<size>``: that ratio's median,
   quartiles, rounds and ``unreliable`` (the interquartile range wider than the ratio's distance from 1);
-- ``train_step_profile.<model>.<size>``: one training step of BGFN and its twin under ``torch.profiler``: all
-  operators and the dense matrix products alone, s (:func:`bgfn.train.speed.training_step_profile`);
-  ``train_ratio_ceiling.<size>``: the twin's profiled step over BGFN's matrix products alone, the ratio BGFN
-  would reach if everything but its matrix arithmetic (LIF, BatchNorm, copies) cost nothing;
+- ``train_step_profile.<model>.<size>``: training steps of BGFN and its twin under ``torch.profiler``, interleaved
+  (:data:`PROFILE_ROUNDS` rounds, :func:`bgfn.train.speed.interleaved_profiles`): the medians of all operators and
+  of the dense matrix products alone, s; ``train_ratio_ceiling.<size>``: the median over the rounds of the twin's
+  profiled step over BGFN's matrix products alone, the ratio BGFN would reach if everything but its matrix
+  arithmetic (LIF, BatchNorm, copies) cost nothing; ``train_ceiling_spread.<size>``: its quartiles and those of
+  BGFN's matrix products over its own profiled step (``matmul_share``, :func:`bgfn.train.speed.ceiling_spread`);
 - ``models_bench``: what ran (threads, device, batch, window, parameter counts, repeats).
 
 Sizes come from ``train.sizes`` of ``params/<size>.yaml`` (the same blocks in every profile). Median of a
@@ -29,14 +31,18 @@ import torch
 from bgfn.profile_schema import load_profile
 from bgfn.io import update_json
 from bgfn.models import METHODS, build_model, count_parameters
-from bgfn.train.speed import (bench_file, interleaved_times, median_time, paired_ratio, quartiles, ratio_text,
-                              training_step, training_step_profile, training_throughput, twin_ratios)
+from bgfn.train.speed import (bench_file, ceiling_spread, interleaved_profiles, interleaved_times, median_profile,
+                              median_time, paired_ratio, quartiles, ratio_text, training_step, training_throughput,
+                              twin_ratios)
 
 SIZES = ("quick", "paper")
 #: (training steps, inference calls) measured per size, after one warm-up each.
 REPEATS = {"quick": (5, 30), "paper": (2, 5)}
 #: Interleaved rounds of the BGFN / twin training steps per size (after one warm-up round).
 PAIR_ROUNDS = {"quick": 21, "paper": 9}
+#: Interleaved rounds of the profiled BGFN / twin training steps per size (after one warm-up round): one profile of
+#: each varied the ceiling by a quarter from run to run (0.41-0.53 at the paper size on one machine).
+PROFILE_ROUNDS = {"quick": 7, "paper": 5}
 PAIR = ("bgfn", "transformer")
 
 
@@ -61,22 +67,15 @@ def bench(model_name: str, size: str) -> tuple[float, float, int, dict]:
                                                                       "repeats": [n_train, n_infer]}
 
 
-def paired_steps(size: str) -> dict[str, list[float]]:
-    """Training step times of BGFN and its twin at ``size``, interleaved (:func:`bgfn.train.speed.interleaved_times`)."""
+def pair_steps(size: str) -> dict:
+    """One training step (:func:`bgfn.train.speed.training_step`) of BGFN and of its twin at ``size``."""
     cfg = load_profile(size)["train"]
     batch, window = int(cfg["optimizer"]["batch_size"]), int(cfg["window"])
     steps = {}
     for m in PAIR:
         torch.manual_seed(0)
         steps[m] = training_step(build_model(m, dict(cfg["sizes"][m][size])), window, batch)
-    return interleaved_times(steps, PAIR_ROUNDS[size])
-
-
-def step_profile(model_name: str, size: str) -> dict:
-    cfg = load_profile(size)["train"]
-    torch.manual_seed(0)
-    model = build_model(model_name, dict(cfg["sizes"][model_name][size]))
-    return training_step_profile(model, int(cfg["window"]), int(cfg["optimizer"]["batch_size"]))
+    return steps
 
 
 def main(sizes=SIZES, methods=METHODS) -> dict:
@@ -95,28 +94,41 @@ def main(sizes=SIZES, methods=METHODS) -> dict:
                   f"{n_params} parameters", flush=True)
     # BGFN's training throughput over its ANN twin's, interleaved round by round, and the ceiling its matrix
     # products set (the twin's profiled step over BGFN's matrix products alone)
-    spread = {}
+    spread, ceilings, profiles = {}, {}, {}
     if all(m in methods for m in PAIR):
         for size in sizes:
-            times = paired_steps(size)
+            steps = pair_steps(size)
+            times = interleaved_times(steps, PAIR_ROUNDS[size])
             spread[size] = paired_ratio(times["transformer"], times["bgfn"])    # BGFN's throughput / the twin's
             for m in PAIR:
                 q = quartiles(times[m])
                 train_rate[m][size] = info["problem"][size]["batch"] / q["median"]
                 info.setdefault("pair_step_s", {}).setdefault(m, {})[size] = q
-    profiles = {m: {size: step_profile(m, size) for size in sizes} for m in PAIR if m in methods}
+            prof = interleaved_profiles(steps, PROFILE_ROUNDS[size])
+            ceilings[size] = ceiling_spread(prof["transformer"], prof["bgfn"])
+            for m in PAIR:
+                profiles.setdefault(m, {})[size] = median_profile(prof[m])
     ratios = twin_ratios(train_rate, profiles)
     ratios["train_ratio_bgfn_over_twin"].update({size: r["median"] for size, r in spread.items()})
+    ratios["train_ratio_ceiling"].update({size: c["ceiling"]["median"] for size, c in ceilings.items()})
     ratio, ceiling = ratios["train_ratio_bgfn_over_twin"], ratios["train_ratio_ceiling"]
     for size, r in ratio.items():
         c = ceiling.get(size, float("nan"))
-        print(f"BGFN / Transformer training throughput, {size}: "
-              + (ratio_text(spread[size]) if size in spread else f"{r:.2f}")
-              + f"; ceiling (twin's step / BGFN's matrix products alone) {c:.2f}: {100 * r / c:.0f} % of it",
-              flush=True)
+        text = (f"BGFN / Transformer training throughput, {size}: "
+                + (ratio_text(spread[size]) if size in spread else f"{r:.2f}")
+                + f"; ceiling (twin's step / BGFN's matrix products alone) {c:.2f}")
+        if size in ceilings:
+            cq, sq = ceilings[size]["ceiling"], ceilings[size]["matmul_share"]
+            text += (f" [IQR {cq['q25']:.2f}-{cq['q75']:.2f}, {cq['rounds']} profiled rounds]: {100 * r / c:.0f} % of "
+                     f"it; BGFN's matrix products {100 * sq['median']:.0f} % [IQR {100 * sq['q25']:.0f}-"
+                     f"{100 * sq['q75']:.0f} %] of its own profiled step")
+        else:
+            text += f": {100 * r / c:.0f} % of it"
+        print(text, flush=True)
     update_json(bench_file(),
                 {"train_windows_per_s": train_rate, "infer_ms": infer_ms, "models_bench": info,
-                 "train_step_profile": profiles, "train_ratio_spread": spread, **ratios})
+                 "train_step_profile": profiles, "train_ratio_spread": spread, "train_ceiling_spread": ceilings,
+                 **ratios})
     return {"train_windows_per_s": train_rate, "infer_ms": infer_ms, "train_ratio_bgfn_over_twin": ratio}
 
 

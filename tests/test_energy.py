@@ -391,6 +391,25 @@ def test_matmul_share_of_a_training_step_counts_only_dense_products():
     assert 0.0 < p["matmul_s"] < p["step_s"]
 
 
+def test_interleaved_profiles_alternate_the_steps_and_the_ceiling_is_taken_round_by_round():
+    from bgfn.train import speed
+
+    calls = []
+    out = speed.interleaved_profiles({"a": lambda: calls.append("a"), "b": lambda: calls.append("b")}, repeats=2)
+    assert calls == ["a", "b", "a", "b", "a", "b"]                     # a warm-up round, then two profiled rounds
+    assert [len(v) for v in out.values()] == [2, 2] and out["a"][0]["matmul_s"] == 0.0
+    # the twin's step over BGFN's matrix products per round, and BGFN's products over its own step
+    twin = [{"step_s": 0.3, "matmul_s": 0.2}, {"step_s": 0.6, "matmul_s": 0.4}, {"step_s": 0.3, "matmul_s": 0.2}]
+    bgfn = [{"step_s": 1.0, "matmul_s": 0.6}, {"step_s": 2.0, "matmul_s": 1.2}, {"step_s": 1.5, "matmul_s": 1.2}]
+    c = speed.ceiling_spread(twin, bgfn)
+    assert c["ceiling"]["median"] == pytest.approx(0.5) and c["ceiling"]["q25"] == pytest.approx(0.375)
+    assert c["ceiling"]["rounds"] == 3                                # 0.5, 0.5, 0.25: a slow round moves both
+    assert c["matmul_share"]["median"] == pytest.approx(0.6) and c["matmul_share"]["q75"] == pytest.approx(0.7)
+    assert speed.median_profile(bgfn) == {"step_s": 1.5, "matmul_s": 1.2}
+    with pytest.raises(ValueError):
+        speed.ceiling_spread(twin, bgfn[:2])
+
+
 def test_twin_ratios_divide_bgfn_by_its_twin_per_size_measured_for_both():
     from bgfn.train.speed import twin_ratios
 

@@ -207,6 +207,18 @@ def _without_native_stderr() -> Iterator[None]:
         os.close(null)
 
 
+def profile_step(step: Callable[[], object]) -> dict[str, float]:
+    """``step()`` once under ``torch.profiler``: ``{'step_s', 'matmul_s'}``, profiled time of all operators and of the
+    dense matrix products alone (:data:`MATMUL_OPS`), s."""
+    # here, not at the top: the profiler loads its own native library, needed by `make bench` alone
+    from torch.profiler import ProfilerActivity, profile
+
+    with _without_native_stderr(), profile(activities=[ProfilerActivity.CPU]) as prof:
+        step()
+    dense, total = matmul_seconds(prof.key_averages())
+    return {"step_s": total, "matmul_s": dense}
+
+
 def training_step_profile(model: nn.Module, window: int, batch: int, in_channels: int = 9,
                           seed: int = 0) -> dict[str, float]:
     """One training step (as :func:`training_throughput`) under ``torch.profiler``, after a warm-up step.
@@ -214,15 +226,51 @@ def training_step_profile(model: nn.Module, window: int, batch: int, in_channels
     Returns ``{'step_s', 'matmul_s'}``: profiled time of all operators and of the dense matrix products alone,
     s. Their ratio says how much of a step is arithmetic that no change of the other layers can remove.
     """
-    # here, not at the top: the profiler loads its own native library, needed by `make bench` alone
-    from torch.profiler import ProfilerActivity, profile
-
     step = _training_step(model, window, batch, in_channels, seed)
     step()
-    with _without_native_stderr(), profile(activities=[ProfilerActivity.CPU]) as prof:
-        step()
-    dense, total = matmul_seconds(prof.key_averages())
-    return {"step_s": total, "matmul_s": dense}
+    return profile_step(step)
+
+
+def interleaved_profiles(steps: dict[str, Callable[[], object]], repeats: int,
+                         warmup: int = 1) -> dict[str, list[dict[str, float]]]:
+    """:func:`profile_step` of every step of ``steps`` in turn (A, B, A, B, ...) ``repeats`` times after ``warmup``
+    unprofiled rounds: per name a list of ``{'step_s', 'matmul_s'}``. As :func:`interleaved_times`, a busy
+    neighbour slows the A and the B of the same round alike, so a per-round ratio of the two keeps."""
+    if repeats < 1:
+        raise ValueError(f"repeats must be >= 1, got {repeats}")
+    for _ in range(warmup):
+        for fn in steps.values():
+            fn()
+    out: dict[str, list[dict[str, float]]] = {name: [] for name in steps}
+    for _ in range(repeats):
+        for name, fn in steps.items():
+            out[name].append(profile_step(fn))
+    return out
+
+
+def ceiling_spread(twin: list[dict[str, float]], bgfn: list[dict[str, float]]) -> dict[str, dict]:
+    """Per-round figures of :func:`interleaved_profiles` of BGFN and its twin.
+
+    Returns
+    -------
+    dict
+        ``ceiling``: quartiles (:func:`quartiles`, plus ``rounds``) of the twin's profiled step over BGFN's matrix
+        products alone, round by round (the throughput ratio BGFN would reach if nothing but its matrix arithmetic
+        cost time); ``matmul_share``: quartiles of BGFN's matrix products over its own profiled step (the share of
+        its step that no change of its other layers can remove: the ratio over the ceiling it reaches, measured
+        within one step).
+    """
+    if len(twin) != len(bgfn) or not twin:
+        raise ValueError("ceiling_spread needs two series of the same, non-zero length")
+    ceiling = [t["step_s"] / b["matmul_s"] for t, b in zip(twin, bgfn)]
+    share = [b["matmul_s"] / b["step_s"] for b in bgfn]
+    return {"ceiling": {**quartiles(ceiling), "rounds": len(ceiling)},
+            "matmul_share": {**quartiles(share), "rounds": len(share)}}
+
+
+def median_profile(profiles: list[dict[str, float]]) -> dict[str, float]:
+    """The median of each figure of a list of :func:`profile_step` results."""
+    return {k: statistics.median(p[k] for p in profiles) for k in ("step_s", "matmul_s")}
 
 
 def twin_ratios(rates: dict, profiles: dict) -> dict[str, dict[str, float]]:

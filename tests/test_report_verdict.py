@@ -209,6 +209,23 @@ def test_the_odometer_answer_says_whether_more_training_windows_made_the_speed_f
         "to 2.20 m/s (notebook 04's learning curve).")
 
 
+def test_the_odometer_answer_says_whether_bgfn_odos_std_ranks_its_errors():
+    from bgfn.evaluate.odometer_uncertainty import UNCERTAINTY_COLUMNS
+
+    odo = _odometer()
+    assert "Does it know when it is wrong?" not in verdict_sentences(_inputs(odometer=odo),
+                                                                     verdict_table(_inputs(odometer=odo)))[5]
+    odo.uncertainty = pd.DataFrame([("d", "BGFN-ODO", g, lo, lo + 0.4, 100, rmse, cov, -0.2)
+                                    for g, lo, rmse, cov in ((1, 0.8, 3.6, 0.45), (2, 1.2, 1.9, 0.75),
+                                                             (3, 1.6, 1.7, 0.9), (4, 2.0, 1.7, 0.98))],
+                                   columns=list(UNCERTAINTY_COLUMNS))
+    inp = _inputs(odometer=odo)
+    assert (" Does it know when it is wrong? its predicted std does not rank its errors in the outages (correlation "
+            "of |error| and std -0.20): the quarter of its epochs with the smallest std (0.80-1.20 m/s) has a speed "
+            "RMSE of 3.60 m/s (45 % within 2 sigma), the one with the largest (2.00-2.40 m/s) 1.70 m/s (98 %).") \
+        in verdict_sentences(inp, verdict_table(inp))[5]
+
+
 def test_odometer_answer_without_its_tables_says_not_measured():
     inp = _inputs()
     assert verdict_sentences(inp, verdict_table(inp))[5].endswith("have not run for this drive (`evaluate.odometer`).")

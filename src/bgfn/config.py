@@ -98,6 +98,7 @@ SHARED_TABLES: dict[str, str] = {
     "odometer_paper": "outage_odometer_paper.csv",  # ... and in each drive's two evaluation outages
     "odometer_networks": "outage_odometer_networks.csv",  # ... each network odometer: validation against outages
     "odometer_curve": "outage_odometer_curve.csv",  # ... the ridge's speed error against its training windows
+    "odometer_uncertainty": "outage_odometer_uncertainty.csv",  # ... each network's predicted std against its error
     "nees": "outage_nees.csv",                  # notebook 04: the filter's consistency in outages (bgfn.evaluate.nees)
     "variants": "outage_variants.csv",          # notebook 03: the learning-problem variants in the two outages
     "energy_odometer": "energy_odometer.csv",   # notebook 05: the learned odometers' energy (bgfn.energy.odometer)

@@ -26,6 +26,9 @@ the paper's tables) as one more fold, :data:`PAPER_FOLD`: its networks and its r
 +- ``train.margin_s``; its rows (one per outage, at the outage's own duration) go to ``outage_odometer_paper.csv``
 (:func:`paper_outage_table`), never into the sweep's statistics.
 
+How far each network's predicted std ranks its speed errors in the outages, the premise of weighing each speed by
+it: :mod:`bgfn.evaluate.odometer_uncertainty` (``outage_odometer_uncertainty.csv``).
+
 With ``curve_folds``, the ridge is also refitted with the sweep's starts split into each of those numbers of folds:
 its speed error against its training windows per fold (:mod:`bgfn.evaluate.ridge_curve`,
 ``outage_odometer_curve.csv``).
@@ -50,6 +53,7 @@ from bgfn.config import SHARED_TABLES, odometer_datasets
 from bgfn.errors import DataError
 from bgfn.data import dataset_id, load_drive
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
+from bgfn.evaluate.odometer_uncertainty import UNCERTAINTY_COLUMNS, uncertainty_lines, uncertainty_table
 from bgfn.evaluate.plots import finish_duration_axes
 from bgfn.evaluate.ridge_curve import CURVE_COLUMNS, curve_lines, plot_curve, ridge_curve
 from bgfn.evaluate.sweep import profile_sweep_plan, sweep_train_config
@@ -355,6 +359,7 @@ class OdometerSection:
     paper: pd.DataFrame | None = None
     networks: pd.DataFrame | None = None
     curve: pd.DataFrame | None = None
+    uncertainty: pd.DataFrame | None = None
 
     def markdown(self) -> str:
         """The summary at the sweep's durations as a Markdown table (:func:`odometer_table`), then the lines."""
@@ -366,6 +371,8 @@ class OdometerSection:
         text = "\n".join(["Median max horizontal error (m) over the sweep's starts:", "", head,
                            "|---" * (len(wide.columns) + 2) + "|", *body, ""] + [f"- {s}" for s in self.lines]
                           + [f"- {s}" for s in network_lines(self.networks)]
+                          + [f"- {s}" for s in uncertainty_lines(self.uncertainty if self.uncertainty is not None
+                                                                 else pd.DataFrame(columns=list(UNCERTAINTY_COLUMNS)))]
                           + [f"- {s}" for s in curve_lines(self.curve if self.curve is not None
                                                            else pd.DataFrame(columns=list(CURVE_COLUMNS)))])
         if self.paper is None or self.paper.empty:
@@ -424,7 +431,11 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
     networks = network_table(rows, facts)
     curves = [f["curve"] for f in facts.values() if f.get("curve") is not None and len(f["curve"])]
     curve = pd.concat(curves, ignore_index=True) if curves else pd.DataFrame(columns=list(CURVE_COLUMNS))
+    ranked = [u for u in (uncertainty_table(name, f["speed_series"]) for name, f in facts.items()
+                          if f.get("speed_series")) if len(u)]
+    uncertainty = (pd.concat(ranked, ignore_index=True) if ranked else pd.DataFrame(columns=list(UNCERTAINTY_COLUMNS)))
     tables = Path(out) / "tables"
+    atomic_write_csv(tables / SHARED_TABLES["odometer_uncertainty"], uncertainty, float_format="%.4f")
     atomic_write_csv(tables / SHARED_TABLES["odometer_curve"], curve, float_format="%.4f")
     atomic_write_csv(tables / SHARED_TABLES["odometer_networks"], networks, float_format="%.4f")
     atomic_write_csv(tables / SHARED_TABLES["odometer"], rows, float_format="%.4f")
@@ -447,7 +458,7 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
     if timings is not None:
         timings["odometer_s"] = time.perf_counter() - t0
     return OdometerSection(rows, summary, odometer_lines(summary) if len(summary) else [], facts, figures, paper,
-                           networks, curve)
+                           networks, curve, uncertainty)
 
 
 def network_table(rows: pd.DataFrame, facts: dict) -> pd.DataFrame:

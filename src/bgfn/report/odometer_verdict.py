@@ -4,7 +4,8 @@ question ("does a learned odometer help?") and its clause in each dataset's head
 Read from notebook 04's odometer tables (:mod:`bgfn.evaluate.odometers`: ``outage_odometer.csv`` with one row per
 start, seed and duration, ``outage_odometer_summary.csv`` with the medians, the ratio to INS+NHC per start and the
 Wilcoxon p against it, ``outage_odometer_paper.csv`` with the rows in each drive's two evaluation outages, ``outage_odometer_curve.csv`` with
-RIDGE-ODO's speed error against its training windows) and notebook 05's ``energy_odometer.csv`` (:mod:`bgfn.energy.odometer`). Nothing here is
+RIDGE-ODO's speed error against its training windows, ``outage_odometer_uncertainty.csv`` with each network's
+predicted std against its speed error) and notebook 05's ``energy_odometer.csv`` (:mod:`bgfn.energy.odometer`). Nothing here is
 typed by hand; a missing table leaves its cells empty and its sentence says so.
 """
 
@@ -16,6 +17,7 @@ import numpy as np
 import pandas as pd
 
 from bgfn.data.names import dataset_id
+from bgfn.evaluate.odometer_uncertainty import uncertainty_sentence
 from bgfn.evaluate.odometers import HOLD, ORACLE, RIDGE
 from bgfn.paper import METHOD_LABELS, nhc_label, odometer_label
 from bgfn.stats import wilcoxon_p
@@ -45,6 +47,7 @@ class OdometerInputs:
     energy: pd.DataFrame | None     # energy_odometer.csv (only the dataset notebook 05 measured)
     paper: pd.DataFrame | None = None   # outage_odometer_paper.csv (the two evaluation outages)
     curve: pd.DataFrame | None = None   # outage_odometer_curve.csv (RIDGE-ODO against its training windows)
+    uncertainty: pd.DataFrame | None = None   # outage_odometer_uncertainty.csv (each network's std against its error)
 
     @property
     def measured(self) -> bool:
@@ -133,12 +136,13 @@ def same_dataset(column: pd.Series, dataset: str) -> pd.Series:
 
 def read_odometer_inputs(odometer: pd.DataFrame | None, summary: pd.DataFrame | None,
                          energy: pd.DataFrame | None, dataset: str,
-                         paper: pd.DataFrame | None = None, curve: pd.DataFrame | None = None) -> OdometerInputs:
+                         paper: pd.DataFrame | None = None, curve: pd.DataFrame | None = None,
+                         uncertainty: pd.DataFrame | None = None) -> OdometerInputs:
     """The tables restricted to ``dataset`` (the energy table only when its ``dataset`` column names it)."""
     def of(df):
         return None if df is None or "dataset" not in df.columns else df[same_dataset(df["dataset"], dataset)]
 
-    return OdometerInputs(of(odometer), of(summary), of(energy), of(paper), of(curve))
+    return OdometerInputs(of(odometer), of(summary), of(energy), of(paper), of(curve), of(uncertainty))
 
 
 def curve_sentence(odo: OdometerInputs) -> str:
@@ -271,6 +275,9 @@ def answer_odometer(odo: OdometerInputs, durations) -> str:
         out += (f" {SUBJECT_ODO} is {twin_comparison(odo, d_long)} at {d_long:g} s, {_energy(odo)}. Its speed error in "
                 f"the outages: RMSE {rmse:.2f} m/s, {100 * cov:.0f} % of epochs within its +-2 sigma ({calib}: "
                 f"{100 * lo:.0f}-{100 * hi:.0f} % is the band of a calibrated std).")
+        u = odo.uncertainty
+        if u is not None and (u["method"] == SUBJECT_ODO).any():
+            out += f" Does it know when it is wrong? {uncertainty_sentence(u[u['method'] == SUBJECT_ODO])}."
         be = odo.oracle_breakeven(d_long)
         at = odo.oracle_at(rmse, d_long)
         out += (f" An oracle speed (the reference's plus white noise) beats {nhc} at {d_long:g} s "

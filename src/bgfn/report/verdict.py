@@ -98,7 +98,8 @@ class VerdictInputs:
                                         read_csv(tables / SHARED_TABLES["odometer_summary"]),
                                         read_csv(tables / SHARED_TABLES["energy_odometer"]), dataset,
                                         read_csv(tables / SHARED_TABLES["odometer_paper"]),
-                                        read_csv(tables / SHARED_TABLES["odometer_curve"])),
+                                        read_csv(tables / SHARED_TABLES["odometer_curve"]),
+                                        read_csv(tables / SHARED_TABLES["odometer_uncertainty"])),
                    of(read_csv(tables / SHARED_TABLES["nees"])), _platform(out, dataset),
                    of(read_csv(tables / SHARED_TABLES["kf_ins_drift"])))
 

@@ -37,7 +37,7 @@ def uncertainty_table(dataset: str, series: dict | None, groups: int = DEFAULT_G
     series : dict or None
         ``{"truth": [K] m/s, "tracks": {label: (speed [K], std [K])}}``, NaN outside the outages.
     groups : int
-        How many groups of equal size (the last ones one epoch smaller where they do not divide).
+        How many groups of equal size (the first ones one epoch larger where they do not divide).
 
     Returns
     -------

@@ -110,6 +110,8 @@ def main(sizes=SIZES, methods=METHODS) -> dict:
                 profiles.setdefault(m, {})[size] = median_profile(prof[m])
     ratios = twin_ratios(train_rate, profiles)
     ratios["train_ratio_bgfn_over_twin"].update({size: r["median"] for size, r in spread.items()})
+    # the ceiling as the median of its per-round values (twin_ratios divides the median profiles), so that it is the
+    # middle of the interquartile range printed beside it
     ratios["train_ratio_ceiling"].update({size: c["ceiling"]["median"] for size, c in ceilings.items()})
     ratio, ceiling = ratios["train_ratio_bgfn_over_twin"], ratios["train_ratio_ceiling"]
     for size, r in ratio.items():

@@ -45,8 +45,9 @@ def uncertainty_table(dataset: str, series: dict | None, groups: int = DEFAULT_G
         :data:`UNCERTAINTY_COLUMNS`, ``groups`` rows per odometer.
     """
     rows = []
-    for label, (speed, std) in ((series or {}).get("tracks") or {}).items():
-        truth = np.asarray(series["truth"], dtype=float)
+    tracks = (series or {}).get("tracks") or {}
+    truth = np.asarray(series["truth"], dtype=float) if tracks else None
+    for label, (speed, std) in tracks.items():
         speed, std = np.asarray(speed, dtype=float), np.asarray(std, dtype=float)
         ok = np.isfinite(speed) & np.isfinite(std) & np.isfinite(truth)
         if np.unique(std[ok]).size <= groups:       # a std per fold, not per epoch: nothing to rank

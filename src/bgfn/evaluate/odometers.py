@@ -371,8 +371,8 @@ class OdometerSection:
         text = "\n".join(["Median max horizontal error (m) over the sweep's starts:", "", head,
                            "|---" * (len(wide.columns) + 2) + "|", *body, ""] + [f"- {s}" for s in self.lines]
                           + [f"- {s}" for s in network_lines(self.networks)]
-                          + [f"- {s}" for s in uncertainty_lines(self.uncertainty if self.uncertainty is not None
-                                                                 else pd.DataFrame(columns=list(UNCERTAINTY_COLUMNS)))]
+                          + [f"- {s}" for s in (uncertainty_lines(self.uncertainty) if self.uncertainty is not None
+                                                else [])]
                           + [f"- {s}" for s in curve_lines(self.curve if self.curve is not None
                                                            else pd.DataFrame(columns=list(CURVE_COLUMNS)))])
         if self.paper is None or self.paper.empty:

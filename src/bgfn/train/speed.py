@@ -70,6 +70,27 @@ def median_time(fn: Callable[[], object], repeats: int, warmup: int = 1) -> floa
     return statistics.median(times)
 
 
+def _interleaved(fns: dict[str, Callable[[], object]], repeats: int, warmup: int, measure: Callable) -> dict:
+    """``measure(fn)`` of every callable of ``fns`` in turn (A, B, A, B, ...) ``repeats`` times, after ``warmup``
+    rounds of plain calls: per name the list of what ``measure`` returned."""
+    if repeats < 1:
+        raise ValueError(f"repeats must be >= 1, got {repeats}")
+    for _ in range(warmup):
+        for fn in fns.values():
+            fn()
+    out: dict[str, list] = {name: [] for name in fns}
+    for _ in range(repeats):
+        for name, fn in fns.items():
+            out[name].append(measure(fn))
+    return out
+
+
+def _wall_time(fn: Callable[[], object]) -> float:
+    t0 = time.perf_counter()
+    fn()
+    return time.perf_counter() - t0
+
+
 def interleaved_times(fns: dict[str, Callable[[], object]], repeats: int, warmup: int = 1) -> dict[str, list[float]]:
     """Wall times of every callable of ``fns``, measured in turn (A, B, A, B, ...) ``repeats`` times after
     ``warmup`` untimed rounds, s.
@@ -78,18 +99,7 @@ def interleaved_times(fns: dict[str, Callable[[], object]], repeats: int, warmup
     the A and the B of the same rounds, so their per-round ratio stays, where timing all A's and then all B's
     would turn the comparison upside down.
     """
-    if repeats < 1:
-        raise ValueError(f"repeats must be >= 1, got {repeats}")
-    for _ in range(warmup):
-        for fn in fns.values():
-            fn()
-    times: dict[str, list[float]] = {name: [] for name in fns}
-    for _ in range(repeats):
-        for name, fn in fns.items():
-            t0 = time.perf_counter()
-            fn()
-            times[name].append(time.perf_counter() - t0)
-    return times
+    return _interleaved(fns, repeats, warmup, _wall_time)
 
 
 def quartiles(values) -> dict[str, float]:
@@ -236,16 +246,7 @@ def interleaved_profiles(steps: dict[str, Callable[[], object]], repeats: int,
     """:func:`profile_step` of every step of ``steps`` in turn (A, B, A, B, ...) ``repeats`` times after ``warmup``
     unprofiled rounds: per name a list of ``{'step_s', 'matmul_s'}``. As :func:`interleaved_times`, a busy
     neighbour slows the A and the B of the same round alike, so a per-round ratio of the two keeps."""
-    if repeats < 1:
-        raise ValueError(f"repeats must be >= 1, got {repeats}")
-    for _ in range(warmup):
-        for fn in steps.values():
-            fn()
-    out: dict[str, list[dict[str, float]]] = {name: [] for name in steps}
-    for _ in range(repeats):
-        for name, fn in steps.items():
-            out[name].append(profile_step(fn))
-    return out
+    return _interleaved(steps, repeats, warmup, profile_step)
 
 
 def ceiling_spread(twin: list[dict[str, float]], bgfn: list[dict[str, float]]) -> dict[str, dict]:

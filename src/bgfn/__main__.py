@@ -5,6 +5,11 @@ profile and its options (:func:`bgfn.profile_schema.with_overrides`) before anyt
 ``python -m bgfn kernels``: compile the navigation's numba kernels into numba's cache (:mod:`bgfn.evaluate.kernels`;
 ``make reproduce`` runs it in the background while notebook 01 prepares the data).
 
+``python -m bgfn odometers``: notebook 04's odometer bars alone (:func:`bgfn.evaluate.run_odometer_section`) for a
+profile, its tables under ``results/<profile>/``; ``--record`` then keeps their summary in ``data/measured/``
+(:mod:`bgfn.evaluate.odometer_sizes`), where the book reads a run made on another machine (a GPU: the profile
+``paper-odometer``).
+
 ``python -m bgfn walltimes``: the wall-time section of the book's "Reproduce it" page
 (:mod:`bgfn.report.walltimes`; ``make book`` writes it), or ``--record JOBS`` to add the notebooks of a finished
 run to the measured runs.
@@ -15,17 +20,22 @@ Example::
     python -m bgfn train --profile quick --variants        # every network of notebook 03, variants included
     python -m bgfn train --profile paper --jobs 8           # 8 runs at a time (default: the profile's parallel:)
     python -m bgfn walltimes --profile quick --record 2 --total-s 655   # after make reproduce JOBS=2
+    python -m bgfn odometers --profile paper-odometer --record          # on a GPU machine
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import time
 
 from bgfn.errors import DataError
+from bgfn.evaluate import evaluation_setup, run_odometer_section
+from bgfn.evaluate import odometer_sizes
 from bgfn.evaluate.kernels import compile_kernels
 from bgfn.io import atomic_write_text
 from bgfn.parallel import Runner
+from bgfn.config import results_dir
 from bgfn.profile_schema import load_profile, with_overrides
 from bgfn.report import walltimes as walltimes_module
 from bgfn.train.runs import train_profile
@@ -70,6 +80,39 @@ def kernels(argv) -> int:
     return 0
 
 
+def odometers(argv) -> int:
+    """``odometers --profile P [--method M ...] [--seed S ...] [--jobs N]``: the odometer bars of the profile's
+    ``evaluate.odometer.datasets`` (one line per finished run), their tables and ``odometer_run.json`` under
+    ``results/P/``; ``odometers --profile P --record [--note TEXT]``: keep that run's summary in ``data/measured/``
+    with the date, the commit and the device (:mod:`bgfn.evaluate.odometer_sizes`)."""
+    p = argparse.ArgumentParser(prog="python -m bgfn odometers", description="The learned odometers' bars alone.")
+    p.add_argument("--profile", default="paper-odometer")
+    p.add_argument("--method", action="append", help="network odometers (evaluate.odometer.methods)")
+    p.add_argument("--seed", action="append", type=int, help="their seeds (evaluate.odometer.network_seeds)")
+    p.add_argument("--jobs", type=int, help="runs at a time (default: the profile's parallel.jobs, BGFN_JOBS)")
+    p.add_argument("--record", action="store_true", help="keep the last run's summary in data/measured/ (no run)")
+    p.add_argument("--note", default="", help="how it was measured (with --record)")
+    a = p.parse_args(argv)
+    try:
+        if a.record:
+            print("recorded in", ", ".join(map(str, odometer_sizes.record(a.profile, a.note))))
+            return 0
+        cfg = with_overrides(load_profile(a.profile), {"evaluate.odometer.methods": a.method,
+                                                       "evaluate.odometer.network_seeds": a.seed,
+                                                       "parallel.jobs": a.jobs}, "command line")
+        setup = evaluation_setup(cfg)
+    except DataError as exc:
+        print(f"error: profile {a.profile!r}: {exc}", file=sys.stderr)
+        return 2
+    t0 = time.perf_counter()
+    runner = setup.runner if a.jobs is None else Runner.of(cfg, environ={})
+    print(f"profile {a.profile!r}: runs {runner.describe()}", flush=True)
+    section = run_odometer_section(cfg, a.profile, setup, results_dir(a.profile), runner, report=print)
+    print(section.markdown())
+    print("wrote", odometer_sizes.write_run_facts(a.profile, cfg, t0, runner.describe()))
+    return 0
+
+
 def main(argv=None) -> int:
     """Parse ``--profile``, ``--dataset``, ``--method``, ``--seed`` (each repeatable), ``--device``, ``--jobs`` and
     ``--variants``; train and print one line per finished run (:class:`bgfn.parallel.RunProgress`)."""
@@ -78,6 +121,8 @@ def main(argv=None) -> int:
         return walltimes(argv[1:])
     if argv[:1] == ["kernels"]:
         return kernels(argv[1:])
+    if argv[:1] == ["odometers"]:
+        return odometers(argv[1:])
     p = argparse.ArgumentParser(prog="python -m bgfn", description="Train BGFN and baselines for a profile.")
     p.add_argument("command", choices=["train"])
     p.add_argument("--profile", default="quick")

@@ -50,13 +50,14 @@ def device_name() -> str:
 
 def write_run_facts(profile: str, cfg: dict, t0: float, jobs: str) -> Path:
     """``results/<profile>/odometer_run.json``: the device, the wall time since ``t0`` (``time.perf_counter``), the
-    runner (``jobs``), torch's version, the commit (or ``$BGFN_COMMIT`` where the copy has no git) and the
+    runner (``jobs``), torch's version, the commit (``$BGFN_COMMIT`` where set: a copy of the tree on another
+    machine may carry no git, or another repository's) and the
     odometers' model size and budget."""
     tc = (cfg["evaluate"]["odometer"].get("train") or {}).get("optimizer") or {}
     facts = {"profile": profile, "size": (cfg["evaluate"]["sweep"].get("train") or {}).get("size"),
              "epochs_max": tc.get("epochs"), "batch_size": tc.get("batch_size"), "device": device_name(),
              "wall_s": round(time.perf_counter() - t0, 1), "jobs": jobs, "torch": torch.__version__,
-             "date": datetime.date.today().isoformat(), "commit": git_commit() or os.environ.get("BGFN_COMMIT")}
+             "date": datetime.date.today().isoformat(), "commit": os.environ.get("BGFN_COMMIT") or git_commit()}
     path = results_dir(profile) / RUN_FACTS
     atomic_write_text(path, json.dumps(facts, indent=1))
     return path
@@ -82,8 +83,8 @@ def record(profile: str, note: str = "", measured: Path = MEASURED_FILE,
     for table, cols, path in ((summary, SUMMARY_COLUMNS, measured), (networks, NETWORK_COLUMNS, measured_networks)):
         new = pd.DataFrame({**run, **{c: table[c] for c in cols}, "note": note}, index=table.index)
         old = read_measured(path)
-        atomic_write_csv(path, pd.concat([old[old["profile"] != profile], new], ignore_index=True),
-                         float_format="%.4f")
+        keep = [old[old["profile"] != profile]] if len(old) else []
+        atomic_write_csv(path, pd.concat([*keep, new], ignore_index=True), float_format="%.4f")
         written.append(path)
     return written
 

@@ -5,8 +5,10 @@ Read from notebook 04's odometer tables (:mod:`bgfn.evaluate.odometers`: ``outag
 start, seed and duration, ``outage_odometer_summary.csv`` with the medians, the ratio to INS+NHC per start and the
 Wilcoxon p against it, ``outage_odometer_paper.csv`` with the rows in each drive's two evaluation outages, ``outage_odometer_curve.csv`` with
 RIDGE-ODO's speed error against its training windows, ``outage_odometer_uncertainty.csv`` with each network's
-predicted std against its speed error) and notebook 05's ``energy_odometer.csv`` (:mod:`bgfn.energy.odometer`). Nothing here is
-typed by hand; a missing table leaves its cells empty and its sentence says so.
+predicted std against its speed error) and notebook 05's ``energy_odometer.csv`` (:mod:`bgfn.energy.odometer`), and a run
+at another model size made on another machine (``data/measured/odometer_sizes.csv``, :mod:`bgfn.evaluate.odometer_sizes`:
+the paper's size on a GPU). Nothing here is typed by hand; a missing table leaves its cells empty and its sentence
+says so.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from bgfn.data.names import dataset_id
+from bgfn.evaluate.odometer_sizes import read_measured
 from bgfn.evaluate.odometer_uncertainty import uncertainty_sentence
 from bgfn.evaluate.odometers import HOLD, ORACLE, RIDGE
 from bgfn.paper import METHOD_LABELS, nhc_label, odometer_label
@@ -26,6 +29,8 @@ from bgfn.stats import wilcoxon_p
 SUBJECT_ODO, TWIN_ODO = odometer_label("bgfn"), odometer_label("transformer")
 #: The learned odometers, the ridge first (the bar the networks must clear).
 LEARNED: tuple[str, ...] = (RIDGE, *(odometer_label(m) for m in METHOD_LABELS))
+#: The network odometers alone.
+NETWORKS: tuple[str, ...] = LEARNED[1:]
 #: Rows the verdict table gains, in order (the oracle row is built apart).
 ODOMETER_ROWS: tuple[str, ...] = (HOLD, *LEARNED)
 #: Label of the oracle row: the reference's speed plus white noise as large as BGFN-ODO's own speed error.
@@ -48,6 +53,7 @@ class OdometerInputs:
     paper: pd.DataFrame | None = None   # outage_odometer_paper.csv (the two evaluation outages)
     curve: pd.DataFrame | None = None   # outage_odometer_curve.csv (RIDGE-ODO against its training windows)
     uncertainty: pd.DataFrame | None = None   # outage_odometer_uncertainty.csv (each network's std against its error)
+    sized: pd.DataFrame | None = None   # data/measured/odometer_sizes.csv (the odometers at another size, elsewhere)
 
     @property
     def measured(self) -> bool:
@@ -137,12 +143,15 @@ def same_dataset(column: pd.Series, dataset: str) -> pd.Series:
 def read_odometer_inputs(odometer: pd.DataFrame | None, summary: pd.DataFrame | None,
                          energy: pd.DataFrame | None, dataset: str,
                          paper: pd.DataFrame | None = None, curve: pd.DataFrame | None = None,
-                         uncertainty: pd.DataFrame | None = None) -> OdometerInputs:
-    """The tables restricted to ``dataset`` (the energy table only when its ``dataset`` column names it)."""
+                         uncertainty: pd.DataFrame | None = None,
+                         sized: pd.DataFrame | None = None) -> OdometerInputs:
+    """The tables restricted to ``dataset`` (the energy table only when its ``dataset`` column names it);
+    ``sized`` defaults to the recorded runs at other sizes (:func:`bgfn.evaluate.odometer_sizes.read_measured`)."""
     def of(df):
         return None if df is None or "dataset" not in df.columns else df[same_dataset(df["dataset"], dataset)]
 
-    return OdometerInputs(of(odometer), of(summary), of(energy), of(paper), of(curve), of(uncertainty))
+    sized = read_measured() if sized is None else sized
+    return OdometerInputs(of(odometer), of(summary), of(energy), of(paper), of(curve), of(uncertainty), of(sized))
 
 
 def curve_sentence(odo: OdometerInputs) -> str:
@@ -158,6 +167,44 @@ def curve_sentence(odo: OdometerInputs) -> str:
             f"({hi['n_train'] / lo['n_train']:.1f} times as many), and its speed RMSE in its "
             f"{hi['duration_s']:g} s outages goes from {lo['outage_speed_rmse_mps']:.2f} to "
             f"{hi['outage_speed_rmse_mps']:.2f} m/s (notebook 04's learning curve).")
+
+
+def size_sentence(odo: OdometerInputs, durations) -> str:
+    """What the odometers gave at another model size, in a run recorded from another machine
+    (``data/measured/odometer_sizes.csv``): per recorded profile, INS+NHC and BGFN-ODO at ``durations`` there,
+    BGFN-ODO's speed RMSE there and here, the best network there, and whether the windows were this run's
+    (INS+NHC within 1 % at every duration: the same starts and filter). Empty without such a run for this drive."""
+    sized = odo.sized
+    if sized is None or not len(sized):
+        return ""
+    nhc, d_long, out = nhc_label("INS"), max(durations), []
+    for profile, g in sized.groupby("profile", sort=False):
+        there = OdometerInputs(None, g.drop(columns=["profile"]).reset_index(drop=True), None)
+        if not there.has(nhc):
+            continue
+        same = odo.measured and all(np.isclose(there.cell(nhc, d), odo.cell(nhc, d), rtol=0.01) for d in durations)
+        r = g.iloc[0]
+
+        def pair(m, src=there):
+            return "/".join(f"{src.cell(m, d):.1f}" for d in durations) + " m"
+
+        nets = {m: there.cell(m, d_long) for m in NETWORKS if there.has(m)}
+        best = min(nets, key=nets.get) if nets else None
+        text = (f" Is it the model size? At the {r['size']} size (profile `{profile}`: up to {r['epochs_max']:.0f} "
+                f"epochs, batch {r['batch_size']:.0f}; run on {r['device']} on {r['date']} at commit {r['commit']}, "
+                f"`data/measured/odometer_sizes.csv`), in " + ("the same windows as here" if same else
+                                                              "its own windows") + f", {nhc} {pair(nhc)}")
+        if there.has(SUBJECT_ODO):
+            text += (f", {SUBJECT_ODO} {pair(SUBJECT_ODO)} (p against {nhc} {'/'.join(_p(there.cell(SUBJECT_ODO, d, 'p_vs_nhc')) for d in durations)}"
+                     f"; speed RMSE {there.cell(SUBJECT_ODO, d_long, 'speed_rmse_mps'):.2f} m/s at {d_long:g} s"
+                     + (f" against {odo.cell(SUBJECT_ODO, d_long, 'speed_rmse_mps'):.2f} m/s here)"
+                        if odo.has(SUBJECT_ODO) else ")"))
+        if best is not None:
+            text += (f"; its best network at {d_long:g} s, {best} ({_m(there.cell(best, d_long))}), "
+                     + (f"beats {nhc} (p < {ALPHA:g})" if beats(there, best, d_long)
+                        else f"does not beat {nhc} significantly"))
+        out.append(text + ".")
+    return "".join(out)
 
 
 def odometer_rows(odo: OdometerInputs, durations) -> list[dict]:
@@ -284,7 +331,7 @@ def answer_odometer(odo: OdometerInputs, durations) -> str:
                 + (f"up to a noise of {be:g} m/s" if np.isfinite(be) else "at no noise level of its grid")
                 + (f"; at {SUBJECT_ODO}'s speed error it reaches {_m(at)}" if np.isfinite(at) else "")
                 + " (how accurate a speed must be, and what better learning could give with this filter).")
-    return out + curve_sentence(odo)
+    return out + curve_sentence(odo) + size_sentence(odo, durations)
 
 
 def odometer_headline(odo: OdometerInputs, durations) -> str:

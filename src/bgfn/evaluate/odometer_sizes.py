@@ -36,7 +36,7 @@ MEASURED_FILE = PROJECT_ROOT / "data" / "measured" / "odometer_sizes.csv"
 #: Their networks' facts (:data:`bgfn.evaluate.odometers.NETWORK_COLUMNS`).
 MEASURED_NETWORKS = PROJECT_ROOT / "data" / "measured" / "odometer_sizes_networks.csv"
 #: What describes a run, before the table's own columns.
-RUN_COLUMNS: tuple[str, ...] = ("profile", "size", "epochs_max", "batch_size", "device", "wall_s", "date", "commit")
+RUN_COLUMNS: tuple[str, ...] = ("profile", "size", "inputs", "epochs_max", "batch_size", "device", "wall_s", "date", "commit")
 #: The run's facts beside its tables.
 RUN_FACTS = "odometer_run.json"
 
@@ -50,11 +50,12 @@ def device_name() -> str:
 
 def write_run_facts(profile: str, cfg: dict, t0: float, jobs: str) -> Path:
     """``results/<profile>/odometer_run.json``: the device, the wall time since ``t0`` (``time.perf_counter``), the
-    runner (``jobs``), torch's version, the commit (``$BGFN_COMMIT`` where set: a copy of the tree on another
+    runner (``jobs``), the networks' inputs, torch's version, the commit (``$BGFN_COMMIT`` where set: a copy of the tree on another
     machine may carry no git, or another repository's) and the
     odometers' model size and budget."""
     tc = (cfg["evaluate"]["odometer"].get("train") or {}).get("optimizer") or {}
     facts = {"profile": profile, "size": (cfg["evaluate"]["sweep"].get("train") or {}).get("size"),
+             "inputs": cfg["evaluate"]["odometer"].get("inputs"),
              "epochs_max": tc.get("epochs"), "batch_size": tc.get("batch_size"), "device": device_name(),
              "wall_s": round(time.perf_counter() - t0, 1), "jobs": jobs, "torch": torch.__version__,
              "date": datetime.date.today().isoformat(), "commit": os.environ.get("BGFN_COMMIT") or git_commit()}

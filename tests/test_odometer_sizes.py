@@ -45,8 +45,8 @@ def _finished_run(root, profile: str, summary: pd.DataFrame) -> None:
                           "outage_coverage_2sigma": 0.7}], columns=list(NETWORK_COLUMNS))
     nets.to_csv(tables / SHARED_TABLES["odometer_networks"], index=False)
     (root / profile / S.RUN_FACTS).write_text(json.dumps(
-        {"profile": profile, "size": "paper", "epochs_max": 1000, "batch_size": 8, "device": "GPU X",
-         "wall_s": 100.0, "date": "2026-01-01", "commit": "abc1234"}))
+        {"profile": profile, "size": "paper", "inputs": "band_frames", "epochs_max": 1000, "batch_size": 8,
+         "device": "GPU X", "wall_s": 100.0, "date": "2026-01-01", "commit": "abc1234"}))
 
 
 def test_record_keeps_a_run_without_the_oracle_grid_and_replaces_only_its_own_profile(monkeypatch, tmp_path):
@@ -76,8 +76,10 @@ def test_the_run_facts_name_the_commit_given_by_the_environment_first(monkeypatc
     monkeypatch.setenv("BGFN_COMMIT", "feed123")     # a copy on another machine: its git, if any, is not ours
     cfg = {"evaluate": {"sweep": {"train": {"size": "paper"}},
                         "odometer": {"train": {"optimizer": {"epochs": 1000, "batch_size": 8}}}}}
+    cfg["evaluate"]["odometer"]["inputs"] = "imu"
     facts = json.loads(S.write_run_facts("paper", cfg, 0.0, "1 job").read_text())
-    assert (facts["commit"], facts["size"], facts["epochs_max"], facts["batch_size"]) == ("feed123", "paper", 1000, 8)
+    assert (facts["commit"], facts["size"], facts["inputs"], facts["epochs_max"], facts["batch_size"]) == (
+        "feed123", "paper", "imu", 1000, 8)
 
 
 def test_the_command_line_records_only_a_finished_run(monkeypatch, tmp_path, capsys):
@@ -94,7 +96,7 @@ def _here(nhc):
 def _sized(nhc, odo, mlp, **kw):
     s = _summary(nhc, odo, mlp, **kw)
     s = s[s["method"] != "ORACLE-SPEED"]
-    return pd.concat([pd.DataFrame({"profile": "paper-odometer", "size": "paper", "epochs_max": 1000,
+    return pd.concat([pd.DataFrame({"profile": "paper-odometer", "size": "paper", "inputs": "imu", "epochs_max": 1000,
                                     "batch_size": 8, "device": "GPU X", "wall_s": 100.0, "date": "2026-01-01",
                                     "commit": "abc1234"}, index=s.index), s], axis=1)
 
@@ -105,7 +107,8 @@ def test_the_size_sentence_pairs_only_the_same_windows_and_says_whether_a_networ
     assert size_sentence(here, DURATIONS) == ""                                   # nothing recorded
     here.sized = _sized(nhc, {30.0: 15.0, 60.0: 40.0}, {30.0: 12.0, 60.0: 30.0})
     text = size_sentence(here, DURATIONS)
-    assert text.startswith(" Is it the model size? At the paper size (profile `paper-odometer`: up to 1000 epochs, "
+    assert text.startswith(" Is it the model size? At the paper size, reading the raw IMU samples (profile "
+                           "`paper-odometer`: up to 1000 epochs, "
                            "batch 8; run on GPU X on 2026-01-01 at commit abc1234")
     assert "in the same windows as here, INS+NHC 10.0/20.0 m, BGFN-ODO 15.0/40.0 m" in text
     assert "speed RMSE 2.60 m/s at 60 s against 2.50 m/s here" in text

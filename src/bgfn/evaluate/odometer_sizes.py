@@ -85,7 +85,9 @@ def record(profile: str, note: str = "", measured: Path = MEASURED_FILE,
         new = pd.DataFrame({**run, **{c: table[c] for c in cols}, "note": note}, index=table.index)
         old = read_measured(path)
         keep = [old[old["profile"] != profile]] if len(old) else []
-        atomic_write_csv(path, pd.concat([*keep, new], ignore_index=True), float_format="%.4f")
+        table = pd.concat([*keep, new], ignore_index=True)
+        atomic_write_csv(path, table[[*new.columns, *(c for c in table.columns if c not in new.columns)]],
+                         float_format="%.4f")
         written.append(path)
     return written
 

@@ -37,6 +37,8 @@ ODOMETER_ROWS: tuple[str, ...] = (HOLD, *LEARNED)
 ORACLE_ODO_ROW = f"oracle speed at {SUBJECT_ODO}'s speed error"
 #: What an odometer reads (the verdict table's ``inputs``).
 ODOMETER_INPUTS = "body-frame IMU"
+#: The odometer networks' inputs (``evaluate.odometer.inputs``) in words.
+INPUT_WORDS = {"band_frames": "band frames", "imu": "the raw IMU samples"}
 #: The coverage of +-2 sigma that a calibrated Gaussian std gives, and the band the issue calls calibrated.
 CALIBRATED_COVERAGE = (0.90, 0.98)
 #: Wilcoxon p below which a difference is called one.
@@ -190,7 +192,8 @@ def size_sentence(odo: OdometerInputs, durations) -> str:
 
         nets = {m: there.cell(m, d_long) for m in NETWORKS if there.has(m)}
         best = min(nets, key=nets.get) if nets else None
-        text = (f" Is it the model size? At the {r['size']} size (profile `{profile}`: up to {r['epochs_max']:.0f} "
+        reads = f", reading {INPUT_WORDS.get(r['inputs'], r['inputs'])}" if isinstance(r.get("inputs"), str) else ""
+        text = (f" Is it the model size? At the {r['size']} size{reads} (profile `{profile}`: up to {r['epochs_max']:.0f} "
                 f"epochs, batch {r['batch_size']:.0f}; run on {r['device']} on {r['date']} at commit {r['commit']}, "
                 f"`data/measured/odometer_sizes.csv`), in " + ("the same windows as here" if same else
                                                               "its own windows") + f", {nhc} {pair(nhc)}")

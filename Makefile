@@ -214,9 +214,10 @@ $(RES)/notebooks/02_kf_baseline.ipynb: $(RES)/notebooks/01_data_prep.ipynb $(wil
 $(RES)/notebooks/03_bgfn_training.ipynb: $(RES)/notebooks/02_kf_baseline.ipynb
 $(RES)/notebooks/04_outage_evaluation.ipynb: $(RES)/notebooks/03_bgfn_training.ipynb
 $(RES)/notebooks/05_energy_estimate.ipynb: $(RES)/notebooks/04_outage_evaluation.ipynb
-# 06 (the results page) reads every earlier output and the paper's published values.
+# 06 (the results page) reads every earlier output, the paper's published values and the odometers' run at the
+# paper's size recorded from a GPU (python -m bgfn odometers --record).
 $(RES)/notebooks/06_results.ipynb: $(RES)/notebooks/05_energy_estimate.ipynb data/paper/outage_max_errors.csv \
-  data/paper/claims.yaml
+  data/paper/claims.yaml $(wildcard data/measured/odometer_sizes.csv)
 # ... and, when they have been run, the variant profiles its "Variants" section compares (notebook parameter
 # `variants`), so a later `make reproduce PROFILE=quick-heading` is picked up by the next `make reproduce`.
 VARIANTS := quick-heading

@@ -190,3 +190,15 @@ def test_the_odometers_learning_rate_search_tunes_inside_the_training_windows(tm
     assert table["lr"].tolist() == [1e-5, 3e-3] and table["dataset"].eq("drive fold 0").all()
     assert table.loc[table["selected"], "lr"].tolist() == [3e-3]       # 6 epochs at 1e-5 barely move the network
     assert (table["tuning_rmse_m"] > 0).all() and table["tuning_rmse_m"].iloc[1] < table["tuning_rmse_m"].iloc[0]
+
+
+def test_the_ensemble_std_adds_the_members_disagreement_to_their_own_uncertainty():
+    from bgfn.learning.odometry import ensemble_speed
+    speeds = np.array([[9.0, 10.0], [11.0, 10.0]])           # disagree by 2 m/s at the first epoch, agree at the second
+    stds = np.array([[0.5, 0.5], [0.5, 1.5]])
+    mean, std = ensemble_speed(speeds, stds)
+    assert mean == pytest.approx([10.0, 10.0])
+    # mixture: sqrt(mean(std^2) + var(speed)) = sqrt(0.25 + 1) and sqrt((0.25 + 2.25) / 2 + 0)
+    assert std == pytest.approx([np.sqrt(1.25), np.sqrt(1.25)])
+    with pytest.raises(DataError, match="at least 2 members"):
+        ensemble_speed(speeds[:1], stds[:1])

@@ -107,7 +107,8 @@ def test_the_speed_figure_draws_each_outage_from_its_own_fold():
     t = np.arange(0.0, 200.0)
     series = {"time": t, "truth": np.full(t.size, 10.0), "outages": [(60.0, 30.0), (100.0, 30.0), (140.0, 30.0)],
               "tracks": {"RIDGE-ODO": (np.where(t > 50, 11.0, np.nan), np.full(t.size, 0.5)),
-                         "BGFN-ODO": (np.where(t > 50, 9.0, np.nan), np.full(t.size, 1.5))}}
+                         "BGFN-ODO": (np.where(t > 50, 9.0, np.nan), np.full(t.size, 1.5)),
+                         "BGFN-ODO-ENS": (np.where(t > 50, 9.5, np.nan), np.full(t.size, 1.0))}}   # not drawn
     fig = O.plot_speed_series(series, "d", n_outages=2)
     axes = fig.axes
     assert len(axes) == 2 and axes[0].get_title() == "start 60 s" and axes[1].get_title() == "start 140 s"
@@ -202,3 +203,23 @@ def test_network_table_sets_each_networks_validation_beside_its_own_folds_outage
     line, = O.network_lines(t)
     assert line.startswith("d, fold 0:") and "BGFN-ODO 0.80, then 3.54 m/s (75 % of outage epochs within" in line
     assert O.network_lines(None) == [] and O.network_lines(t.iloc[:0]) == []
+
+
+def test_the_ensemble_of_two_oppositely_biased_seeds_is_unbiased_and_recalibrated_on_validation():
+    from bgfn.learning import odometry as lo
+    t = np.arange(0.0, 100.0)
+    truth = 10.0 + np.sin(t / 10.0)
+    tracks = {("NET-ODO", 0, 0): (no.SpeedTrack(t, truth + 1.0, np.full(t.size, 0.2)), {}),
+              ("NET-ODO", 0, 1): (no.SpeedTrack(t, truth - 1.0, np.full(t.size, 0.2)), {}),
+              ("ONE-ODO", 0, 0): (no.SpeedTrack(t, truth, np.full(t.size, 0.2)), {})}   # one seed: no ensemble
+    val_t = t[40:60]
+    val = lo.SpeedWindows(np.zeros((val_t.size, 2, 6), np.float32), truth[40:60] + 0.3, val_t, val_t - 2.0)
+    data = {0: lo.SpeedData(val, val, None, {}, {})}
+    out = O.ensemble_tracks(tracks, data)
+    assert list(out) == [("NET-ODO-ENS", 0, 0)]
+    track, facts = out[("NET-ODO-ENS", 0, 0)]
+    assert track.speed == pytest.approx(truth)                       # the biases cancel
+    # mixture std sqrt(0.2^2 + 1^2), then scaled so that the validation residuals (0.3 m/s) have NIS = 1
+    assert facts["calibration"] == pytest.approx(0.3 / np.sqrt(1.04))
+    assert track.std == pytest.approx(np.full(t.size, 0.3))
+    assert facts["val_rmse_mps"] == pytest.approx(0.3) and facts["members"] == 2

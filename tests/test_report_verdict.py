@@ -195,6 +195,22 @@ def test_odometer_rows_answer_and_headline_read_the_odometer_tables():
     assert "better than its ANN twin" in answer and "(overconfident" in answer
 
 
+def test_the_odometer_answer_gives_the_ensembles_error_calibration_and_energy():
+    odo = _odometer()
+    assert "as one ensemble" not in verdict_sentences(_inputs(odometer=odo), verdict_table(_inputs(odometer=odo)))[5]
+    ens = odo.summary[odo.summary["method"] == "BGFN-ODO"].assign(method="BGFN-ODO-ENS", max_h_m=[5.0, 9.0],
+                                                                  coverage_2sigma=0.8)
+    rows = odo.rows[odo.rows["method"] == "BGFN-ODO"].assign(method="BGFN-ODO-ENS")
+    odo.summary, odo.rows = pd.concat([odo.summary, ens]), pd.concat([odo.rows, rows])
+    inp = _inputs(odometer=odo)
+    assert "BGFN-ODO-ENS" in list(verdict_table(inp)["row"])
+    answer = verdict_sentences(inp, verdict_table(inp))[5]
+    # one seed per start here: an ensemble of 1 costs 1 time BGFN-ODO's 0.5 µJ
+    assert ("Its 1 seeds as one ensemble (BGFN-ODO-ENS: the mean speed, the mixture's std recalibrated): 9.0 m at "
+            "60 s, speed RMSE 0.50 m/s, 80 % within +-2 sigma (overconfident), at 1 times the energy per prediction "
+            "(0.5 µJ).") in answer
+
+
 def test_the_odometer_answer_says_whether_more_training_windows_made_the_speed_finer():
     odo = _odometer()
     assert "Would more of this drive help?" not in verdict_sentences(_inputs(odometer=odo),

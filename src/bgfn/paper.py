@@ -106,11 +106,18 @@ def nhc_label(method: str) -> str:
 #: Suffix of a network trained as a learned odometer (forward speed and its std fused with the NHC rows; beyond
 #: the paper, issue 24): ``BGFN-ODO``.
 ODO_SUFFIX = "-ODO"
+#: Suffix of the equal-weight ensemble of an odometer network's seeds (beyond the paper; :func:`ensemble_label`).
+ENSEMBLE_SUFFIX = "-ENS"
 
 
 def odometer_label(method: str) -> str:
     """Label of a network trained as a learned odometer: ``bgfn`` -> ``BGFN-ODO``."""
     return label(method) + ODO_SUFFIX
+
+
+def ensemble_label(odometer: str) -> str:
+    """Label of the equal-weight ensemble of an odometer network's seeds: ``BGFN-ODO`` -> ``BGFN-ODO-ENS``."""
+    return odometer + ENSEMBLE_SUFFIX
 
 
 def base_label(method: str) -> str:

@@ -16,6 +16,10 @@ on a drive, with the same starts, folds and durations as the sweep (:func:`bgfn.
   (:func:`odometer_train_config`) and the profile's ``train.lr`` (the same for every network: notebook 03's search
   tuned its rates for the increments), their std calibrated on their validation windows (NIS = 1; ``val_blocks``
   blocks spread over the drive) (:func:`network_odometers`);
+- ``BGFN-ODO-ENS`` ... (``ensemble`` and two or more ``network_seeds``): per fold the equal-weight ensemble of a
+  network's seeds (:func:`bgfn.learning.odometry.ensemble_speed`: the mean speed, the std of the Gaussian mixture,
+  the members' own uncertainty plus their disagreement), its std calibrated again on the fold's validation windows
+  (:func:`ensemble_tracks`); one row per start, at the members' summed cost per prediction;
 - ``ORACLE-SPEED``: the reference's horizontal speed plus white noise of std ``sigma`` (the grid ``sigmas_mps``),
   fused with std ``sigma``: how accurate a speed must be to help; ``ORACLE-SPEED+WALK`` (when
   ``walk_mps_per_sqrt_s`` > 0): the same plus a random walk the fused std does not know of, the slowly drifting
@@ -68,15 +72,18 @@ from bgfn.train.speed import torch_threads
 from bgfn.nav import odometer as no
 from bgfn.nav.constraints import DEFAULT_PLATFORM
 from bgfn import train
-from bgfn.paper import METHOD_LABELS, nhc_label, odometer_label
+from bgfn.paper import ENSEMBLE_SUFFIX, METHOD_LABELS, ensemble_label, nhc_label, odometer_label
 from bgfn.parallel import Runner
 from bgfn.stats import wilcoxon_p
 
 HOLD, RIDGE, ORACLE, ORACLE_WALK = "INS+NHC+HOLD", "RIDGE-ODO", "ORACLE-SPEED", "ORACLE-SPEED+WALK"
 #: A network odometer's row: ``BGFN-ODO``, ``Transformer-ODO``, ...
 NETWORK_ODOMETERS: tuple[str, ...] = tuple(odometer_label(m) for m in METHOD_LABELS)
+#: The equal-weight ensemble of a network's seeds per fold (``evaluate.odometer.ensemble``): ``BGFN-ODO-ENS`` ...
+ENSEMBLE_ODOMETERS: tuple[str, ...] = tuple(ensemble_label(m) for m in NETWORK_ODOMETERS)
 #: Rows of the odometer table, in order.
-ODOMETER_METHODS: tuple[str, ...] = (nhc_label("INS"), HOLD, RIDGE, *NETWORK_ODOMETERS, ORACLE, ORACLE_WALK)
+ODOMETER_METHODS: tuple[str, ...] = (nhc_label("INS"), HOLD, RIDGE, *NETWORK_ODOMETERS, *ENSEMBLE_ODOMETERS, ORACLE,
+                                     ORACLE_WALK)
 #: Columns of ``tables/outage_odometer.csv``.
 ODOMETER_COLUMNS: tuple[str, ...] = ("dataset", "start_s", "duration_s", "method", "sigma_mps", "seed", "fold",
                                      "max_h_m", "rmse_h_m", "final_h_m", "speed_rmse_mps", "coverage_2sigma")
@@ -278,7 +285,35 @@ def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, data: d
     with torch_threads(optimizer_options(tc)["num_threads"]):
         for key, run, card in zip(keys, runs, cards):
             tracks[key] = calibrated_track(run, card, all_windows)
+    if oc["ensemble"] and len(oc["network_seeds"]) > 1:
+        tracks.update(ensemble_tracks(tracks, data))
     return tracks
+
+
+def ensemble_tracks(tracks: dict, data: dict[int, lo.SpeedData]) -> dict:
+    """Per network and fold, the equal-weight ensemble of its seeds' calibrated tracks (``tracks``, as
+    :func:`network_odometers` returns them): the mean speed and the mixture's std
+    (:func:`bgfn.learning.odometry.ensemble_speed`), that std calibrated again on the fold's validation windows
+    (``data[fold].val``, NIS = 1; the members' own factors were fitted one by one). Keyed
+    ``(BGFN-ODO-ENS, fold, lowest seed)``; its facts: the calibration factor, the validation speed RMSE and the
+    members."""
+    groups: dict = {}
+    for (label, fold, seed), (track, _) in sorted(tracks.items()):
+        groups.setdefault((label, fold), []).append((seed, track))
+    out = {}
+    for (label, fold), members in groups.items():
+        if len(members) < 2:
+            continue
+        t = members[0][1].time
+        speed, std = lo.ensemble_speed(np.stack([m.speed for _, m in members]), np.stack([m.std for _, m in members]))
+        val = data[fold].val
+        v_speed, v_std = no.SpeedTrack(t, speed, std).at(val.t_end)
+        factor = lo.calibration_factor(v_speed - val.speed, v_std)
+        out[(ensemble_label(label), fold, members[0][0])] = (
+            no.SpeedTrack(t, speed, std * factor),
+            {"calibration": factor, "val_rmse_mps": float(np.sqrt(np.nanmean((v_speed - val.speed) ** 2))),
+             "epochs": np.nan, "lr": np.nan, "members": len(members)})
+    return out
 
 
 def calibrated_track(run: train.TrainingRun, card: dict, all_windows: lo.SpeedWindows) -> tuple:
@@ -507,9 +542,9 @@ _BAND_COLOURS = ("tab:orange", "tab:blue", "tab:green", "tab:red", "tab:purple")
 
 
 def plot_speed_series(series: dict, dataset: str, n_outages: int = 4):
-    """The learned odometers' speed (RIDGE-ODO and each network's first seed) with their 2-sigma bands against the
-    reference's in a few outages spread over the drive, every outage predicted by the odometers of its own fold
-    (trained without it)."""
+    """The learned odometers' speed (RIDGE-ODO and each network's first seed; not the ensembles) with their 2-sigma
+    bands against the reference's in a few outages spread over the drive, every outage predicted by the odometers
+    of its own fold (trained without it)."""
     outages = sorted(series["outages"])
     pick = [outages[i] for i in np.unique(np.linspace(0, len(outages) - 1, min(n_outages, len(outages))).round()
                                           .astype(int))] if outages else []
@@ -518,7 +553,8 @@ def plot_speed_series(series: dict, dataset: str, n_outages: int = 4):
     t, truth = np.asarray(series["time"], float), np.asarray(series["truth"], float)
     for ax, (s, d) in zip(axes[0], pick):
         m = (t >= s) & (t <= s + d)
-        for colour, (label, (speed, std)) in zip(_BAND_COLOURS, series["tracks"].items()):
+        singles = {k: v for k, v in series["tracks"].items() if not k.endswith(ENSEMBLE_SUFFIX)}  # one band each
+        for colour, (label, (speed, std)) in zip(_BAND_COLOURS, singles.items()):
             ax.fill_between(t[m] - s, speed[m] - 2 * std[m], speed[m] + 2 * std[m], color=colour, alpha=0.15)
             ax.plot(t[m] - s, speed[m], color=colour, lw=1.0, label=f"{label} (+- 2 sigma)")
         ax.plot(t[m] - s, truth[m], color="black", lw=1.4, label="reference")
@@ -585,7 +621,7 @@ def odometer_lines(summary: pd.DataFrame) -> list[str]:
         by = {m: g[g["method"] == m] for m in ODOMETER_METHODS}
         nhc = float(by[nhc_label("INS")]["max_h_m"].iloc[0]) if len(by[nhc_label("INS")]) else np.nan
         part = [f"{ds}, {du:g} s outages (median max horizontal error): INS+NHC {nhc:.1f} m"]
-        for m in (HOLD, RIDGE, *NETWORK_ODOMETERS):
+        for m in (HOLD, RIDGE, *NETWORK_ODOMETERS, *ENSEMBLE_ODOMETERS):
             if len(by[m]):
                 row = by[m].iloc[0]
                 part.append(f"{m} {row['max_h_m']:.1f} m ({row['ratio_to_nhc']:.2f} of INS+NHC per start"

@@ -337,6 +337,17 @@ def beta_nll(mean, log_var, target, beta: float = 0.5):
     return (nll * var.detach() ** beta).mean() if beta else nll.mean()
 
 
+def ensemble_speed(speeds, stds) -> tuple[np.ndarray, np.ndarray]:
+    """The equal-weight ensemble of M odometers (a deep ensemble: Lakshminarayanan et al., 2017): ``speeds`` and
+    ``stds`` [M, K] (m/s) -> the mean speed [K] and the std of the Gaussian mixture [K],
+    ``sqrt(mean(std^2) + var(speed))``: the members' own uncertainty plus their disagreement, which a single
+    network's std cannot know of (population variance over the members)."""
+    v, s = np.asarray(speeds, dtype=float), np.asarray(stds, dtype=float)
+    if v.ndim != 2 or v.shape != s.shape or v.shape[0] < 2:
+        raise DataError("odometer", "ensemble", "speeds and stds [M, K] of at least 2 members", f"{v.shape}, {s.shape}")
+    return v.mean(axis=0), np.sqrt((s ** 2).mean(axis=0) + v.var(axis=0))
+
+
 def calibration_factor(residuals, std) -> float:
     """The one factor on a predicted std that makes the normalized residuals' mean square 1 on held-out windows
     (NIS = 1 for a scalar measurement): ``sqrt(mean((r / std)^2))``; non-finite pairs are left out."""

@@ -22,15 +22,17 @@ from bgfn.data.names import dataset_id
 from bgfn.evaluate.odometer_sizes import read_measured
 from bgfn.evaluate.odometer_uncertainty import uncertainty_sentence
 from bgfn.evaluate.odometers import HOLD, ORACLE, RIDGE
-from bgfn.paper import METHOD_LABELS, nhc_label, odometer_label
+from bgfn.paper import METHOD_LABELS, ensemble_label, nhc_label, odometer_label
 from bgfn.stats import wilcoxon_p
 
 #: The spiking odometer and its ANN twin.
 SUBJECT_ODO, TWIN_ODO = odometer_label("bgfn"), odometer_label("transformer")
-#: The learned odometers, the ridge first (the bar the networks must clear).
-LEARNED: tuple[str, ...] = (RIDGE, *(odometer_label(m) for m in METHOD_LABELS))
 #: The network odometers alone.
-NETWORKS: tuple[str, ...] = LEARNED[1:]
+NETWORKS: tuple[str, ...] = tuple(odometer_label(m) for m in METHOD_LABELS)
+#: The spiking odometer's ensemble of seeds (``evaluate.odometer.ensemble``).
+SUBJECT_ENS = ensemble_label(SUBJECT_ODO)
+#: The learned odometers, the ridge first (the bar the networks must clear), then each network's ensemble.
+LEARNED: tuple[str, ...] = (RIDGE, *NETWORKS, *(ensemble_label(m) for m in NETWORKS))
 #: Rows the verdict table gains, in order (the oracle row is built apart).
 ODOMETER_ROWS: tuple[str, ...] = (HOLD, *LEARNED)
 #: Label of the oracle row: the reference's speed plus white noise as large as BGFN-ODO's own speed error.
@@ -325,6 +327,15 @@ def answer_odometer(odo: OdometerInputs, durations) -> str:
         out += (f" {SUBJECT_ODO} is {twin_comparison(odo, d_long)} at {d_long:g} s, {_energy(odo)}. Its speed error in "
                 f"the outages: RMSE {rmse:.2f} m/s, {100 * cov:.0f} % of epochs within its +-2 sigma ({calib}: "
                 f"{100 * lo:.0f}-{100 * hi:.0f} % is the band of a calibrated std).")
+        if odo.has(SUBJECT_ENS):
+            n = odo.runs(SUBJECT_ODO)
+            e_rmse, e_cov = (odo.cell(SUBJECT_ENS, d_long, c) for c in ("speed_rmse_mps", "coverage_2sigma"))
+            e_calib = "calibrated" if lo <= e_cov <= hi else "overconfident" if e_cov < lo else "underconfident"
+            e_snn = odo.energy_uj(SUBJECT_ODO)
+            out += (f" Its {n} seeds as one ensemble ({SUBJECT_ENS}: the mean speed, the mixture's std recalibrated): "
+                    f"{_m(odo.cell(SUBJECT_ENS, d_long))} at {d_long:g} s, speed RMSE {e_rmse:.2f} m/s, "
+                    f"{100 * e_cov:.0f} % within +-2 sigma ({e_calib}), at {n} times the energy per prediction"
+                    + (f" ({n * e_snn:.3g} µJ)" if np.isfinite(e_snn) else "") + ".")
         u = odo.uncertainty
         if u is not None and (u["method"] == SUBJECT_ODO).any():
             out += f" Does it know when it is wrong? {uncertainty_sentence(u[u['method'] == SUBJECT_ODO])}."

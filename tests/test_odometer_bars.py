@@ -205,7 +205,7 @@ def test_network_table_sets_each_networks_validation_beside_its_own_folds_outage
     assert O.network_lines(None) == [] and O.network_lines(t.iloc[:0]) == []
 
 
-def test_the_ensemble_of_two_oppositely_biased_seeds_is_unbiased_and_recalibrated_on_validation():
+def test_the_ensemble_of_two_oppositely_biased_seeds_is_unbiased_with_the_mixtures_std():
     from bgfn.learning import odometry as lo
     t = np.arange(0.0, 100.0)
     truth = 10.0 + np.sin(t / 10.0)
@@ -219,7 +219,11 @@ def test_the_ensemble_of_two_oppositely_biased_seeds_is_unbiased_and_recalibrate
     assert list(out) == [("NET-ODO-ENS", 0, 0)]
     track, facts = out[("NET-ODO-ENS", 0, 0)]
     assert track.speed == pytest.approx(truth)                       # the biases cancel
-    # mixture std sqrt(0.2^2 + 1^2), then scaled so that the validation residuals (0.3 m/s) have NIS = 1
+    # the mixture's std sqrt(0.2^2 + 1^2) as it is; on validation the residuals (0.3 m/s) give NIS 0.09 / 1.04
+    assert track.std == pytest.approx(np.full(t.size, np.sqrt(1.04))) and facts["calibration"] == 1.0
+    assert facts["val_nis"] == pytest.approx(0.09 / 1.04)
+    assert facts["val_rmse_mps"] == pytest.approx(0.3) and facts["members"] == 2
+    # recalibrated: scaled so that the validation residuals have NIS = 1
+    track, facts = O.ensemble_tracks(tracks, data, recalibrate=True)[("NET-ODO-ENS", 0, 0)]
     assert facts["calibration"] == pytest.approx(0.3 / np.sqrt(1.04))
     assert track.std == pytest.approx(np.full(t.size, 0.3))
-    assert facts["val_rmse_mps"] == pytest.approx(0.3) and facts["members"] == 2

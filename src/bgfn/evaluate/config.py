@@ -77,7 +77,7 @@ EVALUATE_DEFAULTS: dict[str, Any] = {
                  "paper_outages": False, "window_s": 2.0, "sigmas_mps": [0.05, 0.1, 0.2, 0.5, 1.0, 2.0], "walk_mps_per_sqrt_s": 0.0,
                  "seeds": [0], "hold_std_mps": 1.0, "ridge_alpha": 1.0, "gate_probability": 0.999,
                  "lr_search": False, "inputs": "band_frames", "val_blocks": 4, "curve_folds": [], "train": None,
-                 "ensemble": False},
+                 "ensemble": False, "ensemble_recalibrate": False},
 }
 
 

@@ -332,7 +332,7 @@ def answer_odometer(odo: OdometerInputs, durations) -> str:
             e_rmse, e_cov = (odo.cell(SUBJECT_ENS, d_long, c) for c in ("speed_rmse_mps", "coverage_2sigma"))
             e_calib = "calibrated" if lo <= e_cov <= hi else "overconfident" if e_cov < lo else "underconfident"
             e_snn = odo.energy_uj(SUBJECT_ODO)
-            out += (f" Its {n} seeds as one ensemble ({SUBJECT_ENS}: the mean speed, the mixture's std recalibrated): "
+            out += (f" Its {n} seeds as one ensemble ({SUBJECT_ENS}: the mean speed, the std of the members' mixture): "
                     f"{_m(odo.cell(SUBJECT_ENS, d_long))} at {d_long:g} s, speed RMSE {e_rmse:.2f} m/s, "
                     f"{100 * e_cov:.0f} % within +-2 sigma ({e_calib}), at {n} times the energy per prediction"
                     + (f" ({n * e_snn:.3g} µJ)" if np.isfinite(e_snn) else "") + ".")

@@ -206,7 +206,7 @@ def test_the_odometer_answer_gives_the_ensembles_error_calibration_and_energy():
     assert "BGFN-ODO-ENS" in list(verdict_table(inp)["row"])
     answer = verdict_sentences(inp, verdict_table(inp))[5]
     # one seed per start here: an ensemble of 1 costs 1 time BGFN-ODO's 0.5 µJ
-    assert ("Its 1 seeds as one ensemble (BGFN-ODO-ENS: the mean speed, the std of the members' mixture): 9.0 m at "
+    assert ("BGFN-ODO's 1 seeds as one ensemble (BGFN-ODO-ENS: the mean speed, the std of the members' mixture): 9.0 m at "
             "60 s, speed RMSE 0.50 m/s, 80 % within +-2 sigma (overconfident), at 1 times the energy per prediction "
             "(0.5 µJ).") in answer
 

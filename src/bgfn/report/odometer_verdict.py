@@ -327,18 +327,19 @@ def answer_odometer(odo: OdometerInputs, durations) -> str:
         out += (f" {SUBJECT_ODO} is {twin_comparison(odo, d_long)} at {d_long:g} s, {_energy(odo)}. Its speed error in "
                 f"the outages: RMSE {rmse:.2f} m/s, {100 * cov:.0f} % of epochs within its +-2 sigma ({calib}: "
                 f"{100 * lo:.0f}-{100 * hi:.0f} % is the band of a calibrated std).")
+        u = odo.uncertainty
+        if u is not None and (u["method"] == SUBJECT_ODO).any():
+            out += f" Does it know when it is wrong? {uncertainty_sentence(u[u['method'] == SUBJECT_ODO])}."
         if odo.has(SUBJECT_ENS):
             n = odo.runs(SUBJECT_ODO)
             e_rmse, e_cov = (odo.cell(SUBJECT_ENS, d_long, c) for c in ("speed_rmse_mps", "coverage_2sigma"))
             e_calib = "calibrated" if lo <= e_cov <= hi else "overconfident" if e_cov < lo else "underconfident"
             e_snn = odo.energy_uj(SUBJECT_ODO)
-            out += (f" Its {n} seeds as one ensemble ({SUBJECT_ENS}: the mean speed, the std of the members' mixture): "
+            out += (f" {SUBJECT_ODO}'s {n} seeds as one ensemble ({SUBJECT_ENS}: the mean speed, the std of the "
+                    "members' mixture): "
                     f"{_m(odo.cell(SUBJECT_ENS, d_long))} at {d_long:g} s, speed RMSE {e_rmse:.2f} m/s, "
                     f"{100 * e_cov:.0f} % within +-2 sigma ({e_calib}), at {n} times the energy per prediction"
                     + (f" ({n * e_snn:.3g} µJ)" if np.isfinite(e_snn) else "") + ".")
-        u = odo.uncertainty
-        if u is not None and (u["method"] == SUBJECT_ODO).any():
-            out += f" Does it know when it is wrong? {uncertainty_sentence(u[u['method'] == SUBJECT_ODO])}."
         be = odo.oracle_breakeven(d_long)
         at = odo.oracle_at(rmse, d_long)
         out += (f" An oracle speed (the reference's plus white noise) beats {nhc} at {d_long:g} s "

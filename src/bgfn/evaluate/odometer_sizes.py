@@ -36,7 +36,8 @@ MEASURED_FILE = PROJECT_ROOT / "data" / "measured" / "odometer_sizes.csv"
 #: Their networks' facts (:data:`bgfn.evaluate.odometers.NETWORK_COLUMNS`).
 MEASURED_NETWORKS = PROJECT_ROOT / "data" / "measured" / "odometer_sizes_networks.csv"
 #: What describes a run, before the table's own columns.
-RUN_COLUMNS: tuple[str, ...] = ("profile", "size", "inputs", "epochs_max", "batch_size", "device", "wall_s", "date", "commit")
+RUN_COLUMNS: tuple[str, ...] = ("profile", "size", "inputs", "epochs_max", "batch_size", "device", "wall_s", "date",
+                                "commit")
 #: The run's facts beside its tables.
 RUN_FACTS = "odometer_run.json"
 
@@ -50,9 +51,8 @@ def device_name() -> str:
 
 def write_run_facts(profile: str, cfg: dict, t0: float, jobs: str) -> Path:
     """``results/<profile>/odometer_run.json``: the device, the wall time since ``t0`` (``time.perf_counter``), the
-    runner (``jobs``), the networks' inputs, torch's version, the commit (``$BGFN_COMMIT`` where set: a copy of the tree on another
-    machine may carry no git, or another repository's) and the
-    odometers' model size and budget."""
+    runner (``jobs``), the networks' inputs, torch's version, the odometers' model size and budget, and the commit
+    (``$BGFN_COMMIT`` where set: a copy of the tree on another machine may carry no git, or another one's)."""
     tc = (cfg["evaluate"]["odometer"].get("train") or {}).get("optimizer") or {}
     facts = {"profile": profile, "size": (cfg["evaluate"]["sweep"].get("train") or {}).get("size"),
              "inputs": cfg["evaluate"]["odometer"].get("inputs"),
@@ -67,7 +67,9 @@ def write_run_facts(profile: str, cfg: dict, t0: float, jobs: str) -> Path:
 def record(profile: str, note: str = "", measured: Path = MEASURED_FILE,
            measured_networks: Path = MEASURED_NETWORKS) -> list[Path]:
     """Keep ``profile``'s last odometer run (its tables and :data:`RUN_FACTS`) in the measured files: the summary
-    without the oracle's grid, and the networks' facts, each row led by :data:`RUN_COLUMNS` and ended by ``note``."""
+    without the oracle's grid, and the networks' facts, each row led by :data:`RUN_COLUMNS` and ended by ``note``;
+    the profile's earlier rows are replaced, other profiles' kept. Every input is checked before either file is
+    written."""
     res = results_dir(profile, create=False)
     paths = {"facts": res / RUN_FACTS, "summary": res / "tables" / SHARED_TABLES["odometer_summary"],
              "networks": res / "tables" / SHARED_TABLES["odometer_networks"]}

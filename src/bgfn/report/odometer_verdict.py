@@ -3,12 +3,12 @@ question ("does a learned odometer help?") and its clause in each dataset's head
 
 Read from notebook 04's odometer tables (:mod:`bgfn.evaluate.odometers`: ``outage_odometer.csv`` with one row per
 start, seed and duration, ``outage_odometer_summary.csv`` with the medians, the ratio to INS+NHC per start and the
-Wilcoxon p against it, ``outage_odometer_paper.csv`` with the rows in each drive's two evaluation outages, ``outage_odometer_curve.csv`` with
-RIDGE-ODO's speed error against its training windows, ``outage_odometer_uncertainty.csv`` with each network's
-predicted std against its speed error) and notebook 05's ``energy_odometer.csv`` (:mod:`bgfn.energy.odometer`), and a run
-at another model size made on another machine (``data/measured/odometer_sizes.csv``, :mod:`bgfn.evaluate.odometer_sizes`:
-the paper's size on a GPU). Nothing here is typed by hand; a missing table leaves its cells empty and its sentence
-says so.
+Wilcoxon p against it, ``outage_odometer_paper.csv`` with the rows in each drive's two evaluation outages,
+``outage_odometer_curve.csv`` with RIDGE-ODO's speed error against its training windows,
+``outage_odometer_uncertainty.csv`` with each network's predicted std against its speed error), notebook 05's
+``energy_odometer.csv`` (:mod:`bgfn.energy.odometer`), and a run at another model size made on another machine
+(``data/measured/odometer_sizes.csv``, :mod:`bgfn.evaluate.odometer_sizes`: the paper's size on a GPU). Nothing here
+is typed by hand; a missing table leaves its cells empty and its sentence says so.
 """
 
 from __future__ import annotations
@@ -195,12 +195,13 @@ def size_sentence(odo: OdometerInputs, durations) -> str:
         nets = {m: there.cell(m, d_long) for m in NETWORKS if there.has(m)}
         best = min(nets, key=nets.get) if nets else None
         reads = f", reading {INPUT_WORDS.get(r['inputs'], r['inputs'])}" if isinstance(r.get("inputs"), str) else ""
-        text = (f" Is it the model size? At the {r['size']} size{reads} (profile `{profile}`: up to {r['epochs_max']:.0f} "
-                f"epochs, batch {r['batch_size']:.0f}; run on {r['device']} on {r['date']} at commit {r['commit']}, "
-                f"`data/measured/odometer_sizes.csv`), in " + ("the same windows as here" if same else
-                                                              "its own windows") + f", {nhc} {pair(nhc)}")
+        text = (f" Is it the model size? At the {r['size']} size{reads} (profile `{profile}`: up to "
+                f"{r['epochs_max']:.0f} epochs, batch {r['batch_size']:.0f}; run on {r['device']} on {r['date']} at "
+                f"commit {r['commit']}, `data/measured/odometer_sizes.csv`), in "
+                + ("the same windows as here" if same else "its own windows") + f", {nhc} {pair(nhc)}")
         if there.has(SUBJECT_ODO):
-            text += (f", {SUBJECT_ODO} {pair(SUBJECT_ODO)} (p against {nhc} {'/'.join(_p(there.cell(SUBJECT_ODO, d, 'p_vs_nhc')) for d in durations)}"
+            p_there = "/".join(_p(there.cell(SUBJECT_ODO, d, "p_vs_nhc")) for d in durations)
+            text += (f", {SUBJECT_ODO} {pair(SUBJECT_ODO)} (p against {nhc} {p_there}"
                      f"; speed RMSE {there.cell(SUBJECT_ODO, d_long, 'speed_rmse_mps'):.2f} m/s at {d_long:g} s"
                      + (f" against {odo.cell(SUBJECT_ODO, d_long, 'speed_rmse_mps'):.2f} m/s here)"
                         if odo.has(SUBJECT_ODO) else ")"))

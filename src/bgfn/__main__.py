@@ -29,13 +29,12 @@ import argparse
 import sys
 import time
 
+from bgfn.config import results_dir
 from bgfn.errors import DataError
-from bgfn.evaluate import evaluation_setup, run_odometer_section
-from bgfn.evaluate import odometer_sizes
+from bgfn.evaluate import evaluation_setup, odometer_sizes, run_odometer_section
 from bgfn.evaluate.kernels import compile_kernels
 from bgfn.io import atomic_write_text
 from bgfn.parallel import Runner
-from bgfn.config import results_dir
 from bgfn.profile_schema import load_profile, with_overrides
 from bgfn.report import walltimes as walltimes_module
 from bgfn.train.runs import train_profile

@@ -312,11 +312,11 @@ def ensemble_tracks(tracks: dict, data: dict[int, lo.SpeedData], recalibrate: bo
         speed, std = lo.ensemble_speed(np.stack([m.speed for _, m in members]), np.stack([m.std for _, m in members]))
         val = data[fold].val
         v_speed, v_std = no.SpeedTrack(t, speed, std).at(val.t_end)
-        nis = lo.calibration_factor(v_speed - val.speed, v_std) ** 2
-        factor = float(np.sqrt(nis)) if recalibrate else 1.0
+        fitted = lo.calibration_factor(v_speed - val.speed, v_std)      # sqrt(NIS) on the validation windows
+        factor = fitted if recalibrate else 1.0
         out[(ensemble_label(label), fold, members[0][0])] = (
             no.SpeedTrack(t, speed, std * factor),
-            {"calibration": factor, "val_nis": nis, "epochs": np.nan, "lr": np.nan, "members": len(members),
+            {"calibration": factor, "val_nis": fitted ** 2, "epochs": np.nan, "lr": np.nan, "members": len(members),
              "val_rmse_mps": float(np.sqrt(np.nanmean((v_speed - val.speed) ** 2)))})
     return out
 
@@ -556,9 +556,9 @@ def plot_speed_series(series: dict, dataset: str, n_outages: int = 4):
     fig, axes = plt.subplots(1, max(len(pick), 1), figsize=(3.4 * max(len(pick), 1), 3.0), sharey=True,
                              squeeze=False)
     t, truth = np.asarray(series["time"], float), np.asarray(series["truth"], float)
+    singles = {k: v for k, v in series["tracks"].items() if not k.endswith(ENSEMBLE_SUFFIX)}  # one band each
     for ax, (s, d) in zip(axes[0], pick):
         m = (t >= s) & (t <= s + d)
-        singles = {k: v for k, v in series["tracks"].items() if not k.endswith(ENSEMBLE_SUFFIX)}  # one band each
         for colour, (label, (speed, std)) in zip(_BAND_COLOURS, singles.items()):
             ax.fill_between(t[m] - s, speed[m] - 2 * std[m], speed[m] + 2 * std[m], color=colour, alpha=0.15)
             ax.plot(t[m] - s, speed[m], color=colour, lw=1.0, label=f"{label} (+- 2 sigma)")

@@ -239,6 +239,13 @@ def odometer_rows(odo: OdometerInputs, durations) -> list[dict]:
     return rows
 
 
+def calibration_word(coverage: float) -> str:
+    """``calibrated`` when the +-2 sigma coverage lies in :data:`CALIBRATED_COVERAGE`, else ``overconfident``
+    (below) or ``underconfident`` (above)."""
+    lo, hi = CALIBRATED_COVERAGE
+    return "calibrated" if lo <= coverage <= hi else "overconfident" if coverage < lo else "underconfident"
+
+
 def _m(x: float) -> str:
     return "n/a" if not np.isfinite(x) else f"{x:.1f} m"
 
@@ -324,7 +331,7 @@ def answer_odometer(odo: OdometerInputs, durations) -> str:
         rmse = odo.cell(SUBJECT_ODO, d_long, "speed_rmse_mps")
         cov = odo.cell(SUBJECT_ODO, d_long, "coverage_2sigma")
         lo, hi = CALIBRATED_COVERAGE
-        calib = ("calibrated" if lo <= cov <= hi else "overconfident" if cov < lo else "underconfident")
+        calib = calibration_word(cov)
         out += (f" {SUBJECT_ODO} is {twin_comparison(odo, d_long)} at {d_long:g} s, {_energy(odo)}. Its speed error in "
                 f"the outages: RMSE {rmse:.2f} m/s, {100 * cov:.0f} % of epochs within its +-2 sigma ({calib}: "
                 f"{100 * lo:.0f}-{100 * hi:.0f} % is the band of a calibrated std).")
@@ -334,12 +341,11 @@ def answer_odometer(odo: OdometerInputs, durations) -> str:
         if odo.has(SUBJECT_ENS):
             n = odo.runs(SUBJECT_ODO)
             e_rmse, e_cov = (odo.cell(SUBJECT_ENS, d_long, c) for c in ("speed_rmse_mps", "coverage_2sigma"))
-            e_calib = "calibrated" if lo <= e_cov <= hi else "overconfident" if e_cov < lo else "underconfident"
             e_snn = odo.energy_uj(SUBJECT_ODO)
             out += (f" {SUBJECT_ODO}'s {n} seeds as one ensemble ({SUBJECT_ENS}: the mean speed, the std of the "
                     "members' mixture): "
                     f"{_m(odo.cell(SUBJECT_ENS, d_long))} at {d_long:g} s, speed RMSE {e_rmse:.2f} m/s, "
-                    f"{100 * e_cov:.0f} % within +-2 sigma ({e_calib}), at {n} times the energy per prediction"
+                    f"{100 * e_cov:.0f} % within +-2 sigma ({calibration_word(e_cov)}), at {n} times the energy per prediction"
                     + (f" ({n * e_snn:.3g} µJ)" if np.isfinite(e_snn) else "") + ".")
         be = odo.oracle_breakeven(d_long)
         at = odo.oracle_at(rmse, d_long)

@@ -89,8 +89,35 @@ def test_the_ridge_odometer_learns_speed_from_vibration_and_says_how_well():
     assert np.sqrt(np.mean(err ** 2)) == pytest.approx(model.std_mps)
     assert model.std_mps < 0.25 * np.std(val.speed)        # far better than the mean speed (log energy ~ 2 log v)
     assert (model.predict(val) >= 0).all()
+    # its residuals' correlation, from the same validation windows, travels with its track to the filter
+    assert model.correlation == od.error_correlation(val.t_end, err, np.full(err.size, model.std_mps))
+    assert model.track(ws).correlation == model.correlation >= 1.0
     with pytest.raises(DataError, match="windows"):
         od.RidgeOdometer.fit(train.subset(slice(0, 1)), val, RATE)
+
+
+def test_error_correlation_of_white_and_ar1_errors_and_of_a_shared_offset():
+    rng = np.random.default_rng(0)
+    t = np.arange(20000.0)
+    ones = np.ones(t.size)
+    assert od.error_correlation(t, rng.standard_normal(t.size), ones) < 1.2       # white: about 1
+    phi, e = 0.6, np.zeros(t.size)
+    for i, w in enumerate(rng.standard_normal(t.size)[1:], start=1):
+        e[i] = phi * e[i - 1] + w
+    # AR(1): 1 + 2 sum phi^k = (1 + phi) / (1 - phi) = 4 (3.98 up to 10 s); normalized: the std's size is no matter
+    assert od.error_correlation(t, e, 3.0 * ones) == pytest.approx(4.0, rel=0.1)
+    # a shared offset is an error no averaging removes: rho about 1 at every lag up to max_lag_s (10 s)
+    offset = 1.0 + 0.05 * rng.standard_normal(t.size)
+    assert od.error_correlation(t, offset, ones) == pytest.approx(21.0, rel=0.02)
+    # lags need min_pairs pairs: 12 epochs give lags 1 and 2 only (11 and 10 pairs)
+    assert od.error_correlation(t[:12], offset[:12], ones[:12]) == pytest.approx(5.0, rel=0.02)
+    # lags are multiples of step_s (the aid epochs' spacing): 2 s epochs, lags 2 ... 10 s
+    assert od.error_correlation(t[::2], offset[::2], ones[::2], step_s=2.0) == pytest.approx(11.0, rel=0.02)
+    # NaN residuals are left out; nothing to pair: 1 (fused as white)
+    nan = offset.copy()
+    nan[100:200] = np.nan
+    assert od.error_correlation(t, nan, ones) == pytest.approx(21.0, rel=0.02)
+    assert od.error_correlation([1.0], [0.3], [1.0]) == 1.0
 
 
 def test_speed_windows_skip_epochs_without_a_full_window():

@@ -81,6 +81,20 @@ def test_the_gate_keeps_a_wild_speed_out(biased):
     assert np.abs(ungated).max() > 100.0
 
 
+def test_a_correlated_track_is_fused_as_a_white_one_of_kappa_times_its_variance(biased):
+    """R = kappa std^2: a speed whose errors last kappa epochs weighs in the filter as a white one of std
+    sqrt(kappa) std, while its own std (what its coverage is scored against) stays as it was."""
+    ref, imu, con = biased
+    white = _track(ref, SPEED + 0.5, 0.2)                       # 0.5 m/s too fast all along: one correlated error
+    lasting = white.correlated(9.0)
+    assert np.array_equal(lasting.std, white.std) and lasting.scaled(2.0).correlation == 9.0
+    assert lasting.fused_std(0.2) == pytest.approx(0.6)
+    same = _along_error(imu, ref, od.Odometer(con, _track(ref, SPEED + 0.5, 0.6)))
+    assert np.abs(_along_error(imu, ref, od.Odometer(con, lasting)) - same).max() < 1e-9
+    with pytest.raises(DataError, match="correlation"):
+        white.correlated(0.5)
+
+
 def test_gated_std_drops_only_the_rows_beyond_their_threshold():
     P = np.eye(em.N_STATES) * 0.01
     H = np.zeros((3, em.N_STATES))

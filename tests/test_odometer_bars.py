@@ -223,6 +223,11 @@ def test_the_ensemble_of_two_oppositely_biased_seeds_is_unbiased_with_the_mixtur
     assert track.std == pytest.approx(np.full(t.size, np.sqrt(1.04))) and facts["calibration"] == 1.0
     assert facts["val_nis"] == pytest.approx(0.09 / 1.04)
     assert facts["val_rmse_mps"] == pytest.approx(0.3) and facts["members"] == 2
+    # the validation errors are one shared offset (0.3 m/s): rho = 1 at lags 1 ... 10 s (20 windows leave >= 10
+    # pairs), so kappa = 21; a fact always, fused only with correlation
+    assert facts["correlation"] == pytest.approx(21.0) and track.correlation == 1.0
+    lasting, _ = O.ensemble_tracks(tracks, data, correlation=True)[("NET-ODO-ENS", 0, 0)]
+    assert lasting.correlation == pytest.approx(21.0) and np.array_equal(lasting.std, track.std)
     # recalibrated: scaled so that the validation residuals have NIS = 1
     track, facts = O.ensemble_tracks(tracks, data, recalibrate=True)[("NET-ODO-ENS", 0, 0)]
     assert facts["calibration"] == pytest.approx(0.3 / np.sqrt(1.04))

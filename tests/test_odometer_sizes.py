@@ -78,8 +78,8 @@ def test_the_run_facts_name_the_commit_given_by_the_environment_first(monkeypatc
                         "odometer": {"train": {"optimizer": {"epochs": 1000, "batch_size": 8}}}}}
     cfg["evaluate"]["odometer"]["inputs"] = "imu"
     facts = json.loads(S.write_run_facts("paper", cfg, 0.0, "1 job").read_text())
-    assert (facts["commit"], facts["size"], facts["inputs"], facts["epochs_max"], facts["batch_size"]) == (
-        "feed123", "paper", "imu", 1000, 8)
+    assert (facts["commit"], facts["size"], facts["inputs"], facts["epochs_max"], facts["batch_size"],
+            facts["correlation"]) == ("feed123", "paper", "imu", 1000, 8, False)
 
 
 def test_the_command_line_records_only_a_finished_run(monkeypatch, tmp_path, capsys):
@@ -110,11 +110,14 @@ def test_the_size_sentence_pairs_only_the_same_windows_and_says_whether_a_networ
     assert text.startswith(" Is it the model size? At the paper size, reading the raw IMU samples (profile "
                            "`paper-odometer`: up to 1000 epochs, "
                            "batch 8; run on GPU X on 2026-01-01 at commit abc1234")
-    assert "in the same windows as here, INS+NHC 10.0/20.0 m, BGFN-ODO 15.0/40.0 m" in text
+    # recorded without a correlation column: fused as white, and the sentence says so
+    assert ("in the same windows as here (fused as white errors, R = std^2: recorded before "
+            "`evaluate.odometer.correlation`), INS+NHC 10.0/20.0 m, BGFN-ODO 15.0/40.0 m") in text
     assert "speed RMSE 2.60 m/s at 60 s against 2.50 m/s here" in text
     assert text.endswith("its best network at 60 s, MLP-ODO (30.0 m), does not beat INS+NHC significantly.")
     # other windows (INS+NHC 5 % off), and a network that beats INS+NHC there
     here.sized = _sized({30.0: 10.5, 60.0: 21.0}, {30.0: 8.0, 60.0: 15.0}, {30.0: 12.0, 60.0: 30.0}, p_odo=0.001)
+    here.sized = here.sized.assign(correlation=True)                          # fused with its correlation
     text = size_sentence(here, DURATIONS)
     assert "in its own windows, INS+NHC 10.5/21.0 m" in text
     assert text.endswith("its best network at 60 s, BGFN-ODO (15.0 m), beats INS+NHC (p < 0.05).")

@@ -99,6 +99,7 @@ SHARED_TABLES: dict[str, str] = {
     "odometer_networks": "outage_odometer_networks.csv",  # ... each network odometer: validation against outages
     "odometer_curve": "outage_odometer_curve.csv",  # ... the ridge's speed error against its training windows
     "odometer_uncertainty": "outage_odometer_uncertainty.csv",  # ... each network's predicted std against its error
+    "odometer_errors": "outage_odometer_errors.csv",  # ... each odometer's error: offset per outage and fluctuation
     "nees": "outage_nees.csv",                  # notebook 04: the filter's consistency in outages (bgfn.evaluate.nees)
     "variants": "outage_variants.csv",          # notebook 03: the learning-problem variants in the two outages
     "energy_odometer": "energy_odometer.csv",   # notebook 05: the learned odometers' energy (bgfn.energy.odometer)

@@ -203,7 +203,8 @@ SCHEMA = section(
                          seeds=seq(_SEED, min_len=1), hold_std_mps=_POS, ridge_alpha=_POS,
                          gate_probability=number(0, 1, lo_open=True, hi_open=True, null=True), lr_search=flag(),
                          inputs=text(*ODOMETER_INPUTS), val_blocks=integer(1), curve_folds=seq(integer(1)),
-                         ensemble=flag(), ensemble_recalibrate=flag(), train=Spec("section", null=True, fields=TRAIN.fields))),
+                         ensemble=flag(), ensemble_recalibrate=flag(), correlation=flag(), correlation_max_lag_s=_POS,
+                         train=Spec("section", null=True, fields=TRAIN.fields))),
     energy=section(
         e_mac_pj=_POS, e_ac_pj=_POS, dataset=text(null=True), seed=integer(0, null=True), allow_untrained=flag(),
         max_windows=integer(1, null=True), batch_size=integer(1), sweep_time_steps=seq(integer(1), min_len=1),

@@ -70,6 +70,8 @@ EVALUATE_DEFAULTS: dict[str, Any] = {
     # paper_outages: also in each drive's two evaluation outages (the profile's outage_windows), as one more fold;
     # lr_search: each odometer network's learning rate per fold from train.lr_search's grid (false: train.lr);
     # network_datasets: the drives whose networks train as odometers (null: every drive of the bars);
+    # correlation: the learned odometers fused with R = kappa std^2, kappa the integrated autocorrelation of their
+    # validation errors up to correlation_max_lag_s (bgfn.learning.odometry.error_correlation; false: fused as white);
     # curve_folds: the ridge refitted with the sweep's starts in each of these numbers of folds (bgfn.evaluate.ridge_curve;
     # more than the starts: one per start)
     "odometer": {"datasets": None, "methods": ["bgfn", "transformer", "at_lstm", "mlp"], "network_seeds": [0],
@@ -77,7 +79,8 @@ EVALUATE_DEFAULTS: dict[str, Any] = {
                  "paper_outages": False, "window_s": 2.0, "sigmas_mps": [0.05, 0.1, 0.2, 0.5, 1.0, 2.0], "walk_mps_per_sqrt_s": 0.0,
                  "seeds": [0], "hold_std_mps": 1.0, "ridge_alpha": 1.0, "gate_probability": 0.999,
                  "lr_search": False, "inputs": "band_frames", "val_blocks": 4, "curve_folds": [], "train": None,
-                 "ensemble": False, "ensemble_recalibrate": False},
+                 "ensemble": False, "ensemble_recalibrate": False, "correlation": False,
+                 "correlation_max_lag_s": 10.0},
 }
 
 

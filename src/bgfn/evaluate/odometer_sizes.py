@@ -37,7 +37,7 @@ MEASURED_FILE = PROJECT_ROOT / "data" / "measured" / "odometer_sizes.csv"
 MEASURED_NETWORKS = PROJECT_ROOT / "data" / "measured" / "odometer_sizes_networks.csv"
 #: What describes a run, before the table's own columns.
 RUN_COLUMNS: tuple[str, ...] = ("profile", "size", "inputs", "epochs_max", "batch_size", "device", "wall_s", "date",
-                                "commit")
+                                "commit", "correlation")
 #: The run's facts beside its tables.
 RUN_FACTS = "odometer_run.json"
 
@@ -51,11 +51,13 @@ def device_name() -> str:
 
 def write_run_facts(profile: str, cfg: dict, t0: float, jobs: str) -> Path:
     """``results/<profile>/odometer_run.json``: the device, the wall time since ``t0`` (``time.perf_counter``), the
-    runner (``jobs``), the networks' inputs, torch's version, the odometers' model size and budget, and the commit
-    (``$BGFN_COMMIT`` where set: a copy of the tree on another machine may carry no git, or another one's)."""
+    runner (``jobs``), the networks' inputs, torch's version, the odometers' model size and budget, whether the filter
+    fused them with their error correlation (``evaluate.odometer.correlation``), and the commit (``$BGFN_COMMIT``
+    where set: a copy of the tree on another machine may carry no git, or another one's)."""
     tc = (cfg["evaluate"]["odometer"].get("train") or {}).get("optimizer") or {}
     facts = {"profile": profile, "size": (cfg["evaluate"]["sweep"].get("train") or {}).get("size"),
              "inputs": cfg["evaluate"]["odometer"].get("inputs"),
+             "correlation": bool(cfg["evaluate"]["odometer"].get("correlation", False)),
              "epochs_max": tc.get("epochs"), "batch_size": tc.get("batch_size"), "device": device_name(),
              "wall_s": round(time.perf_counter() - t0, 1), "jobs": jobs, "torch": torch.__version__,
              "date": datetime.date.today().isoformat(), "commit": os.environ.get("BGFN_COMMIT") or git_commit()}

@@ -32,13 +32,20 @@ the paper's tables) as one more fold, :data:`PAPER_FOLD`: its networks and its r
 (:func:`paper_outage_table`), never into the sweep's statistics.
 
 How far each network's predicted std ranks its speed errors in the outages, the premise of weighing each speed by
-it: :mod:`bgfn.evaluate.odometer_uncertainty` (``outage_odometer_uncertainty.csv``).
+it: :mod:`bgfn.evaluate.odometer_uncertainty` (``outage_odometer_uncertainty.csv``). How much of each odometer's
+speed error in the outages is an offset that lasts the outage, which the filter cannot average away:
+:mod:`bgfn.evaluate.odometer_errors` (``outage_odometer_errors.csv``).
 
 With ``curve_folds``, the ridge is also refitted with the sweep's starts split into each of those numbers of folds:
 its speed error against its training windows per fold (:mod:`bgfn.evaluate.ridge_curve`,
 ``outage_odometer_curve.csv``).
 
 Every row is fused at the aid epochs (``nav.nhc.rate_hz``) through the chi-square gate (``gate_probability``).
+With ``correlation`` the learned odometers (the ridge, the networks, the ensembles) are fused with ``R = kappa
+std^2``, ``kappa`` the integrated autocorrelation of their errors on their validation windows
+(:func:`bgfn.learning.odometry.error_correlation`, lags up to ``correlation_max_lag_s``): their errors last
+several epochs, and fused as white they would count each epoch as new information. The learning-free bars keep
+``kappa = 1``: the oracle's noise is white by construction, and the held speed has no validation windows.
 Each row also carries the speed error the odometer made inside the outage against the reference's speed
 (``speed_rmse_mps``) and the share of epochs within its own 2 sigma (``coverage_2sigma``).
 """
@@ -58,6 +65,7 @@ from bgfn.config import SHARED_TABLES, odometer_datasets
 from bgfn.errors import DataError
 from bgfn.data import dataset_id, load_drive
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
+from bgfn.evaluate.odometer_errors import ERROR_COLUMNS, error_parts_lines, error_parts_table
 from bgfn.evaluate.odometer_uncertainty import UNCERTAINTY_COLUMNS, uncertainty_lines, uncertainty_table
 from bgfn.evaluate.plots import finish_duration_axes
 from bgfn.evaluate.ridge_curve import CURVE_COLUMNS, curve_lines, plot_curve, ridge_curve
@@ -97,7 +105,7 @@ PAPER_COLUMNS: tuple[str, ...] = ("dataset", "outage", "start_s", "duration_s", 
                                   "speed_rmse_mps", "coverage_2sigma", "runs")
 #: Columns of ``tables/outage_odometer_networks.csv`` (:func:`network_table`).
 NETWORK_COLUMNS: tuple[str, ...] = ("dataset", "method", "fold", "seed", "lr", "epochs", "val_rmse_mps", "calibration",
-                                    "outage_speed_rmse_mps", "outage_coverage_2sigma")
+                                    "correlation", "outage_speed_rmse_mps", "outage_coverage_2sigma")
 #: Columns of ``tables/outage_odometer_summary.csv`` (:func:`odometer_summary`).
 SUMMARY_COLUMNS: tuple[str, ...] = ("dataset", "duration_s", "method", "sigma_mps", "max_h_m", "ratio_to_nhc",
                                     "speed_rmse_mps", "coverage_2sigma", "runs", "p_vs_nhc")
@@ -178,7 +186,8 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
     data = {k: lo.build_speed_data(ws, fw, margin, val_fraction, int(oc["val_blocks"])) for k, fw in folds.items()}
     net_data = {k: lo.with_inputs(d, oc["inputs"], imu_rate) for k, d in data.items()}
     runs, tracks = [], {}
-    facts = {"ridge_std_mps": {}, "epochs": int(len(all_windows)), "paper_windows": folds.get(PAPER_FOLD, [])}
+    facts = {"ridge_std_mps": {}, "ridge_correlation": {}, "epochs": int(len(all_windows)),
+             "paper_windows": folds.get(PAPER_FOLD, [])}
     honest = {"time": all_windows.t_end, "truth": truth, "outages": [], "tracks": {}}   # each outage: its own fold's
 
     def keep(label: str, track: no.SpeedTrack, inside: np.ndarray) -> None:
@@ -187,9 +196,11 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
         speed[inside], std[inside] = track.at(all_windows.t_end[inside])
 
     for k, fw in folds.items():
-        model = lo.RidgeOdometer.fit(data[k].train, data[k].val, imu_rate, float(oc["ridge_alpha"]))
-        track = model.track(all_windows)
+        model = lo.RidgeOdometer.fit(data[k].train, data[k].val, imu_rate, float(oc["ridge_alpha"]),
+                                     float(oc["correlation_max_lag_s"]))
+        track = model.track(all_windows).correlated(model.correlation if oc["correlation"] else 1.0)
         facts["ridge_std_mps"][int(k)] = model.std_mps
+        facts["ridge_correlation"][int(k)] = model.correlation
         if k != PAPER_FOLD:             # the speed figure: the sweep's outages (the paper's two overlap them)
             keep(RIDGE, track, overlaps(all_windows.t_end, all_windows.t_end, np.array([[s, s + d] for s, d in fw])))
             honest["outages"] += fw
@@ -285,22 +296,27 @@ def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, data: d
     # either way (a thread count changes the order of floating-point sums; measured: a few 1e-4 m in 120 s outages)
     with torch_threads(optimizer_options(tc)["num_threads"]):
         for key, run, card in zip(keys, runs, cards):
-            tracks[key] = calibrated_track(run, card, all_windows)
+            tracks[key] = calibrated_track(run, card, all_windows, bool(oc["correlation"]),
+                                           float(oc["correlation_max_lag_s"]))
     if oc["ensemble"] and len(oc["network_seeds"]) > 1:
-        tracks.update(ensemble_tracks(tracks, data, bool(oc["ensemble_recalibrate"])))
+        tracks.update(ensemble_tracks(tracks, data, bool(oc["ensemble_recalibrate"]), bool(oc["correlation"]),
+                                      float(oc["correlation_max_lag_s"])))
     return tracks
 
 
-def ensemble_tracks(tracks: dict, data: dict[int, lo.SpeedData], recalibrate: bool = False) -> dict:
+def ensemble_tracks(tracks: dict, data: dict[int, lo.SpeedData], recalibrate: bool = False,
+                    correlation: bool = False, max_lag_s: float = lo.DEFAULT_MAX_LAG_S) -> dict:
     """Per network and fold, the equal-weight ensemble of its seeds' calibrated tracks (``tracks``, as
     :func:`network_odometers` returns them): the mean speed and the mixture's std
     (:func:`bgfn.learning.odometry.ensemble_speed`; a deep ensemble's predictive distribution, each member already
     calibrated on the validation windows). With ``recalibrate`` that std is scaled once more to NIS = 1 on the
     fold's validation windows (``data[fold].val``); off by default, because the members agree most there, next to
     their training windows, so the factor takes back the disagreement the ensemble adds where they do not (the
-    methods page gives the measurement). Keyed ``(BGFN-ODO-ENS, fold, lowest seed)``; its facts: the factor
-    applied (1 without ``recalibrate``), the NIS on the validation windows before it, the validation speed RMSE
-    and the members."""
+    methods page gives the measurement). With ``correlation`` the filter fuses it with the integrated
+    autocorrelation of its own validation errors (:func:`bgfn.learning.odometry.error_correlation`, up to
+    ``max_lag_s``), as each member. Keyed ``(BGFN-ODO-ENS, fold, lowest seed)``; its facts: the factor applied (1
+    without ``recalibrate``), the NIS on the validation windows before it, the validation speed RMSE, the
+    correlation and the members."""
     groups: dict = {}
     for (label, fold, seed), (track, _) in tracks.items():         # in the runs' order: fold, network, seed
         groups.setdefault((label, fold), []).append((seed, track))
@@ -314,24 +330,30 @@ def ensemble_tracks(tracks: dict, data: dict[int, lo.SpeedData], recalibrate: bo
         v_speed, v_std = no.SpeedTrack(t, speed, std).at(val.t_end)
         fitted = lo.calibration_factor(v_speed - val.speed, v_std)      # sqrt(NIS) on the validation windows
         factor = fitted if recalibrate else 1.0
+        kappa = lo.error_correlation(val.t_end, v_speed - val.speed, v_std * factor, max_lag_s=max_lag_s)
         out[(ensemble_label(label), fold, members[0][0])] = (
-            no.SpeedTrack(t, speed, std * factor),
+            no.SpeedTrack(t, speed, std * factor, kappa if correlation else 1.0),
             {"calibration": factor, "val_nis": fitted ** 2, "epochs": np.nan, "lr": np.nan, "members": len(members),
-             "val_rmse_mps": float(np.sqrt(np.nanmean((v_speed - val.speed) ** 2)))})
+             "val_rmse_mps": float(np.sqrt(np.nanmean((v_speed - val.speed) ** 2))), "correlation": kappa})
     return out
 
 
-def calibrated_track(run: train.TrainingRun, card: dict, all_windows: lo.SpeedWindows) -> tuple:
+def calibrated_track(run: train.TrainingRun, card: dict, all_windows: lo.SpeedWindows, correlation: bool = False,
+                     max_lag_s: float = lo.DEFAULT_MAX_LAG_S) -> tuple:
     """One trained odometer network's :class:`bgfn.nav.odometer.SpeedTrack` over ``all_windows``, its std calibrated
-    on its validation windows (:func:`bgfn.learning.odometry.calibration_factor`), and its facts."""
+    on its validation windows (:func:`bgfn.learning.odometry.calibration_factor`), and its facts. The integrated
+    autocorrelation of its calibrated validation errors (:func:`bgfn.learning.odometry.error_correlation`, up to
+    ``max_lag_s``) is always a fact; with ``correlation`` the filter fuses the track with it."""
     net = train.load_trained(Path(run.out_dir) / checkpoint_name(run.method, run.seed), device="cpu")
     obj = SpeedObjective(run.data)
     speed_val, std_val = obj.to_units(train.predict_normalized(net.model, net.norm.x(run.data.val.x)))
     factor = lo.calibration_factor(speed_val - run.data.val.speed, std_val)
+    kappa = lo.error_correlation(run.data.val.t_end, speed_val - run.data.val.speed, std_val * factor,
+                                 max_lag_s=max_lag_s)
     speed, std = obj.to_units(train.predict_normalized(net.model, net.norm.x(all_windows.x)))
-    return (no.SpeedTrack(all_windows.t_end, np.maximum(speed, 0.0), std * factor),
+    return (no.SpeedTrack(all_windows.t_end, np.maximum(speed, 0.0), std * factor, kappa if correlation else 1.0),
             {"calibration": factor, "val_rmse_mps": card["val_rmse_mps"], "epochs": card["epochs_run"],
-             "lr": train.method_lr(run.train_cfg, run.method)})
+             "lr": train.method_lr(run.train_cfg, run.method), "correlation": kappa})
 
 
 def odometer_train_config(train_section: dict, ecfg: dict) -> dict:
@@ -400,6 +422,7 @@ class OdometerSection:
     networks: pd.DataFrame | None = None
     curve: pd.DataFrame | None = None
     uncertainty: pd.DataFrame | None = None
+    errors: pd.DataFrame | None = None
 
     def markdown(self) -> str:
         """The summary at the sweep's durations as a Markdown table (:func:`odometer_table`), then the lines."""
@@ -413,6 +436,7 @@ class OdometerSection:
                           + [f"- {s}" for s in network_lines(self.networks)]
                           + [f"- {s}" for s in (uncertainty_lines(self.uncertainty) if self.uncertainty is not None
                                                 else [])]
+                          + [f"- {s}" for s in error_parts_lines(self.errors)]
                           + [f"- {s}" for s in curve_lines(self.curve if self.curve is not None
                                                            else pd.DataFrame(columns=list(CURVE_COLUMNS)))])
         if self.paper is None or self.paper.empty:
@@ -474,7 +498,11 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
     ranked = [u for u in (uncertainty_table(name, f["speed_series"]) for name, f in facts.items()
                           if f.get("speed_series")) if len(u)]
     uncertainty = (pd.concat(ranked, ignore_index=True) if ranked else pd.DataFrame(columns=list(UNCERTAINTY_COLUMNS)))
+    parts = [e for e in (error_parts_table(name, f["speed_series"], ecfg["sweep"]["durations_s"])
+                         for name, f in facts.items() if f.get("speed_series")) if len(e)]
+    errors = pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(columns=list(ERROR_COLUMNS))
     tables = Path(out) / "tables"
+    atomic_write_csv(tables / SHARED_TABLES["odometer_errors"], errors, float_format="%.4f")
     atomic_write_csv(tables / SHARED_TABLES["odometer_uncertainty"], uncertainty, float_format="%.4f")
     atomic_write_csv(tables / SHARED_TABLES["odometer_curve"], curve, float_format="%.4f")
     atomic_write_csv(tables / SHARED_TABLES["odometer_networks"], networks, float_format="%.4f")
@@ -498,12 +526,13 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
     if timings is not None:
         timings["odometer_s"] = time.perf_counter() - t0
     return OdometerSection(rows, summary, odometer_lines(summary) if len(summary) else [], facts, figures, paper,
-                           networks, curve, uncertainty)
+                           networks, curve, uncertainty, errors)
 
 
 def network_table(rows: pd.DataFrame, facts: dict) -> pd.DataFrame:
     """Every network odometer of the sweep's folds (dataset, method, fold, seed): its learning rate and epochs, its
-    speed RMSE on the validation block its std was calibrated on and the calibration factor, and in its own fold's
+    speed RMSE on the validation block its std was calibrated on, the calibration factor and the integrated
+    autocorrelation of its calibrated validation errors (:func:`bgfn.learning.odometry.error_correlation`), and in its own fold's
     outages at the sweep's longest duration its speed RMSE (the RMS over the starts: each holds the same epochs)
     and the share of epochs within its +-2 sigma (:data:`NETWORK_COLUMNS`). Where the outage RMSE is far above
     the validation RMSE, the validation block did not represent the outages, and the calibrated std is too small
@@ -518,6 +547,7 @@ def network_table(rows: pd.DataFrame, facts: dict) -> pd.DataFrame:
             r = r[r["duration_s"] == r["duration_s"].max()] if len(r) else r
             out.append({"dataset": name, **{k: net[k] for k in ("method", "fold", "seed", "lr", "epochs")},
                         "val_rmse_mps": net["val_rmse_mps"], "calibration": net["calibration"],
+                        "correlation": net.get("correlation", np.nan),
                         "outage_speed_rmse_mps": float(np.sqrt(np.mean(r["speed_rmse_mps"] ** 2))) if len(r)
                         else np.nan,
                         "outage_coverage_2sigma": float(r["coverage_2sigma"].mean()) if len(r) else np.nan})

@@ -271,6 +271,46 @@ def band_energies(x: np.ndarray, rate_hz: float, bands=BANDS_HZ) -> np.ndarray:
     return np.stack(out, axis=-1).reshape(len(x), -1)                                        # [M, C * B]
 
 
+#: Longest lag of :func:`error_correlation`, s: the validation blocks last about 15 s, so longer lags have few pairs.
+DEFAULT_MAX_LAG_S = 10.0
+#: Fewest pairs of windows a lag of :func:`error_correlation` needs to count.
+MIN_LAG_PAIRS = 10
+
+
+def error_correlation(t_end, residuals, std, step_s: float = 1.0, max_lag_s: float = DEFAULT_MAX_LAG_S,
+                      min_pairs: int = MIN_LAG_PAIRS) -> float:
+    """The integrated autocorrelation ``kappa = 1 + 2 sum_k rho_k`` of an odometer's normalized errors
+    ``z = residuals / std`` on held-out windows ending at ``t_end`` (s), the epochs ``step_s`` apart (the aid rate):
+    how many consecutive epochs carry the information of one independent measurement.
+
+    ``rho_k = mean(z_i z_j) / mean(z^2)`` over the pairs of windows ``k step_s`` apart (both held out: a block's
+    inside), about zero, not the mean, because a shared offset is an error the filter cannot average away either.
+    The sum stops before the first lag whose ``rho_k <= 0`` (Geyer's initial positive sequence, as for an MCMC
+    chain's effective sample size), at ``max_lag_s``, or where fewer than ``min_pairs`` pairs are left. White
+    errors give 1; an AR(1) error of coefficient ``phi`` gives about ``(1 + phi) / (1 - phi)``. The filter fuses
+    each speed with ``R = kappa std^2`` (:class:`bgfn.nav.odometer.SpeedTrack`), so that ``kappa`` correlated
+    epochs weigh as much as one independent one; non-finite pairs are left out, and 1 is returned when no lag has
+    enough pairs."""
+    t, r, s = (np.asarray(a, dtype=float).ravel() for a in (t_end, residuals, std))
+    ok = np.isfinite(t) & np.isfinite(r) & np.isfinite(s) & (s > 0)
+    t, z = t[ok], r[ok] / s[ok]
+    if z.size < 2 or not np.any(z):
+        return 1.0
+    step = np.round(t / step_s).astype(np.int64)              # epoch numbers on the aid grid
+    where = {int(e): i for i, e in enumerate(step)}
+    power = float(np.mean(z ** 2))
+    total = 0.0
+    for k in range(1, int(np.floor(max_lag_s / step_s + 1e-9)) + 1):
+        pairs = np.array([(i, where[int(e) + k]) for i, e in enumerate(step) if int(e) + k in where], dtype=np.int64)
+        if len(pairs) < min_pairs:
+            break
+        rho = float(np.mean(z[pairs[:, 0]] * z[pairs[:, 1]])) / power
+        if rho <= 0:
+            break
+        total += rho
+    return 1.0 + 2.0 * total
+
+
 @dataclass
 class RidgeOdometer:
     """``RIDGE-ODO``: ridge regression of the forward speed on :func:`band_energies` (module docstring).
@@ -287,6 +327,8 @@ class RidgeOdometer:
         IMU rate the features were computed at.
     alpha : float
         Ridge penalty on the standardized features.
+    correlation : float
+        The integrated autocorrelation of its validation residuals (:func:`error_correlation`, >= 1).
     """
 
     mean: np.ndarray
@@ -296,10 +338,13 @@ class RidgeOdometer:
     std_mps: float
     rate_hz: float
     alpha: float
+    correlation: float = 1.0
 
     @classmethod
-    def fit(cls, train: SpeedWindows, val: SpeedWindows, rate_hz: float, alpha: float = 1.0) -> "RidgeOdometer":
-        """Fit on ``train`` (closed form), the std from the residuals on ``val``."""
+    def fit(cls, train: SpeedWindows, val: SpeedWindows, rate_hz: float, alpha: float = 1.0,
+            max_lag_s: float = DEFAULT_MAX_LAG_S) -> "RidgeOdometer":
+        """Fit on ``train`` (closed form), the std and the correlation (up to ``max_lag_s``) from the residuals on
+        ``val``."""
         if len(train) < 2 or len(val) < 1:
             raise DataError("odometer", "windows", "at least 2 training and 1 validation window",
                             f"{len(train)} and {len(val)}")
@@ -310,7 +355,10 @@ class RidgeOdometer:
         y = train.speed - train.speed.mean()
         coef = np.linalg.solve(z.T @ z + alpha * np.eye(z.shape[1]), z.T @ y)
         model = cls(mean, scale, coef, float(train.speed.mean()), float("nan"), float(rate_hz), float(alpha))
-        model.std_mps = float(np.sqrt(np.mean((model.predict(val) - val.speed) ** 2)))
+        residuals = model.predict(val) - val.speed
+        model.std_mps = float(np.sqrt(np.mean(residuals ** 2)))
+        model.correlation = error_correlation(val.t_end, residuals, np.full(residuals.size, model.std_mps),
+                                              max_lag_s=max_lag_s)
         return model
 
     def predict(self, ws: SpeedWindows) -> np.ndarray:
@@ -319,9 +367,10 @@ class RidgeOdometer:
         return np.maximum(z @ self.coef + self.intercept, 0.0)
 
     def track(self, ws: SpeedWindows) -> SpeedTrack:
-        """The prediction of each window at the epoch it ends at, each with the validation std (a filter's aid)."""
+        """The prediction of each window at the epoch it ends at, each with the validation std (a filter's aid),
+        and the validation residuals' :attr:`correlation`."""
         pred = self.predict(ws)
-        return SpeedTrack(ws.t_end, pred, np.full(pred.size, self.std_mps))
+        return SpeedTrack(ws.t_end, pred, np.full(pred.size, self.std_mps), self.correlation)
 
 
 def beta_nll(mean, log_var, target, beta: float = 0.5):

@@ -5,7 +5,9 @@ accumulate, with its own uncertainty, and the filter owns the fusion). At every 
 constraints (:mod:`bgfn.nav.constraints`: the NHC rows, or ZUPT where the vehicle stands still) the odometer
 adds the forward row of the vehicle-frame velocity::
 
-    z = v^v_x = speed + w,   w ~ N(0, std^2)
+    z = v^v_x = speed + w,   w ~ N(0, kappa std^2)
+
+(``kappa``: the track's error correlation from epoch to epoch, :class:`SpeedTrack`; 1 for white errors.)
 
 With ``M = R_vb C_bn^T`` (NED -> vehicle frame) the computed value is ``v^v_computed = v^v_true + M dV - M [v x] phi``
 (the same linearization as the NHC rows), so the forward row of ``H`` is ``M_x`` on ``dV`` and ``-(M [v x])_x`` on
@@ -42,11 +44,18 @@ DEFAULT_MAX_AGE_S = 1.5
 @dataclass(frozen=True)
 class SpeedTrack:
     """Forward speeds in the vehicle frame with their std: ``time`` [K] (s, increasing), ``speed`` [K] (m/s),
-    ``std`` [K] (m/s, > 0; NaN or a non-positive std: no measurement then)."""
+    ``std`` [K] (m/s, > 0; NaN or a non-positive std: no measurement then).
+
+    ``correlation`` (>= 1, 1: white errors) is the integrated autocorrelation ``kappa`` of the track's errors from
+    one aid epoch to the next (:func:`bgfn.learning.odometry.error_correlation`). ``std`` stays each speed's own
+    uncertainty (what its 2-sigma coverage is scored against); the filter fuses it with ``R = kappa std^2``, the
+    textbook inflation for time-correlated measurement noise: ``kappa`` consecutive speeds then carry the
+    information of one independent speed, not ``kappa`` times as much (:meth:`fused_std`)."""
 
     time: np.ndarray
     speed: np.ndarray
     std: np.ndarray
+    correlation: float = 1.0
 
     def __post_init__(self):
         t, s, d = (np.asarray(a, dtype=float).ravel() for a in (self.time, self.speed, self.std))
@@ -55,9 +64,13 @@ class SpeedTrack:
                             f"{t.size}, {s.size}, {d.size}")
         if t.size > 1 and np.any(np.diff(t) <= 0):
             raise DataError("speed track", "time", "strictly increasing times", "a repeated or earlier time")
+        if not (np.isfinite(self.correlation) and self.correlation >= 1.0):
+            raise DataError("speed track", "correlation", "an integrated autocorrelation >= 1 (1: white errors)",
+                            repr(self.correlation))
         object.__setattr__(self, "time", t)
         object.__setattr__(self, "speed", s)
         object.__setattr__(self, "std", d)
+        object.__setattr__(self, "correlation", float(self.correlation))
 
     def at(self, time, max_age_s: float = DEFAULT_MAX_AGE_S) -> tuple[np.ndarray, np.ndarray]:
         """``(speed, std)`` in force at each of ``time`` (s): the last value at or before it, NaN when there is
@@ -75,7 +88,15 @@ class SpeedTrack:
         """The same speeds with every std times ``factor`` (a calibration fitted so that the NIS is 1)."""
         if not (np.isfinite(factor) and factor > 0):
             raise DataError("speed track", "calibration", "a positive factor", repr(factor))
-        return SpeedTrack(self.time, self.speed, self.std * float(factor))
+        return SpeedTrack(self.time, self.speed, self.std * float(factor), self.correlation)
+
+    def correlated(self, correlation: float) -> "SpeedTrack":
+        """The same speeds and stds with the integrated autocorrelation ``correlation`` (1: fused as white)."""
+        return SpeedTrack(self.time, self.speed, self.std, correlation)
+
+    def fused_std(self, std) -> np.ndarray:
+        """The std the filter fuses a speed of std ``std`` with: ``sqrt(correlation) std`` (class docstring)."""
+        return np.sqrt(self.correlation) * np.asarray(std, dtype=float)
 
 
 def speed_errors(track: SpeedTrack | None, t: np.ndarray, truth: np.ndarray, start: float,
@@ -131,6 +152,7 @@ class Odometer:
         """The vehicle constraints' schedule (:meth:`Constraints.schedule`) with the speed in force at each step."""
         vehicle = self.constraints.schedule(time, source, hold_at)
         speed, std = self.track.at(time, self.max_age_s)
+        std = self.track.fused_std(std)                       # R = kappa std^2 (SpeedTrack's docstring)
         p = self.gate_probability
         if p is not None and not 0.0 < p < 1.0:
             raise DataError(source, "gate_probability", "a probability in (0, 1), or None for no gate", repr(p))

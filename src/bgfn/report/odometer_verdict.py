@@ -20,6 +20,7 @@ import pandas as pd
 
 from bgfn.data.names import dataset_id
 from bgfn.evaluate.odometer_sizes import read_measured
+from bgfn.evaluate.odometer_errors import offset_bar_mps
 from bgfn.evaluate.odometer_uncertainty import uncertainty_sentence
 from bgfn.evaluate.odometers import HOLD, ORACLE, RIDGE
 from bgfn.paper import METHOD_LABELS, ensemble_label, nhc_label, odometer_label
@@ -58,6 +59,8 @@ class OdometerInputs:
     curve: pd.DataFrame | None = None   # outage_odometer_curve.csv (RIDGE-ODO against its training windows)
     uncertainty: pd.DataFrame | None = None   # outage_odometer_uncertainty.csv (each network's std against its error)
     sized: pd.DataFrame | None = None   # data/measured/odometer_sizes.csv (the odometers at another size, elsewhere)
+    errors: pd.DataFrame | None = None  # outage_odometer_errors.csv (each odometer's offset per outage, fluctuation)
+    networks: pd.DataFrame | None = None    # outage_odometer_networks.csv (each network: calibration, correlation)
 
     @property
     def measured(self) -> bool:
@@ -148,14 +151,16 @@ def read_odometer_inputs(odometer: pd.DataFrame | None, summary: pd.DataFrame | 
                          energy: pd.DataFrame | None, dataset: str,
                          paper: pd.DataFrame | None = None, curve: pd.DataFrame | None = None,
                          uncertainty: pd.DataFrame | None = None,
-                         sized: pd.DataFrame | None = None) -> OdometerInputs:
+                         sized: pd.DataFrame | None = None, errors: pd.DataFrame | None = None,
+                         networks: pd.DataFrame | None = None) -> OdometerInputs:
     """The tables restricted to ``dataset`` (the energy table only when its ``dataset`` column names it);
     ``sized`` defaults to the recorded runs at other sizes (:func:`bgfn.evaluate.odometer_sizes.read_measured`)."""
     def of(df):
         return None if df is None or "dataset" not in df.columns else df[same_dataset(df["dataset"], dataset)]
 
     sized = read_measured() if sized is None else sized
-    return OdometerInputs(of(odometer), of(summary), of(energy), of(paper), of(curve), of(uncertainty), of(sized))
+    return OdometerInputs(of(odometer), of(summary), of(energy), of(paper), of(curve), of(uncertainty), of(sized),
+                          of(errors), of(networks))
 
 
 def curve_sentence(odo: OdometerInputs) -> str:
@@ -171,6 +176,38 @@ def curve_sentence(odo: OdometerInputs) -> str:
             f"({hi['n_train'] / lo['n_train']:.1f} times as many), and its speed RMSE in its "
             f"{hi['duration_s']:g} s outages goes from {lo['outage_speed_rmse_mps']:.2f} to "
             f"{hi['outage_speed_rmse_mps']:.2f} m/s (notebook 04's learning curve).")
+
+
+def offset_sentence(odo: OdometerInputs, duration: float) -> str:
+    """Why white noise of the oracle's size helps and BGFN-ODO's error does not: its offset per outage against the
+    offset that alone costs INS+NHC's whole error, its fluctuation, and its correlation in the outages against the
+    kappa it was fused with (``outage_odometer_errors.csv``, ``outage_odometer_networks.csv``; empty without them)."""
+    e = odo.errors
+    if e is None or e.empty:
+        return ""
+    sel = e[(e["method"] == SUBJECT_ODO) & np.isclose(e["duration_s"].astype(float), duration)]
+    if sel.empty:
+        return ""
+    r, nhc = sel.iloc[0], nhc_label("INS")
+    bar = offset_bar_mps(odo.cell(nhc, duration), duration)
+    n = odo.networks
+    fused = (n.loc[n["method"] == SUBJECT_ODO, "correlation"].median()
+             if n is not None and "correlation" in n.columns else float("nan"))
+    return (f" Why does white noise help and its error not? Over the first {duration:g} s of an outage "
+            f"{SUBJECT_ODO}'s speed is off by {r['offset_rms_mps']:.2f} m/s on average (RMS over the outages), an "
+            f"offset the filter cannot average away (alone, more than {bar:.2f} m/s costs as much as {nhc}'s whole "
+            f"{_m(odo.cell(nhc, duration))} in {duration:g} s), and fluctuates by {r['fluctuation_mps']:.2f} m/s around "
+            f"it; consecutive errors there carry the information of one in {r['outage_correlation']:.1f} epochs"
+            + (f", against {fused:.1f} on its validation windows (the kappa `evaluate.odometer.correlation` fuses it "
+               "with)"
+               if np.isfinite(fused) else "") + ".")
+
+
+def fusion_words(correlation) -> str:
+    """How a recorded run fused its odometers (its ``correlation`` column; absent or NaN: recorded before it)."""
+    if isinstance(correlation, (bool, np.bool_)) or correlation in (0, 1, "True", "False"):
+        return "" if str(correlation) in ("True", "1") else " (fused as white errors, R = std^2)"
+    return " (fused as white errors, R = std^2: recorded before `evaluate.odometer.correlation`)"
 
 
 def size_sentence(odo: OdometerInputs, durations) -> str:
@@ -198,7 +235,8 @@ def size_sentence(odo: OdometerInputs, durations) -> str:
         text = (f" Is it the model size? At the {r['size']} size{reads} (profile `{profile}`: up to "
                 f"{r['epochs_max']:.0f} epochs, batch {r['batch_size']:.0f}; run on {r['device']} on {r['date']} at "
                 f"commit {r['commit']}, `data/measured/odometer_sizes.csv`), in "
-                + ("the same windows as here" if same else "its own windows") + f", {nhc} {pair(nhc)}")
+                + ("the same windows as here" if same else "its own windows") + fusion_words(r.get("correlation"))
+                + f", {nhc} {pair(nhc)}")
         if there.has(SUBJECT_ODO):
             p_there = "/".join(_p(there.cell(SUBJECT_ODO, d, "p_vs_nhc")) for d in durations)
             text += (f", {SUBJECT_ODO} {pair(SUBJECT_ODO)} (p against {nhc} {p_there}"
@@ -353,6 +391,7 @@ def answer_odometer(odo: OdometerInputs, durations) -> str:
                 + (f"up to a noise of {be:g} m/s" if np.isfinite(be) else "at no noise level of its grid")
                 + (f"; at {SUBJECT_ODO}'s speed error it reaches {_m(at)}" if np.isfinite(at) else "")
                 + " (how accurate a speed must be, and what better learning could give with this filter).")
+        out += offset_sentence(odo, d_long)
     return out + curve_sentence(odo) + size_sentence(odo, durations)
 
 

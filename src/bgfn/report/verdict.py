@@ -99,7 +99,9 @@ class VerdictInputs:
                                         read_csv(tables / SHARED_TABLES["energy_odometer"]), dataset,
                                         read_csv(tables / SHARED_TABLES["odometer_paper"]),
                                         read_csv(tables / SHARED_TABLES["odometer_curve"]),
-                                        read_csv(tables / SHARED_TABLES["odometer_uncertainty"])),
+                                        read_csv(tables / SHARED_TABLES["odometer_uncertainty"]),
+                                        errors=read_csv(tables / SHARED_TABLES["odometer_errors"]),
+                                        networks=read_csv(tables / SHARED_TABLES["odometer_networks"])),
                    of(read_csv(tables / SHARED_TABLES["nees"])), _platform(out, dataset),
                    of(read_csv(tables / SHARED_TABLES["kf_ins_drift"])))
 

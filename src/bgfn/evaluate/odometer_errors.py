@@ -1,0 +1,95 @@
+"""Why a learned odometer loses where an oracle speed with as much white noise wins: its speed error in the outages
+split into an offset that lasts the outage and a fluctuation around it (beyond the paper; issue 24).
+
+The filter averages a white error away: ``n`` speeds of white noise ``sigma`` leave ``sigma / sqrt(n)`` of it,
+which is why the oracle speed (:mod:`bgfn.evaluate.odometers`, ``ORACLE-SPEED``) helps up to a noise of metres per
+second. An offset shared by every epoch of an outage it cannot average: an offset ``b`` alone moves the solution
+``b t`` along the track. This module measures both on notebook 04's honest speed series (``speed_series`` of
+:func:`bgfn.evaluate.odometers.odometer_rows`: each sweep outage predicted by its own fold's odometer, the networks'
+first seed), per odometer and duration ``D`` (the first ``D`` seconds of each outage):
+
+- ``offset_rms_mps``: the RMS over the outages of each outage's mean speed error;
+- ``fluctuation_mps``: the RMS over the outages of the error's std around that mean;
+- ``outage_correlation``: the median over the outages of the integrated autocorrelation of the normalized error
+  (error / predicted std; :func:`bgfn.learning.odometry.error_correlation`): how many epochs carry one epoch's worth
+  of information in the outages, against the ``kappa`` the filter fused the odometer with (its validation windows',
+  ``tables/outage_odometer_networks.csv``);
+- :func:`offset_bar_mps`: the offset that alone would move the car as far along the track over ``D`` as INS+NHC's
+  median max error: an odometer whose outage offset is larger cannot beat INS+NHC however it is weighted.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from bgfn.learning.odometry import error_correlation
+
+#: Columns of ``tables/outage_odometer_errors.csv`` (:func:`error_parts_table`).
+ERROR_COLUMNS: tuple[str, ...] = ("dataset", "method", "duration_s", "outages", "speed_rmse_mps", "offset_rms_mps",
+                                  "fluctuation_mps", "outage_correlation")
+
+
+def error_parts_table(dataset: str, series: dict | None, durations) -> pd.DataFrame:
+    """Per odometer of ``series`` and duration of ``durations`` (s): its speed error in the outages split into the
+    offset per outage and the fluctuation around it, and its correlation there (module docstring).
+
+    Parameters
+    ----------
+    dataset : str
+    series : dict or None
+        ``{"time": [K] s, "truth": [K] m/s, "outages": [(start, duration), ...], "tracks": {label: (speed [K],
+        std [K])}}``, NaN outside the outages.
+    durations : sequence of float
+        Seconds from each outage's start; an outage shorter than a duration is scored over what it has.
+
+    Returns
+    -------
+    DataFrame
+        :data:`ERROR_COLUMNS`, a row per odometer and duration (none without tracks).
+    """
+    rows = []
+    tracks = (series or {}).get("tracks") or {}
+    if not tracks:
+        return pd.DataFrame(columns=list(ERROR_COLUMNS))
+    t, truth = np.asarray(series["time"], dtype=float), np.asarray(series["truth"], dtype=float)
+    for label, (speed, std) in tracks.items():
+        err_all, std_all = np.asarray(speed, dtype=float) - truth, np.asarray(std, dtype=float)
+        for d in durations:
+            offsets, spreads, kappas, errors = [], [], [], []
+            for start, length in series["outages"]:
+                m = (t > start) & (t <= start + min(float(d), float(length)) + 1e-6) & np.isfinite(err_all)
+                if m.sum() < 2:
+                    continue
+                e = err_all[m]
+                offsets.append(e.mean())
+                spreads.append(e.std())
+                kappas.append(error_correlation(t[m], e, std_all[m]))
+                errors.append(e)
+            if not offsets:
+                continue
+            rows.append({"dataset": dataset, "method": label, "duration_s": float(d), "outages": len(offsets),
+                         "speed_rmse_mps": float(np.sqrt(np.mean(np.concatenate(errors) ** 2))),
+                         "offset_rms_mps": float(np.sqrt(np.mean(np.square(offsets)))),
+                         "fluctuation_mps": float(np.sqrt(np.mean(np.square(spreads)))),
+                         "outage_correlation": float(np.median(kappas))})
+    return pd.DataFrame(rows, columns=list(ERROR_COLUMNS))
+
+
+def offset_bar_mps(max_error_m: float, duration_s: float) -> float:
+    """The speed offset (m/s) that alone moves the solution ``max_error_m`` along the track in ``duration_s``: an
+    odometer off by more than INS+NHC's median max error over the outage's length loses to it."""
+    return float(max_error_m) / float(duration_s)
+
+
+def error_parts_lines(table: pd.DataFrame) -> list[str]:
+    """Per dataset and duration: each odometer's offset and fluctuation in the outages (notebook 04)."""
+    if table is None or table.empty:
+        return []
+    lines = []
+    for (ds, d), g in table.groupby(["dataset", "duration_s"], sort=False):
+        lines.append(f"{ds}, the first {d:g} s of each outage: the learned speed's error as an offset per outage (RMS "
+                     "over the outages) and a fluctuation around it, with its integrated autocorrelation there: "
+                     + "; ".join(f"{r['method']} {r['offset_rms_mps']:.2f} and {r['fluctuation_mps']:.2f} m/s "
+                                 f"(kappa {r['outage_correlation']:.1f})" for _, r in g.iterrows()) + ".")
+    return lines

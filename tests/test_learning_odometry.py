@@ -180,6 +180,32 @@ def test_validation_blocks_spread_over_the_drive_and_keep_away_from_training():
         lo_, hi_ = data.val.t_start, data.val.t_end
         assert not ((data.train.t_start[:, None] <= hi_[None]) & (lo_[None] <= data.train.t_end[:, None])).any()
         assert not ((data.val.t_end > 290.0) & (data.val.t_start < 340.0)).any()
+    assert one.calibration is None and one.calibration_windows is one.val and one.info["n_calibration"] == 0
+
+
+def _quarters(ws):
+    """The quarter of a 600 s drive each run of consecutive windows of ``ws`` lies in."""
+    runs = np.split(ws.t_end, np.flatnonzero(np.diff(ws.t_end) > 1.5) + 1)
+    return [round(float(np.mean(r)) // 150) for r in runs]
+
+
+def test_calibration_blocks_are_every_other_validation_block_and_no_training_window_touches_them():
+    imu, t, speed = _vibrating_drive()
+    epochs = np.arange(5.0, 595.0, 1.0)
+    ws = od.speed_windows(imu, epochs, 200, np.interp(epochs, t, speed))
+    four = od.build_speed_data(ws, [(300.0, 30.0)], margin_s=10.0, val_fraction=0.2, val_blocks=4)
+    split = od.build_speed_data(ws, [(300.0, 30.0)], margin_s=10.0, val_fraction=0.2, val_blocks=4,
+                                calibration_blocks=True)
+    assert _quarters(split.val) == [0, 2] and _quarters(split.calibration) == [1, 3]   # 1st, 3rd stop; 2nd, 4th calibrate
+    assert sorted([*split.val.t_end, *split.calibration.t_end]) == list(four.val.t_end)
+    assert split.calibration_windows is split.calibration and split.info["n_calibration"] == len(split.calibration)
+    assert np.array_equal(split.train.t_end, four.train.t_end)                      # the same training windows
+    # through the networks' front end the calibration windows travel with the split
+    framed = od.with_inputs(split, "band_frames", RATE)
+    assert np.array_equal(framed.calibration.t_end, split.calibration.t_end) and framed.calibration.x.ndim == 3
+    # one block has nothing to alternate: it does both
+    one = od.build_speed_data(ws, [(300.0, 30.0)], margin_s=10.0, val_fraction=0.2, calibration_blocks=True)
+    assert one.calibration is None
 
 
 def test_a_network_odometer_learns_speed_and_its_uncertainty(tmp_path):

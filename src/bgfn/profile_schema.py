@@ -204,6 +204,7 @@ SCHEMA = section(
                          gate_probability=number(0, 1, lo_open=True, hi_open=True, null=True), lr_search=flag(),
                          inputs=text(*ODOMETER_INPUTS), val_blocks=integer(1), curve_folds=seq(integer(1)),
                          ensemble=flag(), ensemble_recalibrate=flag(), correlation=flag(), correlation_max_lag_s=_POS,
+                         calibration_blocks=flag(),
                          train=Spec("section", null=True, fields=TRAIN.fields))),
     energy=section(
         e_mac_pj=_POS, e_ac_pj=_POS, dataset=text(null=True), seed=integer(0, null=True), allow_untrained=flag(),

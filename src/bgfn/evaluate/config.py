@@ -72,6 +72,8 @@ EVALUATE_DEFAULTS: dict[str, Any] = {
     # network_datasets: the drives whose networks train as odometers (null: every drive of the bars);
     # correlation: the learned odometers fused with R = kappa std^2, kappa the integrated autocorrelation of their
     # validation errors up to correlation_max_lag_s (bgfn.learning.odometry.error_correlation; false: fused as white);
+    # calibration_blocks: every other validation block calibrates the odometers' std and kappa, the others stop the
+    # networks' training (false: all the blocks do both);
     # curve_folds: the ridge refitted with the sweep's starts in each of these numbers of folds (bgfn.evaluate.ridge_curve;
     # more than the starts: one per start)
     "odometer": {"datasets": None, "methods": ["bgfn", "transformer", "at_lstm", "mlp"], "network_seeds": [0],
@@ -80,7 +82,7 @@ EVALUATE_DEFAULTS: dict[str, Any] = {
                  "seeds": [0], "hold_std_mps": 1.0, "ridge_alpha": 1.0, "gate_probability": 0.999,
                  "lr_search": False, "inputs": "band_frames", "val_blocks": 4, "curve_folds": [], "train": None,
                  "ensemble": False, "ensemble_recalibrate": False, "correlation": False,
-                 "correlation_max_lag_s": 10.0},
+                 "correlation_max_lag_s": 10.0, "calibration_blocks": False},
 }
 
 

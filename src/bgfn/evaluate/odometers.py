@@ -15,7 +15,9 @@ on a drive, with the same starts, folds and durations as the sweep (:func:`bgfn.
   (:class:`bgfn.train.objectives.SpeedObjective`) with the sweep's budget and ``train`` laid over it
   (:func:`odometer_train_config`) and the profile's ``train.lr`` (the same for every network: notebook 03's search
   tuned its rates for the increments), their std calibrated on their validation windows (NIS = 1; ``val_blocks``
-  blocks spread over the drive) (:func:`network_odometers`);
+  blocks spread over the drive; with ``calibration_blocks`` every other block calibrates and the others stop the
+  training, so that the std is fitted on windows early stopping has not chosen the network on: the ridge's std
+  and every odometer's ``kappa`` come from the same calibration windows) (:func:`network_odometers`);
 - ``BGFN-ODO-ENS`` ... (``ensemble`` and two or more ``network_seeds``): per fold the equal-weight ensemble of a
   network's seeds (:func:`bgfn.learning.odometry.ensemble_speed`: the mean speed, the std of the Gaussian mixture,
   the members' own uncertainty plus their disagreement; with ``ensemble_recalibrate`` scaled once more to NIS = 1
@@ -183,7 +185,8 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
         folds[PAPER_FOLD] = paper
     # one honest split per fold: the ridge and the networks learn from the same windows, the networks through
     # their front end (evaluate.odometer.inputs)
-    data = {k: lo.build_speed_data(ws, fw, margin, val_fraction, int(oc["val_blocks"])) for k, fw in folds.items()}
+    data = {k: lo.build_speed_data(ws, fw, margin, val_fraction, int(oc["val_blocks"]), bool(oc["calibration_blocks"]))
+            for k, fw in folds.items()}
     net_data = {k: lo.with_inputs(d, oc["inputs"], imu_rate) for k, d in data.items()}
     runs, tracks = [], {}
     facts = {"ridge_std_mps": {}, "ridge_correlation": {}, "epochs": int(len(all_windows)),
@@ -196,7 +199,7 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
         speed[inside], std[inside] = track.at(all_windows.t_end[inside])
 
     for k, fw in folds.items():
-        model = lo.RidgeOdometer.fit(data[k].train, data[k].val, imu_rate, float(oc["ridge_alpha"]),
+        model = lo.RidgeOdometer.fit(data[k].train, data[k].calibration_windows, imu_rate, float(oc["ridge_alpha"]),
                                      float(oc["correlation_max_lag_s"]))
         track = model.track(all_windows).correlated(model.correlation if oc["correlation"] else 1.0)
         facts["ridge_std_mps"][int(k)] = model.std_mps
@@ -326,7 +329,7 @@ def ensemble_tracks(tracks: dict, data: dict[int, lo.SpeedData], recalibrate: bo
             continue
         t = members[0][1].time
         speed, std = lo.ensemble_speed(np.stack([m.speed for _, m in members]), np.stack([m.std for _, m in members]))
-        val = data[fold].val
+        val = data[fold].calibration_windows
         v_speed, v_std = no.SpeedTrack(t, speed, std).at(val.t_end)
         fitted = lo.calibration_factor(v_speed - val.speed, v_std)      # sqrt(NIS) on the validation windows
         factor = fitted if recalibrate else 1.0
@@ -346,10 +349,10 @@ def calibrated_track(run: train.TrainingRun, card: dict, all_windows: lo.SpeedWi
     ``max_lag_s``) is always a fact; with ``correlation`` the filter fuses the track with it."""
     net = train.load_trained(Path(run.out_dir) / checkpoint_name(run.method, run.seed), device="cpu")
     obj = SpeedObjective(run.data)
-    speed_val, std_val = obj.to_units(train.predict_normalized(net.model, net.norm.x(run.data.val.x)))
-    factor = lo.calibration_factor(speed_val - run.data.val.speed, std_val)
-    kappa = lo.error_correlation(run.data.val.t_end, speed_val - run.data.val.speed, std_val * factor,
-                                 max_lag_s=max_lag_s)
+    cal = run.data.calibration_windows                  # the validation blocks, or those early stopping never saw
+    speed_val, std_val = obj.to_units(train.predict_normalized(net.model, net.norm.x(cal.x)))
+    factor = lo.calibration_factor(speed_val - cal.speed, std_val)
+    kappa = lo.error_correlation(cal.t_end, speed_val - cal.speed, std_val * factor, max_lag_s=max_lag_s)
     speed, std = obj.to_units(train.predict_normalized(net.model, net.norm.x(all_windows.x)))
     return (no.SpeedTrack(all_windows.t_end, np.maximum(speed, 0.0), std * factor, kappa if correlation else 1.0),
             {"calibration": factor, "val_rmse_mps": card["val_rmse_mps"], "epochs": card["epochs_run"],

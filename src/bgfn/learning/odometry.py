@@ -126,6 +126,9 @@ class SpeedData:
         ``window`` (IMU samples), ``margin_s``, ``val_fraction`` and ``objective: speed``.
     info : dict
         Window counts of the split.
+    calibration : SpeedWindows or None
+        Held-out windows that only calibrate the odometer's std (its factor and its correlation), which early
+        stopping never sees (:func:`build_speed_data` with ``calibration_blocks``); None: ``val`` does both.
     """
 
     train: SpeedWindows
@@ -133,10 +136,16 @@ class SpeedData:
     norm: Normalizer
     options: dict
     info: dict
+    calibration: SpeedWindows | None = None
+
+    @property
+    def calibration_windows(self) -> SpeedWindows:
+        """The windows the std is calibrated on: :attr:`calibration`, else :attr:`val`."""
+        return self.val if self.calibration is None else self.calibration
 
 
 def build_speed_data(ws: SpeedWindows, outage_windows=(), margin_s: float = 30.0,
-                     val_fraction: float = 0.2, val_blocks: int = 1) -> SpeedData:
+                     val_fraction: float = 0.2, val_blocks: int = 1, calibration_blocks: bool = False) -> SpeedData:
     """The honest split of speed windows ``ws`` (sorted by time): windows touching an outage +- ``margin_s`` are
     dropped, ``val_fraction`` of the rest is validation, and training windows touching it are dropped too; the
     normalizer is fitted on the training windows.
@@ -144,7 +153,11 @@ def build_speed_data(ws: SpeedWindows, outage_windows=(), margin_s: float = 30.0
     The validation windows form ``val_blocks`` equal blocks, centred at the ``(k + 1/2) / val_blocks`` quantiles of
     the remaining windows (1: the middle block, as the increments' split). The odometer's std is calibrated on
     them (:func:`calibration_factor`), so several blocks spread over the drive are meant to hold its situations
-    (cruise, turns, stops) rather than one stretch of it, which may be all cruise."""
+    (cruise, turns, stops) rather than one stretch of it, which may be all cruise.
+
+    With ``calibration_blocks`` (and two blocks or more) every other block (the 2nd, the 4th ...) becomes
+    :attr:`SpeedData.calibration` instead: the std is then calibrated on windows that did not choose the network's
+    epoch, whose residuals early stopping has not made small (the others stay ``val``)."""
     lo_, hi_ = ws.span
     idx = np.flatnonzero(~overlaps(lo_, hi_, forbidden_intervals(outage_windows, margin_s)) & np.isfinite(ws.speed))
     n_val = max(1, int(round(val_fraction * idx.size)))
@@ -158,12 +171,17 @@ def build_speed_data(ws: SpeedWindows, outage_windows=(), margin_s: float = 30.0
                         f"{idx.size} in all")
     block = np.array([[ws.t_start[p].min(), ws.t_end[p].max()] for p in parts])
     train = idx[~overlaps(lo_[idx], hi_[idx], block)]
+    cal = None
+    if calibration_blocks and len(parts) > 1:
+        val, cal = np.unique(np.concatenate(parts[0::2])), np.unique(np.concatenate(parts[1::2]))
     tr, va = ws.subset(train), ws.subset(val)
     norm = speed_normalizer(tr)
     options = {"window": int(ws.x.shape[1]), "margin_s": float(margin_s), "val_fraction": float(val_fraction),
                "objective": "speed"}
     return SpeedData(tr, va, norm, options, {"n_train": int(train.size), "n_val": int(val.size),
-                                             "n_outage_excluded": int(ws.x.shape[0] - idx.size)})
+                                             "n_calibration": 0 if cal is None else int(cal.size),
+                                             "n_outage_excluded": int(ws.x.shape[0] - idx.size)},
+                     None if cal is None else ws.subset(cal))
 
 
 def frame_bands(rate_hz: float, frame_s: float = FRAME_S, n_bands: int = FRAME_N_BANDS) -> tuple:
@@ -217,10 +235,11 @@ def speed_normalizer(train: SpeedWindows) -> Normalizer:
 
 
 def with_inputs(data: SpeedData, inputs: str, rate_hz: float) -> SpeedData:
-    """``data``'s split as the odometer networks read it (:func:`network_inputs`): the same training and validation
-    windows through the front end, the input standardization refit on them, ``options['inputs']`` set."""
+    """``data``'s split as the odometer networks read it (:func:`network_inputs`): the same training, validation and
+    calibration windows through the front end, the input standardization refit on them, ``options['inputs']`` set."""
     tr, va = network_inputs(data.train, inputs, rate_hz), network_inputs(data.val, inputs, rate_hz)
-    return SpeedData(tr, va, speed_normalizer(tr), {**data.options, "inputs": inputs}, data.info)
+    cal = None if data.calibration is None else network_inputs(data.calibration, inputs, rate_hz)
+    return SpeedData(tr, va, speed_normalizer(tr), {**data.options, "inputs": inputs}, data.info, cal)
 
 
 def inner_speed_split(data: SpeedData, fraction: float = 0.2) -> SpeedData:

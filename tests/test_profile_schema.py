@@ -6,6 +6,7 @@ from __future__ import annotations
 import pytest
 
 from bgfn import config
+from bgfn.config import odometer_network_seeds
 from bgfn.errors import DataError
 from bgfn.profile_schema import SCHEMA, load_profile, with_overrides
 
@@ -137,3 +138,16 @@ def test_notebook_parameters_are_checked_like_the_profile():
     assert err.value.source == "notebook parameters" and err.value.field == "train.methods"
     with pytest.raises(DataError, match="evaluate.real_imu"):
         with_overrides(cfg, {"evaluate.real_imu": "yes"})
+
+
+def test_odometer_network_seeds_per_drive_need_a_default(params):
+    (params / "mine.yaml").write_text("profile: mine\nbase: smoke\ndescription: v\n"
+                                      "evaluate: {odometer: {network_seeds: {rtklib-drive0708: [0, 1]}}}\n")
+    with pytest.raises(DataError) as err:
+        load_profile("mine")
+    assert err.value.field == "evaluate.odometer.network_seeds" and "'default'" in str(err.value)
+    # quick: three seeds on the real drive, one on every other; a list holds for every drive
+    oc = load_profile("quick")["evaluate"]["odometer"]
+    assert odometer_network_seeds(oc, "rtklib-drive0708") == [0, 1, 2]
+    assert odometer_network_seeds(oc, "turin-sim-ekinox") == [0]
+    assert odometer_network_seeds({"network_seeds": [3, 4]}, "any drive") == [3, 4]

@@ -118,6 +118,23 @@ def odometer_datasets(odometer: dict | None, sweep_datasets) -> list[str]:
     return list(sweep_datasets or []) if names is None else list(names)
 
 
+#: The entry of a per-dataset setting that holds for every dataset not named (``evaluate.odometer.network_seeds``).
+DEFAULT_DATASET_KEY = "default"
+
+
+def odometer_network_seeds(odometer: dict | None, dataset: str) -> list[int]:
+    """The seeds the odometer networks of ``dataset`` train with: ``evaluate.odometer.network_seeds``, one list for
+    every drive or per drive with a ``default`` list for every drive not named (one rule for notebook 04, which
+    trains them, and notebook 05, which measures the first)."""
+    seeds = (odometer or {}).get("network_seeds", [0])
+    if isinstance(seeds, dict):
+        seeds = seeds.get(dataset, seeds.get(DEFAULT_DATASET_KEY))
+    if not seeds:
+        raise DataError("evaluate.odometer", "network_seeds", f"seeds for {dataset} (or a 'default' list)",
+                        repr((odometer or {}).get("network_seeds")))
+    return [int(s) for s in seeds]
+
+
 #: Keys of earlier versions that now live elsewhere: ``section.key`` -> the key to set instead.
 MOVED_KEYS: dict[str, str] = {
     "nav.outage_starts": "outage_windows",

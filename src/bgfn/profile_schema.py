@@ -199,7 +199,7 @@ SCHEMA = section(
         oracle=section(sigmas_m=seq(_NONNEG), seeds=seq(_SEED, min_len=1), durations_s=seq(_POS)),
         odometer=section(datasets=seq(text(), null=True), methods=seq(text(*METHOD_LABELS)),
                          network_datasets=seq(text(), null=True),
-                         network_seeds=seq(_SEED, min_len=1), paper_outages=flag(), window_s=number(0.5), sigmas_mps=seq(_POS), walk_mps_per_sqrt_s=_NONNEG,
+                         network_seeds=either(seq(_SEED, min_len=1), mapping(seq(_SEED, min_len=1))), paper_outages=flag(), window_s=number(0.5), sigmas_mps=seq(_POS), walk_mps_per_sqrt_s=_NONNEG,
                          seeds=seq(_SEED, min_len=1), hold_std_mps=_POS, ridge_alpha=_POS,
                          gate_probability=number(0, 1, lo_open=True, hi_open=True, null=True), lr_search=flag(),
                          inputs=text(*ODOMETER_INPUTS), val_blocks=integer(1), curve_folds=seq(integer(1)),
@@ -367,6 +367,10 @@ def cross_check(cfg: dict) -> None:
                                 or not math.isfinite(value) or value <= 0):
             raise ProfileError("nav.noise_scale" + (f".{key}" if key else ""),
                                "a positive number or 'auto' (or per dataset, with a 'default')", _fmt(value))
+    seeds = (ev.get("odometer") or {}).get("network_seeds")
+    if isinstance(seeds, dict) and "default" not in seeds:
+        raise ProfileError("evaluate.odometer.network_seeds", "a 'default' list beside the per-dataset ones",
+                           _fmt(seeds))
     band = (nav.get("noise_search") or {}).get("range")
     if band and not band[0] < band[1]:
         raise ProfileError("nav.noise_search.range", "[low, high] with low < high", _fmt(band))

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from bgfn.config import odometer_datasets
+from bgfn.config import odometer_datasets, odometer_network_seeds
 from bgfn.data import load_drive
 from bgfn.data.registry import recorded_first
 from bgfn.energy.checkpoint import MEASURED, SPIKING, check_trained
@@ -127,7 +127,7 @@ def odometer_energy(profile: str, cfg: dict, e_mac: float, e_ac: float, batch_si
     if dataset is None:
         return None
     oc = cfg["evaluate"]["odometer"]
-    seed = int(list(oc.get("network_seeds") or [0])[0])
+    seed = odometer_network_seeds(oc, dataset)[0]
     folder = odometer_models_dir(profile, dataset, FOLD, create=False)
     paths = {m: folder / checkpoint_name(m, seed) for m in MEASURED if m in oc["methods"]}
     if "bgfn" not in paths or not paths["bgfn"].is_file():

@@ -63,7 +63,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from bgfn.config import SHARED_TABLES, odometer_datasets
+from bgfn.config import SHARED_TABLES, odometer_datasets, odometer_network_seeds
 from bgfn.errors import DataError
 from bgfn.data import dataset_id, load_drive
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
@@ -234,7 +234,7 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
         tracks[runs[-1].label] = track
         facts["networks"][f"{label} fold {k} seed {seed}"] = {**fact, "method": label, "fold": int(k),
                                                                "seed": int(seed)}
-        if seed == min(oc["network_seeds"]) and k != PAPER_FOLD:
+        if seed == min(odometer_network_seeds(oc, dataset)) and k != PAPER_FOLD:
             keep(label, track, overlaps(all_windows.t_end, all_windows.t_end,
                                         np.array([[s, s + d] for s, d in folds[k]])))
     results = (runner or Runner()).map(odometer_run, [(ctx, r, ecfg["pseudo_gps"]) for r in runs],
@@ -285,7 +285,7 @@ def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, data: d
         out = odometer_models_dir(profile, dataset, int(k))
         tk = train.with_selected_lr(tc, None if search is None else search[search["dataset"] == fold_name(dataset, k)])
         for m in oc["methods"]:
-            for seed in oc["network_seeds"]:
+            for seed in odometer_network_seeds(oc, dataset):
                 label = odometer_label(m)
                 runs.append(train.TrainingRun(f"{dataset} fold {k} {label} seed {seed}", m, data[int(k)],
                                               train.size_config(tk, m), tk, int(seed), out, None,
@@ -301,7 +301,7 @@ def network_odometers(cfg: dict, profile: str, dataset: str, ecfg: dict, data: d
         for key, run, card in zip(keys, runs, cards):
             tracks[key] = calibrated_track(run, card, all_windows, bool(oc["correlation"]),
                                            float(oc["correlation_max_lag_s"]))
-    if oc["ensemble"] and len(oc["network_seeds"]) > 1:
+    if oc["ensemble"] and len(odometer_network_seeds(oc, dataset)) > 1:
         tracks.update(ensemble_tracks(tracks, data, bool(oc["ensemble_recalibrate"]), bool(oc["correlation"]),
                                       float(oc["correlation_max_lag_s"])))
     return tracks

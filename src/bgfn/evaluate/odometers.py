@@ -313,7 +313,8 @@ def ensemble_tracks(tracks: dict, data: dict[int, lo.SpeedData], recalibrate: bo
     :func:`network_odometers` returns them): the mean speed and the mixture's std
     (:func:`bgfn.learning.odometry.ensemble_speed`; a deep ensemble's predictive distribution, each member already
     calibrated on the validation windows). With ``recalibrate`` that std is scaled once more to NIS = 1 on the
-    fold's validation windows (``data[fold].val``); off by default, because the members agree most there, next to
+    fold's calibration windows (``data[fold].calibration_windows``: its validation blocks, or those early stopping
+    never saw); off by default, because the members agree most there, next to
     their training windows, so the factor takes back the disagreement the ensemble adds where they do not (the
     methods page gives the measurement). With ``correlation`` the filter fuses it with the integrated
     autocorrelation of its own validation errors (:func:`bgfn.learning.odometry.error_correlation`, up to

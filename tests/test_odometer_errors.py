@@ -5,7 +5,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bgfn.evaluate.odometer_errors import ERROR_COLUMNS, error_parts_lines, error_parts_table, offset_bar_mps
+from bgfn.evaluate.odometer_errors import (ERROR_COLUMNS, error_parts_lines, error_parts_table, offset_bar_mps,
+                                           plot_error_parts)
 from bgfn.report.odometer_verdict import OdometerInputs, fusion_words, offset_sentence
 
 
@@ -62,3 +63,12 @@ def test_a_recorded_run_says_how_its_odometers_were_fused():
     assert fusion_words(True) == "" and fusion_words(np.bool_(True)) == ""
     assert fusion_words(False) == " (fused as white errors, R = std^2)"
     assert "recorded before" in fusion_words(np.nan) and "recorded before" in fusion_words(None)
+
+
+def test_the_figure_has_a_panel_per_duration_and_the_bar_where_it_is_known():
+    table = error_parts_table("d", _series(), [30.0, 60.0])
+    fig = plot_error_parts(table, "d", {60.0: offset_bar_mps(30.0, 60.0)})
+    axes = fig.axes
+    assert len(axes) == 2 and [len(ax.patches) for ax in axes] == [4, 4]         # 2 odometers x (offset, fluctuation)
+    dashed = [[ln for ln in ax.get_lines() if ln.get_linestyle() == "--"] for ax in axes]
+    assert [len(d) for d in dashed] == [0, 1] and dashed[1][0].get_ydata()[0] == pytest.approx(0.5)

@@ -20,6 +20,7 @@ first seed), per odometer and duration ``D`` (the first ``D`` seconds of each ou
 
 from __future__ import annotations
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
@@ -80,6 +81,30 @@ def offset_bar_mps(max_error_m: float, duration_s: float) -> float:
     """The speed offset (m/s) that alone moves the solution ``max_error_m`` along the track in ``duration_s``: an
     odometer off by more than INS+NHC's median max error over the outage's length loses to it."""
     return float(max_error_m) / float(duration_s)
+
+
+def plot_error_parts(table: pd.DataFrame, dataset: str, bars: dict):
+    """Per duration of ``table`` (one dataset's rows) a panel: each odometer's offset per outage (RMS) beside its
+    fluctuation, m/s, and a dashed line at ``bars[duration]`` (:func:`offset_bar_mps` of INS+NHC's median max error
+    there; absent: no line). An offset above the line alone costs more than INS+NHC's whole error."""
+    durations = sorted(table["duration_s"].unique())
+    fig, axes = plt.subplots(1, max(len(durations), 1), figsize=(3.2 * max(len(durations), 1), 3.4), sharey=True,
+                             squeeze=False)
+    for ax, d in zip(axes[0], durations):
+        g = table[table["duration_s"] == d]
+        x = np.arange(len(g))
+        ax.bar(x - 0.2, g["offset_rms_mps"], 0.4, color="tab:red", label="offset per outage (RMS)")
+        ax.bar(x + 0.2, g["fluctuation_mps"], 0.4, color="tab:gray", label="fluctuation around it")
+        if np.isfinite(bars.get(d, np.nan)):
+            ax.axhline(bars[d], color="black", ls="--", lw=1.0, label="INS+NHC's max error / duration")
+        ax.set_xticks(x, g["method"], rotation=90, fontsize=7)
+        ax.set_title(f"first {d:g} s of each outage", fontsize=9)
+    axes[0][0].set_ylabel("speed error (m/s)")
+    axes[0][0].legend(fontsize=6, loc="upper left")
+    fig.suptitle(f"{dataset}: the learned speed's error in the outages, an offset the filter cannot average away "
+                 "and a fluctuation it can", fontsize=9)
+    fig.tight_layout()
+    return fig
 
 
 def error_parts_lines(table: pd.DataFrame) -> list[str]:

@@ -67,7 +67,8 @@ from bgfn.config import SHARED_TABLES, odometer_datasets, odometer_network_seeds
 from bgfn.errors import DataError
 from bgfn.data import dataset_id, load_drive
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
-from bgfn.evaluate.odometer_errors import ERROR_COLUMNS, error_parts_lines, error_parts_table
+from bgfn.evaluate.odometer_errors import (ERROR_COLUMNS, error_parts_lines, error_parts_table, offset_bar_mps,
+                                           plot_error_parts)
 from bgfn.evaluate.odometer_uncertainty import UNCERTAINTY_COLUMNS, uncertainty_lines, uncertainty_table
 from bgfn.evaluate.plots import finish_duration_axes
 from bgfn.evaluate.ridge_curve import CURVE_COLUMNS, curve_lines, plot_curve, ridge_curve
@@ -522,6 +523,13 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
             save_figure(fig, Path(out) / "figures" / f"{stem}_{dataset_id(name)}.png")
             plt.close(fig)
             figures.append(fig)
+    for name in errors["dataset"].unique():
+        nhc = summary[(summary["dataset"] == name) & (summary["method"] == nhc_label("INS"))]
+        fig = plot_error_parts(errors[errors["dataset"] == name], name,
+                               {float(d): offset_bar_mps(m, d) for d, m in zip(nhc["duration_s"], nhc["max_h_m"])})
+        save_figure(fig, Path(out) / "figures" / f"odometer_errors_{dataset_id(name)}.png")
+        plt.close(fig)
+        figures.append(fig)
     if len(curve):
         fig = plot_curve(curve)
         save_figure(fig, Path(out) / "figures" / "odometer_curve.png")

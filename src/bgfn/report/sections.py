@@ -138,14 +138,15 @@ def training_section(res: ProfileResults) -> list:
 def odometer_section(res: ProfileResults) -> list:
     """The bars a learned odometer must clear (notebook 04, :mod:`bgfn.evaluate.odometers`): median max horizontal
     error per dataset, method (the oracle speed per sigma) and duration, its lines, then per dataset (recorded drives
-    first) the odometers' speed in a few outages and the error growth over the outage."""
+    first) the odometers' speed in a few outages, the error growth over the outage and the speed error's offset per
+    outage beside its fluctuation."""
     file = res.table(SHARED_TABLES["odometer_summary"])
     summary = read_csv(file)
     if summary is None or summary.empty:
         return [missing_note(file, "the odometer bars", "notebook 04, `evaluate.odometer`")]
     wide = odometer_table(summary)
     figures = [res.out / "figures" / f"{stem}_{dataset_id(d)}.png" for d in recorded_first(summary["dataset"].unique())
-               for stem in ("odometer_speed", "odometer_growth")]
+               for stem in ("odometer_speed", "odometer_growth", "odometer_errors")]
     return [compact(wide.style.format("{:.1f}"), f"Median max horizontal error (m) over the sweep's starts, "
                                                  f"profile {res.profile}"),
             bullets(odometer_lines(summary)), *[f for f in figures if f.is_file()]]

@@ -236,7 +236,7 @@ def test_the_odometer_answer_says_whether_bgfn_odos_std_ranks_its_errors():
                                                              (3, 1.6, 1.7, 0.9), (4, 2.0, 1.7, 0.98))],
                                    columns=list(UNCERTAINTY_COLUMNS))
     inp = _inputs(odometer=odo)
-    assert (" Does it know when it is wrong? its predicted std does not rank its errors in the outages (correlation "
+    assert (" Does it know when it is wrong? Its predicted std does not rank its errors in the outages (correlation "
             "of |error| and std -0.20): the quarter of its epochs with the smallest std (0.80-1.20 m/s) has a speed "
             "RMSE of 3.60 m/s (45 % within 2 sigma), the one with the largest (2.00-2.40 m/s) 1.70 m/s (98 %).") \
         in verdict_sentences(inp, verdict_table(inp))[5]

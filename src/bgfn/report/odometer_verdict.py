@@ -375,7 +375,8 @@ def answer_odometer(odo: OdometerInputs, durations) -> str:
                 f"{100 * lo:.0f}-{100 * hi:.0f} % is the band of a calibrated std).")
         u = odo.uncertainty
         if u is not None and (u["method"] == SUBJECT_ODO).any():
-            out += f" Does it know when it is wrong? {uncertainty_sentence(u[u['method'] == SUBJECT_ODO])}."
+            said = uncertainty_sentence(u[u['method'] == SUBJECT_ODO])
+            out += f" Does it know when it is wrong? {said[:1].upper()}{said[1:]}."
         if odo.has(SUBJECT_ENS):
             n = odo.runs(SUBJECT_ODO)
             e_rmse, e_cov = (odo.cell(SUBJECT_ENS, d_long, c) for c in ("speed_rmse_mps", "coverage_2sigma"))

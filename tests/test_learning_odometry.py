@@ -196,7 +196,8 @@ def test_calibration_blocks_are_every_other_validation_block_and_no_training_win
     four = od.build_speed_data(ws, [(300.0, 30.0)], margin_s=10.0, val_fraction=0.2, val_blocks=4)
     split = od.build_speed_data(ws, [(300.0, 30.0)], margin_s=10.0, val_fraction=0.2, val_blocks=4,
                                 calibration_blocks=True)
-    assert _quarters(split.val) == [0, 2] and _quarters(split.calibration) == [1, 3]   # 1st, 3rd stop; 2nd, 4th calibrate
+    # the 1st and 3rd blocks stop the training, the 2nd and 4th calibrate
+    assert _quarters(split.val) == [0, 2] and _quarters(split.calibration) == [1, 3]
     assert sorted([*split.val.t_end, *split.calibration.t_end]) == list(four.val.t_end)
     assert split.calibration_windows is split.calibration and split.info["n_calibration"] == len(split.calibration)
     assert np.array_equal(split.train.t_end, four.train.t_end)                      # the same training windows

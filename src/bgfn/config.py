@@ -118,7 +118,8 @@ def odometer_datasets(odometer: dict | None, sweep_datasets) -> list[str]:
     return list(sweep_datasets or []) if names is None else list(names)
 
 
-#: The entry of a per-dataset setting that holds for every dataset not named (``evaluate.odometer.network_seeds``).
+#: The entry of a per-dataset setting that holds for every dataset it does not name (``outage_windows``,
+#: ``nav.noise_scale``, ``evaluate.odometer.network_seeds``).
 DEFAULT_DATASET_KEY = "default"
 
 

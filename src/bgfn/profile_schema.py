@@ -26,8 +26,8 @@ import sys
 from dataclasses import dataclass, field
 from typing import Any
 
-from bgfn.config import (MAIN_VARIANT, VARIANT_NAME, VARIANT_RUN_KEYS, file_setting, odometer_datasets,
-                         profile_chain, read_profile, set_keys, variant_config)
+from bgfn.config import (DEFAULT_DATASET_KEY, MAIN_VARIANT, VARIANT_NAME, VARIANT_RUN_KEYS, file_setting,
+                         odometer_datasets, profile_chain, read_profile, set_keys, variant_config)
 from bgfn.data import load_drive
 from bgfn.data.names import profile_datasets, unique_ids
 from bgfn.errors import DataError
@@ -36,7 +36,7 @@ from bgfn.learning import learning_options
 from bgfn.learning.odometry import ODOMETER_INPUTS
 from bgfn.nav.baseline import filter_start
 from bgfn.nav.constraints import MOUNTING_WEIGHTS, MOUNTINGS
-from bgfn.nav.outages import DEFAULT_KEY, check_windows, is_rule, outage_entry, picked_outages
+from bgfn.nav.outages import check_windows, is_rule, outage_entry, picked_outages
 from bgfn.paper import METHOD_LABELS
 from bgfn.parallel import BACKENDS, SCHEDULER_ENV
 
@@ -199,7 +199,8 @@ SCHEMA = section(
         oracle=section(sigmas_m=seq(_NONNEG), seeds=seq(_SEED, min_len=1), durations_s=seq(_POS)),
         odometer=section(datasets=seq(text(), null=True), methods=seq(text(*METHOD_LABELS)),
                          network_datasets=seq(text(), null=True),
-                         network_seeds=either(seq(_SEED, min_len=1), mapping(seq(_SEED, min_len=1))), paper_outages=flag(), window_s=number(0.5), sigmas_mps=seq(_POS), walk_mps_per_sqrt_s=_NONNEG,
+                         network_seeds=either(seq(_SEED, min_len=1), mapping(seq(_SEED, min_len=1))),
+                         paper_outages=flag(), window_s=number(0.5), sigmas_mps=seq(_POS), walk_mps_per_sqrt_s=_NONNEG,
                          seeds=seq(_SEED, min_len=1), hold_std_mps=_POS, ridge_alpha=_POS,
                          gate_probability=number(0, 1, lo_open=True, hi_open=True, null=True), lr_search=flag(),
                          inputs=text(*ODOMETER_INPUTS), val_blocks=integer(1), curve_folds=seq(integer(1)),
@@ -343,11 +344,11 @@ def _check_outage_entries(cfg: dict) -> None:
         else:
             _check_window_list(path, entry, t0, t1)
     spec = cfg.get("outage_windows")
-    if isinstance(spec, dict) and DEFAULT_KEY not in spec:      # every dataset a notebook loads needs its outages
+    if isinstance(spec, dict) and DEFAULT_DATASET_KEY not in spec:   # every dataset a notebook loads needs its outages
         uncovered = [d for d in profile_datasets(cfg) if d not in spec]
         if uncovered:
-            raise ProfileError("outage_windows", f"an entry for every dataset of the profile, or a '{DEFAULT_KEY}' "
-                               "entry", f"none for {', '.join(uncovered)}")
+            raise ProfileError("outage_windows", "an entry for every dataset of the profile, or a "
+                               f"'{DEFAULT_DATASET_KEY}' entry", f"none for {', '.join(uncovered)}")
 
 
 def cross_check(cfg: dict) -> None:
@@ -360,17 +361,17 @@ def cross_check(cfg: dict) -> None:
     data, tr, ev = cfg.get("data") or {}, cfg.get("train") or {}, cfg.get("evaluate") or {}
     nav = cfg.get("nav") or {}
     ns = nav.get("noise_scale")
-    if isinstance(ns, dict) and "default" not in ns:
-        raise ProfileError("nav.noise_scale", "a 'default' entry beside the per-dataset ones", _fmt(ns))
+    if isinstance(ns, dict) and DEFAULT_DATASET_KEY not in ns:
+        raise ProfileError("nav.noise_scale", f"a '{DEFAULT_DATASET_KEY}' entry beside the per-dataset ones", _fmt(ns))
     for key, value in (ns.items() if isinstance(ns, dict) else [(None, ns)] if "noise_scale" in nav else []):
         if value != "auto" and (isinstance(value, bool) or not isinstance(value, (int, float))
                                 or not math.isfinite(value) or value <= 0):
             raise ProfileError("nav.noise_scale" + (f".{key}" if key else ""),
                                "a positive number or 'auto' (or per dataset, with a 'default')", _fmt(value))
     seeds = (ev.get("odometer") or {}).get("network_seeds")
-    if isinstance(seeds, dict) and "default" not in seeds:
-        raise ProfileError("evaluate.odometer.network_seeds", "a 'default' list beside the per-dataset ones",
-                           _fmt(seeds))
+    if isinstance(seeds, dict) and DEFAULT_DATASET_KEY not in seeds:
+        raise ProfileError("evaluate.odometer.network_seeds", f"a '{DEFAULT_DATASET_KEY}' list beside the per-dataset "
+                           "ones", _fmt(seeds))
     band = (nav.get("noise_search") or {}).get("range")
     if band and not band[0] < band[1]:
         raise ProfileError("nav.noise_search.range", "[low, high] with low < high", _fmt(band))
@@ -537,7 +538,7 @@ def check_with_drives(profile: str) -> list[str]:
         drive = load_drive(name, profile=profile)
         t = drive.imu["time"].to_numpy(float)
         t0, t1 = filter_start(drive, cfg["nav"]), float(t[-1])     # a self-aligned filter starts late
-        key = (f"outage_windows.{name if name in spec else DEFAULT_KEY}" if isinstance(spec, dict)
+        key = (f"outage_windows.{name if name in spec else DEFAULT_DATASET_KEY}" if isinstance(spec, dict)
                else "outage_windows")
         entry = outage_entry(cfg, name)
         rule = is_rule(entry)

@@ -544,11 +544,11 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
 def network_table(rows: pd.DataFrame, facts: dict) -> pd.DataFrame:
     """Every network odometer of the sweep's folds (dataset, method, fold, seed): its learning rate and epochs, its
     speed RMSE on the validation block its std was calibrated on, the calibration factor and the integrated
-    autocorrelation of its calibrated validation errors (:func:`bgfn.learning.odometry.error_correlation`), and in its own fold's
-    outages at the sweep's longest duration its speed RMSE (the RMS over the starts: each holds the same epochs)
-    and the share of epochs within its +-2 sigma (:data:`NETWORK_COLUMNS`). Where the outage RMSE is far above
-    the validation RMSE, the validation block did not represent the outages, and the calibrated std is too small
-    there."""
+    autocorrelation of its calibrated validation errors (:func:`bgfn.learning.odometry.error_correlation`), and in
+    its own fold's outages at the sweep's longest duration its speed RMSE (the RMS over the starts: each holds the
+    same epochs) and the share of epochs within its +-2 sigma (:data:`NETWORK_COLUMNS`). Where the outage RMSE is
+    far above the validation RMSE, the validation block did not represent the outages, and the calibrated std is
+    too small there."""
     out = []
     for name, f in facts.items():
         for net in (f.get("networks") or {}).values():

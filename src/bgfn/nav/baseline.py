@@ -33,6 +33,7 @@ import numpy as np
 import pandas as pd
 
 from .. import paper
+from ..config import DEFAULT_DATASET_KEY
 from ..errors import DataError
 from ..io import atomic_write_csv
 from . import constraints as cn, metrics, navego_setup
@@ -59,8 +60,6 @@ NAV_DEFAULTS: dict = {
     "zupt": dict(cn.ZUPT_DEFAULTS),
     "constraints_in_gps_run": False,
 }
-#: Key of the entry for every other drive when ``nav.noise_scale`` is a mapping per dataset.
-DEFAULT_SCALE_KEY = "default"
 #: ``nav.noise_scale`` that asks for the factor from the data.
 AUTO = "auto"
 #: Label of the standalone INS with the vehicle constraints (:func:`bgfn.paper.nhc_label`).
@@ -91,8 +90,8 @@ def nav_config(section: dict | None) -> dict:
         if scale != AUTO and (isinstance(scale, bool) or not isinstance(scale, (int, float)) or not scale > 0):
             raise DataError("params nav", "noise_scale" + (f".{key}" if key else ""),
                             f"a positive number or {AUTO!r}", repr(scale))
-    if isinstance(spec, dict) and DEFAULT_SCALE_KEY not in spec:
-        raise DataError("params nav", "noise_scale", f"a '{DEFAULT_SCALE_KEY}' entry beside the per-dataset ones",
+    if isinstance(spec, dict) and DEFAULT_DATASET_KEY not in spec:
+        raise DataError("params nav", "noise_scale", f"a '{DEFAULT_DATASET_KEY}' entry beside the per-dataset ones",
                         repr(spec))
     return cfg
 
@@ -103,7 +102,7 @@ def noise_scale_of(cfg: dict, dataset: str):
     Drives differ: a simulated IMU's filter is set from the error model it was made with (1), a recorded IMU's
     datasheet says nothing of the car's vibration (``auto``)."""
     spec = cfg["noise_scale"]
-    return spec.get(dataset, spec[DEFAULT_SCALE_KEY]) if isinstance(spec, dict) else spec
+    return spec.get(dataset, spec[DEFAULT_DATASET_KEY]) if isinstance(spec, dict) else spec
 
 
 def gps_constraints(drive, cfg: dict, initial: FilterState, noise: FilterNoise):

@@ -19,6 +19,7 @@ from typing import Callable, NamedTuple, Optional
 import numpy as np
 import pandas as pd
 
+from ..config import DEFAULT_DATASET_KEY
 from ..errors import DataError
 from . import earth, outage_rules
 
@@ -112,8 +113,6 @@ def epochs_before(imu_time, starts, source: str = "outage_windows") -> np.ndarra
     return imu_time[before]
 
 
-#: Key of a per-dataset ``outage_windows`` mapping that answers for every dataset it does not name.
-DEFAULT_KEY = "default"
 #: Default of ``train.margin_s``: how far (s) training and validation data stay from an evaluation outage, and
 #: how much training data a rule's outages must leave (read here and by :data:`bgfn.learning.LEARNING_DEFAULTS`).
 DEFAULT_MARGIN_S = 30.0
@@ -134,10 +133,10 @@ def outage_entry(profile: dict, dataset: str | None = None):
     where = f"profile {profile.get('profile')!r}"
     spec = profile.get("outage_windows")
     if isinstance(spec, dict):
-        key = dataset if dataset in spec else DEFAULT_KEY
+        key = dataset if dataset in spec else DEFAULT_DATASET_KEY
         if key not in spec:
-            raise DataError(where, f"outage_windows.{dataset if dataset is not None else DEFAULT_KEY}",
-                            f"an entry for this dataset or a '{DEFAULT_KEY}' entry", f"keys {sorted(spec)}")
+            raise DataError(where, f"outage_windows.{dataset if dataset is not None else DEFAULT_DATASET_KEY}",
+                            f"an entry for this dataset or a '{DEFAULT_DATASET_KEY}' entry", f"keys {sorted(spec)}")
         spec = spec[key]
     if not spec:
         raise DataError(where, "outage_windows", "the evaluation outages: a list of [start, duration] in s, or a "
@@ -149,7 +148,7 @@ def default_windows(profile: dict) -> list[tuple[float, float]] | None:
     """The windows of the profile's one list or ``default`` list; None when ``default`` is a rule or missing
     (then every dataset has its own entry). What a reader without a drive, e.g. a run description, shows."""
     spec = profile.get("outage_windows")
-    entry = spec.get(DEFAULT_KEY) if isinstance(spec, dict) else spec
+    entry = spec.get(DEFAULT_DATASET_KEY) if isinstance(spec, dict) else spec
     if not entry or is_rule(entry):
         return None
     return [(float(s), float(d)) for s, d in entry]

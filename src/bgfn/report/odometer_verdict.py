@@ -196,8 +196,8 @@ def offset_sentence(odo: OdometerInputs, duration: float) -> str:
     return (f" Why does white noise help and its error not? Over the first {duration:g} s of an outage "
             f"{SUBJECT_ODO}'s speed is off by {r['offset_rms_mps']:.2f} m/s on average (RMS over the outages), an "
             f"offset the filter cannot average away (alone, more than {bar:.2f} m/s costs as much as {nhc}'s whole "
-            f"{_m(odo.cell(nhc, duration))} in {duration:g} s), and fluctuates by {r['fluctuation_mps']:.2f} m/s around "
-            f"it; consecutive errors there carry the information of one in {r['outage_correlation']:.1f} epochs"
+            f"{_m(odo.cell(nhc, duration))} in {duration:g} s), and fluctuates by {r['fluctuation_mps']:.2f} m/s "
+            f"around it; consecutive errors there carry the information of one in {r['outage_correlation']:.1f} epochs"
             + (f", against {fused:.1f} on its validation windows (the kappa `evaluate.odometer.correlation` fuses it "
                "with)"
                if np.isfinite(fused) else "") + ".")

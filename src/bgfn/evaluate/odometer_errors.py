@@ -24,14 +24,15 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from bgfn.learning.odometry import error_correlation
+from bgfn.learning.odometry import DEFAULT_MAX_LAG_S, error_correlation
 
 #: Columns of ``tables/outage_odometer_errors.csv`` (:func:`error_parts_table`).
 ERROR_COLUMNS: tuple[str, ...] = ("dataset", "method", "duration_s", "outages", "speed_rmse_mps", "offset_rms_mps",
                                   "fluctuation_mps", "outage_correlation")
 
 
-def error_parts_table(dataset: str, series: dict | None, durations) -> pd.DataFrame:
+def error_parts_table(dataset: str, series: dict | None, durations,
+                      max_lag_s: float = DEFAULT_MAX_LAG_S) -> pd.DataFrame:
     """Per odometer of ``series`` and duration of ``durations`` (s): its speed error in the outages split into the
     offset per outage and the fluctuation around it, and its correlation there (module docstring).
 
@@ -43,6 +44,8 @@ def error_parts_table(dataset: str, series: dict | None, durations) -> pd.DataFr
         std [K])}}``, NaN outside the outages.
     durations : sequence of float
         Seconds from each outage's start; an outage shorter than a duration is scored over what it has.
+    max_lag_s : float
+        Longest lag of the correlation, s (``evaluate.odometer.correlation_max_lag_s``, as the fused ``kappa``).
 
     Returns
     -------
@@ -65,7 +68,7 @@ def error_parts_table(dataset: str, series: dict | None, durations) -> pd.DataFr
                 e = err_all[m]
                 offsets.append(e.mean())
                 spreads.append(e.std())
-                kappas.append(error_correlation(t[m], e, std_all[m]))
+                kappas.append(error_correlation(t[m], e, std_all[m], max_lag_s=max_lag_s))
                 errors.append(e)
             if not offsets:
                 continue

@@ -408,7 +408,8 @@ def run_odometer_bars(cfg: dict, profile: str, datasets, ecfg: dict, runner: Run
                    "forward speed, fused with the non-holonomic constraints)")
         elif report is not None:
             report(f"{name}: {len(rows)} odometer rows in {facts[name]['wall_s']:.1f} s; RIDGE-ODO std per fold "
-                   + ", ".join(f"{v:.2f} m/s" for v in facts[name]["ridge_std_mps"].values()))
+                   + ", ".join(f"{v:.2f} m/s (kappa {facts[name]['ridge_correlation'][k]:.1f})"
+                               for k, v in facts[name]["ridge_std_mps"].items()))
     rows = pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(columns=list(ODOMETER_COLUMNS))
     return rows, facts
 
@@ -503,7 +504,8 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
     ranked = [u for u in (uncertainty_table(name, f["speed_series"]) for name, f in facts.items()
                           if f.get("speed_series")) if len(u)]
     uncertainty = (pd.concat(ranked, ignore_index=True) if ranked else pd.DataFrame(columns=list(UNCERTAINTY_COLUMNS)))
-    parts = [e for e in (error_parts_table(name, f["speed_series"], ecfg["sweep"]["durations_s"])
+    parts = [e for e in (error_parts_table(name, f["speed_series"], ecfg["sweep"]["durations_s"],
+                                           float(ecfg["odometer"]["correlation_max_lag_s"]))
                          for name, f in facts.items() if f.get("speed_series")) if len(e)]
     errors = pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(columns=list(ERROR_COLUMNS))
     tables = Path(out) / "tables"

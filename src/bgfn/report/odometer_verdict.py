@@ -205,9 +205,9 @@ def offset_sentence(odo: OdometerInputs, duration: float) -> str:
 
 def fusion_words(correlation) -> str:
     """How a recorded run fused its odometers (its ``correlation`` column; absent or NaN: recorded before it)."""
-    if isinstance(correlation, (bool, np.bool_)) or correlation in (0, 1, "True", "False"):
-        return "" if str(correlation) in ("True", "1") else " (fused as white errors, R = std^2)"
-    return " (fused as white errors, R = std^2: recorded before `evaluate.odometer.correlation`)"
+    if correlation is None or pd.isna(correlation):
+        return " (fused as white errors, R = std^2: recorded before `evaluate.odometer.correlation`)"
+    return "" if str(correlation) in ("True", "1", "1.0") else " (fused as white errors, R = std^2)"
 
 
 def size_sentence(odo: OdometerInputs, durations) -> str:

@@ -12,7 +12,10 @@ from torch.overrides import TorchFunctionMode
 
 from bgfn.models import BGFN, build_model, count_parameters
 from bgfn.models.bgfn import SSA
-from bgfn.models.lif import atan_surrogate_grad, beta_from_tau, lif_modules, lif_reference, make_lif
+from bgfn.models import lif_kernels
+from bgfn.models.lif import (DEFAULT_TAU, atan_surrogate_grad, beta_from_tau, lif_modules, lif_reference,
+                             make_lif)
+from bgfn.train.speed import torch_threads
 
 torch.set_num_threads(1)
 
@@ -81,13 +84,33 @@ def test_fused_lif_equals_eq_lif_and_spikingjelly_forward_and_backward(tau, thr,
     assert x_f.grad.abs().sum() > 0
 
 
-def test_fused_lif_refuses_a_second_backward_pass_through_the_same_forward():
-    # its backward pass computes the surrogate in the memory of the saved potentials
+def test_fused_lif_backward_leaves_its_saved_tensors_so_a_second_pass_gives_the_same_gradient():
     x = (torch.rand(3, 4, 5) * 2).requires_grad_(True)
     s = make_lif()(x)
     s.sum().backward(retain_graph=True)
-    with pytest.raises(RuntimeError, match="runs once per forward pass"):
-        s.sum().backward()
+    first = x.grad.clone()
+    s.sum().backward()
+    torch.testing.assert_close(x.grad, 2 * first, rtol=0, atol=0)
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_fused_lif_gives_the_same_bits_with_any_number_of_threads(threads):
+    # more neurons than one chunk of the kernels, so that several chunks (and threads) share them
+    g = torch.Generator().manual_seed(3)
+    current = torch.randn(4, 3, lif_kernels.CHUNK + 77, generator=g) * 1.5
+    upstream = torch.randn(current.shape, generator=g)
+
+    def run(n):
+        x = current.clone().requires_grad_(True)
+        with torch_threads(n):
+            s = make_lif()(x)
+            (s * upstream).sum().backward()
+        return s.detach(), x.grad
+
+    s_1, g_1 = run(1)
+    s_n, g_n = run(threads)
+    assert torch.equal(s_1, s_n) and torch.equal(g_1, g_n)
+    assert torch.equal(s_1, lif_reference(current, beta_from_tau(DEFAULT_TAU))[0])
 
 
 def test_fused_lif_falls_back_to_spikingjelly_when_the_membrane_is_not_at_rest():
@@ -122,14 +145,18 @@ def test_ssa_shapes_and_attention_without_softmax():
     ssa = SSA(D, H, scale=0.125, tau=2.0, v_threshold=1.0, attn_threshold=0.5, alpha=2.0)
     x = (torch.rand(T, B, N, D) > 0.5).float()
     assert ssa(x).shape == (T, B, N, D)
-    q, k, v = ((torch.rand(T, B, H, N, D // H) > 0.5).float() for _ in range(3))
-    a = ssa.attend(q, k, v)
-    assert a.shape == (T, B, H, N, D // H)
-    assert torch.allclose(a, (q @ k.transpose(-2, -1) @ v) * 0.125)   # Q K^T V * scale, either order
-    assert torch.allclose(ssa.attend(q, k, 3 * v), 3 * a)              # linear in V: no normalization
-    assert torch.allclose(ssa.attend(2 * q, k, v), 2 * a)              # softmax would not scale like this
-    attn = q @ k.transpose(-2, -1) * 0.125
-    assert not torch.allclose(attn.sum(-1), torch.ones(()))            # rows do not sum to 1
+    for n in (N, 3):                                                   # Q (K^T V) (dh = 4 < N), (Q K^T) V
+        q, k, v = ((torch.rand(T, B, n, D) > 0.5).float() for _ in range(3))   # [T, B, N, D], head h: columns
+        a = ssa.attend(q, k, v)
+        assert a.shape == (T, B, n, D)
+        heads = [x.reshape(T, B, n, H, D // H).transpose(2, 3) for x in (q, k, v)]   # [T, B, H, N, dh]
+        qh, kh, vh = heads
+        per_head = (qh @ kh.transpose(-2, -1) @ vh) * 0.125             # Q K^T V * scale, either order
+        assert torch.equal(a, per_head.transpose(2, 3).reshape(T, B, n, D))
+        assert torch.allclose(ssa.attend(q, k, 3 * v), 3 * a)          # linear in V: no normalization
+        assert torch.allclose(ssa.attend(2 * q, k, v), 2 * a)          # softmax would not scale like this
+        attn = qh @ kh.transpose(-2, -1) * 0.125
+        assert not torch.allclose(attn.sum(-1), torch.ones(()))        # rows do not sum to 1
 
 
 class _Calls(TorchFunctionMode):
@@ -176,9 +203,9 @@ def test_encoder_neurons_resolve_a_constant_input_finer():
     for k in (1, 8):
         model = BGFN(in_channels=1, **{**TINY, "encoder_neurons": k}).eval()
         enc = model.spike_encoder
-        with torch.no_grad():                    # spread the thresholds: neuron j fires for inputs above ~j/k
+        with torch.no_grad():                    # spread the thresholds by the BN offsets: neuron j fires above ~j/k
             enc.conv.weight.fill_(1.0 / 3)       # kernel 3 on a constant input: the input value
-            enc.conv.bias.copy_(-torch.linspace(0, 1, k * TINY["time_steps"]))
+            enc.bn.bias.copy_(-torch.linspace(0, 1, k * TINY["time_steps"]))
         x = torch.linspace(-0.5, 1.5, 400)[:, None, None].expand(400, 5, 1)   # [B, N=5, C=1], constant in time
         s = enc(x)                               # [T_s, B, N, K]
         assert s.shape == (TINY["time_steps"], 400, 5, k)

@@ -52,11 +52,15 @@ def _bn(bn: nn.BatchNorm1d, x: torch.Tensor) -> torch.Tensor:
 
 
 class LinearBNLIF(nn.Module):
-    """SN(BN(Linear(x))): the basic spiking layer of Spikformer. [T, B, N, Din] -> [T, B, N, Dout] spikes."""
+    """SN(BN(Linear(x))): the basic spiking layer of Spikformer. [T, B, N, Din] -> [T, B, N, Dout] spikes.
+
+    The Linear has no bias, as Spikformer's convolutions before a BatchNorm: BN subtracts the batch mean (in
+    training) or the running mean (in evaluation), which cancels any constant the Linear adds.
+    """
 
     def __init__(self, d_in: int, d_out: int, tau: float, v_threshold: float, alpha: float):
         super().__init__()
-        self.linear = nn.Linear(d_in, d_out)
+        self.linear = nn.Linear(d_in, d_out, bias=False)
         self.bn = nn.BatchNorm1d(d_out)
         self.lif = make_lif(tau, v_threshold, alpha)
 
@@ -76,8 +80,9 @@ class SpikeEncoder(nn.Module):
         self.in_channels, self.time_steps, self.neurons = in_channels, time_steps, neurons
         self.out_channels = in_channels * neurons
         # T_s kernels per channel and neuron (groups=C); 'same' padding keeps one token per IMU sample
+        # no bias: the BatchNorm after it cancels one (LinearBNLIF)
         self.conv = nn.Conv1d(in_channels, self.out_channels * time_steps, kernel_size, padding=kernel_size // 2,
-                              groups=in_channels)
+                              groups=in_channels, bias=False)
         self.bn = nn.BatchNorm1d(self.out_channels * time_steps)
         self.lif = make_lif(tau, v_threshold, alpha)
 
@@ -119,10 +124,6 @@ class SSA(nn.Module):
         self.attn_lif = make_lif(tau, attn_threshold, alpha)
         self.proj = LinearBNLIF(dim, dim, tau, v_threshold, alpha)
 
-    def _split(self, x):                                 # [T, B, N, D]
-        T, B, N, D = x.shape
-        return x.reshape(T, B, N, self.heads, D // self.heads).transpose(2, 3)   # [T, B, H, N, dh]
-
     @staticmethod
     def kv_first(n_tokens: int, head_dim: int) -> bool:
         """Product order of :meth:`attend`: Q (K^T V) when the head is narrower than the window (cheaper).
@@ -132,17 +133,26 @@ class SSA(nn.Module):
         return head_dim < n_tokens
 
     def attend(self, q, k, v):
-        """Q K^T V * scale per head, no softmax. q, k, v: [T, B, H, N, dh] -> [T, B, H, N, dh]."""
-        N, dh = q.shape[-2], q.shape[-1]
+        """Q K^T V * scale per head, no softmax. q, k, v: [T, B, N, D] -> [T, B, N, D]; head h is columns
+        ``h*dh:(h+1)*dh`` of every token.
+
+        Each head's columns are a strided [T*B, N, dh] view that ``bmm`` reads in place: splitting into a
+        [T, B, H, N, dh] tensor instead cost a copy of Q, K, V and of the result, forward and backward (about a
+        tenth of BGFN's training step at the paper's size, ``make bench``). The scale comes last, as in
+        Spikformer: the intermediate product stays integer-valued, which is what the energy count (and
+        SpikingJelly's synaptic-operation counter it is checked against) reads as spikes.
+        """
+        T, B, N, D = q.shape
+        dh = D // self.heads
+        heads = zip(*(x.reshape(T * B, N, D).split(dh, dim=-1) for x in (q, k, v)))   # H x [T*B, N, dh] views
         if self.kv_first(N, dh):
-            return (q @ (k.transpose(-2, -1) @ v)) * self.scale    # K^T V: [T, B, H, dh, dh]
-        return ((q @ k.transpose(-2, -1)) @ v) * self.scale         # Q K^T: [T, B, H, N, N]
+            out = [torch.bmm(qh, torch.bmm(kh.transpose(1, 2), vh)) for qh, kh, vh in heads]   # K^T V: [T*B, dh, dh]
+        else:
+            out = [torch.bmm(torch.bmm(qh, kh.transpose(1, 2)), vh) for qh, kh, vh in heads]   # Q K^T: [T*B, N, N]
+        return (torch.cat(out, dim=-1) * self.scale).view(T, B, N, D)                  # [T, B, N, D]
 
     def forward(self, x):                                # [T, B, N, D]
-        T, B, N, D = x.shape
-        q, k, v = self._split(self.q(x)), self._split(self.k(x)), self._split(self.v(x))  # [T, B, H, N, dh]
-        a = self.attend(q, k, v)                         # [T, B, H, N, dh]
-        a = a.transpose(2, 3).reshape(T, B, N, D)        # [T, B, N, D]
+        a = self.attend(self.q(x), self.k(x), self.v(x))  # [T, B, N, D]
         return self.proj(self.attn_lif(a))               # [T, B, N, D] spikes
 
 

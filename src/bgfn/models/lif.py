@@ -26,14 +26,12 @@ The backward pass replaces dS/dU by the derivative of the ATan surrogate (Eq. eq
 Speed: on the CPU, SpikingJelly's multi-step LIF runs the recursion as many small autograd operations per
 step (charge, fire, reset, surrogate), and this overhead, not arithmetic, made BGFN train many times slower
 than its ANN twin. :class:`FusedLIFNode` is a ``LIFNode`` whose multi-step pass on the CPU is one autograd
-node (:class:`FusedLIF`): the forward loop stores U(t) and S(t), the backward pass applies the same chain rule
-in reverse (the surrogate derivative evaluated once over all steps, then one fused multiply-add per step).
-Spikes are bit-identical and gradients equal within float32 rounding (tests compare it with
-:func:`lif_reference` and with SpikingJelly's ``LIFNode``). It writes every step into tensors allocated once and
-computes the surrogate in the memory of its saved potentials: at the paper's size each fresh [B, N, D]
-tensor cost page faults that took as long as the arithmetic (torch.profiler), so its backward pass runs once
-per forward pass (``retain_graph=True`` is refused). On a CUDA device, or for any setting it does not
-cover, it falls back to SpikingJelly's own implementation (whose CUDA kernels are fused already).
+node (:class:`FusedLIF`) whose forward and backward passes are numba kernels (:mod:`bgfn.models.lif_kernels`):
+each neuron's ``T`` steps run in registers, one pass over memory each way, where torch operations took three
+passes per step forward and ten backward over tensors too large for the cache. Spikes are bit-identical and
+gradients equal within float32 rounding (tests compare it with :func:`lif_reference` and with SpikingJelly's
+``LIFNode``). On a CUDA device, for another dtype than float32, or for any setting it does not cover, it falls
+back to SpikingJelly's own implementation (whose CUDA kernels are fused already).
 """
 
 from __future__ import annotations
@@ -42,6 +40,8 @@ import math
 
 import torch
 from spikingjelly.activation_based import neuron, surrogate
+
+from . import lif_kernels
 
 #: Membrane time constant of every LIF layer (SpikingJelly ``tau``); beta = 1 - 1/tau = 0.5.
 DEFAULT_TAU = 2.0
@@ -73,66 +73,46 @@ class FusedLIF(torch.autograd.Function):
 
         dL/dU(t) = dL/dS(t) g'(U(t) - U_thr) + dL/dU(t+1) (1 - S(t)) beta,     dL/dI(t) = dL/dU(t)
 
-    with ``g'`` the ATan surrogate derivative (Eq. eq:surrogate_gradient).
+    with ``g'`` the ATan surrogate derivative (Eq. eq:surrogate_gradient). Both passes are the numba kernels of
+    :mod:`bgfn.models.lif_kernels` (float32 on the CPU); the forward pass saves ``g'`` with the spike in its sign.
     """
 
     @staticmethod
     def forward(ctx, current: torch.Tensor, tau: float, u_thr: float, alpha: float):    # current [T, ...]
-        # Every step writes into tensors allocated once: at the paper's size a fresh [B, N, D] tensor per op costs
-        # page faults that took as long as the arithmetic (torch.profiler, make bench).
-        # Three operations per step, each writing in place (charge, fire, reset): a bool mask copied into the
-        # spikes and a masked reset took twice as long at the paper's size (make bench).
-        spikes = torch.empty_like(current)                                             # [T, ...]
-        potential = torch.empty_like(current)                                          # U(t), [T, ...]
-        v = torch.zeros_like(current[0])                        # SpikingJelly's V = (1 - S) U; H = beta V
-        exact_half = tau == 2.0                                 # V - V/2 == V/2 exactly in floating point
-        for t in range(current.shape[0]):
-            u, s = potential[t], spikes[t]
-            # charge with SpikingJelly's rounding, V - V/tau + I (= beta V + I), so spikes are bit-identical
-            if t == 0:
-                u.copy_(current[0])
-            elif exact_half:
-                torch.add(current[t], v, alpha=0.5, out=u)
-            else:
-                u.copy_(v - v / tau + current[t])
-            torch.ge(u, u_thr, out=s)                           # fire: S(t) = [U(t) >= U_thr] as 0.0 / 1.0
-            torch.addcmul(u, u, s, value=-1.0, out=v)           # hard reset to 0: V = U - U S, exactly U or 0
-        ctx.save_for_backward(potential, spikes)
-        ctx.beta, ctx.u_thr, ctx.alpha, ctx.used = beta_from_tau(tau), u_thr, alpha, False
+        T = current.shape[0]
+        cur = current.detach().contiguous().view(T, -1)                                # [T, M]
+        spikes, surrogate = torch.empty_like(cur), torch.empty_like(cur)               # [T, M]
+        v = torch.empty_like(cur[0])                                                   # SpikingJelly's V, [M]
+        lif_kernels.lif_forward(cur.numpy(), spikes.numpy(), surrogate.numpy(), v.numpy(), tau, u_thr, alpha,
+                                threads=torch.get_num_threads())
+        ctx.save_for_backward(surrogate)
+        ctx.beta = beta_from_tau(tau)
         ctx.mark_non_differentiable(v)          # the state between calls; every forward pass starts at rest
-        return spikes, v                                        # spikes, SpikingJelly's v after the last step
+        return spikes.view(current.shape), v.view(current.shape[1:])   # spikes, SpikingJelly's v after the last step
 
     @staticmethod
     def backward(ctx, grad_spikes: torch.Tensor, grad_v: torch.Tensor):
-        if ctx.used:
-            raise RuntimeError("FusedLIF's backward reuses the memory of its saved potentials, so it runs once per "
-                               "forward pass (no retain_graph=True); use make_lif(fused=False) for repeated passes")
-        ctx.used = True
-        potential, spikes = ctx.saved_tensors
-        k = math.pi / 2.0 * ctx.alpha
-        # g'(U - U_thr) for every step at once, in the potentials' memory (no longer needed), then dL/dS g'
-        grad = potential.sub_(ctx.u_thr).mul_(k).square_().add_(1.0).reciprocal_().mul_(ctx.alpha / 2.0)
-        grad.mul_(grad_spikes)
-        keep = torch.empty_like(grad[0])                        # dH(t)/dU(t) = (1 - S(t)) beta, reset detached
-        for t in range(grad.shape[0] - 2, -1, -1):              # the membrane carries dL/dU(t+1) back
-            torch.mul(spikes[t], -ctx.beta, out=keep).add_(ctx.beta)
-            grad[t].addcmul_(grad[t + 1], keep)
-        return grad, None, None, None
+        (surrogate,) = ctx.saved_tensors                                               # [T, M]
+        grad = grad_spikes.contiguous().view(surrogate.shape)
+        grad_current = torch.empty_like(surrogate)
+        lif_kernels.lif_backward(grad.numpy(), surrogate.numpy(), grad_current.numpy(), ctx.beta,
+                                 threads=torch.get_num_threads())
+        return grad_current.view(grad_spikes.shape), None, None, None
 
 
 class FusedLIFNode(neuron.LIFNode):
     """SpikingJelly's multi-step ``LIFNode`` whose CPU pass is :class:`FusedLIF` (module docstring).
 
     It is a ``LIFNode`` (hooks, ``reset_net``, firing-rate and energy counts see it as one); the fused pass
-    runs when the membrane starts from rest (after a reset) and the layer is the paper's (hard reset to 0,
-    ``decay_input=False``, ATan surrogate, detached reset, no stored potential sequence); otherwise, and on
-    CUDA, SpikingJelly's own implementation runs.
+    runs for float32 currents when the membrane starts from rest (after a reset) and the layer is the paper's
+    (hard reset to 0, ``decay_input=False``, ATan surrogate, detached reset, no stored potential sequence);
+    otherwise, and on CUDA, SpikingJelly's own implementation runs.
     """
 
     def _fusable(self, x_seq: torch.Tensor) -> bool:
         v = self._memories.get("v")
-        return (not x_seq.is_cuda and isinstance(v, float) and v == 0.0 and self.v_reset == 0.0
-                and not self.decay_input and self.detach_reset and not self.store_v_seq
+        return (not x_seq.is_cuda and x_seq.dtype == torch.float32 and isinstance(v, float) and v == 0.0
+                and self.v_reset == 0.0 and not self.decay_input and self.detach_reset and not self.store_v_seq
                 and isinstance(self.surrogate_function, surrogate.ATan)
                 and getattr(self, "_neuron_precision", None) is None)
 

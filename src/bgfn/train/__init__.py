@@ -6,6 +6,7 @@ Modules, one concept each (every public name is re-exported here):
 - :mod:`bgfn.train.options`: the ``train:`` optimizer settings, per-method learning rate, model size blocks;
 - :mod:`bgfn.train.loop`: :func:`train_model`, one ``(method, seed)`` with early stopping, checkpoint, card and
   resume;
+- :mod:`bgfn.train.memory`: :func:`keep_freed_memory`, freed tensors kept in the heap for the next step;
 - :mod:`bgfn.train.objectives`: what a run fits, the paper's increments or a learned odometer's speed;
 - :mod:`bgfn.train.trained`: :class:`TrainedModel` and :func:`load_trained`, a checkpoint predicting
   delta_p_gps (Eq. pred-gps);
@@ -31,6 +32,7 @@ The command line ``python -m bgfn train --profile ...`` is the package's edge (:
 from bgfn.learning import REFERENCES, VAL_POSITIONS
 from bgfn.train.estimate import estimate_lines, measure_paper_step, paper_training_estimate, speed_lines
 from bgfn.train.loop import set_seed, train_model
+from bgfn.train.memory import keep_freed_memory
 from bgfn.train.lr_search import (LR_SEARCH_COLUMNS, LR_SEARCH_DEFAULTS, LR_SEARCH_FILE, chosen_learning_rates,
                                   lr_search_options, next_learning_rate, search_learning_rates,
                                   search_profile_learning_rates, search_profile_rates, search_train_config,
@@ -57,7 +59,7 @@ __all__ = [
     # options
     "OPTIMIZER_DEFAULTS", "train_subsection", "optimizer_options", "method_lr", "size_config", "even_subset",
     # the loop and a trained network
-    "set_seed", "train_model", "pick_device", "predict_normalized", "TrainedModel", "load_trained",
+    "set_seed", "train_model", "keep_freed_memory", "pick_device", "predict_normalized", "TrainedModel", "load_trained",
     "checkpoint_predictions",
     # learning-rate search
     "LR_SEARCH_DEFAULTS", "LR_SEARCH_FILE", "LR_SEARCH_COLUMNS", "lr_search_options", "search_learning_rates",

@@ -41,6 +41,7 @@ from bgfn.io import atomic_path, atomic_write_json
 from bgfn.learning import LearningData
 from bgfn.models import build_model, count_parameters, is_spiking
 from bgfn.train import checkpoints
+from bgfn.train.memory import keep_freed_memory
 from bgfn.train.objectives import objective_of
 from bgfn.train.options import even_subset, method_lr, optimizer_options
 from bgfn.train.trained import pick_device, predict_normalized
@@ -130,6 +131,7 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
     dev = pick_device(device)
     if o["num_threads"]:
         torch.set_num_threads(int(o["num_threads"]))
+    keep_freed_memory()                                     # no page faults for every step's fresh tensors
 
     tr_idx = even_subset(len(data.train), o["max_train_windows"])
     va_idx = even_subset(len(data.val), o["max_val_windows"])

@@ -25,6 +25,7 @@ import torch
 from torch import nn
 
 from bgfn.config import RESULTS_ROOT
+from bgfn.train.memory import keep_freed_memory
 
 #: IMU rate of the Turin drive, Hz.
 IMU_RATE_HZ = 100.0
@@ -160,7 +161,9 @@ def throughput(model: nn.Module, window: int, batch: int = 64, in_channels: int 
 
 
 def _training_step(model: nn.Module, window: int, batch: int, in_channels: int, seed: int) -> Callable[[], None]:
-    """One training step on a fixed random batch: forward, BPTT backward and an AdamW step."""
+    """One training step on a fixed random batch: forward, BPTT backward and an AdamW step (with the memory
+    setting of the training loop, :func:`bgfn.train.memory.keep_freed_memory`)."""
+    keep_freed_memory()
     g = torch.Generator().manual_seed(seed)
     x, y = torch.randn(batch, window, in_channels, generator=g), torch.randn(batch, 2, generator=g)
     opt = torch.optim.AdamW(model.parameters(), lr=1e-3)

@@ -1,4 +1,4 @@
-"""Compile the navigation's numba kernels into numba's cache before the notebooks call them.
+"""Compile the navigation's numba kernels (and BGFN's LIF kernels) into numba's cache before the notebooks call them.
 
 Every kernel of the filter engine and its aids (:mod:`bgfn.nav.strapdown`, :mod:`bgfn.nav.filter`,
 :mod:`bgfn.nav.error_model`, :mod:`bgfn.nav.constraints`, ...) is ``numba.njit(cache=True)``: numba compiles it on
@@ -12,6 +12,10 @@ the same functions for the same argument types. ``make reproduce`` runs it in th
 (``python -m bgfn kernels``) while notebook 01 prepares the data, which does not need them. Nothing here changes
 a result: a kernel missing from the cache is compiled where it is first called, as before, and one that two
 processes compile at the same time is written to the cache atomically by numba.
+
+BGFN's LIF layers (:mod:`bgfn.models.lif_kernels`) are numba kernels too: :func:`compile_lif_kernels` runs one
+forward and backward pass on one thread and on two, the two variants training uses (a parallel runner's worker
+trains on one thread), so that notebook 03's workers load them instead of each compiling them.
 """
 
 from __future__ import annotations
@@ -19,12 +23,15 @@ from __future__ import annotations
 import time
 
 import numpy as np
+import torch
 
 from bgfn.data import Drive
 from bgfn.data import imu_errors as ie
 from bgfn.evaluate.hybrid import navigation_context, run_outages
 from bgfn.nav import baseline, sim
+from bgfn.models.lif import make_lif
 from bgfn.nav import odometer as no
+from bgfn.train.speed import torch_threads
 
 #: The synthetic drive: length, s; rest at its start, s (ZUPT and the at-rest alignment see a still IMU); the
 #: outage (start, duration), s after its first row.
@@ -56,4 +63,13 @@ def compile_kernels(nav_section: dict | None = None) -> float:
     epochs = np.arange(start - 5.0, start + OUTAGE[1] + 5.0, 1.0)
     track = no.SpeedTrack(epochs, np.full(epochs.size, 8.0), np.full(epochs.size, 0.5))
     run_outages(ctx, window, None, "INS", None, None, constraints=no.Odometer(ctx.constraints, track))
+    compile_lif_kernels()
     return time.perf_counter() - t0
+
+
+def compile_lif_kernels() -> None:
+    """One forward and backward pass of a fused LIF layer on one thread and on two (the numbers are thrown away)."""
+    for threads in (1, 2):
+        with torch_threads(threads):
+            x = torch.ones(2, 3, 4, requires_grad=True)
+            make_lif()(x).sum().backward()

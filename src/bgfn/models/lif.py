@@ -74,28 +74,26 @@ class FusedLIF(torch.autograd.Function):
         dL/dU(t) = dL/dS(t) g'(U(t) - U_thr) + dL/dU(t+1) (1 - S(t)) beta,     dL/dI(t) = dL/dU(t)
 
     with ``g'`` the ATan surrogate derivative (Eq. eq:surrogate_gradient). Both passes are the numba kernels of
-    :mod:`bgfn.models.lif_kernels` (float32 on the CPU); the forward pass saves ``g'`` with the spike in its sign.
+    :mod:`bgfn.models.lif_kernels` (float32 on the CPU); the backward pass recomputes U(t) from the saved currents.
     """
 
     @staticmethod
     def forward(ctx, current: torch.Tensor, tau: float, u_thr: float, alpha: float):    # current [T, ...]
         T = current.shape[0]
         cur = current.detach().contiguous().view(T, -1)                                # [T, M]
-        spikes, surrogate = torch.empty_like(cur), torch.empty_like(cur)               # [T, M]
-        v = torch.empty_like(cur[0])                                                   # SpikingJelly's V, [M]
-        lif_kernels.lif_forward(cur.numpy(), spikes.numpy(), surrogate.numpy(), v.numpy(), tau, u_thr, alpha,
-                                threads=torch.get_num_threads())
-        ctx.save_for_backward(surrogate)
-        ctx.beta = beta_from_tau(tau)
+        spikes, v = torch.empty_like(cur), torch.empty_like(cur[0])                    # [T, M]; SpikingJelly's V
+        lif_kernels.lif_forward(cur.numpy(), spikes.numpy(), v.numpy(), tau, u_thr, threads=torch.get_num_threads())
+        ctx.save_for_backward(cur)              # the backward pass recomputes U(t) from the currents
+        ctx.params = (tau, u_thr, alpha)
         ctx.mark_non_differentiable(v)          # the state between calls; every forward pass starts at rest
         return spikes.view(current.shape), v.view(current.shape[1:])   # spikes, SpikingJelly's v after the last step
 
     @staticmethod
     def backward(ctx, grad_spikes: torch.Tensor, grad_v: torch.Tensor):
-        (surrogate,) = ctx.saved_tensors                                               # [T, M]
-        grad = grad_spikes.contiguous().view(surrogate.shape)
-        grad_current = torch.empty_like(surrogate)
-        lif_kernels.lif_backward(grad.numpy(), surrogate.numpy(), grad_current.numpy(), ctx.beta,
+        (cur,) = ctx.saved_tensors                                                     # [T, M]
+        grad = grad_spikes.contiguous().view(cur.shape)
+        grad_current = torch.empty_like(cur)
+        lif_kernels.lif_backward(cur.numpy(), grad.numpy(), grad_current.numpy(), *ctx.params,
                                  threads=torch.get_num_threads())
         return grad_current.view(grad_spikes.shape), None, None, None
 

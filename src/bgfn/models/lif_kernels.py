@@ -3,18 +3,17 @@ and its BPTT backward pass with the ATan surrogate (Eq. eq:surrogate_gradient), 
 
 Why numba: written as torch operations, one LIF step is three passes over a [B, N, D] tensor (charge, fire,
 reset) and its backward pass seven more (the surrogate, then the membrane's chain rule), each reading and writing
-the whole tensor; at the paper's size these tensors do not stay in the cache from one operation to the next. Here
-each neuron's ``T`` steps run in registers: the forward pass reads the currents once and writes the spikes and the
-surrogate derivative once; the backward pass reads the upstream gradient and the surrogate once and writes the
-gradient of the currents once.
+the whole tensor; at the paper's size these tensors do not stay in the cache from one operation to the next, so
+memory traffic, not arithmetic, set the layer's cost. Here each neuron's ``T`` steps run in registers: the
+forward pass reads the currents once and writes the spikes once; the backward pass reads the currents and the
+upstream gradient once, recomputes the potentials U(t) of a chunk into a buffer that stays in the cache, and
+writes the gradient of the currents once. Recomputing U(t) is cheaper than writing it (or the surrogate) in the
+forward pass and reading it back (``make bench``), and it is the same arithmetic, so the gradients are the same bits.
 
 Layout: every array is ``[T, M]`` float32 and C-contiguous (``M`` = all neurons of the batch). The neurons are
 cut into chunks of :data:`CHUNK`; each chunk runs its ``T`` steps over contiguous rows, which LLVM vectorizes.
 The chunks are independent, so the result does not depend on how many threads share them: the same bits with
 one thread or many.
-
-The surrogate derivative is stored with the spike in its sign (``-g'`` where the neuron fired, ``+g'`` where it
-did not; ``g' > 0`` always), so the backward pass needs no second saved tensor for the reset term.
 """
 
 from __future__ import annotations
@@ -32,68 +31,83 @@ _JIT = dict(cache=True, error_model="numpy")        # numpy's division semantics
 
 
 @numba.njit(inline="always", **_JIT)
-def _steps_forward(current, spikes, surrogate, v, lo, hi, tau, u_thr, k, half_alpha):
-    """Neurons ``lo:hi``, all ``T`` steps from rest: charge, fire, hard reset (Eq. eq:LIF); ``v`` holds
+def _charge(v, current, tau):
+    """U(t) = V - V/tau + I: SpikingJelly's charge with its rounding (== I + beta V), so spikes are bit-identical."""
+    return v - v / tau + current
+
+
+@numba.njit(inline="always", **_JIT)
+def _steps_forward(current, spikes, v, lo, hi, tau, u_thr):
+    """Neurons ``lo:hi``, all ``T`` steps from rest: charge, fire, hard reset to 0 (Eq. eq:LIF); ``v`` holds
     SpikingJelly's V."""
     # rows sliced as [t, lo:hi] of the C-contiguous arrays: numba knows them contiguous, so LLVM vectorizes
     v = v[lo:hi]
     v[:] = 0.0
     for t in range(current.shape[0]):
-        c, s, g_out = current[t, lo:hi], spikes[t, lo:hi], surrogate[t, lo:hi]
+        c, s = current[t, lo:hi], spikes[t, lo:hi]
         for j in range(c.size):
-            # V - V/tau + I: SpikingJelly's charge with its rounding (== I + beta V), so spikes are bit-identical
-            u = v[j] - v[j] / tau + c[j]
-            x = (u - u_thr) * k
-            g = half_alpha / (x * x + np.float32(1.0))       # g'(U - U_thr), Eq. (eq:surrogate_gradient)
+            u = _charge(v[j], c[j], tau)
             fire = u >= u_thr
             s[j] = np.float32(1.0) if fire else np.float32(0.0)
-            g_out[j] = -g if fire else g                     # the spike in the sign
-            v[j] = np.float32(0.0) if fire else u            # hard reset to 0
+            v[j] = np.float32(0.0) if fire else u
 
 
 @numba.njit(inline="always", **_JIT)
-def _steps_backward(grad_spikes, surrogate, grad_current, lo, hi, beta):
-    """Neurons ``lo:hi``, the steps in reverse: dL/dU(t) = dL/dS(t) g'(t) + dL/dU(t+1) (1 - S(t)) beta."""
-    T = grad_spikes.shape[0]
-    last, gs, gi = surrogate[T - 1, lo:hi], grad_spikes[T - 1, lo:hi], grad_current[T - 1, lo:hi]
-    for j in range(gs.size):
-        gi[j] = gs[j] * abs(last[j])
-    for t in range(T - 2, -1, -1):
-        gs, g_t = grad_spikes[t, lo:hi], surrogate[t, lo:hi]
-        gi, gi_next = grad_current[t, lo:hi], grad_current[t + 1, lo:hi]
-        for j in range(gs.size):
-            keep = beta if g_t[j] > 0 else np.float32(0.0)   # reset detached: no path through a fired neuron
-            gi[j] = gs[j] * abs(g_t[j]) + gi_next[j] * keep
+def _steps_backward(current, grad_spikes, grad_current, lo, hi, tau, u_thr, k, half_alpha, beta):
+    """Neurons ``lo:hi``: U(t) recomputed as in the forward pass, then the steps in reverse,
+    dL/dU(t) = dL/dS(t) g'(U(t) - U_thr) + dL/dU(t+1) (1 - S(t)) beta (reset detached)."""
+    T, n = current.shape[0], hi - lo
+    u = np.empty((T, n), dtype=np.float32)         # this chunk's potentials: T x CHUNK floats, in the cache
+    v = np.zeros(n, dtype=np.float32)
+    for t in range(T):
+        c, u_t = current[t, lo:hi], u[t]
+        for j in range(n):
+            u_t[j] = _charge(v[j], c[j], tau)
+            v[j] = np.float32(0.0) if u_t[j] >= u_thr else u_t[j]
+    for t in range(T - 1, -1, -1):
+        gs, gi, u_t = grad_spikes[t, lo:hi], grad_current[t, lo:hi], u[t]
+        if t == T - 1:                              # nothing after the last step
+            for j in range(n):
+                x = (u_t[j] - u_thr) * k
+                gi[j] = gs[j] * (half_alpha / (x * x + np.float32(1.0)))       # g', Eq. (eq:surrogate_gradient)
+        else:
+            gi_next = grad_current[t + 1, lo:hi]
+            for j in range(n):
+                x = (u_t[j] - u_thr) * k
+                keep = np.float32(0.0) if u_t[j] >= u_thr else beta            # no path through a fired neuron
+                gi[j] = gs[j] * (half_alpha / (x * x + np.float32(1.0))) + gi_next[j] * keep
 
 
 # Each pass twice, over numba's threads (prange) and on the calling thread (range): two functions, not one compiled
 # twice, because numba's cache keys a function by its name and line, not by the parallel flag.
 @numba.njit(parallel=True, **_JIT)
-def _forward_parallel(current, spikes, surrogate, v, tau, u_thr, k, half_alpha):
+def _forward_parallel(current, spikes, v, tau, u_thr):
     M = current.shape[1]
     for c in prange((M + CHUNK - 1) // CHUNK):
-        _steps_forward(current, spikes, surrogate, v, c * CHUNK, min(M, (c + 1) * CHUNK), tau, u_thr, k, half_alpha)
+        _steps_forward(current, spikes, v, c * CHUNK, min(M, (c + 1) * CHUNK), tau, u_thr)
 
 
 @numba.njit(**_JIT)
-def _forward_serial(current, spikes, surrogate, v, tau, u_thr, k, half_alpha):
+def _forward_serial(current, spikes, v, tau, u_thr):
     M = current.shape[1]
     for c in range((M + CHUNK - 1) // CHUNK):
-        _steps_forward(current, spikes, surrogate, v, c * CHUNK, min(M, (c + 1) * CHUNK), tau, u_thr, k, half_alpha)
+        _steps_forward(current, spikes, v, c * CHUNK, min(M, (c + 1) * CHUNK), tau, u_thr)
 
 
 @numba.njit(parallel=True, **_JIT)
-def _backward_parallel(grad_spikes, surrogate, grad_current, beta):
-    M = grad_spikes.shape[1]
+def _backward_parallel(current, grad_spikes, grad_current, tau, u_thr, k, half_alpha, beta):
+    M = current.shape[1]
     for c in prange((M + CHUNK - 1) // CHUNK):
-        _steps_backward(grad_spikes, surrogate, grad_current, c * CHUNK, min(M, (c + 1) * CHUNK), beta)
+        _steps_backward(current, grad_spikes, grad_current, c * CHUNK, min(M, (c + 1) * CHUNK), tau, u_thr, k,
+                        half_alpha, beta)
 
 
 @numba.njit(**_JIT)
-def _backward_serial(grad_spikes, surrogate, grad_current, beta):
-    M = grad_spikes.shape[1]
+def _backward_serial(current, grad_spikes, grad_current, tau, u_thr, k, half_alpha, beta):
+    M = current.shape[1]
     for c in range((M + CHUNK - 1) // CHUNK):
-        _steps_backward(grad_spikes, surrogate, grad_current, c * CHUNK, min(M, (c + 1) * CHUNK), beta)
+        _steps_backward(current, grad_spikes, grad_current, c * CHUNK, min(M, (c + 1) * CHUNK), tau, u_thr, k,
+                        half_alpha, beta)
 
 
 def _parallel(threads: int) -> bool:
@@ -105,9 +119,9 @@ def _parallel(threads: int) -> bool:
     return True
 
 
-def lif_forward(current: np.ndarray, spikes: np.ndarray, surrogate: np.ndarray, v: np.ndarray, tau: float,
-                u_thr: float, alpha: float, threads: int = 1) -> None:
-    """Eq. (eq:LIF) from rest over all steps, written into ``spikes``, ``surrogate`` and ``v``.
+def lif_forward(current: np.ndarray, spikes: np.ndarray, v: np.ndarray, tau: float, u_thr: float,
+                threads: int = 1) -> None:
+    """Eq. (eq:LIF) from rest over all steps, written into ``spikes`` and ``v``.
 
     Parameters
     ----------
@@ -115,22 +129,22 @@ def lif_forward(current: np.ndarray, spikes: np.ndarray, surrogate: np.ndarray, 
         Input current I(t) of ``M`` neurons.
     spikes : float32 array [T, M]
         Out: S(t) in {0, 1}.
-    surrogate : float32 array [T, M]
-        Out: g'(U(t) - U_thr) (Eq. eq:surrogate_gradient), negated where S(t) = 1.
     v : float32 array [M]
         Out: SpikingJelly's membrane state V after the last step (0 where the neuron fired).
-    tau, u_thr, alpha : float
-        Time constant (beta = 1 - 1/tau), threshold, ATan steepness.
+    tau, u_thr : float
+        Time constant (beta = 1 - 1/tau) and threshold.
     threads : int
         Threads to share the neurons (the caller's torch threads); the result is the same for any number.
     """
+    (_forward_parallel if _parallel(threads) else _forward_serial)(current, spikes, v, np.float32(tau),
+                                                                   np.float32(u_thr))
+
+
+def lif_backward(current: np.ndarray, grad_spikes: np.ndarray, grad_current: np.ndarray, tau: float, u_thr: float,
+                 alpha: float, threads: int = 1) -> None:
+    """BPTT through :func:`lif_forward` on the same ``current`` [T, M]: dL/dI(t) written into ``grad_current``
+    [T, M] (float32, like the inputs) from dL/dS(t) in ``grad_spikes``; ``alpha`` is the ATan steepness."""
     f32 = np.float32
-    args = (current, spikes, surrogate, v, f32(tau), f32(u_thr), f32(np.pi / 2.0 * alpha), f32(alpha / 2.0))
-    (_forward_parallel if _parallel(threads) else _forward_serial)(*args)
-
-
-def lif_backward(grad_spikes: np.ndarray, surrogate: np.ndarray, grad_current: np.ndarray, beta: float,
-                 threads: int = 1) -> None:
-    """BPTT through :func:`lif_forward`: dL/dI(t) written into ``grad_current`` [T, M] (float32, like the inputs)."""
-    (_backward_parallel if _parallel(threads) else _backward_serial)(grad_spikes, surrogate, grad_current,
-                                                                     np.float32(beta))
+    (_backward_parallel if _parallel(threads) else _backward_serial)(
+        current, grad_spikes, grad_current, f32(tau), f32(u_thr), f32(np.pi / 2.0 * alpha), f32(alpha / 2.0),
+        f32(1.0 - 1.0 / tau))

@@ -124,6 +124,10 @@ class SSA(nn.Module):
         self.attn_lif = make_lif(tau, attn_threshold, alpha)
         self.proj = LinearBNLIF(dim, dim, tau, v_threshold, alpha)
 
+    def _split(self, x):                                 # [T, B, N, D]
+        T, B, N, D = x.shape
+        return x.reshape(T, B, N, self.heads, D // self.heads).transpose(2, 3)   # [T, B, H, N, dh]
+
     @staticmethod
     def kv_first(n_tokens: int, head_dim: int) -> bool:
         """Product order of :meth:`attend`: Q (K^T V) when the head is narrower than the window (cheaper).
@@ -133,26 +137,17 @@ class SSA(nn.Module):
         return head_dim < n_tokens
 
     def attend(self, q, k, v):
-        """Q K^T V * scale per head, no softmax. q, k, v: [T, B, N, D] -> [T, B, N, D]; head h is columns
-        ``h*dh:(h+1)*dh`` of every token.
-
-        Each head's columns are a strided [T*B, N, dh] view that ``bmm`` reads in place: splitting into a
-        [T, B, H, N, dh] tensor instead cost a copy of Q, K, V and of the result, forward and backward (about a
-        tenth of BGFN's training step at the paper's size, ``make bench``). The scale comes last, as in
-        Spikformer: the intermediate product stays integer-valued, which is what the energy count (and
-        SpikingJelly's synaptic-operation counter it is checked against) reads as spikes.
-        """
-        T, B, N, D = q.shape
-        dh = D // self.heads
-        heads = zip(*(x.reshape(T * B, N, D).split(dh, dim=-1) for x in (q, k, v)))   # H x [T*B, N, dh] views
+        """Q K^T V * scale per head, no softmax. q, k, v: [T, B, H, N, dh] -> [T, B, H, N, dh]."""
+        N, dh = q.shape[-2], q.shape[-1]
         if self.kv_first(N, dh):
-            out = [torch.bmm(qh, torch.bmm(kh.transpose(1, 2), vh)) for qh, kh, vh in heads]   # K^T V: [T*B, dh, dh]
-        else:
-            out = [torch.bmm(torch.bmm(qh, kh.transpose(1, 2)), vh) for qh, kh, vh in heads]   # Q K^T: [T*B, N, N]
-        return (torch.cat(out, dim=-1) * self.scale).view(T, B, N, D)                  # [T, B, N, D]
+            return (q @ (k.transpose(-2, -1) @ v)) * self.scale    # K^T V: [T, B, H, dh, dh]
+        return ((q @ k.transpose(-2, -1)) @ v) * self.scale         # Q K^T: [T, B, H, N, N]
 
     def forward(self, x):                                # [T, B, N, D]
-        a = self.attend(self.q(x), self.k(x), self.v(x))  # [T, B, N, D]
+        T, B, N, D = x.shape
+        q, k, v = self._split(self.q(x)), self._split(self.k(x)), self._split(self.v(x))  # [T, B, H, N, dh]
+        a = self.attend(q, k, v)                         # [T, B, H, N, dh]
+        a = a.transpose(2, 3).reshape(T, B, N, D)        # [T, B, N, D]
         return self.proj(self.attn_lif(a))               # [T, B, N, D] spikes
 
 

@@ -7,8 +7,9 @@ the whole tensor; at the paper's size these tensors do not stay in the cache fro
 memory traffic, not arithmetic, set the layer's cost. Here each neuron's ``T`` steps run in registers: the
 forward pass reads the currents once and writes the spikes once; the backward pass reads the currents and the
 upstream gradient once, recomputes the potentials U(t) of a chunk into a buffer that stays in the cache, and
-writes the gradient of the currents once. Recomputing U(t) is cheaper than writing it (or the surrogate) in the
-forward pass and reading it back (``make bench``), and it is the same arithmetic, so the gradients are the same bits.
+writes the gradient of the currents once. Recomputing U(t) is the same arithmetic, so the gradients are the same
+bits, and it was a little faster than writing the surrogate in the forward pass and reading it back (an interleaved
+A/B of the paper-size training step, in the README).
 
 Layout: every array is ``[T, M]`` float32 and C-contiguous (``M`` = all neurons of the batch). The neurons are
 cut into chunks of :data:`CHUNK`; each chunk runs its ``T`` steps over contiguous rows, which LLVM vectorizes.

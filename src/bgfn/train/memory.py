@@ -3,9 +3,10 @@
 Why: torch allocates every activation and gradient of a training step afresh. glibc serves a block above its
 ``mmap`` threshold (128 KiB to start with) with fresh pages from the OS and returns them when the tensor is freed,
 so the next step touches new pages again: the kernel zeroes each 4 KiB page on its first touch. At the paper's
-size BGFN's [T, B, N, D] tensors are 6.5 MB each, and a step cost about 31,000 such page faults (about 5 % of its
-wall time, ``getrusage``); its ANN twin, with T = 1 and fewer layers, about 1,900. Raising the ``mmap`` and trim
-thresholds keeps freed blocks in the heap, where the next step finds them already mapped (about one fault per step).
+size BGFN's [T, B, N, D] tensors are 6.5 MB each, and a step cost about 31,000 such page faults (``getrusage``);
+its ANN twin, with T = 1 and fewer layers, about 1,900. Raising the ``mmap`` and trim thresholds keeps freed blocks
+in the heap, where the next step finds them already mapped: under 2,000 faults per BGFN step, which took a few per
+cent less wall time (the README's ``make bench`` paragraph).
 
 This is the usual advice for CPU training with torch (a caching allocator such as jemalloc or tcmalloc does the same
 by default); it changes no number, only where a tensor's memory comes from. The price is that a training process

@@ -63,8 +63,8 @@ __all__ = [
     "checkpoint_predictions",
     # learning-rate search
     "LR_SEARCH_DEFAULTS", "LR_SEARCH_FILE", "LR_SEARCH_COLUMNS", "lr_search_options", "search_learning_rates",
-    "next_learning_rate", "search_train_config", "with_selected_lr", "tuned_train_config", "search_profile_learning_rates",
-    "selected_train_configs", "chosen_learning_rates", "search_profile_rates",
+    "next_learning_rate", "search_train_config", "with_selected_lr", "tuned_train_config",
+    "search_profile_learning_rates", "selected_train_configs", "chosen_learning_rates", "search_profile_rates",
     # independent runs
     "TrainingRun", "train_run", "train_runs", "run_summary", "expected_cost",
     # a profile's training

@@ -28,8 +28,8 @@ import torch
 from bgfn.data import Drive
 from bgfn.data import imu_errors as ie
 from bgfn.evaluate.hybrid import navigation_context, run_outages
-from bgfn.nav import baseline, sim
 from bgfn.models.lif import make_lif
+from bgfn.nav import baseline, sim
 from bgfn.nav import odometer as no
 from bgfn.train.speed import torch_threads
 

@@ -84,7 +84,7 @@ class FusedLIF(torch.autograd.Function):
         spikes, v = torch.empty_like(cur), torch.empty_like(cur[0])                    # [T, M]; SpikingJelly's V
         lif_kernels.lif_forward(cur.numpy(), spikes.numpy(), v.numpy(), tau, u_thr, threads=torch.get_num_threads())
         ctx.save_for_backward(cur)              # the backward pass recomputes U(t) from the currents
-        ctx.params = (tau, u_thr, alpha)
+        ctx.params = (tau, u_thr, alpha, beta_from_tau(tau))
         ctx.mark_non_differentiable(v)          # the state between calls; every forward pass starts at rest
         return spikes.view(current.shape), v.view(current.shape[1:])   # spikes, SpikingJelly's v after the last step
 

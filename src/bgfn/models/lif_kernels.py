@@ -142,10 +142,11 @@ def lif_forward(current: np.ndarray, spikes: np.ndarray, v: np.ndarray, tau: flo
 
 
 def lif_backward(current: np.ndarray, grad_spikes: np.ndarray, grad_current: np.ndarray, tau: float, u_thr: float,
-                 alpha: float, threads: int = 1) -> None:
+                 alpha: float, beta: float, threads: int = 1) -> None:
     """BPTT through :func:`lif_forward` on the same ``current`` [T, M]: dL/dI(t) written into ``grad_current``
-    [T, M] (float32, like the inputs) from dL/dS(t) in ``grad_spikes``; ``alpha`` is the ATan steepness."""
+    [T, M] (float32, like the inputs) from dL/dS(t) in ``grad_spikes``; ``alpha`` is the ATan steepness, ``beta``
+    the decay factor of ``tau`` (:func:`bgfn.models.lif.beta_from_tau`)."""
     f32 = np.float32
     (_backward_parallel if _parallel(threads) else _backward_serial)(
         current, grad_spikes, grad_current, f32(tau), f32(u_thr), f32(np.pi / 2.0 * alpha), f32(alpha / 2.0),
-        f32(1.0 - 1.0 / tau))
+        f32(beta))

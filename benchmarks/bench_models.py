@@ -15,6 +15,10 @@ Adds to ``results/bench.json``:
   profiled step over BGFN's matrix products alone, the ratio BGFN would reach if everything but its matrix
   arithmetic (LIF, BatchNorm, copies) cost nothing; ``train_ceiling_spread.<size>``: its quartiles and those of
   BGFN's matrix products over its own profiled step (``matmul_share``, :func:`bgfn.train.speed.ceiling_spread`);
+- ``train_ceiling_replay.<size>``: the same two figures without the profiler (which slows the step: its own thread
+  shares the cores): BGFN's matrix products recorded once (:func:`bgfn.train.speed.matmul_calls`) and replayed alone
+  on operands of the same shapes (:func:`bgfn.train.speed.matmul_replay`), timed in the same interleaved rounds as
+  the two steps, so each round gives the twin's step over those products and the products over BGFN's step;
 - ``models_bench``: what ran (threads, device, batch, window, parameter counts, repeats).
 
 Sizes come from ``train.sizes`` of ``params/<size>.yaml`` (the same blocks in every profile). Median of a
@@ -31,9 +35,9 @@ import torch
 from bgfn.profile_schema import load_profile
 from bgfn.io import update_json
 from bgfn.models import METHODS, build_model, count_parameters
-from bgfn.train.speed import (bench_file, ceiling_spread, interleaved_profiles, interleaved_times, median_profile,
-                              median_time, paired_ratio, quartiles, ratio_text, training_step, training_throughput,
-                              twin_ratios)
+from bgfn.train.speed import (bench_file, ceiling_spread, interleaved_profiles, interleaved_times, matmul_calls,
+                              matmul_replay, median_profile, median_time, paired_ratio, quartiles, ratio_text,
+                              training_step, training_throughput, twin_ratios)
 
 SIZES = ("quick", "paper")
 #: (training steps, inference calls) measured per size, after one warm-up each.
@@ -94,11 +98,17 @@ def main(sizes=SIZES, methods=METHODS) -> dict:
                   f"{n_params} parameters", flush=True)
     # BGFN's training throughput over its ANN twin's, interleaved round by round, and the ceiling its matrix
     # products set (the twin's profiled step over BGFN's matrix products alone)
-    spread, ceilings, profiles = {}, {}, {}
+    spread, ceilings, profiles, replayed = {}, {}, {}, {}
     if all(m in methods for m in PAIR):
         for size in sizes:
             steps = pair_steps(size)
-            times = interleaved_times(steps, PAIR_ROUNDS[size])
+            # BGFN's matrix products alone, unprofiled, in the same rounds as the two steps
+            matmuls = matmul_replay(matmul_calls(steps["bgfn"]))
+            times = interleaved_times({**steps, "bgfn_matmuls": matmuls}, PAIR_ROUNDS[size])
+            replayed[size] = ceiling_spread([{"step_s": t} for t in times["transformer"]],
+                                            [{"step_s": b, "matmul_s": mm}
+                                             for b, mm in zip(times["bgfn"], times["bgfn_matmuls"])])
+            replayed[size]["matmul_ms"] = 1e3 * quartiles(times["bgfn_matmuls"])["median"]
             spread[size] = paired_ratio(times["transformer"], times["bgfn"])    # BGFN's throughput / the twin's
             for m in PAIR:
                 q = quartiles(times[m])
@@ -126,10 +136,18 @@ def main(sizes=SIZES, methods=METHODS) -> dict:
                      f"{100 * sq['q75']:.0f} %] of its own profiled step")
         else:
             text += f": {100 * r / c:.0f} % of it"
+        if size in replayed:
+            cq, sq = replayed[size]["ceiling"], replayed[size]["matmul_share"]
+            step_ms = 1e3 * info["pair_step_s"]["bgfn"][size]["median"]
+            text += (f"\n    without the profiler: BGFN's matrix products replayed alone {replayed[size]['matmul_ms']:.0f} ms "
+                     f"of its {step_ms:.0f} ms step, {100 * sq['median']:.0f} % [IQR {100 * sq['q25']:.0f}-"
+                     f"{100 * sq['q75']:.0f} %]; ceiling {cq['median']:.2f} [IQR {cq['q25']:.2f}-{cq['q75']:.2f}]: "
+                     f"{100 * r / cq['median']:.0f} % of it")
         print(text, flush=True)
     update_json(bench_file(),
                 {"train_windows_per_s": train_rate, "infer_ms": infer_ms, "models_bench": info,
                  "train_step_profile": profiles, "train_ratio_spread": spread, "train_ceiling_spread": ceilings,
+                 "train_ceiling_replay": replayed,
                  **ratios})
     return {"train_windows_per_s": train_rate, "infer_ms": infer_ms, "train_ratio_bgfn_over_twin": ratio}
 

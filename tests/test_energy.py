@@ -7,6 +7,7 @@ import math
 import pytest
 import torch
 from torch import nn
+from torch.overrides import TorchFunctionMode
 
 from bgfn import energy
 from bgfn.models import build_model
@@ -408,6 +409,35 @@ def test_interleaved_profiles_alternate_the_steps_and_the_ceiling_is_taken_round
     assert speed.median_profile(bgfn) == {"step_s": 1.5, "matmul_s": 1.2}
     with pytest.raises(ValueError):
         speed.ceiling_spread(twin, bgfn[:2])
+
+
+def test_matmul_calls_record_a_steps_products_and_the_replay_runs_the_same_products_again():
+    from bgfn.train import speed
+
+    lin = torch.nn.Linear(5, 3, bias=False)
+
+    def macs(calls):                                   # [a, b] x [b, c]: a b c multiply-accumulates each
+        return sum(a * b * c for _, ((a, b), (_b, c)) in calls)
+
+    x = torch.randn(4, 5)
+    calls = speed.matmul_calls(lambda: lin(x).sum().backward())
+    # forward x W^T (4 x 5 x 3) and the weight's gradient (another 60): 120; the input needs no gradient
+    assert {name for name, _ in calls} == {"aten::mm"} and len(calls) == 2 and macs(calls) == 120
+    x.requires_grad_(True)
+    assert macs(speed.matmul_calls(lambda: lin(x).sum().backward())) == 180     # + the input's gradient
+
+    ran = []
+
+    class Spy(TorchFunctionMode):
+        def __torch_function__(self, func, types, args=(), kwargs=None):
+            if func is torch.mm:
+                ran.append(tuple(tuple(a.shape) for a in args))
+            return func(*args, **(kwargs or {}))
+
+    replay = speed.matmul_replay(calls)
+    with Spy():
+        replay()
+    assert ran == [shapes for _, shapes in calls]      # the same products, in the same order, no other work
 
 
 def test_twin_ratios_divide_bgfn_by_its_twin_per_size_measured_for_both():

@@ -86,10 +86,11 @@ class FusedLIF(torch.autograd.Function):
         ctx.save_for_backward(cur)              # the backward pass recomputes U(t) from the currents
         ctx.params = (tau, u_thr, alpha, beta_from_tau(tau))
         ctx.mark_non_differentiable(v)          # the state between calls; every forward pass starts at rest
+        ctx.set_materialize_grads(False)        # v has no gradient: no [B, N, D] of zeros for it in each backward
         return spikes.view(current.shape), v.view(current.shape[1:])   # spikes, SpikingJelly's v after the last step
 
     @staticmethod
-    def backward(ctx, grad_spikes: torch.Tensor, grad_v: torch.Tensor):
+    def backward(ctx, grad_spikes: torch.Tensor, grad_v: None):   # spikes: the one differentiable output
         (cur,) = ctx.saved_tensors                                                     # [T, M]
         grad = grad_spikes.contiguous().view(cur.shape)
         grad_current = torch.empty_like(cur)

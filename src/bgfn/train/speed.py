@@ -244,6 +244,41 @@ def training_step_profile(model: nn.Module, window: int, batch: int, in_channels
     return profile_step(step)
 
 
+#: the dense products :func:`matmul_calls` records and :func:`matmul_replay` runs again: torch's function and how
+#: many of the operator's inputs are its operands (``addmm``: the added matrix, then the two factors). The encoder's
+#: convolution (a few hundredths of BGFN's products) is left out.
+REPLAYED_OPS = {"aten::mm": (torch.mm, 2), "aten::bmm": (torch.bmm, 2), "aten::addmm": (torch.addmm, 3)}
+
+
+def matmul_calls(step: Callable[[], object]) -> list[tuple[str, tuple[tuple[int, ...], ...]]]:
+    """The dense matrix products of one ``step()`` (:data:`REPLAYED_OPS`), in the order they ran: (operator, shapes of
+    its operands), recorded by ``torch.profiler`` with shapes."""
+    from torch.profiler import ProfilerActivity, profile        # as in profile_step: needed by `make bench` alone
+
+    with _without_native_stderr(), profile(activities=[ProfilerActivity.CPU], record_shapes=True) as prof:
+        step()
+    return [(e.name, tuple(tuple(int(n) for n in shape) for shape in e.input_shapes[:REPLAYED_OPS[e.name][1]]))
+            for e in prof.events() if e.name in REPLAYED_OPS]
+
+
+def matmul_replay(calls: list[tuple[str, tuple[tuple[int, ...], ...]]], seed: int = 0) -> Callable[[], None]:
+    """A callable that runs the products of :func:`matmul_calls` again, unprofiled, on random float32 operands of the
+    same shapes: BGFN's matrix products alone, timed as any step is.
+
+    Every call gets operands of its own, so that they come from memory, not from the cache, as in the step (at the
+    paper's size they take most of a gigabyte). The operands are C-contiguous, where a step may hand the library
+    a transposed one; either way the library reads it in place.
+    """
+    g = torch.Generator().manual_seed(seed)
+    ops = [(REPLAYED_OPS[name][0], [torch.randn(shape, generator=g) for shape in shapes]) for name, shapes in calls]
+
+    def replay():
+        for fn, operands in ops:
+            fn(*operands)
+
+    return replay
+
+
 def interleaved_profiles(steps: dict[str, Callable[[], object]], repeats: int,
                          warmup: int = 1) -> dict[str, list[dict[str, float]]]:
     """:func:`profile_step` of every step of ``steps`` in turn (A, B, A, B, ...) ``repeats`` times after ``warmup``

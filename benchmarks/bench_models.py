@@ -18,7 +18,8 @@ Adds to ``results/bench.json``:
 - ``train_ceiling_replay.<size>``: the same two figures without the profiler (which slows the step: its own thread
   shares the cores): BGFN's matrix products recorded once (:func:`bgfn.train.speed.matmul_calls`) and replayed alone
   on operands of the same shapes (:func:`bgfn.train.speed.matmul_replay`), timed in the same interleaved rounds as
-  the two steps, so each round gives the twin's step over those products and the products over BGFN's step;
+  the two steps, so each round gives the twin's step over those products and the products over BGFN's step
+  (``ceiling``, ``matmul_share``: quartiles; ``matmul_ms``, ``step_ms``: medians of the two, ms);
 - ``models_bench``: what ran (threads, device, batch, window, parameter counts, repeats).
 
 Sizes come from ``train.sizes`` of ``params/<size>.yaml`` (the same blocks in every profile). Median of a
@@ -109,6 +110,7 @@ def main(sizes=SIZES, methods=METHODS) -> dict:
                                             [{"step_s": b, "matmul_s": mm}
                                              for b, mm in zip(times["bgfn"], times["bgfn_matmuls"])])
             replayed[size]["matmul_ms"] = 1e3 * quartiles(times["bgfn_matmuls"])["median"]
+            replayed[size]["step_ms"] = 1e3 * quartiles(times["bgfn"])["median"]
             spread[size] = paired_ratio(times["transformer"], times["bgfn"])    # BGFN's throughput / the twin's
             for m in PAIR:
                 q = quartiles(times[m])
@@ -138,9 +140,8 @@ def main(sizes=SIZES, methods=METHODS) -> dict:
             text += f": {100 * r / c:.0f} % of it"
         if size in replayed:
             cq, sq = replayed[size]["ceiling"], replayed[size]["matmul_share"]
-            step_ms = 1e3 * info["pair_step_s"]["bgfn"][size]["median"]
             text += (f"\n    without the profiler: BGFN's matrix products replayed alone {replayed[size]['matmul_ms']:.0f} ms "
-                     f"of its {step_ms:.0f} ms step, {100 * sq['median']:.0f} % [IQR {100 * sq['q25']:.0f}-"
+                     f"of its {replayed[size]['step_ms']:.0f} ms step, {100 * sq['median']:.0f} % [IQR {100 * sq['q25']:.0f}-"
                      f"{100 * sq['q75']:.0f} %]; ceiling {cq['median']:.2f} [IQR {cq['q25']:.2f}-{cq['q75']:.2f}]: "
                      f"{100 * r / cq['median']:.0f} % of it")
         print(text, flush=True)

@@ -444,6 +444,11 @@ def test_speed_lines_give_the_ratio_to_the_twin_and_the_ceiling_of_the_matrix_pr
     assert "take 0.50 s of its 0.70 s, the twin's whole step 0.20 s" in lines[1]
     assert "at most 0.40 of the twin's throughput: with T_s = 4 SNN steps" in lines[1]
     assert len(T.speed_lines({k: v for k, v in bench.items() if k != "train_ratio_ceiling"})) == 1   # older bench
+    # without the profiler: products replayed alone, 300 of 400 ms; the twin's step over them 0.4, of which 0.25
+    replay = {"paper": {"matmul_ms": 300.0, "step_ms": 400.0, "matmul_share": {"median": 0.75},
+                        "ceiling": {"median": 0.4}}}
+    third = T.speed_lines({**bench, "train_ceiling_replay": replay})[2]
+    assert "take 300 ms of its 400 ms step (75 %); the ceiling they set is 0.40, of which BGFN reaches 62 %" in third
     assert T.speed_lines({}) == [] and T.speed_lines(None) == []
 
 

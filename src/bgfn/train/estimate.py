@@ -71,7 +71,8 @@ def speed_lines(bench: dict | None, paper_cfg: dict | None = None) -> list[str]:
     """Plain lines for notebook 03: BGFN's training throughput over its ANN twin's (``make bench``'s
     ``train_ratio_bgfn_over_twin``) at each measured size, and at the paper size the ceiling that the
     twin's profiled step over BGFN's matrix products alone sets (``train_ratio_ceiling``; with ``paper_cfg``, the
-    ``paper`` profile, its T_s is named). Empty without them."""
+    ``paper`` profile, its T_s is named), and the same without the profiler (``train_ceiling_replay``). Empty
+    without them."""
     time_steps = (((paper_cfg or {}).get("train") or {}).get("sizes") or {}).get("bgfn", {}).get("paper", {}).get(
         "time_steps")
     ratio = (bench or {}).get("train_ratio_bgfn_over_twin") or {}
@@ -88,6 +89,13 @@ def speed_lines(bench: dict | None, paper_cfg: dict | None = None) -> list[str]:
                      f"of its {b['step_s']:.2f} s, the twin's whole step {t['step_s']:.2f} s; even if its LIF, "
                      f"BatchNorm and copies cost nothing BGFN would reach at most {ceiling:.2f} of the twin's "
                      f"throughput: {steps}every spiking layer multiplies T_s times as many rows as the twin's")
+    replay = ((bench or {}).get("train_ceiling_replay") or {}).get("paper")
+    if replay and "paper" in ratio:
+        lines.append(f"paper size, without the profiler (it slows a step; its own thread shares the cores): BGFN's "
+                     f"matrix products, replayed alone, take {replay['matmul_ms']:.0f} ms of its {replay['step_ms']:.0f} "
+                     f"ms step ({100 * replay['matmul_share']['median']:.0f} %); the ceiling they set is "
+                     f"{replay['ceiling']['median']:.2f}, of which BGFN reaches "
+                     f"{100 * ratio['paper'] / replay['ceiling']['median']:.0f} %")
     return lines
 
 

@@ -253,7 +253,8 @@ REPLAYED_OPS = {"aten::mm": (torch.mm, 2), "aten::bmm": (torch.bmm, 2), "aten::a
 def matmul_calls(step: Callable[[], object]) -> list[tuple[str, tuple[tuple[int, ...], ...]]]:
     """The dense matrix products of one ``step()`` (:data:`REPLAYED_OPS`), in the order they ran: (operator, shapes of
     its operands), recorded by ``torch.profiler`` with shapes."""
-    from torch.profiler import ProfilerActivity, profile        # as in profile_step: needed by `make bench` alone
+    # as in profile_step: the profiler's native library, needed by `make bench` alone
+    from torch.profiler import ProfilerActivity, profile
 
     with _without_native_stderr(), profile(activities=[ProfilerActivity.CPU], record_shapes=True) as prof:
         step()

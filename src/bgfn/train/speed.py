@@ -220,15 +220,20 @@ def _without_native_stderr() -> Iterator[None]:
         os.close(null)
 
 
-def profile_step(step: Callable[[], object]) -> dict[str, float]:
-    """``step()`` once under ``torch.profiler``: ``{'step_s', 'matmul_s'}``, profiled time of all operators and of the
-    dense matrix products alone (:data:`MATMUL_OPS`), s."""
+def _profiled(step: Callable[[], object], record_shapes: bool = False):
+    """``step()`` once under ``torch.profiler`` (CPU activity, its native lines on stderr discarded): the profile."""
     # here, not at the top: the profiler loads its own native library, needed by `make bench` alone
     from torch.profiler import ProfilerActivity, profile
 
-    with _without_native_stderr(), profile(activities=[ProfilerActivity.CPU]) as prof:
+    with _without_native_stderr(), profile(activities=[ProfilerActivity.CPU], record_shapes=record_shapes) as prof:
         step()
-    dense, total = matmul_seconds(prof.key_averages())
+    return prof
+
+
+def profile_step(step: Callable[[], object]) -> dict[str, float]:
+    """``step()`` once under ``torch.profiler``: ``{'step_s', 'matmul_s'}``, profiled time of all operators and of the
+    dense matrix products alone (:data:`MATMUL_OPS`), s."""
+    dense, total = matmul_seconds(_profiled(step).key_averages())
     return {"step_s": total, "matmul_s": dense}
 
 
@@ -253,13 +258,8 @@ REPLAYED_OPS = {"aten::mm": (torch.mm, 2), "aten::bmm": (torch.bmm, 2), "aten::a
 def matmul_calls(step: Callable[[], object]) -> list[tuple[str, tuple[tuple[int, ...], ...]]]:
     """The dense matrix products of one ``step()`` (:data:`REPLAYED_OPS`), in the order they ran: (operator, shapes of
     its operands), recorded by ``torch.profiler`` with shapes."""
-    # as in profile_step: the profiler's native library, needed by `make bench` alone
-    from torch.profiler import ProfilerActivity, profile
-
-    with _without_native_stderr(), profile(activities=[ProfilerActivity.CPU], record_shapes=True) as prof:
-        step()
     return [(e.name, tuple(tuple(int(n) for n in shape) for shape in e.input_shapes[:REPLAYED_OPS[e.name][1]]))
-            for e in prof.events() if e.name in REPLAYED_OPS]
+            for e in _profiled(step, record_shapes=True).events() if e.name in REPLAYED_OPS]
 
 
 def matmul_replay(calls: list[tuple[str, tuple[tuple[int, ...], ...]]], seed: int = 0) -> Callable[[], None]:

@@ -12,6 +12,7 @@ import pytest
 import torch
 
 from bgfn import learning as L
+from bgfn import models
 from bgfn import train as T
 from bgfn.errors import DataError
 from bgfn.train import loop, lr_search
@@ -65,6 +66,39 @@ def test_card_checkpoint_and_references(data, tmp_path):
     assert again["val_rmse_ins_m"] == pytest.approx(card["val_rmse_ins_m"])
     assert json.loads((tmp_path / "mlp_seed0.json").read_text())["val_rmse_ins_m"] == again["val_rmse_ins_m"]
     assert (tmp_path / "mlp_seed0.pt").stat().st_mtime_ns == mtime
+
+
+def test_a_network_trained_under_another_definition_of_its_layers_is_trained_again(data, tmp_path, monkeypatch):
+    size = {"n_recent": 5, "hidden": 16}
+    card = T.train_model("mlp", data, size, _cfg(), seed=0, out_dir=tmp_path, progress=False)
+    mtime = (tmp_path / "mlp_seed0.pt").stat().st_mtime_ns
+    # the fingerprint is the package's source, read once per process
+    assert models.definition_fingerprint() == models.definition_fingerprint() and \
+        len(models.definition_fingerprint()) == 16
+    # the same code: reused, not trained
+    again = T.train_model("mlp", data, size, _cfg(), seed=0, out_dir=tmp_path, progress=False)
+    assert (tmp_path / "mlp_seed0.pt").stat().st_mtime_ns == mtime and again["history"] == card["history"]
+    # the layers' code changed (as when a bias was removed): trained again, and the checkpoint rewritten
+    monkeypatch.setattr(loop, "definition_fingerprint", lambda: "another-definition")
+    retrained = T.train_model("mlp", data, size, _cfg(), seed=0, out_dir=tmp_path, progress=False)
+    assert (tmp_path / "mlp_seed0.pt").stat().st_mtime_ns != mtime
+    assert retrained["config_hash"] != card["config_hash"]
+
+
+def test_a_checkpoint_whose_weights_the_code_no_longer_builds_is_refused_by_name(data, tmp_path):
+    T.train_model("mlp", data, {"n_recent": 5, "hidden": 16}, _cfg(epochs=1), seed=0, out_dir=tmp_path,
+                  progress=False)
+    path = tmp_path / "mlp_seed0.pt"
+    ck = torch.load(path, weights_only=True)
+    first = next(iter(ck["state_dict"]))
+    ck["state_dict"]["net.99.bias"] = torch.zeros(3)            # a weight the code does not build (an old bias)
+    ck["state_dict"][first] = torch.zeros(7, 7)                 # and one of another shape
+    torch.save(ck, path)
+    with pytest.raises(DataError) as err:
+        T.load_trained(path)
+    msg = str(err.value)
+    assert "mlp_seed0.pt" in msg and "state_dict" in msg and "unexpected net.99.bias" in msg
+    assert f"other shape {first}" in msg and "train it again" in msg
 
 
 @pytest.mark.parametrize("method,size", [("mlp", {"n_recent": 10, "hidden": 32}), ("at_lstm", {"hidden": 16})])

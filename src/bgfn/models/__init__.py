@@ -6,6 +6,10 @@ Chen et al. 2024), ``mlp`` (static MLP).
 
 from __future__ import annotations
 
+import functools
+import hashlib
+from pathlib import Path
+
 from torch import nn
 
 from .baselines import ATLSTM, MLP, TransformerTwin
@@ -41,6 +45,21 @@ def build_model(method: str, size_cfg: dict | None = None, in_channels: int = 9)
     return MODELS[method](**kwargs)
 
 
+@functools.cache
+def definition_fingerprint() -> str:
+    """Hash of this package's source files: the code that defines every network (layers, LIF, its kernels).
+
+    A trained network is reused only when it was trained under the same definition (the configuration hash of
+    :func:`bgfn.train.loop.train_model`), so that a changed layer (a removed bias, other LIF dynamics) trains it
+    again instead of loading weights the code no longer matches, or silently reusing a network of other dynamics.
+    Any edit of these files counts, a comment too: the safe side for results a reader must be able to trust.
+    """
+    h = hashlib.sha256()
+    for path in sorted(Path(__file__).parent.glob("*.py")):
+        h.update(path.name.encode() + b"\0" + path.read_bytes())
+    return h.hexdigest()[:16]
+
+
 def count_parameters(model: nn.Module) -> int:
     """Number of trainable parameters."""
     return sum(p.numel() for p in model.parameters() if p.requires_grad)
@@ -52,4 +71,4 @@ def is_spiking(model: nn.Module) -> bool:
 
 
 __all__ = ["BGFN", "MLP", "ATLSTM", "TransformerTwin", "MODELS", "METHODS", "build_model", "count_parameters",
-           "is_spiking"]
+           "definition_fingerprint", "is_spiking"]

@@ -16,7 +16,9 @@ early stopping on the validation loss (MSE of the normalized increments; for a l
 beta-NLL of its speed and variance, :mod:`bgfn.train.objectives`).
 
 A completed run is not redone: if its card exists with the same configuration hash, :func:`train_model`
-returns the card (delete the files to retrain).
+returns the card (delete the files to retrain). The hash covers the method, seed, sizes, optimizer, learning
+options, the training data and the source of :mod:`bgfn.models`, so a network trained under another definition
+of its layers is trained again rather than loaded.
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ from tqdm import tqdm
 from bgfn.errors import DataError
 from bgfn.io import atomic_path, atomic_write_json
 from bgfn.learning import LearningData
-from bgfn.models import build_model, count_parameters, is_spiking
+from bgfn.models import build_model, count_parameters, definition_fingerprint, is_spiking
 from bgfn.train import checkpoints
 from bgfn.train.memory import keep_freed_memory
 from bgfn.train.objectives import objective_of
@@ -141,8 +143,10 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
                         f"{len(train_ws)} and {len(val_ws)}")
     in_channels = train_ws.x.shape[-1]
     obj = objective_of(data)                                # the paper's increments, or an odometer's speed
+    # the network's code is part of what a run is: a changed layer trains again (bgfn.models.definition_fingerprint)
     config = {"method": method, "seed": int(seed), "card": CARD_VERSION, "size_cfg": size_cfg, "optimizer": o, "lr": lr,
-              "options": data.options, "data": _data_fingerprint(data), "device": dev.type}
+              "options": data.options, "data": _data_fingerprint(data), "device": dev.type,
+              "model_code": definition_fingerprint()}
     chash = _config_hash(config)
 
     out = Path(out_dir) if out_dir is not None else None

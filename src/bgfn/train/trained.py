@@ -16,6 +16,7 @@ import torch
 from spikingjelly.activation_based import functional
 from torch import nn
 
+from bgfn.errors import DataError
 from bgfn.learning import Normalizer, WindowSet, from_target_frame, prediction_windows
 from bgfn.models import build_model, is_spiking
 from bgfn.train import checkpoints
@@ -74,13 +75,35 @@ class TrainedModel:
 
 
 def load_trained(path: str | Path, device: str | None = None) -> TrainedModel:
-    """Load a best checkpoint ``<method>_seed<k>.pt`` written by :func:`bgfn.train.loop.train_model`."""
+    """Load a best checkpoint ``<method>_seed<k>.pt`` written by :func:`bgfn.train.loop.train_model`.
+
+    Raises
+    ------
+    bgfn.errors.DataError
+        The file is not a checkpoint of ours, or its weights do not fit the network the code builds (written by
+        another definition of its layers); the message names the file and the differing weights.
+    """
     dev = pick_device(device)
     ck = checkpoints.read_checkpoint(path, dev)
     model = build_model(ck["method"], ck["size_cfg"], in_channels=ck["in_channels"]).to(dev)
+    mismatch = _weights_mismatch(model, ck["state_dict"])
+    if mismatch:
+        raise DataError(path, "state_dict", f"the weights of the {ck['method']} network this code builds (delete the "
+                        "checkpoint and its card to train it again)", mismatch)
     model.load_state_dict(ck["state_dict"])
     model.eval()
     return TrainedModel(ck["method"], model, Normalizer.from_dict(ck["norm"]), ck["options"], ck["size_cfg"], dev)
+
+
+def _weights_mismatch(model: nn.Module, state: dict) -> str:
+    """'' when ``state`` has exactly the weights of ``model`` (names and shapes), else what differs, briefly."""
+    want = {k: tuple(v.shape) for k, v in model.state_dict().items()}
+    have = {k: tuple(v.shape) for k, v in state.items()}
+    parts = [f"{label} {', '.join(sorted(keys)[:3])}{' ...' if len(keys) > 3 else ''}"
+             for label, keys in (("unexpected", have.keys() - want.keys()), ("missing", want.keys() - have.keys()),
+                                 ("other shape", {k for k in want.keys() & have.keys() if want[k] != have[k]}))
+             if keys]
+    return "; ".join(parts)
 
 
 def checkpoint_predictions(folder: str | Path, ws: WindowSet, methods, seed: int, device: str = "cpu") -> dict:

@@ -4,6 +4,7 @@ search; a profile's training over datasets, methods and seeds, and its tables.""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -15,6 +16,7 @@ from bgfn import learning as L
 from bgfn import models
 from bgfn import train as T
 from bgfn.errors import DataError
+from bgfn.io import sources_hash
 from bgfn.train import loop, lr_search
 from bgfn.profile_schema import load_profile, with_overrides
 
@@ -68,13 +70,23 @@ def test_card_checkpoint_and_references(data, tmp_path):
     assert (tmp_path / "mlp_seed0.pt").stat().st_mtime_ns == mtime
 
 
+def test_the_definition_fingerprint_is_the_hash_of_the_models_source(tmp_path):
+    a, b = tmp_path / "a.py", tmp_path / "b.py"
+    a.write_text("x = 1\n")
+    b.write_text("y = 2\n")
+    before = sources_hash([a, b])
+    assert sources_hash([a, b, tmp_path / "absent.py"]) == before         # a missing file is skipped
+    a.write_text("x = 1\n# a comment\n")                                  # any edit counts
+    assert sources_hash([a, b]) != before
+    package = Path(models.__file__).parent
+    assert models.definition_fingerprint() == sources_hash(sorted(package.glob("*.py")))[:16]
+    assert {p.name for p in package.glob("*.py")} >= {"bgfn.py", "lif.py", "lif_kernels.py", "baselines.py"}
+
+
 def test_a_network_trained_under_another_definition_of_its_layers_is_trained_again(data, tmp_path, monkeypatch):
     size = {"n_recent": 5, "hidden": 16}
     card = T.train_model("mlp", data, size, _cfg(), seed=0, out_dir=tmp_path, progress=False)
     mtime = (tmp_path / "mlp_seed0.pt").stat().st_mtime_ns
-    # the fingerprint is the package's source, read once per process
-    assert models.definition_fingerprint() == models.definition_fingerprint() and \
-        len(models.definition_fingerprint()) == 16
     # the same code: reused, not trained
     again = T.train_model("mlp", data, size, _cfg(), seed=0, out_dir=tmp_path, progress=False)
     assert (tmp_path / "mlp_seed0.pt").stat().st_mtime_ns == mtime and again["history"] == card["history"]

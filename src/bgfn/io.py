@@ -1,11 +1,13 @@
 """Atomic file output: write to a temporary file in the same folder, then rename.
 
-A crash or a bad input never leaves a half-written table, figure or cache entry behind.
+A crash or a bad input never leaves a half-written table, figure or cache entry behind. Also the fingerprint of
+source files (:func:`sources_hash`) that decides whether a cached dataset or a trained network is still current.
 """
 
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 import os
 import tempfile
@@ -97,3 +99,13 @@ def update_json(path: str | Path, updates: dict) -> dict:
     merge(data, updates)
     atomic_write_json(path, data)
     return data
+
+
+def sources_hash(paths) -> str:
+    """SHA-256 (hex) of the bytes of ``paths`` in the given order, files that do not exist skipped: the fingerprint
+    of the code a cache entry or a trained network was made by (:mod:`bgfn.data.drives`, :mod:`bgfn.models`)."""
+    h = hashlib.sha256()
+    for p in map(Path, paths):
+        if p.is_file():
+            h.update(p.read_bytes())
+    return h.hexdigest()

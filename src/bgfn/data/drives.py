@@ -50,6 +50,7 @@ from bgfn.data.registry import COMMON_PARAMS, DATASETS, DEFAULT_DATASET
 from bgfn.data.rtklib import LEVER_ARM_M as RTKLIB_LEVER_ARM_M, Q_FIX, quality_spans, read_imu_csv, read_pos, read_tag
 from bgfn.data.trajectory import smooth_reference
 from bgfn.errors import DataError
+from bgfn.io import sources_hash
 from bgfn.nav.earth import curvature_radii
 from bgfn.nav.metrics import REFERENCE_EXCLUDED_KEY
 from bgfn.nav.sim import imu_from_trajectory
@@ -120,11 +121,8 @@ def profile_overrides(name: str, profile: str) -> dict:
 def _source_hash() -> str:
     here = Path(__file__).resolve().parent
     nav = here.parent / "nav"
-    h = hashlib.sha256()
-    for p in [here / f"{m}.py" for m in _KEY_MODULES] + [nav / "sim.py", nav / "earth.py", nav / "transform.py"]:
-        if p.is_file():
-            h.update(p.read_bytes())
-    return h.hexdigest()
+    return sources_hash([here / f"{m}.py" for m in _KEY_MODULES] + [nav / "sim.py", nav / "earth.py",
+                                                                     nav / "transform.py"])
 
 
 def cache_key(name: str, params: dict, checksums: dict) -> str:

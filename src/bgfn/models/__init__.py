@@ -7,10 +7,11 @@ Chen et al. 2024), ``mlp`` (static MLP).
 from __future__ import annotations
 
 import functools
-import hashlib
 from pathlib import Path
 
 from torch import nn
+
+from bgfn.io import sources_hash
 
 from .baselines import ATLSTM, MLP, TransformerTwin
 from .bgfn import BGFN
@@ -54,10 +55,7 @@ def definition_fingerprint() -> str:
     again instead of loading weights the code no longer matches, or silently reusing a network of other dynamics.
     Any edit of these files counts, a comment too: the safe side for results a reader must be able to trust.
     """
-    h = hashlib.sha256()
-    for path in sorted(Path(__file__).parent.glob("*.py")):
-        h.update(path.name.encode() + b"\0" + path.read_bytes())
-    return h.hexdigest()[:16]
+    return sources_hash(sorted(Path(__file__).parent.glob("*.py")))[:16]
 
 
 def count_parameters(model: nn.Module) -> int:

@@ -70,7 +70,7 @@ def test_card_checkpoint_and_references(data, tmp_path):
     assert (tmp_path / "mlp_seed0.pt").stat().st_mtime_ns == mtime
 
 
-def test_the_definition_fingerprint_is_the_hash_of_the_models_source(tmp_path):
+def test_the_code_fingerprints_are_hashes_of_the_source(tmp_path):
     a, b = tmp_path / "a.py", tmp_path / "b.py"
     a.write_text("x = 1\n")
     b.write_text("y = 2\n")
@@ -80,18 +80,21 @@ def test_the_definition_fingerprint_is_the_hash_of_the_models_source(tmp_path):
     assert sources_hash([a, b]) != before
     package = Path(models.__file__).parent
     assert models.definition_fingerprint() == sources_hash(sorted(package.glob("*.py")))[:16]
+    assert loop.training_fingerprint() == sources_hash([Path(loop.__file__).resolve(),
+                                                        Path(loop.__file__).resolve().with_name("objectives.py")])[:16]
     assert {p.name for p in package.glob("*.py")} >= {"bgfn.py", "lif.py", "lif_kernels.py", "baselines.py"}
 
 
-def test_a_network_trained_under_another_definition_of_its_layers_is_trained_again(data, tmp_path, monkeypatch):
+@pytest.mark.parametrize("fingerprint", ["definition_fingerprint", "training_fingerprint"])
+def test_a_network_trained_under_other_code_is_trained_again(data, tmp_path, monkeypatch, fingerprint):
     size = {"n_recent": 5, "hidden": 16}
     card = T.train_model("mlp", data, size, _cfg(), seed=0, out_dir=tmp_path, progress=False)
     mtime = (tmp_path / "mlp_seed0.pt").stat().st_mtime_ns
     # the same code: reused, not trained
     again = T.train_model("mlp", data, size, _cfg(), seed=0, out_dir=tmp_path, progress=False)
     assert (tmp_path / "mlp_seed0.pt").stat().st_mtime_ns == mtime and again["history"] == card["history"]
-    # the layers' code changed (as when a bias was removed): trained again, and the checkpoint rewritten
-    monkeypatch.setattr(loop, "definition_fingerprint", lambda: "another-definition")
+    # the layers' code (as when a bias was removed) or the loop's changed: trained again, the checkpoint rewritten
+    monkeypatch.setattr(loop, fingerprint, lambda: "other-code")
     retrained = T.train_model("mlp", data, size, _cfg(), seed=0, out_dir=tmp_path, progress=False)
     assert (tmp_path / "mlp_seed0.pt").stat().st_mtime_ns != mtime
     assert retrained["config_hash"] != card["config_hash"]

@@ -17,13 +17,15 @@ beta-NLL of its speed and variance, :mod:`bgfn.train.objectives`).
 
 A completed run is not redone: if its card exists with the same configuration hash, :func:`train_model`
 returns the card (delete the files to retrain). The hash covers the method, seed, sizes, optimizer, learning
-options, the training data and the source of :mod:`bgfn.models`, so a network trained under another definition
-of its layers is trained again rather than loaded.
+options, the training data and the code: the source of :mod:`bgfn.models` and of this loop and its objectives
+(:func:`training_fingerprint`), so a network trained under another definition of its layers or its loss is trained
+again rather than loaded.
 """
 
 from __future__ import annotations
 
 import copy
+import functools
 import hashlib
 import json
 import os
@@ -39,7 +41,7 @@ from torch import nn
 from tqdm import tqdm
 
 from bgfn.errors import DataError
-from bgfn.io import atomic_path, atomic_write_json
+from bgfn.io import atomic_path, atomic_write_json, sources_hash
 from bgfn.learning import LearningData
 from bgfn.models import build_model, count_parameters, definition_fingerprint, is_spiking
 from bgfn.train import checkpoints
@@ -63,6 +65,15 @@ def set_seed(seed: int, deterministic: bool = True) -> None:
 #: Version of the card's layout in the configuration hash: a card of an older layout is trained again
 #: (2: epoch 0 is the initial network).
 CARD_VERSION = 2
+
+
+@functools.cache
+def training_fingerprint() -> str:
+    """Hash of the training code a run's configuration hash covers besides the network's own
+    (:func:`bgfn.models.definition_fingerprint`): this loop and the objectives (targets, losses, references). An edit
+    of either trains every network again, as an edit of the data code rebuilds the data cache."""
+    here = Path(__file__).resolve()
+    return sources_hash([here, here.with_name("objectives.py")])[:16]
 
 
 def _config_hash(obj: Any) -> str:
@@ -143,10 +154,10 @@ def train_model(method: str, data: LearningData, size_cfg: dict | None = None, t
                         f"{len(train_ws)} and {len(val_ws)}")
     in_channels = train_ws.x.shape[-1]
     obj = objective_of(data)                                # the paper's increments, or an odometer's speed
-    # the network's code is part of what a run is: a changed layer trains again (bgfn.models.definition_fingerprint)
+    # the code is part of what a run is: a changed layer or loss trains again (definition and training fingerprints)
     config = {"method": method, "seed": int(seed), "card": CARD_VERSION, "size_cfg": size_cfg, "optimizer": o, "lr": lr,
               "options": data.options, "data": _data_fingerprint(data), "device": dev.type,
-              "model_code": definition_fingerprint()}
+              "code": {"model": definition_fingerprint(), "training": training_fingerprint()}}
     chash = _config_hash(config)
 
     out = Path(out_dir) if out_dir is not None else None

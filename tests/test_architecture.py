@@ -52,6 +52,10 @@ def test_the_package_keeps_its_contracts(tmp_path):
     # two modules of one package importing each other
     ({"nav/planted_a.py": "from bgfn.nav import planted_b\n",
       "nav/planted_b.py": "def f():\n    from bgfn.nav import planted_a\n    return planted_a\n"}, "No import cycle"),
+    # the paper's evaluation reaching for a study beyond the paper
+    ({"evaluate/planted.py": "from bgfn.studies.odometer import bars\n"}, "The paper's pipeline imports no study"),
+    # one study importing another, beside the outage sweep they share
+    ({"studies/gallery/planted.py": "from bgfn.studies.odometer import bars\n"}, "Studies: odometer"),
     # the filter engine importing an aid
     ({"nav/filter.py": "+from bgfn.nav import constraints\n"}, "The filter engine imports no aid"),
 ])

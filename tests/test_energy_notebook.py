@@ -12,7 +12,7 @@ import torch
 
 from bgfn import energy
 from bgfn.config import PROJECT_ROOT
-from bgfn.energy.odometer import OdometerEnergy, odometer_dataset
+from bgfn.studies.odometer.energy import OdometerEnergy, odometer_dataset
 from bgfn.energy.record import REPORTED_KEYS
 from bgfn.learning import WindowSet
 from bgfn.models import build_model

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bgfn import evaluate as ev
+from bgfn import evaluate as ev, studies
 from bgfn import paper
 from bgfn import learning as L
 from bgfn import stats
@@ -314,7 +314,7 @@ def test_evaluate_config_rejects_unknown_keys():
 
 def test_sweep_plan_spreads_starts_in_contiguous_folds(drive5):
     sw = {"n_starts": 7, "folds": 3, "durations_s": [10.0, 30.0], "warmup_s": 20.0}
-    plan = ev.sweep_plan(drive5, sw, window_samples=50)
+    plan = studies.outage_sweep.sweep_plan(drive5, sw, window_samples=50)
     assert len(plan) == 7 and plan["start_s"].is_monotonic_increasing
     assert plan["start_s"].min() >= 20.0 and plan["start_s"].max() + 30.0 <= drive5.imu["time"].iloc[-1]
     assert plan["fold"].tolist() == [0, 0, 0, 1, 1, 2, 2]
@@ -322,7 +322,7 @@ def test_sweep_plan_spreads_starts_in_contiguous_folds(drive5):
     ref_end = float(drive5.reference["time"].iloc[-1]) - 7.05
     short = copy.copy(drive5)
     short.reference = drive5.reference[drive5.reference["time"] <= ref_end].reset_index(drop=True)
-    cut = ev.sweep_plan(short, sw, window_samples=50)
+    cut = studies.outage_sweep.sweep_plan(short, sw, window_samples=50)
     assert cut["start_s"].max() + 30.0 <= ref_end < plan["start_s"].max() + 30.0
 
 
@@ -376,10 +376,10 @@ def test_sweep_summary_and_comparisons():
                 rows.append({"dataset": "d", "start_s": float(start), "duration_s": 30.0, "method": m,
                              "seed": seed, "fold": 0, "max_h_m": v})
     df = pd.DataFrame(rows)
-    s = ev.sweep_summary(df, n_boot=300)
+    s = studies.outage_sweep.sweep_summary(df, n_boot=300)
     ins = s[s["method"] == "INS"].iloc[0]
     assert ins["n"] == 12 and ins["ci_lo_m"] <= ins["median_m"] <= ins["ci_hi_m"]
-    c = ev.sweep_comparisons(df).set_index("baseline")
+    c = studies.outage_sweep.sweep_comparisons(df).set_index("baseline")
     assert c.loc["INS", "win_rate"] == 1.0 and c.loc["MLP", "wins"] == 36 and c.loc["INS", "p_value"] < 1e-6
     assert c.loc["INS", "n_starts"] == 12 and c.loc["INS", "p_value_by_start"] < 1e-2
     assert set(c["method"]) == {"BGFN"}
@@ -387,16 +387,16 @@ def test_sweep_summary_and_comparisons():
     nhc = df[df["method"] != "MLP"].assign(method=lambda x: x["method"] + "+NHC",
                                            max_h_m=lambda x: np.where(x["method"] == "INS", 0.5, 0.3) * x["max_h_m"])
     both = pd.concat([df, nhc], ignore_index=True)
-    s = ev.sweep_summary(both, n_boot=100)
+    s = studies.outage_sweep.sweep_summary(both, n_boot=100)
     assert s.loc[s["method"] == "INS+NHC", "n"].item() == 12                 # one value per start, like INS
-    c = ev.sweep_comparisons(both)
+    c = studies.outage_sweep.sweep_comparisons(both)
     assert set(c.loc[c["method"] == "BGFN", "baseline"]) == {"INS", "MLP", "INS+NHC", "BGFN+NHC"}
     pair = c[(c["method"] == "BGFN+NHC")].set_index("baseline")
     assert list(pair.index) == ["INS+NHC"] and pair.loc["INS+NHC", "wins"] == 36
-    (line,) = ev.describe_sweep(s, c)
+    (line,) = studies.outage_sweep.describe_sweep(s, c)
     assert "BGFN vs INS: wins 36/36" in line and "BGFN+NHC vs INS+NHC: wins 36/36" in line
     # a pairs table of older runs (no method column) still reads
-    (old,) = ev.describe_sweep(ev.sweep_summary(df, n_boot=100), ev.sweep_comparisons(df).drop(columns="method"))
+    (old,) = studies.outage_sweep.describe_sweep(studies.outage_sweep.sweep_summary(df, n_boot=100), studies.outage_sweep.sweep_comparisons(df).drop(columns="method"))
     assert "BGFN vs INS: wins 36/36" in old
 
 
@@ -597,10 +597,10 @@ def test_pseudo_std_sensitivity_runs_the_first_seeds_networks_with_their_validat
         models[("bgfn", seed)].val_rmse_m = 0.5
     res = ev.evaluate_dataset(cfg, "none", "turin-sim-ekinox", drive=drive5, ecfg=ecfg, models=models)
     assert res.drive is drive5
-    sens = ev.pseudo_std_sensitivity(cfg, "none", res, ecfg)
+    sens = studies.outage_sweep.pseudo_std_sensitivity(cfg, "none", res, ecfg)
     assert sens.seed == 1 and list(sens.alternative.models) == [("bgfn", 1)]       # the first seed only
     t = sens.table.set_index(["outage", "method"])
-    assert list(sens.table.columns) == list(ev.SENSITIVITY_COLUMNS)
+    assert list(sens.table.columns) == list(studies.outage_sweep.SENSITIVITY_COLUMNS)
     seed1 = res.per_seed[res.per_seed["seed"] == 1].set_index(["outage", "method"])
     # the left side is seed 1's own run, not the median over seeds
     assert t.loc[(1, "BGFN"), "max_east_m"] == seed1.loc[(1, "BGFN"), "max_east_m"]
@@ -609,7 +609,7 @@ def test_pseudo_std_sensitivity_runs_the_first_seeds_networks_with_their_validat
     for m in ("INS", "GPS"):
         assert t.loc[(1, m), "max_east_m"] == t.loc[(1, m), "max_east_m (validation std)"]
     assert t.loc[(1, "BGFN"), "max_east_m"] != t.loc[(1, "BGFN"), "max_east_m (validation std)"]
-    path = ev.save_sensitivity(tmp_path, sens)
+    path = studies.outage_sweep.save_sensitivity(tmp_path, sens)
     assert path.name == "outage_dataset_std_validation.csv"
     assert list(pd.read_csv(path).columns) == list(ev.TABLE_COLUMNS)
 
@@ -644,20 +644,20 @@ def test_sweep_tables_and_lines():
                             "method": ["BGFN", "INS", "BGFN", "INS"], "n": 4, "n_starts": 4,
                             "median_m": [1.25, 3.0, 2.0, 9.0], "ci_lo_m": [1.0, 2.0, 1.5, 8.0],
                             "ci_hi_m": [1.5, 4.0, 2.5, 10.0]})
-    wide = ev.sweep_interval_table(summary)
+    wide = studies.outage_sweep.sweep_interval_table(summary)
     assert list(wide.columns) == ["10 s", "30 s"] and list(wide.index) == [("d", "INS"), ("d", "BGFN")]
     assert wide.loc[("d", "BGFN"), "30 s"] == "2.0 [1.5, 2.5]" and wide.loc[("d", "INS"), "10 s"] == "3.0 [2.0, 4.0]"
     sweep = pd.DataFrame({"start_s": [1.0, 1.0, 2.0, 2.0], "duration_s": 10.0, "method": ["INS", "BGFN"] * 2,
                           "seed": 0})
-    assert ev.describe_sweep_size(sweep) == "4 rows, 2 starts x 1 durations x 2 methods x 1 seeds"
+    assert studies.outage_sweep.describe_sweep_size(sweep) == "4 rows, 2 starts x 1 durations x 2 methods x 1 seeds"
     # the fold networks are described with the sweep's train overrides over the train: section
     cfg = load_profile("smoke")
     ecfg = ev.evaluate_config({"methods": ["mlp"], "sweep": {"train": {"optimizer": {"epochs": 7}}}}, cfg["train"])
-    lines = ev.describe_sweep_setup(cfg["train"], ecfg, ["d"])
+    lines = studies.outage_sweep.describe_sweep_setup(cfg["train"], ecfg, ["d"])
     assert lines[0].startswith("datasets ['d']: ") and lines[0].endswith("x methods ['MLP'] + INS + GPS")
     assert f"'epochs': 7, 'batch_size': {cfg['train']['optimizer']['batch_size']}" in lines[1]
     assert lines[2] == f"  {'MLP':>12}: {cfg['train']['sizes']['mlp'][cfg['train']['size']]}"
-    rows, info, timings = ev.run_sweeps(cfg, "smoke", [], ecfg)
+    rows, info, timings = studies.outage_sweep.run_sweeps(cfg, "smoke", [], ecfg)
     assert list(rows.columns) == list(ev.SWEEP_COLUMNS) and rows.empty and info == {} and timings == {}
 
 

@@ -9,9 +9,9 @@ import pytest
 from synthetic_drive import demo_drive
 
 from bgfn.data import Drive, load_drive
-from bgfn.data import gallery as G
+from bgfn.studies.gallery import logs as G
 from bgfn.data import imu_levels
-from bgfn.evaluate import gallery as EG
+from bgfn.studies.gallery import runs as EG
 from bgfn.nav import sim
 from bgfn.profile_schema import load_profile
 

@@ -9,8 +9,8 @@ import pytest
 from synthetic_drive import demo_drive
 
 from bgfn.data import Drive
-from bgfn.data import imu_roughness as R
-from bgfn.evaluate import imu_twin as T
+from bgfn.studies.ins_fidelity import imu_roughness as R
+from bgfn.studies.ins_fidelity import imu_twin as T
 from bgfn.nav.earth import earth_rate_n
 
 RATE = 100.0

@@ -1,4 +1,4 @@
-"""Standalone-INS drift over the sweep's starts (bgfn.evaluate.ins_drift), on a small synthetic drive."""
+"""Standalone-INS drift over the sweep's starts (bgfn.studies.ins_fidelity.ins_drift), on a small synthetic drive."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bgfn import evaluate as ev
+from bgfn import evaluate as ev, studies
 from bgfn.profile_schema import load_profile, with_overrides
 from bgfn.data import Drive
 from synthetic_drive import demo_drive
@@ -27,11 +27,11 @@ def cfg():
 
 @pytest.fixture(scope="module")
 def runs(cfg):
-    return ev.ins_drift_runs(cfg, [_drive("calm", "ekinox-d"), _drive("rough", "mpu6000")])
+    return studies.ins_fidelity.ins_drift_runs(cfg, [_drive("calm", "ekinox-d"), _drive("rough", "mpu6000")])
 
 
 def test_every_start_duration_and_method_once_and_prefixes_never_exceed_the_whole_run(cfg, runs):
-    starts = ev.drift_starts(cfg, _drive("calm", "ekinox-d"))
+    starts = studies.ins_fidelity.drift_starts(cfg, _drive("calm", "ekinox-d"))
     # the sweep's starts: evenly spread from the warm-up on, room for the longest duration at the end
     assert len(starts) == 3 and starts[0] >= 20.0 and starts[-1] + 10.0 <= 150.0
     assert np.diff(starts) == pytest.approx([starts[1] - starts[0]] * 2, abs=0.1)
@@ -42,8 +42,8 @@ def test_every_start_duration_and_method_once_and_prefixes_never_exceed_the_whol
 
 
 def test_a_consumer_mems_imu_drifts_further_than_a_tactical_one_and_the_summary_is_the_median(runs):
-    summary = ev.drift_summary(runs)
-    assert list(summary.columns) == list(ev.DRIFT_COLUMNS) and (summary["n_starts"] == 3).all()
+    summary = studies.ins_fidelity.drift_summary(runs)
+    assert list(summary.columns) == list(studies.ins_fidelity.DRIFT_COLUMNS) and (summary["n_starts"] == 3).all()
     level = summary.set_index(["dataset", "duration_s", "method"])["median_max_h_m"]
     assert level[("rough", 10.0, "INS")] > 2.0 * level[("calm", 10.0, "INS")]
     sel = runs[(runs["dataset"] == "rough") & (runs["duration_s"] == 10.0) & (runs["method"] == "INS")]
@@ -55,16 +55,16 @@ def test_sentences_put_the_stand_in_beside_the_recorded_drive():
                             "duration_s": [30.0] * 4, "method": ["INS", "INS", "INS+NHC", "INS+NHC"],
                             "n_starts": [20, 18, 20, 18], "median_max_h_m": [10.0, 40.0, 4.0, 6.0],
                             "q25_max_h_m": [0.0] * 4, "q75_max_h_m": [0.0] * 4})
-    lines = ev.drift_sentences(summary, stand_in="sim", recorded="real")
+    lines = studies.ins_fidelity.drift_sentences(summary, stand_in="sim", recorded="real")
     assert lines == ["30 s outages, median max horizontal error over up to 20 starts: INS 10.0 m on the stand-in "
                      "sim, 40.0 m on the recorded drive real (4.0 times); INS+NHC 4.0 m on the stand-in sim, 6.0 m "
                      "on the recorded drive real (1.5 times)",
                      "The stand-in's standalone INS drifts outside a factor 1.5 of the recorded drive's at 30 s (4.00) "
                      "(recorded over stand-in)."]
-    assert ev.drift_sentences(summary, stand_in="sim", recorded="absent") == []
+    assert studies.ins_fidelity.drift_sentences(summary, stand_in="sim", recorded="absent") == []
     # INS 1.4 times (within 1.5): the verdict turns; INS+NHC plays no part in it
     summary.loc[1, "median_max_h_m"] = 14.0
-    assert ev.drift_sentences(summary, stand_in="sim", recorded="real")[-1] == (
+    assert studies.ins_fidelity.drift_sentences(summary, stand_in="sim", recorded="real")[-1] == (
         "The stand-in's standalone INS drifts within a factor 1.5 of the recorded drive's at every duration.")
 
 
@@ -72,7 +72,7 @@ def test_the_drives_give_the_same_rows_spread_over_two_processes(cfg, runs):
     from bgfn.parallel import Runner
 
     lines = []
-    two = ev.ins_drift_runs(cfg, [_drive("calm", "ekinox-d"), _drive("rough", "mpu6000")], report=lines.append,
+    two = studies.ins_fidelity.ins_drift_runs(cfg, [_drive("calm", "ekinox-d"), _drive("rough", "mpu6000")], report=lines.append,
                             runner=Runner(2))
     assert two.to_csv(index=False) == runs.to_csv(index=False)            # row for row, the drives' order kept
     assert len(lines) == 2 and all(line.startswith("[INS drift] ") and "3 starts x 2 durations" in line

@@ -242,7 +242,8 @@ def test_learning_windows_start_after_the_filter(rest_drive):
 
 
 def test_sweep_plan_and_outage_evaluation_wait_for_the_filter(rest_drive):
-    from bgfn.evaluate import navigation_context, sweep_plan
+    from bgfn.evaluate import navigation_context
+    from bgfn.studies.outage_sweep import sweep_plan
 
     drive, _ = rest_drive
     t_a = baseline.filter_start(drive, NAV)

@@ -1,5 +1,5 @@
 """The filter set up as NaveGo v1.4 does (bgfn.nav.navego_setup) and the INS row under each setup
-(bgfn.nav.ins_setups): NaveGo's Q and P0 from the error profile, the shipped setup untouched, the physics of
+(bgfn.studies.ins_fidelity.ins_setups): NaveGo's Q and P0 from the error profile, the shipped setup untouched, the physics of
 removing a static bias, and the table beside the paper's INS row."""
 
 from __future__ import annotations
@@ -16,7 +16,8 @@ from bgfn import paper
 from bgfn.data import Drive
 from bgfn.data import imu_errors as ie
 from bgfn.errors import DataError
-from bgfn.nav import baseline, ins_setups, metrics, sim
+from bgfn.nav import baseline, metrics, sim
+from bgfn.studies.ins_fidelity import ins_setups
 from bgfn.nav import error_model as em
 from bgfn.nav import navego_setup as ns
 from bgfn.nav import state as st

@@ -1,4 +1,4 @@
-"""The filter's consistency in outages (bgfn.evaluate.nees): NEES summaries and words from hand-made rows."""
+"""The filter's consistency in outages (bgfn.studies.ins_fidelity.nees): NEES summaries and words from hand-made rows."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bgfn.evaluate import nees as N
+from bgfn.studies.ins_fidelity import nees as N
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.parallel import Runner
 from bgfn.profile_schema import load_profile

@@ -1,4 +1,4 @@
-"""The odometer bars (bgfn.evaluate.odometers): the oracle speed's noise, the speed errors and the summary
+"""The odometer bars (bgfn.studies.odometer.bars): the oracle speed's noise, the speed errors and the summary
 checked by hand, and the rows of a synthetic drive laid out as the table says."""
 
 import numpy as np
@@ -6,7 +6,7 @@ import pandas as pd
 import pytest
 
 from bgfn import evaluate as ev
-from bgfn.evaluate import odometers as O
+from bgfn.studies.odometer import bars as O
 from bgfn.nav import odometer as no
 from bgfn.profile_schema import load_profile
 from synthetic_drive import demo_drive

@@ -1,11 +1,11 @@
-"""A learned odometer's speed error split into an offset per outage and a fluctuation (bgfn.evaluate.odometer_errors),
+"""A learned odometer's speed error split into an offset per outage and a fluctuation (bgfn.studies.odometer.errors),
 and the verdict's sentence on it."""
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from bgfn.evaluate.odometer_errors import (ERROR_COLUMNS, error_parts_lines, error_parts_table, offset_bar_mps,
+from bgfn.studies.odometer.errors import (ERROR_COLUMNS, error_parts_lines, error_parts_table, offset_bar_mps,
                                            plot_error_parts)
 from bgfn.report.odometer_verdict import OdometerInputs, fusion_words, offset_sentence
 

@@ -1,4 +1,4 @@
-"""The odometers at another model size, recorded from another machine (bgfn.evaluate.odometer_sizes) and read by the
+"""The odometers at another model size, recorded from another machine (bgfn.studies.odometer.sizes) and read by the
 verdict's odometer answer (bgfn.report.odometer_verdict.size_sentence)."""
 
 import json
@@ -11,8 +11,8 @@ from bgfn import config
 from bgfn.__main__ import main
 from bgfn.config import SHARED_TABLES
 from bgfn.errors import DataError
-from bgfn.evaluate import odometer_sizes as S
-from bgfn.evaluate.odometers import NETWORK_COLUMNS, SUMMARY_COLUMNS
+from bgfn.studies.odometer import sizes as S
+from bgfn.studies.odometer.bars import NETWORK_COLUMNS, SUMMARY_COLUMNS
 from bgfn.report.odometer_verdict import OdometerInputs, size_sentence
 
 DURATIONS = (30.0, 60.0)

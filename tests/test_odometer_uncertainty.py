@@ -1,9 +1,9 @@
-"""A learned odometer's predicted std against its speed error (bgfn.evaluate.odometer_uncertainty)."""
+"""A learned odometer's predicted std against its speed error (bgfn.studies.odometer.uncertainty)."""
 
 import numpy as np
 import pytest
 
-from bgfn.evaluate.odometer_uncertainty import ranks_errors, uncertainty_lines, uncertainty_table
+from bgfn.studies.odometer.uncertainty import ranks_errors, uncertainty_lines, uncertainty_table
 
 
 def _series(informative: bool):

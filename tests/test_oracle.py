@@ -1,4 +1,4 @@
-"""The oracle rows (bgfn.evaluate.oracle) and the true increments they are built from (bgfn.evaluate.increments).
+"""The oracle rows (bgfn.studies.outage_sweep.oracle) and the true increments they are built from (bgfn.studies.outage_sweep.increments).
 
 A small synthetic drive (demo trajectory, Ekinox-grade IMU with fixed biases, 5 Hz GNSS, lever arm) keeps every
 test fast; its standalone INS drifts several metres in a 30 s outage.
@@ -10,11 +10,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bgfn import evaluate as ev
+from bgfn import evaluate as ev, studies
 from bgfn.profile_schema import load_profile
 from bgfn.data import Drive
 from bgfn.errors import DataError
-from bgfn.evaluate import oracle as orc
+from bgfn.studies.outage_sweep import oracle as orc
 from bgfn.nav import sim
 from bgfn.profile_schema import ProfileError, validate
 from synthetic_drive import LEVER, demo_drive
@@ -55,18 +55,18 @@ def test_true_increments_are_the_noise_free_fix_increments_of_the_antenna(drive)
     from bgfn.learning.targets import gnss_increments
 
     inc = gnss_increments(fixes)
-    truth = ev.AntennaTruth(drive.reference, LEVER, "synthetic")
+    truth = studies.outage_sweep.AntennaTruth(drive.reference, LEVER, "synthetic")
     d = truth.increments(inc["t_from"], inc["t_to"])
     assert np.abs(d - inc[["dn", "de"]].to_numpy()).max() < 1e-6
     # the lever arm matters in turns: the IMU's own increments differ from the antenna's
-    imu = ev.AntennaTruth(drive.reference, [0.0, 0.0, 0.0]).increments(inc["t_from"], inc["t_to"])
+    imu = studies.outage_sweep.AntennaTruth(drive.reference, [0.0, 0.0, 0.0]).increments(inc["t_from"], inc["t_to"])
     assert np.abs(imu - d).max() > 1e-3
     with pytest.raises(DataError):
         truth.increments([drive.reference["time"].iloc[-1]], [drive.reference["time"].iloc[-1] + 1.0])
 
 
 def test_exact_oracle_sums_to_the_antenna_displacement_and_has_no_increment_error(ctx):
-    truth = ev.AntennaTruth.of(ctx)
+    truth = studies.outage_sweep.AntennaTruth.of(ctx)
     noise = orc.oracle_noise("synthetic", 0, 2000)
     t0 = float(ctx.drive.reference["time"].iloc[0])
     run = ev.run_outages(ctx, [(40.0, 30.0)], orc.OracleIncrements(truth, ctx.gnss_interval_s, 0.0, noise, t0),
@@ -76,22 +76,22 @@ def test_exact_oracle_sums_to_the_antenna_displacement_and_has_no_increment_erro
     moved = truth.increments([40.0], [last["time"]])[0]
     assert np.hypot(last["cum_dn"] - moved[0], last["cum_de"] - moved[1]) < 0.01
     assert len(run.increments) == 150 and len(run.pseudo) == 30       # 5 Hz increments fused at 1 Hz
-    assert ev.increment_rmse(run, truth, ctx.gnss_interval_s) == pytest.approx(0.0, abs=1e-9)
+    assert studies.outage_sweep.increment_rmse(run, truth, ctx.gnss_interval_s) == pytest.approx(0.0, abs=1e-9)
 
 
 def test_increment_rmse_of_white_noise_is_its_sigma_per_axis(ctx):
-    truth = ev.AntennaTruth.of(ctx)
+    truth = studies.outage_sweep.AntennaTruth.of(ctx)
     t0 = float(ctx.drive.reference["time"].iloc[0])
     runs = ev.run_outages(ctx, [(s, d) for _, s, d in WINDOWS],
                           orc.OracleIncrements(truth, ctx.gnss_interval_s, 0.5, orc.oracle_noise("x", 1, 2000), t0),
                           "oracle", 1)
-    e = np.concatenate([ev.increment_errors(r, truth, ctx.gnss_interval_s) for r in runs])     # 450 x 2 draws
+    e = np.concatenate([studies.outage_sweep.increment_errors(r, truth, ctx.gnss_interval_s) for r in runs])     # 450 x 2 draws
     assert np.sqrt(np.mean(e ** 2)) == pytest.approx(0.5, rel=0.1)
     assert abs(e.mean()) < 0.1
     # a prefix keeps only the increments that end inside it
-    assert len(ev.increment_errors(runs[0], truth, ctx.gnss_interval_s, 10.0)) == 50
+    assert len(studies.outage_sweep.increment_errors(runs[0], truth, ctx.gnss_interval_s, 10.0)) == 50
     ins = ev.run_outages(ctx, [(40.0, 30.0)], None)[0]
-    assert np.isnan(ev.increment_rmse(ins, truth, ctx.gnss_interval_s))
+    assert np.isnan(studies.outage_sweep.increment_rmse(ins, truth, ctx.gnss_interval_s))
 
 
 # ----------------------------------------------------------------------------------------------- oracle runs
@@ -223,11 +223,11 @@ def test_run_oracle_writes_its_tables_and_figure(drive, ctx, tmp_path):
     per_seed = pd.DataFrame([{"outage": 1, "start_s": r.start, "method": r.method, "seed": r.seed,
                               **ev.window_metrics(r.errors, r.start, r.duration)} for r in runs])
     res = ev.TableResult("synthetic", "synthetic", per_seed, per_seed, runs, drive=drive)
-    plan = ev.sweep_plan(drive, ecfg["sweep"], 20)
+    plan = studies.outage_sweep.sweep_plan(drive, ecfg["sweep"], 20)
     sweep = pd.DataFrame({"dataset": "synthetic", "start_s": plan["start_s"], "duration_s": 20.0,
                           "method": "INS+NHC", "seed": 0, "fold": 0, "max_h_m": 0.05, "increment_rmse_m": np.nan})
     lines = []
-    o = ev.run_oracle(cfg, "t", setup, tmp_path, {"synthetic": res}, sweep, report=lines.append)
+    o = studies.outage_sweep.run_oracle(cfg, "t", setup, tmp_path, {"synthetic": res}, sweep, report=lines.append)
     assert lines[0].startswith("synthetic: ") and list(o.timings) == ["oracle_synthetic_s"]
     for key in ("oracle", "oracle_breakeven", "oracle_runs"):
         assert (tmp_path / "tables" / SHARED_TABLES[key]).exists()
@@ -246,7 +246,7 @@ def test_run_oracle_writes_its_tables_and_figure(drive, ctx, tmp_path):
     plt.close("all")
     # an empty grid: no oracle, nothing run
     ecfg0 = {**ecfg, "oracle": _oracle([])}
-    empty = ev.run_oracle(cfg, "t", ev.EvaluationSetup("t", "", ecfg0, ["synthetic"], [], [], [], windows))
+    empty = studies.outage_sweep.run_oracle(cfg, "t", ev.EvaluationSetup("t", "", ecfg0, ["synthetic"], [], [], [], windows))
     assert empty.table.empty and empty.describe() == []
 
 
@@ -270,10 +270,10 @@ def test_profiles_define_the_oracle_and_its_durations_fit_the_sweep():
 def test_sweep_rows_carry_each_networks_increment_error(drive, monkeypatch, tmp_path):
     # the sweep with stand-in networks (no training): exact increments score 0, white noise its sigma
     from bgfn import config, train
-    from bgfn.evaluate import sweep as sweep_module
+    from bgfn.studies.outage_sweep import sweep as sweep_module
 
     monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)
-    truth = ev.AntennaTruth(drive.reference, LEVER)
+    truth = studies.outage_sweep.AntennaTruth(drive.reference, LEVER)
     t0 = float(drive.reference["time"].iloc[0])
     noise = orc.oracle_noise("synthetic", 0, 1000)
     stand_in = {"mlp": orc.OracleIncrements(truth, 0.2, 0.0, noise, t0),
@@ -290,7 +290,7 @@ def test_sweep_rows_carry_each_networks_increment_error(drive, monkeypatch, tmp_
     ecfg = ev.evaluate_config({"methods": ["bgfn", "mlp"], "sweep": {
         "n_starts": 2, "folds": 2, "durations_s": [10.0, 30.0], "warmup_s": 30.0, "seeds": [0]},
         "oracle": _oracle([0.0], durations=[30.0])}, cfg["train"])
-    rows, _ = ev.run_sweep(cfg, "t", "synthetic", drive=drive, ecfg=ecfg)
+    rows, _ = studies.outage_sweep.run_sweep(cfg, "t", "synthetic", drive=drive, ecfg=ecfg)
     assert list(rows.columns) == list(ev.SWEEP_COLUMNS)
     inc = rows.groupby(["method", "duration_s"])["increment_rmse_m"]
     assert rows.loc[rows["method"].isin(["INS", "GPS"]), "increment_rmse_m"].isna().all()
@@ -302,7 +302,7 @@ def test_increments_past_the_reference_are_left_out():
     """A window at a drive's end: its last GNSS epoch may lie past the last reference row; it is not scored."""
     from types import SimpleNamespace
 
-    from bgfn.evaluate.increments import AntennaTruth, increment_errors
+    from bgfn.studies.outage_sweep.increments import AntennaTruth, increment_errors
 
     t = np.arange(0.0, 10.001, 0.01)
     ref = pd.DataFrame({"time": t, "lat": 0.7 + 1e-7 * t, "lon": 0.1 + 0 * t, "h": 100.0 + 0 * t,

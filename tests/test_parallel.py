@@ -216,7 +216,7 @@ def test_a_paired_ratio_is_unreliable_when_its_spread_exceeds_the_difference():
 def synthetic_sweep_setup(tmp_path_factory):
     from synthetic_drive import demo_drive
 
-    from bgfn import evaluate as ev
+    from bgfn import evaluate as ev, studies
 
     cfg = load_profile("smoke")
     nav = {"init": {"position_std_m": 1.0, "height_std_m": 2.0, "velocity_std_mps": 0.1, "level_std_deg": 0.2,
@@ -229,21 +229,21 @@ def synthetic_sweep_setup(tmp_path_factory):
 
 
 def test_the_sweep_gives_the_same_rows_with_one_job_and_with_two(synthetic_sweep_setup, tmp_path, monkeypatch):
-    from bgfn import config, evaluate as ev
+    from bgfn import config, evaluate as ev, studies
 
     drive, cfg, ecfg = synthetic_sweep_setup
     tables = {}
     for jobs in (1, 2):
         monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path / f"jobs{jobs}")    # networks trained anew each time
-        rows, info = ev.run_sweep(cfg, "t", "synthetic", drive=drive, ecfg=ecfg, runner=Runner(jobs))
+        rows, info = studies.outage_sweep.run_sweep(cfg, "t", "synthetic", drive=drive, ecfg=ecfg, runner=Runner(jobs))
         tables[jobs] = rows.to_csv(index=False)
         assert (tmp_path / f"jobs{jobs}").exists()                              # the workers wrote there
     assert tables[1] == tables[2] and "MLP" in tables[1]
 
 
 def test_the_oracle_grid_gives_the_same_rows_with_one_job_and_with_two(synthetic_sweep_setup):
-    from bgfn import evaluate as ev
-    from bgfn.evaluate import oracle as orc
+    from bgfn import evaluate as ev, studies
+    from bgfn.studies.outage_sweep import oracle as orc
 
     drive, cfg, _ = synthetic_sweep_setup
     windows = [("1", 40.0, 30.0), ("2", 75.0, 30.0)]

@@ -228,7 +228,7 @@ def test_training_and_sweep_tables():
 ALLOWED: dict[str, str] = {
     "0.05 m": "truth smoothing sigma (setting, deviations row 5)",
     "100 m/s": "the velocity std that makes NaveGo's velocity rows carry nothing (setting of make navego-check)",
-    "30 %": "how far our setup of NaveGo may lie from NaveGo itself (issue 26; bgfn.nav.ins_setups.NAVEGO_TOLERANCE)",
+    "30 %": "how far our setup of NaveGo may lie from NaveGo itself (issue 26; bgfn.studies.ins_fidelity.ins_setups.NAVEGO_TOLERANCE)",
     "10 %": "Ekinox run-to-run bias part (setting, row 7)",
     "3 %": "MPU-6000 scale-factor tolerance (setting, row 8)",
     "2 %": "MPU-6000 cross-axis tolerance (setting, row 8)",

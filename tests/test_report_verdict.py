@@ -226,7 +226,7 @@ def test_the_odometer_answer_says_whether_more_training_windows_made_the_speed_f
 
 
 def test_the_odometer_answer_says_whether_bgfn_odos_std_ranks_its_errors():
-    from bgfn.evaluate.odometer_uncertainty import UNCERTAINTY_COLUMNS
+    from bgfn.studies.odometer.uncertainty import UNCERTAINTY_COLUMNS
 
     odo = _odometer()
     assert "Does it know when it is wrong?" not in verdict_sentences(_inputs(odometer=odo),
@@ -288,7 +288,7 @@ def test_the_oracle_speed_row_says_when_the_networks_speed_error_is_beyond_its_g
 
 
 def test_the_ins_answer_puts_navego_itself_beside_our_setup_of_it():
-    from bgfn.nav import ins_setups
+    from bgfn.studies.ins_fidelity import ins_setups
     from bgfn.report.verdict import answer_ins_tuning
 
     rows = [("turin-sim-mpu6000", "field", o, s, e, e, 1.0, 0.1, 1.7, 0.05, 0.8)

@@ -1,4 +1,4 @@
-"""RIDGE-ODO's learning curve (bgfn.evaluate.ridge_curve) on synthetic windows whose vibration power says the speed:
+"""RIDGE-ODO's learning curve (bgfn.studies.odometer.ridge_curve) on synthetic windows whose vibration power says the speed:
 more folds hold out less and so train on more windows, every start is predicted by a ridge that never saw it, and
 a speed the band energies determine is learned at every number of folds."""
 
@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bgfn.evaluate import ridge_curve as RC
+from bgfn.studies.odometer import ridge_curve as RC
 from bgfn.learning import odometry as lo
 
 RATE, WINDOW = 100.0, 200                                  # 2 s windows at 100 Hz, one per second

@@ -1,6 +1,6 @@
 """Input and protocol variants (issue 17, outcome 3): the honest and leaky protocols of bgfn.learning.split, the
 variants of a profile (bgfn.train.variants) merged and schema-checked like profiles, their outage table
-(bgfn.evaluate.variants), and the learning-rate search's budget (bgfn.train.lr_search)."""
+(bgfn.studies.outage_sweep.variant_outages), and the learning-rate search's budget (bgfn.train.lr_search)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import torch
 import yaml
 
 from bgfn import config
-from bgfn import evaluate as ev
+from bgfn import evaluate as ev, studies
 from bgfn import learning as L
 from bgfn import train as T
 from bgfn.errors import DataError
@@ -171,15 +171,15 @@ def test_variant_table_counts_the_networks_of_every_cell(tmp_path, monkeypatch):
         seen.append(path.relative_to(tmp_path).as_posix())
         return _Fixed(dn=1.0 + 0.1 * len(seen))
 
-    per_run = ev.variant_runs(vplan, drives={"turin-sim-ekinox": _drive(5.0)}, loader=loader)
-    table = ev.variant_table(per_run)
-    assert list(table.columns) == list(ev.VARIANT_COLUMNS)
+    per_run = studies.outage_sweep.variant_runs(vplan, drives={"turin-sim-ekinox": _drive(5.0)}, loader=loader)
+    table = studies.outage_sweep.variant_table(per_run)
+    assert list(table.columns) == list(studies.outage_sweep.VARIANT_COLUMNS)
     # the main networks are notebook 03's, the variant's under models/variants/<variant>/<dataset>/
     assert "toy/models/turin-sim-ekinox/mlp_seed2.pt" in seen
     assert "toy/models/variants/leaky/turin-sim-ekinox/bgfn_seed0.pt" in seen and len(seen) == 2 * 2 * 3
-    nets = table[table["variant"] != ev.NO_VARIANT]
+    nets = table[table["variant"] != studies.outage_sweep.NO_VARIANT]
     assert len(nets) == 2 * 2 * 2 and (nets["n_runs"] == 3).all()          # 2 outages x 2 variants x 2 methods
-    ins = table[table["variant"] == ev.NO_VARIANT]
+    ins = table[table["variant"] == studies.outage_sweep.NO_VARIANT]
     assert ins["method"].tolist() == ["INS", "INS"] and (ins["n_runs"] == 0).all()
     # a cell is the median over its networks: recomputed from the runs
     cell = per_run[(per_run["variant"] == "leaky") & (per_run["method"] == "BGFN") & (per_run["outage"] == 2)]
@@ -187,13 +187,13 @@ def test_variant_table_counts_the_networks_of_every_cell(tmp_path, monkeypatch):
     assert len(cell) == 3 and row["max_h_m"].item() == pytest.approx(np.median(cell["max_h_m"]))
     assert row[["inputs", "protocol", "test"]].values.tolist() == [["eq21", "leaky", "dataset"]]
     # fewer networks in a cell: n_runs follows
-    fewer = ev.variant_table(per_run[~((per_run["variant"] == "leaky") & (per_run["seed"] == 2))])
+    fewer = studies.outage_sweep.variant_table(per_run[~((per_run["variant"] == "leaky") & (per_run["seed"] == 2))])
     assert fewer.loc[fewer["variant"] == "leaky", "n_runs"].eq(2).all()
     assert fewer.loc[fewer["variant"] == MAIN_VARIANT, "n_runs"].eq(3).all()
-    wide = ev.variant_pivot(table)
+    wide = studies.outage_sweep.variant_pivot(table)
     assert list(wide.columns) == [MAIN_VARIANT, "leaky", "INS"] and len(wide) == 4
     with pytest.raises(DataError, match="checkpoint"):
-        ev.variant_runs(vplan, drives={"turin-sim-ekinox": _drive(5.0)})     # nothing trained in tmp_path
+        studies.outage_sweep.variant_runs(vplan, drives={"turin-sim-ekinox": _drive(5.0)})     # nothing trained in tmp_path
 
 
 def test_train_variants_stores_networks_apart_with_the_main_learning_rate(tmp_path, monkeypatch):

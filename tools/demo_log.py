@@ -6,7 +6,7 @@ and ``params/<PROFILE>.yaml``: the README's two lines with the absolute path (``
 drive turns too gently for the rule's manoeuvre) and the smallest budget, so that ``make reproduce
 PROFILE=<PROFILE>`` runs the whole chain on it in a few minutes. CI runs exactly that (``.ci/run``, issue 25): the
 documented own-log path by absolute path, end to end, every notebook and the book. With ``--walker`` the log is the
-gallery's synthetic walk instead (:func:`bgfn.data.gallery.walker_log`, ``platform: walker``) and the profile is
+gallery's synthetic walk instead (:func:`bgfn.studies.gallery.logs.walker_log`, ``platform: walker``) and the profile is
 based on ``params/own-walker.yaml``, with the outages picked by its rule and a four-start sweep.
 """
 
@@ -22,7 +22,7 @@ import pandas as pd
 from bgfn.config import PARAMS_DIR
 from bgfn.data import Drive, write_csv_drive
 from bgfn.data import imu_errors as ie
-from bgfn.data.gallery import walker_log
+from bgfn.studies.gallery.logs import walker_log
 from bgfn.nav import sim
 
 T0 = 243000.0                    # GPS time of week of the first epoch, s

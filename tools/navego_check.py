@@ -5,7 +5,7 @@ removes the fixes inside the profile's outages (as NaveGo's ``gnss_outage.m`` do
 ``ins_gnss.m`` under GNU Octave (Debian packages ``octave`` and ``octave-control``), and compares its trajectory
 with the drive's reference: the max |east| and |north| error in each outage and the horizontal RMS outside them.
 The numbers go to ``data/measured/navego_check.csv`` with the date, the commit and the versions, which the book
-reads (the *NaveGo* rows beside our ``navego`` setup, :mod:`bgfn.nav.ins_setups`).
+reads (the *NaveGo* rows beside our ``navego`` setup, :mod:`bgfn.studies.ins_fidelity.ins_setups`).
 
 NaveGo's source is read from ``../shared/navego-v1.4/`` (LGPL-3.0) at run time; nothing of it is copied here. It
 is a tool, not part of the package: the artifact never needs Octave.
@@ -58,7 +58,7 @@ from bgfn.io import atomic_write_csv
 from bgfn.nav.baseline import nav_config, run_drive
 from bgfn.nav.earth import curvature_radii, lla_to_ned
 from bgfn.nav.outages import outage_windows
-from bgfn.nav.ins_setups import NAVEGO_CHECK_COLUMNS, NAVEGO_CHECK_FILE, NAVEGO_VARIANTS
+from bgfn.studies.ins_fidelity.ins_setups import NAVEGO_CHECK_COLUMNS, NAVEGO_CHECK_FILE, NAVEGO_VARIANTS
 from bgfn.profile_schema import load_profile
 
 NAVEGO_DIR = PROJECT_ROOT.parent / "shared" / "navego-v1.4"
@@ -70,7 +70,7 @@ BIAS_FEEDBACK_PATCH: tuple[tuple[str, str], ...] = (
     ("ab_dyn   = -kf.xp(13:15);", "ab_dyn   = ab_dyn + kf.xp(13:15);"),   # line 409: +, the sign of F's C_bn x_a
 )
 #: NaveGo's runs per drive: as released, and with its bias feedback made consistent (module docstring).
-VARIANTS: tuple[str, ...] = tuple(NAVEGO_VARIANTS)      # the CSV's variant column, read by bgfn.nav.ins_setups
+VARIANTS: tuple[str, ...] = tuple(NAVEGO_VARIANTS)      # the CSV's variant column, read by bgfn.studies.ins_fidelity.ins_setups
 #: The bias states step by step (issue 26): NaveGo's estimates at every fix of each run's first TRACE_S seconds,
 #: beside our filter under NaveGo's setup and the drive's true biases (a simulated drive's), at the same fixes.
 TRACE_FILE = PROJECT_ROOT / "data" / "measured" / "navego_bias_trace.csv"

@@ -5,9 +5,9 @@ profile and its options (:func:`bgfn.profile_schema.with_overrides`) before anyt
 ``python -m bgfn kernels``: compile the navigation's numba kernels into numba's cache (:mod:`bgfn.evaluate.kernels`;
 ``make reproduce`` runs it in the background while notebook 01 prepares the data).
 
-``python -m bgfn odometers``: notebook 04's odometer bars alone (:func:`bgfn.evaluate.run_odometer_section`) for a
+``python -m bgfn odometers``: notebook 04's odometer bars alone (:func:`bgfn.studies.odometer.bars.run_odometer_section`) for a
 profile, its tables under ``results/<profile>/``; ``--record`` then keeps their summary in ``data/measured/``
-(:mod:`bgfn.evaluate.odometer_sizes`), where the book reads a run made on another machine (a GPU: the profile
+(:mod:`bgfn.studies.odometer.sizes`), where the book reads a run made on another machine (a GPU: the profile
 ``paper-odometer``).
 
 ``python -m bgfn walltimes``: the wall-time section of the book's "Reproduce it" page
@@ -31,7 +31,9 @@ import time
 
 from bgfn.config import results_dir
 from bgfn.errors import DataError
-from bgfn.evaluate import evaluation_setup, odometer_sizes, run_odometer_section
+from bgfn.evaluate import evaluation_setup
+from bgfn.studies.odometer import sizes as odometer_sizes
+from bgfn.studies.odometer.bars import run_odometer_section
 from bgfn.evaluate.kernels import compile_kernels
 from bgfn.io import atomic_write_text
 from bgfn.parallel import Runner
@@ -83,7 +85,7 @@ def odometers(argv) -> int:
     """``odometers --profile P [--method M ...] [--seed S ...] [--jobs N]``: the odometer bars of the profile's
     ``evaluate.odometer.datasets`` (one line per finished run), their tables and ``odometer_run.json`` under
     ``results/P/``; ``odometers --profile P --record [--note TEXT]``: keep that run's summary in ``data/measured/``
-    with the date, the commit and the device (:mod:`bgfn.evaluate.odometer_sizes`)."""
+    with the date, the commit and the device (:mod:`bgfn.studies.odometer.sizes`)."""
     p = argparse.ArgumentParser(prog="python -m bgfn odometers", description="The learned odometers' bars alone.")
     p.add_argument("--profile", default="paper-odometer")
     p.add_argument("--method", action="append", help="network odometers (evaluate.odometer.methods)")

@@ -90,19 +90,19 @@ SHARED_TABLES: dict[str, str] = {
     "kf_ins_drift_runs": "kf_ins_drift_runs.csv",
     "kf_nees_scan": "kf_nees_scan.csv",         # notebook 02: INS consistency vs the gyro bias instability
     "kf_imu_twin": "kf_imu_twin.csv",           # notebook 02: the recorded IMU against its trajectory twin
-    "oracle": "outage_oracle.csv",              # notebook 04: the oracle rows (bgfn.evaluate.oracle)
+    "oracle": "outage_oracle.csv",              # notebook 04: the oracle rows (bgfn.studies.outage_sweep.oracle)
     "oracle_breakeven": "outage_oracle_breakeven.csv",
     "oracle_runs": "outage_oracle_runs.csv",
-    "odometer": "outage_odometer.csv",          # notebook 04: the bars of a learned odometer (bgfn.evaluate.odometers)
+    "odometer": "outage_odometer.csv",          # notebook 04: the bars of a learned odometer (bgfn.studies.odometer.bars)
     "odometer_summary": "outage_odometer_summary.csv",
     "odometer_paper": "outage_odometer_paper.csv",  # ... and in each drive's two evaluation outages
     "odometer_networks": "outage_odometer_networks.csv",  # ... each network odometer: validation against outages
     "odometer_curve": "outage_odometer_curve.csv",  # ... the ridge's speed error against its training windows
     "odometer_uncertainty": "outage_odometer_uncertainty.csv",  # ... each network's predicted std against its error
     "odometer_errors": "outage_odometer_errors.csv",  # ... each odometer's error: offset per outage and fluctuation
-    "nees": "outage_nees.csv",                  # notebook 04: the filter's consistency in outages (bgfn.evaluate.nees)
+    "nees": "outage_nees.csv",                  # notebook 04: the filter's consistency in outages (bgfn.studies.ins_fidelity.nees)
     "variants": "outage_variants.csv",          # notebook 03: the learning-problem variants in the two outages
-    "energy_odometer": "energy_odometer.csv",   # notebook 05: the learned odometers' energy (bgfn.energy.odometer)
+    "energy_odometer": "energy_odometer.csv",   # notebook 05: the learned odometers' energy (bgfn.studies.odometer.energy)
 }
 #: Where a top-level ``datasets:`` puts its list (the datasets of every notebook, their variants and odometers),
 #: unless the same file or a later one in the ``base:`` chain sets that section's own ``datasets``.

@@ -31,7 +31,8 @@ from bgfn.config import (DEFAULT_DATASET_KEY, MAIN_VARIANT, VARIANT_NAME, VARIAN
 from bgfn.data import load_drive
 from bgfn.data.names import profile_datasets, unique_ids
 from bgfn.errors import DataError
-from bgfn.evaluate import EVALUATE_DEFAULTS, evaluate_config, sweep_plan
+from bgfn.evaluate import EVALUATE_DEFAULTS, evaluate_config
+from bgfn.studies.outage_sweep.sweep import sweep_plan
 from bgfn.learning import learning_options
 from bgfn.learning.odometry import ODOMETER_INPUTS
 from bgfn.nav.baseline import filter_start

@@ -12,7 +12,7 @@ Public API:
   :func:`load_csv_drive`, :func:`write_csv_drive`: the building blocks.
 - :mod:`bgfn.data.rtklib`: readers of RTKLIB-logged files, behind the dataset ``rtklib-drive0708`` (a real car
   drive: recorded MEMS IMU, RTK reference without attitude); :mod:`bgfn.data.imu_levels`: a drive's IMU
-  noise levels at rest and while driving; :mod:`bgfn.data.imu_roughness` (on :mod:`bgfn.data.allan`): its Allan
+  noise levels at rest and while driving; :mod:`bgfn.studies.ins_fidelity.imu_roughness` (on :mod:`bgfn.data.allan`): its Allan
   deviation, the bias between stops, and the trajectory twin (the same road with a simulated IMU).
 - :mod:`bgfn.data.summary` (``summary_table``) and :mod:`bgfn.data.plots` (matplotlib; not imported here):
   notebook 01's tables and figures.

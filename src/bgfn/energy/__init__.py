@@ -30,7 +30,6 @@ Modules, one concept each (every public name is also importable from ``bgfn.ener
 * :mod:`~bgfn.energy.crosscheck` -- SpikingJelly 2.0's operation counter on the same spikes;
 * :mod:`~bgfn.energy.tables` -- energy per layer, totals, reduction against the twin, the measured CPU speed beside
   them;
-* :mod:`~bgfn.energy.odometer` -- the same count for the learned odometers (``BGFN-ODO`` against its twin);
 * :mod:`~bgfn.energy.record` -- ``energy.json``, what notebook 05 hands to the results page;
 * :mod:`~bgfn.energy.plots` -- notebook 05's figures.
 """
@@ -40,7 +39,6 @@ from bgfn.energy.checkpoint import (MEASURED, EvaluationWindows, MeasuredModels,
 from bgfn.energy.counts import (LayerCount, break_even_note, layer_counts, mean_rate, measure_firing_rates, rates_table,
                                 reduction_vs_rate, reduction_vs_time_steps, same_size_builder, with_rates)
 from bgfn.energy.crosscheck import Crosscheck, compare_with_spikingjelly, spikingjelly_counts
-from bgfn.energy.odometer import OdometerEnergy, odometer_energy
 from bgfn.energy.passes import fold_batchnorm, is_spike_count
 from bgfn.energy.plots import plot_energy_per_layer, plot_firing_rates, plot_sweeps
 from bgfn.energy.record import energy_summary, result_markdown
@@ -51,7 +49,7 @@ from bgfn.energy.tables import (COLUMNS, EnergyTotals, attention_energy_uj, ener
 
 __all__ = [
     "E_AC_PJ", "E_MAC_PJ", "COLUMNS", "MEASURED",
-    "Crosscheck", "EnergyTotals", "OdometerEnergy", "odometer_energy", "EvaluationWindows", "LayerCount", "MeasuredModels",
+    "Crosscheck", "EnergyTotals", "EvaluationWindows", "LayerCount", "MeasuredModels",
     "attention_energy_uj", "break_even_note", "compare_with_spikingjelly", "energy_checkpoint", "energy_summary",
     "energy_table", "energy_totals", "energy_uj", "evaluation_windows", "fold_batchnorm", "is_spike_count",
     "layer_counts", "load_measured", "mean_rate", "measure_firing_rates", "model_name", "plot_energy_per_layer",

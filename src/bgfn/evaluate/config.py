@@ -29,8 +29,8 @@ COLORS: dict[str, str] = {**_BASE_COLORS, **{nhc_label(m): c for m, c in _BASE_C
 METRIC_COLUMNS: tuple[str, ...] = ("max_east_m", "max_north_m", "rmse_h_m", "final_h_m")
 TABLE_COLUMNS: tuple[str, ...] = ("outage", "method") + METRIC_COLUMNS
 #: Columns of ``tables/outage_sweep.csv``; ``increment_rmse_m``: a network's predicted delta_p_gps against the true
-#: ones inside the outage, RMSE per horizontal axis (:func:`bgfn.evaluate.increments.increment_rmse`; NaN for INS, GPS);
-#: ``nees_h``: the horizontal NEES at the window's end against the filter's own covariance (:mod:`bgfn.evaluate.nees`).
+#: ones inside the outage, RMSE per horizontal axis (:func:`bgfn.studies.outage_sweep.increments.increment_rmse`; NaN for INS, GPS);
+#: ``nees_h``: the horizontal NEES at the window's end against the filter's own covariance (:mod:`bgfn.studies.ins_fidelity.nees`).
 SWEEP_COLUMNS: tuple[str, ...] = ("dataset", "start_s", "duration_s", "method", "seed", "fold", "max_east_m",
                                   "max_north_m", "max_h_m", "rmse_h_m", "final_h_m", "increment_rmse_m", "nees_h")
 #: The paper's test -> our outage table file (``results/<profile>/tables/``).
@@ -62,10 +62,10 @@ EVALUATE_DEFAULTS: dict[str, Any] = {
         "level": 0.95,
         "boot_seed": 0,
     },
-    # the pseudo-GPS from the true increments plus noise (bgfn.evaluate.oracle)
+    # the pseudo-GPS from the true increments plus noise (bgfn.studies.outage_sweep.oracle)
     "oracle": {"sigmas_m": [0.0, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0], "seeds": [0, 1],
                "durations_s": [30.0, 60.0]},
-    # the bars of a learned odometer in the sweep's windows (bgfn.evaluate.odometers): datasets ([] none; null:
+    # the bars of a learned odometer in the sweep's windows (bgfn.studies.odometer.bars): datasets ([] none; null:
     # the sweep's), the IMU window of the ridge odometer, the oracle speed's noise grid and random walk, the held speed's std, the ridge penalty, the gate;
     # paper_outages: also in each drive's two evaluation outages (the profile's outage_windows), as one more fold;
     # lr_search: each odometer network's learning rate per fold from train.lr_search's grid (false: train.lr);
@@ -74,7 +74,7 @@ EVALUATE_DEFAULTS: dict[str, Any] = {
     # validation errors up to correlation_max_lag_s (bgfn.learning.odometry.error_correlation; false: fused as white);
     # calibration_blocks: every other validation block calibrates the odometers' std and kappa, the others stop the
     # networks' training (false: all the blocks do both);
-    # curve_folds: the ridge refitted with the sweep's starts in each of these numbers of folds (bgfn.evaluate.ridge_curve;
+    # curve_folds: the ridge refitted with the sweep's starts in each of these numbers of folds (bgfn.studies.odometer.ridge_curve;
     # more than the starts: one per start)
     "odometer": {"datasets": None, "methods": ["bgfn", "transformer", "at_lstm", "mlp"], "network_seeds": [0],
                  "network_datasets": None,

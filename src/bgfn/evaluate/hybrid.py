@@ -466,7 +466,7 @@ def window_metrics(errors: pd.DataFrame, start: float, duration: float, sd: pd.D
         ``nees_h``: the normalized estimation error squared of the horizontal position at the last epoch against the
         filter's own std there (``sd``, :attr:`OutageRun.sd`; NaN without it), ``(e_N / sd_N)^2 + (e_E / sd_E)^2``:
         chi-square with 2 degrees of freedom when the filter is consistent (the north-east correlation of its
-        covariance left out: :mod:`bgfn.evaluate.nees`).
+        covariance left out: :mod:`bgfn.studies.ins_fidelity.nees`).
     """
     t = errors["time"].to_numpy(float)
     m = (t >= start - 1e-6) & (t <= start + duration + 1e-6)

@@ -35,7 +35,7 @@ def evaluation_record(setup: EvaluationSetup, results: Mapping[str, TableResult]
     sweep_rows : int
         Rows of ``tables/outage_sweep.csv``.
     sweep_info : dict
-        ``{dataset: info}`` of :func:`bgfn.evaluate.sweep.run_sweeps`.
+        ``{dataset: info}`` of :func:`bgfn.studies.outage_sweep.sweep.run_sweeps`.
     timings : dict
         Wall times, s.
 

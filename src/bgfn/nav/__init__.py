@@ -50,6 +50,6 @@ Modules (pyins style, one concept each; SI units, radians, NED, tables as in CON
   ``run_baseline(drive, cfg, windows)``, ``ins_layout``, ``save_baseline``; :mod:`~bgfn.nav.plots` -- its figures.
 - :mod:`~bgfn.nav.navego_setup` -- the filter set up as NaveGo v1.4's ``ins_gnss.m`` (``nav.ins_tuning: navego``):
   ``navego_noise``, ``static_biases``, ``initial_bias_estimates``, ``remove_static_biases``.
-- :mod:`~bgfn.nav.ins_setups` -- the standalone-INS row under each setup beside the paper's:
+- :mod:`~bgfn.studies.ins_fidelity.ins_setups` -- the standalone-INS row under each setup beside the paper's:
   ``ins_tuning_table(drive, cfg, windows)``, ``layout``, ``gap_explained``, ``sentences``, ``save_table``.
 """

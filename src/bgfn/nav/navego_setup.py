@@ -61,7 +61,7 @@ states integrate the true bias without bound (``tools/navego_check.py`` explains
 with the feedback made consistent, all 15 states zeroed and the estimates corrected by them: our closed-loop
 filter's scheme, and the run this setup is compared with on a rough IMU). (An earlier
 reading of a later ``ins_gnss.m``, Version 012, which zeroes the whole state and so does not accumulate them, is
-why :func:`bgfn.nav.ins_setups.ins_tuning_table` also shows a run whose bias estimates are cleared at the outage
+why :func:`bgfn.studies.ins_fidelity.ins_setups.ins_tuning_table` also shows a run whose bias estimates are cleared at the outage
 start; v1.4 as mirrored here is Version 011.)
 """
 

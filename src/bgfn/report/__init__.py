@@ -19,7 +19,7 @@ Modules, in the order the page needs them:
   sweep tables;
 - :mod:`bgfn.report.provenance` -- the source and run-metadata line under every table;
 - :mod:`bgfn.report.sentences` -- plain sentences computed from the numbers;
-- :mod:`bgfn.report.variants` -- profiles side by side, and one profile against the untrained references;
+- :mod:`bgfn.report.profile_comparison` -- profiles side by side, and one profile against the untrained references;
 - :mod:`bgfn.report.glance` -- the run header, the *At a glance* lines and ``findings.md``;
 - :mod:`bgfn.report.figures` -- the page's figure lists and the four drawings made from the profile;
 - :mod:`bgfn.report.sections` -- each section of the page as the pieces to display;
@@ -41,7 +41,7 @@ from bgfn.report.sentences import (BASELINES, EXTRA_METHODS, EXTRA_TAGS, bullets
 from bgfn.report.tables import (REFERENCE_LABELS, TABLE_STYLES, TRAINING_COLUMNS, best_mask, compact, energy_table,
                                 fmt_num, kf_table, reduction_comparison, reductions, style_layout, sweep_table,
                                 training_table)
-from bgfn.report.variants import (compared_profiles, profile_tables, reference_sentences, variant_outage_table,
+from bgfn.report.profile_comparison import (compared_profiles, profile_tables, reference_sentences, variant_outage_table,
                                   variant_sentences, variant_sweep_table, variant_training_table, variants_section)
 from bgfn.report.verdict import Verdict, VerdictInputs, verdict_of, verdict_table
 

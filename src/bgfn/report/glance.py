@@ -13,7 +13,7 @@ from bgfn.paper import TESTS
 from bgfn.report.provenance import meta_line, run_meta
 from bgfn.report.reading import read_json, rel
 from bgfn.report.sentences import energy_sentences, summary_sentence
-from bgfn.report.variants import reference_sentences
+from bgfn.report.profile_comparison import reference_sentences
 
 #: The JSON files of notebooks 02-05 (what each holds).
 RUN_FILES: dict[str, str] = {RUN_RECORDS["kf_baseline"]: "notebook 02, Kalman filter baseline",

@@ -1,13 +1,13 @@
 """The learned odometer in the verdict (beyond the paper, issue 24): its rows in the verdict table, the sixth
 question ("does a learned odometer help?") and its clause in each dataset's headline.
 
-Read from notebook 04's odometer tables (:mod:`bgfn.evaluate.odometers`: ``outage_odometer.csv`` with one row per
+Read from notebook 04's odometer tables (:mod:`bgfn.studies.odometer.bars`: ``outage_odometer.csv`` with one row per
 start, seed and duration, ``outage_odometer_summary.csv`` with the medians, the ratio to INS+NHC per start and the
 Wilcoxon p against it, ``outage_odometer_paper.csv`` with the rows in each drive's two evaluation outages,
 ``outage_odometer_curve.csv`` with RIDGE-ODO's speed error against its training windows,
 ``outage_odometer_uncertainty.csv`` with each network's predicted std against its speed error), notebook 05's
-``energy_odometer.csv`` (:mod:`bgfn.energy.odometer`), and a run at another model size made on another machine
-(``data/measured/odometer_sizes.csv``, :mod:`bgfn.evaluate.odometer_sizes`: the paper's size on a GPU). Nothing here
+``energy_odometer.csv`` (:mod:`bgfn.studies.odometer.energy`), and a run at another model size made on another machine
+(``data/measured/odometer_sizes.csv``, :mod:`bgfn.studies.odometer.sizes`: the paper's size on a GPU). Nothing here
 is typed by hand; a missing table leaves its cells empty and its sentence says so.
 """
 
@@ -19,10 +19,10 @@ import numpy as np
 import pandas as pd
 
 from bgfn.data.names import dataset_id
-from bgfn.evaluate.odometer_sizes import read_measured
-from bgfn.evaluate.odometer_errors import offset_bar_mps
-from bgfn.evaluate.odometer_uncertainty import uncertainty_sentence
-from bgfn.evaluate.odometers import HOLD, ORACLE, RIDGE
+from bgfn.studies.odometer.sizes import read_measured
+from bgfn.studies.odometer.errors import offset_bar_mps
+from bgfn.studies.odometer.uncertainty import uncertainty_sentence
+from bgfn.studies.odometer.bars import HOLD, ORACLE, RIDGE
 from bgfn.paper import METHOD_LABELS, ensemble_label, nhc_label, odometer_label
 from bgfn.stats import wilcoxon_p
 
@@ -154,7 +154,7 @@ def read_odometer_inputs(odometer: pd.DataFrame | None, summary: pd.DataFrame | 
                          sized: pd.DataFrame | None = None, errors: pd.DataFrame | None = None,
                          networks: pd.DataFrame | None = None) -> OdometerInputs:
     """The tables restricted to ``dataset`` (the energy table only when its ``dataset`` column names it);
-    ``sized`` defaults to the recorded runs at other sizes (:func:`bgfn.evaluate.odometer_sizes.read_measured`)."""
+    ``sized`` defaults to the recorded runs at other sizes (:func:`bgfn.studies.odometer.sizes.read_measured`)."""
     def of(df):
         return None if df is None or "dataset" not in df.columns else df[same_dataset(df["dataset"], dataset)]
 

@@ -13,7 +13,8 @@ from bgfn import paper
 from bgfn.config import RUN_RECORDS, SHARED_TABLES
 from bgfn.data.names import dataset_id
 from bgfn.data.registry import recorded_first
-from bgfn.evaluate import describe_sweep, odometer_lines, odometer_table
+from bgfn.studies.outage_sweep.sweep import describe_sweep
+from bgfn.studies.odometer.bars import odometer_lines, odometer_table
 from bgfn.report.glance import run_header
 from bgfn.report.provenance import cards_line, model_cards, outage_datasets, outage_provenance, provenance, short_source
 from bgfn.report.reading import ProfileResults, missing_note, read_csv
@@ -136,7 +137,7 @@ def training_section(res: ProfileResults) -> list:
 
 
 def odometer_section(res: ProfileResults) -> list:
-    """The bars a learned odometer must clear (notebook 04, :mod:`bgfn.evaluate.odometers`): median max horizontal
+    """The bars a learned odometer must clear (notebook 04, :mod:`bgfn.studies.odometer.bars`): median max horizontal
     error per dataset, method (the oracle speed per sigma) and duration, its lines, then per dataset (recorded drives
     first) the odometers' speed in a few outages, the error growth over the outage and the speed error's offset per
     outage beside its fluctuation."""
@@ -154,7 +155,7 @@ def odometer_section(res: ProfileResults) -> list:
 
 def sweep_section(res: ProfileResults) -> list:
     """The outage sweep (notebook 04) as ``median [interval]`` per duration, its source, the paired
-    comparisons (:func:`bgfn.evaluate.describe_sweep`) when their table is there."""
+    comparisons (:func:`bgfn.studies.outage_sweep.sweep.describe_sweep`) when their table is there."""
     file = res.table(SHARED_TABLES["sweep_summary"])
     st = sweep_table(res.sweep)
     if st is None:

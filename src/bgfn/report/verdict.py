@@ -3,12 +3,12 @@ outage sweep, and sentences answering the five questions a navigation engineer a
 (issue 17):
 
 1. *How accurate must the increments be?* The oracle's break-even noise against the network's own increment error
-   (:mod:`bgfn.evaluate.oracle`).
+   (:mod:`bgfn.studies.outage_sweep.oracle`).
 2. *Does it beat the learning-free aids?* INS+NHC, and BGFN fused together with NHC (:mod:`bgfn.nav.constraints`).
 3. *Can the networks know the speed?* The velocity-input variant against Eq. (eq21)'s inputs, in the outages and
    on the validation block (which networks improved on their initial weights, and how far).
 4. *Was the paper's protocol leaky?* The networks trained on the whole drive, test outages included.
-5. *Is the INS row comparable?* The INS row under NaveGo v1.4's bias modelling (:mod:`bgfn.nav.ins_setups`).
+5. *Is the INS row comparable?* The INS row under NaveGo v1.4's bias modelling (:mod:`bgfn.studies.ins_fidelity.ins_setups`).
 6. *Does a learned odometer help?* The networks trained as odometers (forward speed and its std fused with the NHC
    rows; beyond the paper, issue 24) against INS+NHC, the spiking one against its twin, at what energy
    (:mod:`bgfn.report.odometer_verdict`).
@@ -33,7 +33,7 @@ from bgfn.data.names import dataset_id
 from bgfn.data.registry import recorded_first
 from bgfn.evaluate.tables import table_paths
 from bgfn.nav.constraints import aided_ins_words
-from bgfn.nav.ins_setups import NAVEGO_CONSISTENT, NAVEGO_RUN, gap_explained
+from bgfn.studies.ins_fidelity.ins_setups import NAVEGO_CONSISTENT, NAVEGO_RUN, gap_explained
 from bgfn.report.odometer_verdict import (OdometerInputs, answer_odometer, odometer_headline, odometer_rows,
                                           read_odometer_inputs, same_dataset)
 from bgfn.report.reading import read_csv, read_json
@@ -51,7 +51,7 @@ ORACLE_ROW = "oracle at BGFN's increment error"
 #: Columns of :func:`verdict_table`.
 VERDICT_COLUMNS: tuple[str, ...] = ("row", "inputs", "protocol", "outage 1", "outage 2", "sweep 30 s", "sweep 60 s",
                                     "p 30 s", "p 60 s", "runs", "covariance")
-#: Rows whose filter consistency in the outages the table states (``covariance``: :mod:`bgfn.evaluate.nees`).
+#: Rows whose filter consistency in the outages the table states (``covariance``: :mod:`bgfn.studies.ins_fidelity.nees`).
 NEES_ROWS: tuple[str, ...] = ("INS", "INS+NHC")
 
 
@@ -153,7 +153,7 @@ def _oracle_value(breakeven: pd.DataFrame | None, outage: str, duration: float |
 
 
 def nees_of(nees: pd.DataFrame | None, method: str) -> pd.Series | None:
-    """The NEES row (:mod:`bgfn.evaluate.nees`) that speaks for ``method``: the sweep at its longest verdict duration
+    """The NEES row (:mod:`bgfn.studies.ins_fidelity.nees`) that speaks for ``method``: the sweep at its longest verdict duration
     (:data:`SWEEP_DURATIONS`), else the paper's first outage; None without one."""
     if nees is None or not len(nees):
         return None

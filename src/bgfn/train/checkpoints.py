@@ -89,7 +89,7 @@ def all_windows_models_dir(profile: str, dataset: str, create: bool = True) -> P
     return _made(results_dir(profile, create=create) / "models" / ALL_WINDOWS_DIR / dataset_id(dataset), create)
 
 
-#: Folder of a sweep fold's models that holds its learned odometers (:mod:`bgfn.evaluate.odometers`).
+#: Folder of a sweep fold's models that holds its learned odometers (:mod:`bgfn.studies.odometer.bars`).
 ODOMETER_DIR = "odometer"
 
 

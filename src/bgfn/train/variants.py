@@ -13,7 +13,7 @@ and the result is checked as a whole profile when the profile loads (a misspelt 
 same budget and **the learning rates the main search selected** for each dataset and method
 (:mod:`bgfn.train.lr_search`; the variants are not searched again, so a variant is compared at the rate its
 main network uses). They are stored under ``results/<profile>/models/variants/<variant>/<dataset>/``
-(:func:`bgfn.train.checkpoints.variant_models_dir`); :mod:`bgfn.evaluate.variants` evaluates them in the outages.
+(:func:`bgfn.train.checkpoints.variant_models_dir`); :mod:`bgfn.studies.outage_sweep.variant_outages` evaluates them in the outages.
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """The energy of the learned odometers (beyond the paper, issue 24): ``BGFN-ODO`` against its ANN twin
 ``Transformer-ODO``, counted by the same rules as the paper's model (:mod:`bgfn.energy.rules`).
 
-Which networks: the odometers that notebook 04 trained (:mod:`bgfn.evaluate.odometers`) on the first dataset of
+Which networks: the odometers that notebook 04 trained (:mod:`bgfn.studies.odometer.bars`) on the first dataset of
 ``evaluate.odometer.datasets`` (null: the sweep's), recorded drives first, in sweep fold 0, with the first of
 ``evaluate.odometer.network_seeds``. Which windows: ``energy.max_windows`` IMU windows of the odometer's length
 (``evaluate.odometer.window_s``) evenly spaced over that drive: an odometer reads the raw body-frame IMU only, so

@@ -6,7 +6,7 @@ value comes from the reference trajectory: the antenna sits at ``p_imu + C_bn @ 
 :func:`bgfn.learning.position_increment` of the two antenna positions, exactly as the training targets are formed
 from the GNSS fixes. Two users:
 
-- the oracle rows (:mod:`bgfn.evaluate.oracle`) feed the filter these true increments plus noise;
+- the oracle rows (:mod:`bgfn.studies.outage_sweep.oracle`) feed the filter these true increments plus noise;
 - every network run in the outages gets its *increment error*: the RMSE of its predicted ``delta_p_gps`` against
   the true ones inside the outage, per horizontal axis, so that it reads on the same scale as the oracle's
   per-axis noise ``sigma`` (:func:`increment_rmse`; the ``increment_rmse_m`` column of the outage sweep).

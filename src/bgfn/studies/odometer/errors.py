@@ -2,10 +2,10 @@
 split into an offset that lasts the outage and a fluctuation around it (beyond the paper; issue 24).
 
 The filter averages a white error away: ``n`` speeds of white noise ``sigma`` leave ``sigma / sqrt(n)`` of it,
-which is why the oracle speed (:mod:`bgfn.evaluate.odometers`, ``ORACLE-SPEED``) helps up to a noise of metres per
+which is why the oracle speed (:mod:`bgfn.studies.odometer.bars`, ``ORACLE-SPEED``) helps up to a noise of metres per
 second. An offset shared by every epoch of an outage it cannot average: an offset ``b`` alone moves the solution
 ``b t`` along the track. This module measures both on notebook 04's honest speed series (``speed_series`` of
-:func:`bgfn.evaluate.odometers.odometer_rows`: each sweep outage predicted by its own fold's odometer, the networks'
+:func:`bgfn.studies.odometer.bars.odometer_rows`: each sweep outage predicted by its own fold's odometer, the networks'
 first seed), per odometer and duration ``D`` (the first ``D`` seconds of each outage):
 
 - ``offset_rms_mps``: the RMS over the outages of each outage's mean speed error;

@@ -38,13 +38,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import paper
-from ..config import PROJECT_ROOT, SHARED_TABLES
-from ..io import atomic_write_csv
-from . import metrics, navego_setup
-from .baseline import Baseline, filter_imu, nav_config, run_baseline
-from .filter import run_outage
-from .outages import check_windows
+from bgfn import paper
+from bgfn.config import PROJECT_ROOT, SHARED_TABLES
+from bgfn.io import atomic_write_csv
+from bgfn.nav import metrics, navego_setup
+from bgfn.nav.baseline import Baseline, filter_imu, nav_config, run_baseline
+from bgfn.nav.filter import run_outage
+from bgfn.nav.outages import check_windows
 
 #: Setup of the INS row with the bias estimates cleared at the outage start (a bound: no accumulated bias estimate).
 RESET = "navego-reset"

@@ -17,7 +17,7 @@ from bgfn.data import load_drive
 from bgfn.errors import DataError
 from bgfn.evaluate.config import SEEDLESS_METHODS, SWEEP_COLUMNS, TABLE_METHODS, evaluate_config
 from bgfn.evaluate.hybrid import NavContext, gps_run, navigation_context, run_outages, window_metrics
-from bgfn.evaluate.increments import AntennaTruth, increment_rmse
+from bgfn.studies.outage_sweep.increments import AntennaTruth, increment_rmse
 from bgfn.evaluate.networks import load_model
 from bgfn.learning import build_learning_data, learning_options
 from bgfn.nav.baseline import filter_start
@@ -163,7 +163,7 @@ class _Sweep:
         """The rows of one outage run, one per duration (and per seed for a run without one)."""
         for du in self.durations:
             mtr = window_metrics(run.errors, run.start, du, run.sd)
-            # the network's own increment error in this outage (the oracle's sigma axis, bgfn.evaluate.oracle)
+            # the network's own increment error in this outage (the oracle's sigma axis, bgfn.studies.outage_sweep.oracle)
             mtr["increment_rmse_m"] = (increment_rmse(run, self.truth, self.ctx.gnss_interval_s, du)
                                        if len(run.increments) else float("nan"))
             for seed in ([run.seed] if run.seed is not None else self.seeds):

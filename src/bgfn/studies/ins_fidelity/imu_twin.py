@@ -1,18 +1,18 @@
 """Is the stand-in's IMU as rough as a real one? The recorded drive against its trajectory twin (notebook 02).
 
 The stand-in ``turin-sim-mpu6000`` simulates a consumer MEMS IMU; its INS drift decides how hard the paper's field
-test is. Measured at rest (:mod:`bgfn.data.imu_roughness`: Allan deviation, the bias between stops) the recorded
+test is. Measured at rest (:mod:`bgfn.studies.ins_fidelity.imu_roughness`: Allan deviation, the bias between stops) the recorded
 car's IMU is no rougher than the stand-in's error model, yet in outages it drifts several times further. What acts
 only while driving (scale factor and misalignment under turns, vibration rectification, a bias that wanders with
 temperature and load) is not seen at rest; it is seen by the filter.
 
 The measurement: the **effective gyro bias instability** of a drive, the value of the filter's gyro bias
 instability at which its standalone INS is consistent in outages (median NEES = the chi-square median 1.39,
-:mod:`bgfn.evaluate.nees`; log-log interpolated on the scan's grid, :func:`effective_instability`). It lumps every
+:mod:`bgfn.studies.ins_fidelity.nees`; log-log interpolated on the scan's grid, :func:`effective_instability`). It lumps every
 unmodelled driving error into the one term that dominates a MEMS INS's drift. Measured on
 
 - the recorded drive (its real IMU), and
-- its **trajectory twin** (:func:`bgfn.data.imu_roughness.trajectory_twin`): the same road, GNSS, starts and
+- its **trajectory twin** (:func:`bgfn.studies.ins_fidelity.imu_roughness.trajectory_twin`): the same road, GNSS, starts and
   filter, with the stand-in's error model simulated on it (several seeds), whose truth is known: even a perfect
   error model needs some margin (the filter does not model scale factor, misalignment or vibration).
 
@@ -33,8 +33,8 @@ import numpy as np
 import pandas as pd
 
 from bgfn.config import SHARED_TABLES
-from bgfn.data.imu_roughness import trajectory_twin
-from bgfn.evaluate.nees import CHI2_MEDIAN, consistency_scan
+from bgfn.studies.ins_fidelity.imu_roughness import trajectory_twin
+from bgfn.studies.ins_fidelity.nees import CHI2_MEDIAN, consistency_scan
 from bgfn.io import atomic_write_csv
 from bgfn.paper import test_of
 from bgfn.parallel import Runner
@@ -47,7 +47,7 @@ TWIN_COLUMNS: tuple[str, ...] = ("dataset", "imu", "seed", "duration_s", "effect
 
 
 def effective_instability(scan: pd.DataFrame) -> pd.DataFrame:
-    """Per dataset and duration of a :func:`bgfn.evaluate.consistency_scan`: the gyro bias instability at which the
+    """Per dataset and duration of a :func:`bgfn.studies.ins_fidelity.nees.consistency_scan`: the gyro bias instability at which the
     median NEES first falls to :data:`CHI2_MEDIAN` (deg/s, log-log interpolated; NaN when it never does, the grid's
     first value when it already does there).
 
@@ -99,7 +99,7 @@ def twin_check(cfg: dict, recorded, stand_in, seeds=TWIN_SEEDS, scan: pd.DataFra
     seeds : sequence of int
         Seeds of the twin's IMU errors.
     scan : DataFrame, optional
-        The recorded drive's :func:`bgfn.evaluate.consistency_scan` (notebook 02 has run it; default: run here).
+        The recorded drive's :func:`bgfn.studies.ins_fidelity.nees.consistency_scan` (notebook 02 has run it; default: run here).
     gyro_dps : float, optional
         Simulate the twin with this gyro bias instability (deg/s, every axis) instead of the stand-in's.
     report : callable, optional

@@ -82,7 +82,7 @@ def car_log(recorded: Drive, folder: Path) -> Path:
     10 Hz, ``meta.yaml`` with its lever arm and error model (``platform: car``)."""
     ref = recorded.reference.iloc[::10].reset_index(drop=True)
     drive = Drive("car-drive0708", ref, recorded.imu, recorded.gnss,
-                  {**recorded.meta, "source": f"{recorded.name} through the CSV path (bgfn.data.gallery)"})
+                  {**recorded.meta, "source": f"{recorded.name} through the CSV path (bgfn.studies.gallery.logs)"})
     write_csv_drive(drive, folder)
     _add_meta(folder, {"platform": "car"})
     return Path(folder)
@@ -105,7 +105,7 @@ def phone_log(recorded: Drive, folder: Path, seed: int = 5) -> Path:
     drive = Drive("phone-drive0708", ref.reset_index(drop=True), imu, gnss.reset_index(drop=True),
                   {**meta, "lever_arm_m": [0.0, 0.0, 0.0],
                    "source": f"the first {PHONE_DURATION_S:g} s of {recorded.name} as a phone logs it "
-                             "(bgfn.data.gallery)"})
+                             "(bgfn.studies.gallery.logs)"})
     write_csv_drive(drive, folder)
     # the receiver reports neither an accuracy nor a velocity: its file has positions only
     atomic_write_csv(Path(folder) / "gnss.csv", drive.gnss[["time", "lat", "lon", "h"]], float_format="%.17g")
@@ -149,7 +149,7 @@ def walker_log(folder: Path, seed: int = WALK_SEED) -> Path:
     gnss = sim.gnss_from_trajectory(truth, 1.0, 1.5, 3.0, [0.0, 0.0, 0.0], seed=seed + 1)
     ref = truth.iloc[::20].reset_index(drop=True).assign(roll=np.nan, pitch=np.nan, yaw=np.nan)
     drive = Drive("walk", ref, imu, gnss, {"lever_arm_m": [0.0, 0.0, 0.0], "imu_errors": errors,
-                                           "source": "a synthetic walk (bgfn.data.gallery)"})
+                                           "source": "a synthetic walk (bgfn.studies.gallery.logs)"})
     write_csv_drive(drive, folder)
     _add_meta(folder, {"platform": "walker"})
     return Path(folder)

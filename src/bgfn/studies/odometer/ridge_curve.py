@@ -1,6 +1,6 @@
 """How the simple learned odometer's speed error falls with its training windows (beyond the paper; issue 24).
 
-The learned odometers of :mod:`bgfn.evaluate.odometers` train per fold of the sweep's outage starts, outside that
+The learned odometers of :mod:`bgfn.studies.odometer.bars` train per fold of the sweep's outage starts, outside that
 fold's outages +- ``train.margin_s``. On a short drive a fold holds out much of it: with 2 folds each odometer
 learns from a few minutes of driving. Whether that is why its speed is too coarse to help the filter is a question
 the drive itself can answer: split the same starts into more folds (``evaluate.odometer.curve_folds``; as many
@@ -40,7 +40,7 @@ def ridge_curve(dataset: str, plans: dict[int, pd.DataFrame], ws: lo.SpeedWindow
     dataset : str
     plans : dict
         Number of folds -> the sweep's starts split into that many folds (``start_s``, ``fold``;
-        :func:`bgfn.evaluate.sweep.sweep_plan`).
+        :func:`bgfn.studies.outage_sweep.sweep.sweep_plan`).
     ws : SpeedWindows
         The windows with the GPS-aided solution's forward speed (the training targets).
     all_windows : SpeedWindows

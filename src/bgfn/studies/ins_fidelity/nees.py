@@ -37,7 +37,7 @@ from bgfn.data.names import dataset_id
 from bgfn.data.registry import SIMULATED_IMU
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.evaluate.plots import finish_duration_axes
-from bgfn.evaluate.sweep import profile_sweep_plan
+from bgfn.studies.outage_sweep.sweep import profile_sweep_plan
 from bgfn.io import atomic_write_csv, save_figure
 from bgfn.parallel import Runner
 
@@ -143,7 +143,7 @@ def nees_section(out: str | Path, results: dict, sweep: pd.DataFrame | None) -> 
 
 
 #: Gyro bias instabilities the scan tries, deg/s (half the MPU-6000 profile's 0.01 deg/s up to 0.3 deg/s; dense where the
-#: recorded drive and its trajectory twin turn consistent, :mod:`bgfn.evaluate.imu_twin`).
+#: recorded drive and its trajectory twin turn consistent, :mod:`bgfn.studies.ins_fidelity.imu_twin`).
 SCAN_GYRO_BIAS_DPS: tuple[float, ...] = (0.005, 0.01, 0.02, 0.03, 0.05, 0.1, 0.2, 0.3)
 #: Columns of ``tables/kf_nees_scan.csv``.
 SCAN_COLUMNS: tuple[str, ...] = ("dataset", "gyro_bias_instability_dps", "profile", "duration_s", "runs",

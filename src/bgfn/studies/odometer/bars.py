@@ -2,7 +2,7 @@
 
 A learned odometer predicts the forward speed and its std from body-frame IMU windows, and the filter fuses it
 with the NHC rows (:mod:`bgfn.nav.odometer`). Before any network, this module measures what such an aid is worth
-on a drive, with the same starts, folds and durations as the sweep (:func:`bgfn.evaluate.sweep.sweep_plan`):
+on a drive, with the same starts, folds and durations as the sweep (:func:`bgfn.studies.outage_sweep.sweep.sweep_plan`):
 
 - ``INS+NHC``: the learning-free aid (:mod:`bgfn.nav.constraints`);
 - ``INS+NHC+HOLD``: the forward speed at the outage start held constant, std ``hold_std_mps`` (the dumb prior);
@@ -34,12 +34,12 @@ the paper's tables) as one more fold, :data:`PAPER_FOLD`: its networks and its r
 (:func:`paper_outage_table`), never into the sweep's statistics.
 
 How far each network's predicted std ranks its speed errors in the outages, the premise of weighing each speed by
-it: :mod:`bgfn.evaluate.odometer_uncertainty` (``outage_odometer_uncertainty.csv``). How much of each odometer's
+it: :mod:`bgfn.studies.odometer.uncertainty` (``outage_odometer_uncertainty.csv``). How much of each odometer's
 speed error in the outages is an offset that lasts the outage, which the filter cannot average away:
-:mod:`bgfn.evaluate.odometer_errors` (``outage_odometer_errors.csv``).
+:mod:`bgfn.studies.odometer.errors` (``outage_odometer_errors.csv``).
 
 With ``curve_folds``, the ridge is also refitted with the sweep's starts split into each of those numbers of folds:
-its speed error against its training windows per fold (:mod:`bgfn.evaluate.ridge_curve`,
+its speed error against its training windows per fold (:mod:`bgfn.studies.odometer.ridge_curve`,
 ``outage_odometer_curve.csv``).
 
 Every row is fused at the aid epochs (``nav.nhc.rate_hz``) through the chi-square gate (``gate_probability``).
@@ -67,12 +67,12 @@ from bgfn.config import SHARED_TABLES, odometer_datasets, odometer_network_seeds
 from bgfn.errors import DataError
 from bgfn.data import dataset_id, load_drive
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
-from bgfn.evaluate.odometer_errors import (ERROR_COLUMNS, error_parts_lines, error_parts_table, offset_bar_mps,
+from bgfn.studies.odometer.errors import (ERROR_COLUMNS, error_parts_lines, error_parts_table, offset_bar_mps,
                                            plot_error_parts)
-from bgfn.evaluate.odometer_uncertainty import UNCERTAINTY_COLUMNS, uncertainty_lines, uncertainty_table
+from bgfn.studies.odometer.uncertainty import UNCERTAINTY_COLUMNS, uncertainty_lines, uncertainty_table
 from bgfn.evaluate.plots import finish_duration_axes
-from bgfn.evaluate.ridge_curve import CURVE_COLUMNS, curve_lines, plot_curve, ridge_curve
-from bgfn.evaluate.sweep import profile_sweep_plan, sweep_train_config
+from bgfn.studies.odometer.ridge_curve import CURVE_COLUMNS, curve_lines, plot_curve, ridge_curve
+from bgfn.studies.outage_sweep.sweep import profile_sweep_plan, sweep_train_config
 from bgfn.io import atomic_write_csv, save_figure
 from bgfn.learning import odometry as lo
 from bgfn.learning.split import overlaps
@@ -252,7 +252,7 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
                              "sigma_mps": run.sigma_mps, "seed": run.seed, "fold": run.fold,
                              **{c: m[c] for c in ("max_h_m", "rmse_h_m", "final_h_m")},
                              **no.speed_errors(track, all_windows.t_end, truth, r.start, float(du))})
-    # the ridge's speed error as more folds hold out less of the drive (bgfn.evaluate.ridge_curve)
+    # the ridge's speed error as more folds hold out less of the drive (bgfn.studies.odometer.ridge_curve)
     n_starts = int(plan["fold"].size)                                       # more folds than starts: one per start
     plans = {n: profile_sweep_plan(cfg, drive, {**sw, "folds": n})
              for n in sorted({min(int(n), n_starts) for n in oc["curve_folds"]})}
@@ -362,7 +362,7 @@ def calibrated_track(run: train.TrainingRun, card: dict, all_windows: lo.SpeedWi
 
 
 def odometer_train_config(train_section: dict, ecfg: dict) -> dict:
-    """The odometer networks' ``train:`` section: the sweep's (:func:`bgfn.evaluate.sweep.sweep_train_config`)
+    """The odometer networks' ``train:`` section: the sweep's (:func:`bgfn.studies.outage_sweep.sweep.sweep_train_config`)
     with ``evaluate.odometer.train`` laid over it the same way (null: the sweep's budget as it is)."""
     return sweep_train_config(sweep_train_config(train_section, ecfg["sweep"]), {"train": ecfg["odometer"]["train"]})
 

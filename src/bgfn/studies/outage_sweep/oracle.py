@@ -1,21 +1,21 @@
 """Oracle rows (beyond the paper, issue 17): how accurate must the increments be for the pseudo-GPS to help?
 
 A stand-in network, :class:`OracleIncrements`, returns the *true* ``delta_p_gps`` of every GNSS interval (the
-reference's antenna increments, :mod:`bgfn.evaluate.increments`) plus white noise of std ``sigma`` per increment
+reference's antenna increments, :mod:`bgfn.studies.outage_sweep.increments`) plus white noise of std ``sigma`` per increment
 and horizontal axis. It goes through :func:`bgfn.evaluate.run_outages` exactly like a trained network: the same
 outage start states, pseudo-GPS epochs, running sum of Eq. (pred-gps) from the filter's antenna position at the
 start, and fix std (``evaluate.pseudo_gps``). Since the increments are summed, their errors random-walk: after
 ``k`` increments the pseudo fix is off by ``sigma sqrt(k)`` per axis (plus the start error every method shares).
 
 For every test (each dataset of the tables and of the sweep, keyed by dataset like every other table) the
-oracle runs in the paper's outages and in the sweep's starts (:func:`bgfn.evaluate.sweep_plan`, the same starts,
+oracle runs in the paper's outages and in the sweep's starts (:func:`bgfn.studies.outage_sweep.sweep.sweep_plan`, the same starts,
 so its numbers sit beside the sweep medians) for the grid ``evaluate.oracle.sigmas_m`` and noise seeds
 ``evaluate.oracle.seeds`` (sigma = 0 once: nothing random), together with the standalone INS in the same
 windows. Results:
 
 - ``outage_oracle.csv`` (:data:`ORACLE_COLUMNS`): per dataset, windows (``outage``: the paper's ``1``, ``2``,
   or ``sweep``), duration and sigma, the median max horizontal error with its bootstrap interval (over starts,
-  clustered by start as :func:`bgfn.evaluate.sweep_summary` does; over the noise seeds in a single outage);
+  clustered by start as :func:`bgfn.studies.outage_sweep.sweep.sweep_summary` does; over the noise seeds in a single outage);
 - ``outage_oracle_breakeven.csv`` (:data:`BREAKEVEN_COLUMNS`): the **break-even sigma**, where the oracle curve
   crosses a learning-free baseline (INS; INS+NHC or any other ``INS...`` row when the sweep or the tables hold
   one), interpolated linearly between grid points (:func:`crossing_sigma`), and each network's own increment
@@ -46,8 +46,8 @@ from bgfn.data import load_drive
 from bgfn.errors import DataError
 from bgfn.evaluate.config import COLORS
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
-from bgfn.evaluate.increments import AntennaTruth, increment_rmse
-from bgfn.evaluate.sweep import profile_sweep_plan
+from bgfn.studies.outage_sweep.increments import AntennaTruth, increment_rmse
+from bgfn.studies.outage_sweep.sweep import profile_sweep_plan
 from bgfn.io import atomic_write_csv, save_figure
 from bgfn.nav.outages import outage_windows
 from bgfn.paper import METHOD_LABELS, test_of
@@ -214,7 +214,7 @@ def oracle_table(runs: pd.DataFrame, increment_s: dict, n_boot: int = 2000, leve
                  seed: int = 0) -> pd.DataFrame:
     """Median max horizontal error per dataset, windows, duration, method and sigma, with its bootstrap interval.
 
-    Over several starts (the sweep) whole starts are resampled, as :func:`bgfn.evaluate.sweep_summary` does; in
+    Over several starts (the sweep) whole starts are resampled, as :func:`bgfn.studies.outage_sweep.sweep.sweep_summary` does; in
     one outage the runs themselves (the noise seeds).
 
     Parameters
@@ -473,7 +473,7 @@ class OracleResult:
 
 
 def plot_oracle(table: pd.DataFrame, levels: pd.DataFrame, breakeven: pd.DataFrame, dataset: str):
-    """The oracle rows of one dataset (:mod:`bgfn.evaluate.oracle`): aided error against the increment noise.
+    """The oracle rows of one dataset (:mod:`bgfn.studies.outage_sweep.oracle`): aided error against the increment noise.
 
     One panel per windows and duration (the sweep's durations, then the paper's outages): the oracle's median max
     horizontal error with its interval against sigma (log axis; sigma = 0 at the left edge), the learning-free
@@ -561,7 +561,7 @@ def run_oracle(cfg: dict, profile: str, setup, out=None, results: dict | None = 
     sweep : DataFrame, optional
         The sweep's rows (networks' levels and increment errors in the sweep's windows).
     figures : bool
-        Draw :func:`bgfn.evaluate.plot_oracle` per dataset.
+        Draw :func:`bgfn.studies.outage_sweep.oracle.plot_oracle` per dataset.
     report : callable, optional
         Called with a line per dataset when it is done.
     runner : bgfn.parallel.Runner, optional

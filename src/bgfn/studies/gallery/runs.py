@@ -1,4 +1,4 @@
-"""The gallery of own logs (notebook 07): each log of :data:`bgfn.data.gallery.GALLERY` loaded through the CSV path
+"""The gallery of own logs (notebook 07): each log of :data:`bgfn.studies.gallery.logs.GALLERY` loaded through the CSV path
 and run through the navigation part of the chain with the profile a user would write for it.
 
 For each log: what the loader decided (the clocks: the GNSS-IMU offset it estimated or applied; the mounting it
@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from bgfn.data import load_drive
-from bgfn.data.gallery import GalleryLog
+from bgfn.studies.gallery.logs import GalleryLog
 from bgfn.nav.baseline import nav_config, run_baseline
 from bgfn.nav.constraints import DEFAULT_PLATFORM, platform_aids
 from bgfn.nav.outages import describe_windows, outage_windows
@@ -44,7 +44,7 @@ class GalleryRun:
 
 def run_log(log: GalleryLog, folder: Path, cfg: dict) -> GalleryRun:
     """Load ``folder`` by its absolute path and run the GPS-aided filter and its outages under ``cfg`` (the loaded
-    profile the log's :meth:`~bgfn.data.gallery.GalleryLog.profile_text` describes)."""
+    profile the log's :meth:`~bgfn.studies.gallery.logs.GalleryLog.profile_text` describes)."""
     folder = Path(folder).resolve()
     drive = load_drive(folder)
     windows = outage_windows(cfg, drive, str(folder))

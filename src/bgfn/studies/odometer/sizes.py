@@ -1,6 +1,6 @@
 """The learned odometers at another model size, run on another machine and kept in ``data/measured/``.
 
-quick trains its odometer networks (:mod:`bgfn.evaluate.odometers`) at the smoke size to fit 15 minutes on two
+quick trains its odometer networks (:mod:`bgfn.studies.odometer.bars`) at the smoke size to fit 15 minutes on two
 cores. Whether their failure against INS+NHC is a matter of size is a question for the paper's size (dim 256,
 4 blocks, batch 8, up to 1000 epochs: the profile ``paper-odometer``), which takes minutes on a GPU and hours
 here. Such a run is made once, elsewhere, and kept:
@@ -28,12 +28,12 @@ import torch
 
 from bgfn.config import PROJECT_ROOT, SHARED_TABLES, git_commit, results_dir
 from bgfn.errors import DataError
-from bgfn.evaluate.odometers import NETWORK_COLUMNS, ORACLE, ORACLE_WALK, SUMMARY_COLUMNS
+from bgfn.studies.odometer.bars import NETWORK_COLUMNS, ORACLE, ORACLE_WALK, SUMMARY_COLUMNS
 from bgfn.io import atomic_write_csv, atomic_write_text
 
 #: Summary rows of runs made elsewhere (:func:`record`).
 MEASURED_FILE = PROJECT_ROOT / "data" / "measured" / "odometer_sizes.csv"
-#: Their networks' facts (:data:`bgfn.evaluate.odometers.NETWORK_COLUMNS`).
+#: Their networks' facts (:data:`bgfn.studies.odometer.bars.NETWORK_COLUMNS`).
 MEASURED_NETWORKS = PROJECT_ROOT / "data" / "measured" / "odometer_sizes_networks.csv"
 #: What describes a run, before the table's own columns.
 RUN_COLUMNS: tuple[str, ...] = ("profile", "size", "inputs", "epochs_max", "batch_size", "device", "wall_s", "date",

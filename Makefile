@@ -61,7 +61,9 @@ UV_PIN := $(shell grep -m1 '^uv==' requirements.lock)
 LOCK_HASH := $(shell sha256sum requirements.lock | cut -c1-16)
 STAMP := $(VENV)/.installed-$(LOCK_HASH)
 
-NOTEBOOKS := 01_data_prep 02_kf_baseline 03_bgfn_training 04_outage_evaluation 05_energy_estimate 06_results 07_own_logs
+# The paper's five steps, the studies beyond it, own logs, the results page last.
+NOTEBOOKS := 01_data_prep 02_kf_baseline 03_bgfn_training 04_outage_evaluation 05_energy_estimate \
+             06_outage_sweep 07_learned_odometer 08_ins_fidelity 09_own_logs 10_results
 # A profile's notebooks also depend on the profile(s) it builds on (`base:` in its YAML; two levels followed).
 base_of = $(shell sed -n 's/^base:[[:space:]]*\([A-Za-z0-9_.-]*\).*/\1/p' params/$(1).yaml 2>/dev/null)
 BASE1 := $(call base_of,$(PROFILE))
@@ -210,21 +212,25 @@ $(RES)/.data-fingerprint: FORCE | $(STAMP)
 FORCE:
 
 # Each notebook reads what the previous one wrote.
-$(RES)/notebooks/02_kf_baseline.ipynb: $(RES)/notebooks/01_data_prep.ipynb $(wildcard data/measured/navego_check.csv)
+$(RES)/notebooks/02_kf_baseline.ipynb: $(RES)/notebooks/01_data_prep.ipynb
 $(RES)/notebooks/03_bgfn_training.ipynb: $(RES)/notebooks/02_kf_baseline.ipynb
 $(RES)/notebooks/04_outage_evaluation.ipynb: $(RES)/notebooks/03_bgfn_training.ipynb
 $(RES)/notebooks/05_energy_estimate.ipynb: $(RES)/notebooks/04_outage_evaluation.ipynb
-# 06 (the results page) reads every earlier output, the paper's published values and the odometers' run at the
+# The studies beyond the paper: 06 reads notebook 04's runs and notebook 03's learning rates; 07 trains its own
+# odometers; 08 compares our INS with NaveGo's measured run.
+$(RES)/notebooks/06_outage_sweep.ipynb: $(RES)/notebooks/05_energy_estimate.ipynb
+$(RES)/notebooks/07_learned_odometer.ipynb: $(RES)/notebooks/06_outage_sweep.ipynb
+$(RES)/notebooks/08_ins_fidelity.ipynb: $(RES)/notebooks/07_learned_odometer.ipynb $(wildcard data/measured/navego_check.csv)
+# 09 (the gallery of own logs) needs only the data and the navigation.
+$(RES)/notebooks/09_own_logs.ipynb: $(RES)/notebooks/08_ins_fidelity.ipynb
+# 10 (the results page) reads every earlier output, the paper's published values and the odometers' run at the
 # paper's size recorded from a GPU (python -m bgfn odometers --record).
-$(RES)/notebooks/06_results.ipynb: $(RES)/notebooks/05_energy_estimate.ipynb data/paper/outage_max_errors.csv \
+$(RES)/notebooks/10_results.ipynb: $(RES)/notebooks/09_own_logs.ipynb data/paper/outage_max_errors.csv \
   data/paper/claims.yaml $(wildcard data/measured/odometer_sizes.csv)
 # ... and, when they have been run, the variant profiles its "Variants" section compares (notebook parameter
 # `variants`), so a later `make reproduce PROFILE=quick-heading` is picked up by the next `make reproduce`.
 VARIANTS := quick-heading
-$(RES)/notebooks/06_results.ipynb: $(wildcard $(filter-out $(RES)/%,$(VARIANTS:%=results/%/notebooks/05_energy_estimate.ipynb)))
-
-# 07 (the gallery of own logs) needs only the data and the navigation; it runs last, after the results page.
-$(RES)/notebooks/07_own_logs.ipynb: $(RES)/notebooks/06_results.ipynb
+$(RES)/notebooks/10_results.ipynb: $(wildcard $(filter-out $(RES)/%,$(VARIANTS:%=results/%/notebooks/06_outage_sweep.ipynb)))
 
 _notebooks: $(EXEC)
 
@@ -240,7 +246,7 @@ define build_book
 	@for d in tables figures; do if [ -d "$(RES)/$$d" ]; then cp -r "$(RES)/$$d" book/_generated/; fi; done
 	@find book/notebooks book/_generated -name '.*' -type f -delete   # never a temporary or hidden file
 	@if [ -f "$(RES)/findings.md" ]; then cp "$(RES)/findings.md" book/_generated/; else \
-	  echo "No findings yet: notebook 06 of profile \`$(PROFILE)\` has not written them." > book/_generated/findings.md; fi
+	  echo "No findings yet: notebook 10 of profile \`$(PROFILE)\` has not written them." > book/_generated/findings.md; fi
 	@$(PY) -m bgfn walltimes --profile $(PROFILE) --markdown book/_generated/wall_times.md
 	@printf '%s\n' "Built from the executed notebooks of profile \`$(PROFILE)\` (\`params/$(PROFILE).yaml\`)," \
 	  "commit \`$$(git rev-parse --short HEAD 2>/dev/null || echo unknown)\`." > book/_generated/build_info.md

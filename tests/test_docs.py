@@ -39,6 +39,27 @@ def test_notebooks_are_thin(nb):
     assert "parameters" in code[0].metadata.get("tags", [])
 
 
+#: The paper's five steps in the brief's order; every other notebook comes after them.
+PAPER_NOTEBOOKS = ["01_data_prep", "02_kf_baseline", "03_bgfn_training", "04_outage_evaluation", "05_energy_estimate"]
+
+
+def test_the_papers_notebooks_come_first_and_hold_no_study():
+    """A reader who edits notebook 01-05 meets only the paper's pipeline: no import of a study beyond the paper,
+    no section titled beyond the paper; the studies, own logs and the results page follow in that order."""
+    names = [p.stem for p in NOTEBOOKS]
+    assert names[:5] == PAPER_NOTEBOOKS and names[-1] == "10_results", names
+    for nb in NOTEBOOKS[:5]:
+        cells = nbformat.read(nb, as_version=4).cells
+        code = "\n".join(c.source for c in cells if c.cell_type == "code")
+        assert "studies" not in code, f"{nb.name} imports a study beyond the paper"
+        headings = [line for c in cells if c.cell_type == "markdown" for line in c.source.splitlines()
+                    if line.startswith("#")]
+        assert not [h for h in headings if "beyond the paper" in h.lower()], (nb.name, headings)
+    for nb in NOTEBOOKS[5:8]:
+        code = "\n".join(c.source for c in nbformat.read(nb, as_version=4).cells if c.cell_type == "code")
+        assert "bgfn.studies" in code, f"{nb.name}: a study notebook calls its package in bgfn.studies"
+
+
 def test_readme_layout_names_every_package_and_top_level_module():
     block = _block(PROJECT_ROOT / "README.md", "## Layout")
     for package, stem in _modules():

@@ -597,10 +597,10 @@ def test_pseudo_std_sensitivity_runs_the_first_seeds_networks_with_their_validat
         models[("bgfn", seed)].val_rmse_m = 0.5
     res = ev.evaluate_dataset(cfg, "none", "turin-sim-ekinox", drive=drive5, ecfg=ecfg, models=models)
     assert res.drive is drive5
-    sens = studies.outage_sweep.pseudo_std_sensitivity(cfg, "none", res, ecfg)
+    sens = ev.pseudo_std_sensitivity(cfg, "none", res, ecfg)
     assert sens.seed == 1 and list(sens.alternative.models) == [("bgfn", 1)]       # the first seed only
     t = sens.table.set_index(["outage", "method"])
-    assert list(sens.table.columns) == list(studies.outage_sweep.SENSITIVITY_COLUMNS)
+    assert list(sens.table.columns) == list(ev.SENSITIVITY_COLUMNS)
     seed1 = res.per_seed[res.per_seed["seed"] == 1].set_index(["outage", "method"])
     # the left side is seed 1's own run, not the median over seeds
     assert t.loc[(1, "BGFN"), "max_east_m"] == seed1.loc[(1, "BGFN"), "max_east_m"]
@@ -609,7 +609,7 @@ def test_pseudo_std_sensitivity_runs_the_first_seeds_networks_with_their_validat
     for m in ("INS", "GPS"):
         assert t.loc[(1, m), "max_east_m"] == t.loc[(1, m), "max_east_m (validation std)"]
     assert t.loc[(1, "BGFN"), "max_east_m"] != t.loc[(1, "BGFN"), "max_east_m (validation std)"]
-    path = studies.outage_sweep.save_sensitivity(tmp_path, sens)
+    path = ev.save_sensitivity(tmp_path, sens)
     assert path.name == "outage_dataset_std_validation.csv"
     assert list(pd.read_csv(path).columns) == list(ev.TABLE_COLUMNS)
 
@@ -661,7 +661,7 @@ def test_sweep_tables_and_lines():
     assert list(rows.columns) == list(ev.SWEEP_COLUMNS) and rows.empty and info == {} and timings == {}
 
 
-def test_evaluation_record_is_what_notebook_06_reads(tmp_path):
+def test_evaluation_record_is_what_the_results_page_reads(tmp_path):
     import json
 
     from bgfn import report
@@ -671,7 +671,7 @@ def test_evaluation_record_is_what_notebook_06_reads(tmp_path):
     results = {"turin-sim-ekinox": _table_result("turin-sim-ekinox"),
                "turin-sim-mpu6000": _table_result("turin-sim-mpu6000")}
     reductions = {n: ev.reduction_table(r) for n, r in results.items()}
-    path = ev.write_evaluation_record(tmp_path, setup, results, reductions, 0, {}, {"tables_x_s": 1.0})
+    path = ev.write_evaluation_record(tmp_path, setup, results, reductions, {"tables_x_s": 1.0})
     rec = json.loads(path.read_text())
     assert path.name == ev.RECORD_FILE and rec["meta"]["profile"] == "smoke" and rec["profile"] == "smoke"
     assert rec["outage_windows"] == [list(w) for w in setup.windows] and rec["evaluate"]["seeds"] == [0]
@@ -679,6 +679,6 @@ def test_evaluation_record_is_what_notebook_06_reads(tmp_path):
     bgfn1 = [r for r in rec["reduction_vs_ins_pct"]["dataset"] if r["outage"] == 1 and r["method"] == "BGFN"][0]
     assert bgfn1["east_%"] == pytest.approx(80.0)
     assert rec["paper_claims"] == paper.claims()["bgfn_reduction_vs_ins_pct"]
-    assert rec["sweep"] == {"rows": 0, "info": {}} and rec["timings_s"] == {"tables_x_s": 1.0}
+    assert "sweep" not in rec and rec["timings_s"] == {"tables_x_s": 1.0}
     assert report.outage_datasets(rec) == {"dataset": "turin-sim-ekinox", "field": "turin-sim-mpu6000",
                                            "real": "rtklib-drive0708"}

@@ -1,4 +1,4 @@
-"""The gallery's own logs (notebook 07): written as a user has them, read back through the CSV path to the same
+"""The gallery's own logs (notebook 09): written as a user has them, read back through the CSV path to the same
 drive, a walk that walks, and each platform's aids in the rows."""
 
 from __future__ import annotations

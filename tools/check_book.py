@@ -15,7 +15,7 @@ For every ``*.html`` page under the build folder (theme templates in ``_static/`
 - the book must contain at least one executed-notebook page (``notebooks/*.html``) and no page may show a
   Python traceback cell output (a notebook that failed but was built anyway);
 - the index page (``index.html``, or the page its ``<meta http-equiv="refresh">`` redirects to) and the
-  results page (``--results PAGE``, default the first of ``notebooks/06_results.html``, ``results.html``,
+  results page (``--results PAGE``, default the first of ``notebooks/10_results.html``, ``results.html``,
   ``notebooks/*results*.html``) each contain at least one ``<table>`` and one ``<img>``.
 
 ``--screenshots DIR`` (optional, not used by CI): when a Chromium binary is found (``chromium``,
@@ -91,7 +91,7 @@ def _pages(root: Path) -> list[Path]:
 
 
 #: Candidates for the results page, in order of preference (``--results`` overrides).
-RESULTS_CANDIDATES: tuple[str, ...] = ("notebooks/06_results.html", "results.html")
+RESULTS_CANDIDATES: tuple[str, ...] = ("notebooks/10_results.html", "results.html")
 
 
 def index_page(root: Path) -> Path | None:

@@ -73,7 +73,10 @@ RUN_RECORDS: dict[str, str] = {
     "training": "training.json",                # notebook 03
     "evaluation": "outage_evaluation.json",     # notebook 04
     "energy": "energy.json",                    # notebook 05
-    "findings": "findings.md",                  # notebook 06: the lines the book's first page includes
+    "sweep": "outage_sweep.json",               # notebook 06: the sweep's sizes and wall times
+    "odometer": "outage_odometer.json",         # notebook 07: the learned odometer's wall times
+    "ins_fidelity": "ins_fidelity.json",        # notebook 08: the INS row under NaveGo's setup
+    "findings": "findings.md",                  # notebook 10: the lines the book's first page includes
 }
 #: ... and shared tables (``results/<profile>/tables/<name>``).
 SHARED_TABLES: dict[str, str] = {

@@ -8,7 +8,8 @@ max |east|, max |north| (the paper's tables), horizontal RMSE and final error; t
 Modules, in the order of the protocol: :mod:`~bgfn.evaluate.config` (methods, columns, the ``evaluate:``
 settings), :mod:`~bgfn.evaluate.hybrid` (Eq. pred-gps, the GPS-aided run, the outage runs, their metrics),
 :mod:`~bgfn.evaluate.networks` (notebook 03's checkpoints), :mod:`~bgfn.evaluate.tables` (Tables 1-2),
-:mod:`~bgfn.evaluate.claims` (ours beside the paper's), :mod:`~bgfn.evaluate.plots` (the outage figures),
+:mod:`~bgfn.evaluate.claims` (ours beside the paper's), :mod:`~bgfn.evaluate.pseudo_std` (the
+tables again with each network's own pseudo-fix std, which the paper does not state), :mod:`~bgfn.evaluate.plots` (the outage figures),
 :mod:`~bgfn.evaluate.record` (the record the results page reads). The studies beyond the paper (the outage
 sweep, the oracle, the learned odometer, the INS's fidelity) are in :mod:`bgfn.studies`.
 """
@@ -20,11 +21,13 @@ from bgfn.evaluate.config import (COLORS, EVALUATE_DEFAULTS, FIGURE_METHODS, MET
 from bgfn.evaluate.hybrid import (NavContext, OutageRun, gps_run, navigation_context, pseudo_gps_positions, run_outages,
                                   window_metrics)
 from bgfn.evaluate.networks import ensure_models, load_model
+from bgfn.evaluate.pseudo_std import (SENSITIVITY_COLUMNS, Sensitivity, pseudo_std_sensitivity, save_sensitivity,
+                                      sensitivity_table)
 from bgfn.evaluate.plots import outage_figures, plot_gps_row, plot_outage, plot_sweep_boxes
 from bgfn.evaluate.record import RECORD_FILE, evaluation_record, write_evaluation_record
 from bgfn.evaluate.tables import (TableResult, aggregate_seeds, describe_tables, error_reduction, error_series,
-                                  evaluate_dataset, fix_error_table, representative_seeds, run_tables,
-                                  save_table_result, table_file, table_paths)
+                                  evaluate_dataset, fix_error_table, keep_results, kept_results, KEPT_RESULTS,
+                                  representative_seeds, run_tables, save_table_result, table_file, table_paths)
 
 __all__ = [
     "REDUCTION_COLUMNS", "claim_lines", "ours_above_paper", "paper_table_title", "reduction_table", "COLORS",
@@ -34,5 +37,6 @@ __all__ = [
     "window_metrics", "ensure_models", "load_model", "outage_figures", "plot_gps_row", "plot_outage",
     "plot_sweep_boxes", "RECORD_FILE", "evaluation_record", "write_evaluation_record", "TableResult",
     "aggregate_seeds", "describe_tables", "error_reduction", "error_series", "evaluate_dataset", "fix_error_table",
-    "representative_seeds", "run_tables", "save_table_result", "table_file", "table_paths",
+    "SENSITIVITY_COLUMNS", "Sensitivity", "pseudo_std_sensitivity", "save_sensitivity", "sensitivity_table",
+    "KEPT_RESULTS", "keep_results", "kept_results", "representative_seeds", "run_tables", "save_table_result", "table_file", "table_paths",
 ]

@@ -1,6 +1,6 @@
 """``results/<profile>/outage_evaluation.json``: the record of one run of notebook 04 (its configuration, the
-outages, the tables, the reductions against INS beside the paper's, the sweep's sizes, wall times and run
-metadata). Notebook 06 reads it (:func:`bgfn.report.outage_datasets`: which dataset stands for which test).
+outages, the tables, the reductions against INS beside the paper's, wall times and run metadata). The results
+page reads it (:func:`bgfn.report.outage_datasets`: which dataset stands for which test).
 """
 
 from __future__ import annotations
@@ -21,8 +21,7 @@ RECORD_FILE = RUN_RECORDS["evaluation"]
 
 
 def evaluation_record(setup: EvaluationSetup, results: Mapping[str, TableResult],
-                      reductions: Mapping[str, pd.DataFrame], sweep_rows: int, sweep_info: dict,
-                      timings: dict) -> dict:
+                      reductions: Mapping[str, pd.DataFrame], timings: dict) -> dict:
     """The content of ``outage_evaluation.json`` (without the run metadata).
 
     Parameters
@@ -32,10 +31,6 @@ def evaluation_record(setup: EvaluationSetup, results: Mapping[str, TableResult]
         ``{dataset: TableResult}`` of the two tables.
     reductions : mapping
         ``{dataset: reduction_table(...)}`` (:func:`bgfn.evaluate.claims.reduction_table`).
-    sweep_rows : int
-        Rows of ``tables/outage_sweep.csv``.
-    sweep_info : dict
-        ``{dataset: info}`` of :func:`bgfn.studies.outage_sweep.sweep.run_sweeps`.
     timings : dict
         Wall times, s.
 
@@ -46,7 +41,7 @@ def evaluation_record(setup: EvaluationSetup, results: Mapping[str, TableResult]
         profile's default list), ``outage_windows_by_dataset`` (``{dataset: [[start, duration], ...]}``: the
         windows each table was evaluated in),
         ``datasets``, ``real_imu_notes``, ``tables`` and ``reduction_vs_ins_pct`` (keyed by the paper's test),
-        ``paper_claims`` (the BGFN reductions the paper quotes, %), ``sweep`` (``rows``, ``info``),
+        ``paper_claims`` (the BGFN reductions the paper quotes, %),
         ``timings_s``, ``constraints`` (per test the vehicle constraints' facts of the ``+NHC`` rows, or None).
     """
     return {
@@ -58,17 +53,15 @@ def evaluation_record(setup: EvaluationSetup, results: Mapping[str, TableResult]
         "tables": {res.test: res.table.to_dict(orient="records") for res in results.values()},
         "reduction_vs_ins_pct": {results[n].test: r.to_dict(orient="records") for n, r in reductions.items()},
         "paper_claims": paper.claims()["bgfn_reduction_vs_ins_pct"],
-        "sweep": {"rows": int(sweep_rows), "info": sweep_info},
         "timings_s": timings,
         "constraints": {res.test: res.constraints for res in results.values()},
     }
 
 
 def write_evaluation_record(out, setup: EvaluationSetup, results: Mapping[str, TableResult],
-                            reductions: Mapping[str, pd.DataFrame], sweep_rows: int, sweep_info: dict,
-                            timings: dict) -> Path:
+                            reductions: Mapping[str, pd.DataFrame], timings: dict) -> Path:
     """Write :func:`evaluation_record` plus ``meta`` (:func:`bgfn.config.run_metadata`) to
     ``<out>/outage_evaluation.json`` atomically; returns the path."""
-    record = {**evaluation_record(setup, results, reductions, sweep_rows, sweep_info, timings),
+    record = {**evaluation_record(setup, results, reductions, timings),
               "meta": run_metadata(setup.profile)}
     return atomic_write_json(Path(out) / RECORD_FILE, record)

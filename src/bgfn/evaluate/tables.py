@@ -4,6 +4,8 @@ ours are :mod:`bgfn.evaluate.claims`."""
 
 from __future__ import annotations
 
+import dataclasses
+import pickle
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -18,7 +20,7 @@ from bgfn.data.names import dataset_id
 from bgfn.evaluate.config import METRIC_COLUMNS, TABLE_COLUMNS, TABLE_FILES, TABLE_METHODS, evaluate_config
 from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
 from bgfn.evaluate.networks import ensure_models
-from bgfn.io import atomic_write_csv
+from bgfn.io import atomic_write_bytes, atomic_write_csv
 from bgfn.nav import outages
 from bgfn.paper import METHOD_LABELS, nhc_label, test_of
 
@@ -177,6 +179,30 @@ def run_tables(cfg: dict, profile: str, datasets, ecfg: dict, out,
             report(f"{name} ({res.test} test): {len(res.runs)} runs in {timings[f'tables_{name}_s']:.1f} s -> "
                    + ", ".join(str(Path(q).relative_to(out)) for q in paths.values()))
     return results, timings
+
+#: The runs of the paper's outages as notebook 04 computed them, for the studies that build on them (the oracle's
+#: and the NEES's levels of each network): exact, where the CSV tables are rounded (``results/<profile>/``).
+KEPT_RESULTS = "evaluation/table_results.pkl"
+
+
+def keep_results(out, results: dict) -> Path:
+    """Write ``{dataset: TableResult}`` for later notebooks, without the drives (reloaded from the data cache)
+    and the networks (reloaded from their checkpoints); atomically."""
+    light = {name: dataclasses.replace(res, drive=None, models={}) for name, res in results.items()}
+    return atomic_write_bytes(Path(out) / KEPT_RESULTS, pickle.dumps(light, protocol=pickle.HIGHEST_PROTOCOL))
+
+
+def kept_results(out) -> dict:
+    """``{dataset: TableResult}`` that notebook 04 kept (:func:`keep_results`); a clear error when it has not run.
+
+    The file is this run's own output under ``results/<profile>/``, never a user's file.
+    """
+    path = Path(out) / KEPT_RESULTS
+    if not path.is_file():
+        raise FileNotFoundError(f"{path.name} not found under {Path(out).name}/evaluation/: run notebook 04 "
+                                "(04_outage_evaluation) of this profile first")
+    return pickle.loads(path.read_bytes())
+
 
 def table_file(test: str) -> str:
     """File name of a test's table under ``tables/``: ``outage_dataset.csv``, ``outage_field.csv``, else

@@ -1,4 +1,4 @@
-"""The results page (notebook 06): our tables beside the paper's, where each number came from, and plain
+"""The results page (notebook 10): our tables beside the paper's, where each number came from, and plain
 sentences computed from the numbers.
 
 Inputs (all written by notebooks 01-05 under ``results/<profile>/``; a missing file is reported, never
@@ -57,7 +57,7 @@ __all__ = [
     # public before, not listed: the variants section's functions and the training tables' labels
     "compared_profiles", "profile_tables", "variant_training_table", "variant_outage_table", "variant_sentences",
     "variant_sweep_table", "REFERENCE_LABELS", "TRAINING_COLUMNS",
-    # the page as sections of pieces to display (notebook 06)
+    # the page as sections of pieces to display (notebook 10)
     "Verdict", "VerdictInputs", "verdict_of", "verdict_table",
     "ProfileResults", "read_results", "OutageSection", "header_section", "outage_section", "energy_section",
     "kf_section", "training_section", "sweep_section", "odometer_section", "variants_section", "paper_figure_section",

@@ -1,6 +1,6 @@
 """Diagrams and illustrations of the paper drawn from code (matplotlib patches and arrows, no graphviz).
 
-Every function returns a :class:`matplotlib.figure.Figure`; notebook 06 saves them into
+Every function returns a :class:`matplotlib.figure.Figure`; notebook 10 saves them into
 ``results/<profile>/figures/`` (``bgfn.io.save_figure``) and the book shows them. The diagrams read the real
 configuration, so they change when a profile changes a parameter:
 

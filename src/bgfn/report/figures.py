@@ -1,5 +1,5 @@
 """The figures of the results page: the paper's figures that carry data or structure (and what regenerates
-each), the figures beyond the paper, and the four drawings notebook 06 makes itself from the profile.
+each), the figures beyond the paper, and the four drawings notebook 10 makes itself from the profile.
 
 The drawing code is :mod:`bgfn.report.diagrams` (imported here as ``drawings``); this module decides *which*
 figures the page shows, with which caption, and what to say when one is missing.
@@ -22,15 +22,15 @@ from bgfn.train import size_config
 
 #: The paper's figures that carry data or structure, and what regenerates each (``{dataset}``: per dataset).
 PAPER_FIGURES: tuple[dict[str, str], ...] = (
-    {"label": "ins-gps-loose", "file": "diagram_loosely_coupled.png", "by": "notebook 06 (bgfn.report.diagrams)",
+    {"label": "ins-gps-loose", "file": "diagram_loosely_coupled.png", "by": "notebook 10 (bgfn.report.diagrams)",
      "caption": "A block diagram of a loosely coupled GPS/INS integration."},
-    {"label": "fig:LIF", "file": "lif_neuron.png", "by": "notebook 06 (bgfn.report.diagrams)",
+    {"label": "fig:LIF", "file": "lif_neuron.png", "by": "notebook 10 (bgfn.report.diagrams)",
      "caption": "The LIF neuron: a SpikingJelly LIF node with the model's time constant and threshold, driven by "
                 "an input current; membrane potential, threshold and output spikes."},
-    {"label": "BGFN", "file": "diagram_hybrid_system.png", "by": "notebook 06 (bgfn.report.diagrams)",
+    {"label": "BGFN", "file": "diagram_hybrid_system.png", "by": "notebook 10 (bgfn.report.diagrams)",
      "caption": "The GPS/INS integrated navigation system based on BGFN (training mode solid, prediction mode "
                 "dashed)."},
-    {"label": "BGFN-arc", "file": "diagram_bgfn_architecture.png", "by": "notebook 06 (bgfn.report.diagrams)",
+    {"label": "BGFN-arc", "file": "diagram_bgfn_architecture.png", "by": "notebook 10 (bgfn.report.diagrams)",
      "caption": "The architecture of the BGFN, read from the model this profile builds."},
     {"label": "3d", "file": "trajectory_3d.png", "by": "notebook 01",
      "caption": "The NaveGo dataset trajectory, the two outages in red."},

@@ -52,5 +52,5 @@ def findings_markdown(profile: str, lines: Sequence[str]) -> str:
     """The *At a glance* lines as a Markdown list for the book's first page (``results/<profile>/findings.md``,
     included there by the book build)."""
     head = (f"From profile `{profile}` (`params/{profile}.yaml`); how each number is made, and the paper's beside "
-            "it, is on the {doc}`results page <notebooks/06_results>`.")
+            "it, is on the {doc}`results page <notebooks/10_results>`.")
     return head + "\n\n" + "\n".join(f"- {s}" for s in lines) + "\n"

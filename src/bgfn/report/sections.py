@@ -1,4 +1,4 @@
-"""The sections of the results page (notebook 06), each as the pieces to display, in order.
+"""The sections of the results page (notebook 10), each as the pieces to display, in order.
 
 A *piece* is a Markdown string, a pandas Styler (a table) or a :class:`~pathlib.Path` (a figure file); the
 notebook only displays them, between its prose. An input that is missing gives a note saying which notebook

@@ -1,4 +1,4 @@
-"""Three own logs as users have them, written as CSV folders for the book's gallery (notebook 07).
+"""Three own logs as users have them, written as CSV folders for the book's gallery (notebook 09).
 
 Each is what a user would bring (``data/README.md``): ``imu.csv``, ``gnss.csv``, ``reference.csv`` and a
 ``meta.yaml`` with the keys real logs need, and a profile of a few lines (:data:`GALLERY`).

@@ -1,4 +1,4 @@
-"""The gallery of own logs (notebook 07): each log of :data:`bgfn.studies.gallery.logs.GALLERY` loaded through the CSV path
+"""The gallery of own logs (notebook 09): each log of :data:`bgfn.studies.gallery.logs.GALLERY` loaded through the CSV path
 and run through the navigation part of the chain with the profile a user would write for it.
 
 For each log: what the loader decided (the clocks: the GNSS-IMU offset it estimated or applied; the mounting it

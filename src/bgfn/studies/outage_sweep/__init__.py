@@ -4,8 +4,8 @@ Two outages cannot rank methods. The sweep (:mod:`~bgfn.studies.outage_sweep.swe
 drive, trains each fold's networks without its outages and evaluates every method in them, with bootstrap
 intervals and paired tests; the oracle (:mod:`~bgfn.studies.outage_sweep.oracle`) replaces a network by the true
 increments plus noise (:mod:`~bgfn.studies.outage_sweep.increments`) to find the accuracy at which a pseudo-GPS fix
-beats INS+NHC; :mod:`~bgfn.studies.outage_sweep.variant_outages` evaluates the learning-problem variants of
-notebook 03, :mod:`~bgfn.studies.outage_sweep.pseudo_std` the tables with each network's own pseudo-fix std.
+beats INS+NHC; :mod:`~bgfn.studies.outage_sweep.variant_outages` trains and evaluates the learning-problem variants
+(velocity inputs, a leaky protocol) in the paper's two outages.
 """
 
 from bgfn.studies.outage_sweep.increments import AntennaTruth, increment_errors, increment_rmse
@@ -13,8 +13,6 @@ from bgfn.studies.outage_sweep.oracle import (BREAKEVEN_COLUMNS, ORACLE_COLUMNS,
                                               breakeven_table, crossing_sigma, curve_at, describe_oracle, method_levels,
                                               oracle_interval_table, oracle_runs, oracle_table, oracle_windows,
                                               plot_oracle, run_oracle)
-from bgfn.studies.outage_sweep.pseudo_std import (SENSITIVITY_COLUMNS, Sensitivity, pseudo_std_sensitivity,
-                                                  save_sensitivity, sensitivity_table)
 from bgfn.studies.outage_sweep.sweep import (describe_sweep, describe_sweep_setup, describe_sweep_size, pairs_style,
                                              profile_sweep_plan, run_sweep, run_sweeps, sweep_comparisons,
                                              sweep_interval_table, sweep_plan, sweep_summary, sweep_train_config)
@@ -25,7 +23,6 @@ __all__ = [
     "AntennaTruth", "increment_errors", "increment_rmse", "BREAKEVEN_COLUMNS", "ORACLE_COLUMNS", "OracleIncrements",
     "OracleResult", "breakeven_table", "crossing_sigma", "curve_at", "describe_oracle", "method_levels",
     "oracle_interval_table", "oracle_runs", "oracle_table", "oracle_windows", "plot_oracle", "run_oracle",
-    "SENSITIVITY_COLUMNS", "Sensitivity", "pseudo_std_sensitivity", "save_sensitivity", "sensitivity_table",
     "describe_sweep", "describe_sweep_setup", "describe_sweep_size", "pairs_style", "profile_sweep_plan",
     "run_sweep", "run_sweeps", "sweep_comparisons", "sweep_interval_table", "sweep_plan", "sweep_summary",
     "sweep_train_config", "NO_VARIANT", "VARIANT_COLUMNS", "VARIANT_METRICS", "load_variant_network",

@@ -303,8 +303,8 @@ strip: $(STAMP)
 	  print("stripped:", " ".join(dirty) if dirty else "nothing (all notebooks clean)")'
 
 # ---------------------------------------------------------------- NaveGo beside us
-# NaveGo v1.4's own ins_gnss.m under GNU Octave on the Turin drives and the profile's outages (issue 26;
-# tools/navego_check.py, NaveGo read from ../shared/navego-v1.4): its numbers go to data/measured/navego_check.csv,
+# NaveGo v1.4's own ins_gnss.m under GNU Octave on the Turin drives and the profile's outages
+# (tools/navego_check.py, NaveGo read from ../shared/navego-v1.4): its numbers go to data/measured/navego_check.csv,
 # which the book shows beside our `navego` setup. Not part of `reproduce`: the artifact never needs Octave.
 navego-check: $(STAMP)
 	@command -v octave >/dev/null || { echo "error: GNU Octave is not installed -- apt-get install -y octave" \

@@ -85,7 +85,7 @@ def test_overrides_need_one_drive_with_both_states():
 
 
 def test_stand_in_vibration_is_the_real_drives():
-    """The profiles' field-test stand-in vibrates as the recorded car's IMU does (deviations row 61)."""
+    """The profiles' field-test stand-in vibrates as the recorded car's IMU does (deviations page)."""
     from bgfn.profile_schema import load_profile
     from bgfn.data import load_drive
     from bgfn.data.acquire import MissingFileError

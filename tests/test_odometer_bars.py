@@ -6,7 +6,7 @@ import pandas as pd
 import pytest
 
 from bgfn import evaluate as ev
-from bgfn.studies.odometer import bars as O
+from bgfn.studies.odometer import bars as O, section as OS
 from bgfn.nav import odometer as no
 from bgfn.profile_schema import load_profile
 from synthetic_drive import demo_drive
@@ -109,7 +109,7 @@ def test_the_speed_figure_draws_each_outage_from_its_own_fold():
               "tracks": {"RIDGE-ODO": (np.where(t > 50, 11.0, np.nan), np.full(t.size, 0.5)),
                          "BGFN-ODO": (np.where(t > 50, 9.0, np.nan), np.full(t.size, 1.5)),
                          "BGFN-ODO-ENS": (np.where(t > 50, 9.5, np.nan), np.full(t.size, 1.0))}}   # not drawn
-    fig = O.plot_speed_series(series, "d", n_outages=2)
+    fig = OS.plot_speed_series(series, "d", n_outages=2)
     axes = fig.axes
     assert len(axes) == 2 and axes[0].get_title() == "start 60 s" and axes[1].get_title() == "start 140 s"
     assert axes[0].get_ylabel() == "forward speed (m/s)"
@@ -124,7 +124,7 @@ def test_the_error_growth_figure_has_one_line_per_row_and_the_oracle_at_its_grid
             for m, e in (("INS+NHC", 1.0), ("RIDGE-ODO", 0.8), ("BGFN-ODO", 0.9)) for d in (10.0, 30.0, 60.0)]
     rows += [{"method": "ORACLE-SPEED", "sigma_mps": s, "duration_s": d, "max_h_m": s * d}
              for s in (0.05, 0.5, 2.0) for d in (10.0, 30.0, 60.0)]
-    fig = O.plot_error_growth(pd.DataFrame(rows), "d")
+    fig = OS.plot_error_growth(pd.DataFrame(rows), "d")
     lines = {ln.get_label(): ln.get_ydata() for ln in fig.axes[0].get_lines()}
     assert set(lines) == {"INS+NHC", "RIDGE-ODO", "BGFN-ODO", "ORACLE-SPEED 0.05 m/s", "ORACLE-SPEED 2 m/s"}
     assert np.allclose(lines["RIDGE-ODO"], [8.0, 24.0, 48.0])
@@ -200,9 +200,9 @@ def test_network_table_sets_each_networks_validation_beside_its_own_folds_outage
     row = t.iloc[0]
     assert row["outage_speed_rmse_mps"] == pytest.approx(np.sqrt((9 + 16) / 2))  # RMS over the starts
     assert row["outage_coverage_2sigma"] == pytest.approx(0.75) and row["val_rmse_mps"] == 0.8
-    line, = O.network_lines(t)
+    line, = OS.network_lines(t)
     assert line.startswith("d, fold 0:") and "BGFN-ODO 0.80, then 3.54 m/s (75 % of outage epochs within" in line
-    assert O.network_lines(None) == [] and O.network_lines(t.iloc[:0]) == []
+    assert OS.network_lines(None) == [] and OS.network_lines(t.iloc[:0]) == []
 
 
 def test_the_ensemble_of_two_oppositely_biased_seeds_is_unbiased_with_the_mixtures_std():

@@ -1,4 +1,4 @@
-"""A user's own log, end to end (issue 16, outcome 5): a CSV folder named by path in a four-line profile runs
+"""A user's own log, end to end: a CSV folder named by path in a four-line profile runs
 through notebooks 01-04's library path; outputs only under results/<profile>/, the data folder untouched.
 
 The drive is written by the test as a logger would: IMU times that jitter (7.5-12.5 ms steps around 10 ms), a
@@ -239,7 +239,7 @@ def test_implausible_units_and_axes_name_the_csv_file_and_column(tmp_path, truth
     ("name: my drive/2\n", "name", "dataset id"),
     ("- a\n- b\n", "<top level>", "a mapping"),
     ("name: [unclosed\n", "<yaml>", "valid YAML"),
-    # the keys of real logs (issue 25)
+    # the keys of real logs
     ("platform: boat\n", "platform", "car, walker, other"),
     ("gnss_latency_s: 18.0\n", "gnss_latency_s", "18 s between GPS time and UTC"),
     ("gnss_latency_s: -0.1\n", "gnss_latency_s", ">= 0"),

@@ -226,19 +226,19 @@ def test_training_and_sweep_tables():
 # ----------------------------------------------------------------------------------------------- the book
 #: Numbers with a unit the book may type: the paper's and the profiles' settings, never a result.
 ALLOWED: dict[str, str] = {
-    "0.05 m": "truth smoothing sigma (setting, deviations row 5)",
+    "0.05 m": "truth smoothing sigma (setting, (deviations page)",
     "100 m/s": "the velocity std that makes NaveGo's velocity rows carry nothing (setting of make navego-check)",
-    "30 %": "how far our setup of NaveGo may lie from NaveGo itself (issue 26; bgfn.studies.ins_fidelity.ins_setups.NAVEGO_TOLERANCE)",
-    "10 %": "Ekinox run-to-run bias part (setting, row 7)",
-    "3 %": "MPU-6000 scale-factor tolerance (setting, row 8)",
-    "2 %": "MPU-6000 cross-axis tolerance (setting, row 8)",
-    "[0.3, 0.3, 0.6] m": "simulated GNSS white noise (setting, row 9)",
-    "[1, 1, 2] m": "simulated GNSS correlated noise (setting, row 9)",
-    "[-0.369, 0, -0.219] m": "lever arm (setting, row 9)",
-    "[1, 1, 3] m": "Ekinox GNSS stdm (data setting, row 10)",
-    "4.6 pJ": "45 nm float32 MAC energy (Horowitz 2014, setting, row 20)",
-    "0.9 pJ": "45 nm float32 add energy (Horowitz 2014, setting, row 20)",
-    "95 %": "bootstrap interval level (setting, row 26)",
+    "30 %": "how far our setup of NaveGo may lie from NaveGo itself (bgfn.studies.ins_fidelity.ins_setups.NAVEGO_TOLERANCE)",
+    "10 %": "Ekinox run-to-run bias part (setting)",
+    "3 %": "MPU-6000 scale-factor tolerance (setting)",
+    "2 %": "MPU-6000 cross-axis tolerance (setting)",
+    "[0.3, 0.3, 0.6] m": "simulated GNSS white noise (setting)",
+    "[1, 1, 2] m": "simulated GNSS correlated noise (setting)",
+    "[-0.369, 0, -0.219] m": "lever arm (setting)",
+    "[1, 1, 3] m": "Ekinox GNSS stdm (data setting)",
+    "4.6 pJ": "45 nm float32 MAC energy (Horowitz 2014, setting)",
+    "0.9 pJ": "45 nm float32 add energy (Horowitz 2014, setting)",
+    "95 %": "bootstrap interval level (setting)",
 }
 UNIT = r"(?:%|m/s\b|m\b|km\b|cm\b|mm\b|µJ|uJ|mJ|nJ|pJ|J\b)"
 RESULT_LIKE = re.compile(r"(?<![\w.\-])(?:\[[^\]\n]*\d[^\]\n]*\]|-?\d+(?:\.\d+)?)\s*" + UNIT)

@@ -1,4 +1,4 @@
-"""Input and protocol variants (issue 17, outcome 3): the honest and leaky protocols of bgfn.learning.split, the
+"""Input and protocol variants: the honest and leaky protocols of bgfn.learning.split, the
 variants of a profile (bgfn.train.variants) merged and schema-checked like profiles, their outage table
 (bgfn.studies.outage_sweep.variant_outages), and the learning-rate search's budget (bgfn.train.lr_search)."""
 

@@ -4,7 +4,7 @@
 jittery ~100 Hz, ``gnss.csv`` at 1 Hz with a lever arm, ``reference.csv`` at 5 Hz, ``meta.yaml``; GPS time of week)
 and ``params/<PROFILE>.yaml``: the README's two lines with the absolute path (``base: own``), one outage (the demo
 drive turns too gently for the rule's manoeuvre) and the smallest budget, so that ``make reproduce
-PROFILE=<PROFILE>`` runs the whole chain on it in a few minutes. CI runs exactly that (``.ci/run``, issue 25): the
+PROFILE=<PROFILE>`` runs the whole chain on it in a few minutes. CI runs exactly that (``.ci/run``): the
 documented own-log path by absolute path, end to end, every notebook and the book. With ``--walker`` the log is the
 gallery's synthetic walk instead (:func:`bgfn.studies.gallery.logs.walker_log`, ``platform: walker``) and the profile is
 based on ``params/own-walker.yaml``, with the outages picked by its rule and a four-start sweep.

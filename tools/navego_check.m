@@ -1,5 +1,5 @@
 function navego_check(in_file, out_file, navego_dir)
-% navego_check: run NaveGo's ins_gnss on a drive exported by tools/navego_check.py (issue 26).
+% navego_check: run NaveGo's ins_gnss on a drive exported by tools/navego_check.py.
 %
 %   navego_check(in_file, out_file, navego_dir)
 %

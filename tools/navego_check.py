@@ -1,4 +1,4 @@
-"""NaveGo v1.4 run beside ours (issue 26): its INS-only errors in the paper's outages and its GPS-aided accuracy.
+"""NaveGo v1.4 run beside ours: its INS-only errors in the paper's outages and its GPS-aided accuracy.
 
 ``make navego-check`` (or ``python tools/navego_check.py``) exports each drive to NaveGo's ``imu``/``gnss`` structs,
 removes the fixes inside the profile's outages (as NaveGo's ``gnss_outage.m`` does), runs NaveGo's own
@@ -71,7 +71,7 @@ BIAS_FEEDBACK_PATCH: tuple[tuple[str, str], ...] = (
 )
 #: NaveGo's runs per drive: as released, and with its bias feedback made consistent (module docstring).
 VARIANTS: tuple[str, ...] = tuple(NAVEGO_VARIANTS)      # the CSV's variant column, read by bgfn.studies.ins_fidelity.ins_setups
-#: The bias states step by step (issue 26): NaveGo's estimates at every fix of each run's first TRACE_S seconds,
+#: The bias states step by step: NaveGo's estimates at every fix of each run's first TRACE_S seconds,
 #: beside our filter under NaveGo's setup and the drive's true biases (a simulated drive's), at the same fixes.
 TRACE_FILE = PROJECT_ROOT / "data" / "measured" / "navego_bias_trace.csv"
 TRACE_S = 120.0

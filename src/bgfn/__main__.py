@@ -33,7 +33,7 @@ from bgfn.config import results_dir
 from bgfn.errors import DataError
 from bgfn.evaluate import evaluation_setup
 from bgfn.studies.odometer import sizes as odometer_sizes
-from bgfn.studies.odometer.bars import run_odometer_section
+from bgfn.studies.odometer.section import run_odometer_section
 from bgfn.evaluate.kernels import compile_kernels
 from bgfn.io import atomic_write_text
 from bgfn.parallel import Runner

@@ -57,7 +57,7 @@ TESTS: dict[str, dict] = {
     "field": {"label": "tab-real", "title": "field test", "file": "outage_field.csv",
               "caption": "The max position error among different algorithms in the real field test",
               "paper": "field"},
-    # a recorded car drive (issue 16): no values of its own in the paper; its field test (also a car with a
+    # a recorded car drive: no values of its own in the paper; its field test (also a car with a
     # MEMS IMU, one outage cruising, one manoeuvring) is the closest published comparison
     "real": {"label": None, "title": "real drive", "file": "outage_real.csv",
              "caption": "The max position error (m) among different algorithms on a recorded car drive with a "
@@ -104,7 +104,7 @@ def nhc_label(method: str) -> str:
 
 
 #: Suffix of a network trained as a learned odometer (forward speed and its std fused with the NHC rows; beyond
-#: the paper, issue 24): ``BGFN-ODO``.
+#: the paper): ``BGFN-ODO``.
 ODO_SUFFIX = "-ODO"
 #: Suffix of the equal-weight ensemble of an odometer network's seeds (beyond the paper; :func:`ensemble_label`).
 ENSEMBLE_SUFFIX = "-ENS"

@@ -252,7 +252,7 @@ def _build_rtklib(name: str, p: dict, paths: dict) -> Drive:
       (:func:`bgfn.data.gnss.degrade_fixes`); velocity = the reference's at the fix times (a consumer
       receiver's Doppler velocity is of that class, a few cm/s; the filter uses positions only).
     - IMU errors: no datasheet comes with the data; the filter gets the MPU-6000 consumer-MEMS profile
-      (:data:`bgfn.data.imu_errors.MPU6000`, with ``imu_errors`` overrides), book deviations row 42.
+      (:data:`bgfn.data.imu_errors.MPU6000`, with ``imu_errors`` overrides; deviations page).
     """
     pos, week = read_pos(paths["gnss_1934_sf.pos"])
     imu_native, imu_info = read_imu_csv(paths["imu_1934.csv"], read_tag(paths["imu_1934.csv.tag"]), week=week,

@@ -26,7 +26,7 @@ What was verified in the source and what is assumed:
   ``imu_t_off = -0.125`` s (``drive_config.py``; ``GNSS_IMU.py`` *adds* it to the IMU time: a logging delay;
   verified). The source (``convert_imu_file.py``) also stretches the counter so that the last sample falls at
   the tag's last tick (a factor 1 + 2.9e-4 here); this drive's data contradict that stretch, so it is not
-  applied (``stretch_to_tags=False``; book deviations row 43): the IMU's yaw rate, matched against the rate of
+  applied (``stretch_to_tags=False``; deviations page): the IMU's yaw rate, matched against the rate of
   the course over ground of the RTK positions (symmetric differences, speed above 3 m/s), lags by the same
   0.02-0.03 s in each third of the drive without the stretch, but drifts by 0.085 s from the first third to the
   last with it (``tests/test_data_rtklib.py``). That residual lag is under 3 IMU samples: the source's offset

@@ -1,4 +1,4 @@
-"""The odometer learning problem (beyond the paper, issue 24): body-frame IMU windows -> forward speed.
+"""The odometer learning problem (beyond the paper): body-frame IMU windows -> forward speed.
 
 Unlike ``delta_p_gps`` (:mod:`bgfn.learning.targets`), the forward speed does not accumulate, and an IMU window can
 observe it: centripetal acceleration over yaw rate in turns, the vibration spectrum while rolling, stillness at

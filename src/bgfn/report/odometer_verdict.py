@@ -1,4 +1,4 @@
-"""The learned odometer in the verdict (beyond the paper, issue 24): its rows in the verdict table, the sixth
+"""The learned odometer in the verdict (beyond the paper): its rows in the verdict table, the sixth
 question ("does a learned odometer help?") and its clause in each dataset's headline.
 
 Read from notebook 04's odometer tables (:mod:`bgfn.studies.odometer.bars`: ``outage_odometer.csv`` with one row per

@@ -1,6 +1,5 @@
 """The verdict on top of the results page: per test one table of every aid in the paper's two outages and in the
-outage sweep, and sentences answering the five questions a navigation engineer asks of a learned outage aid
-(issue 17):
+outage sweep, and sentences answering the five questions a navigation engineer asks of a learned outage aid:
 
 1. *How accurate must the increments be?* The oracle's break-even noise against the network's own increment error
    (:mod:`bgfn.studies.outage_sweep.oracle`).
@@ -10,7 +9,7 @@ outage sweep, and sentences answering the five questions a navigation engineer a
 4. *Was the paper's protocol leaky?* The networks trained on the whole drive, test outages included.
 5. *Is the INS row comparable?* The INS row under NaveGo v1.4's bias modelling (:mod:`bgfn.studies.ins_fidelity.ins_setups`).
 6. *Does a learned odometer help?* The networks trained as odometers (forward speed and its std fused with the NHC
-   rows; beyond the paper, issue 24) against INS+NHC, the spiking one against its twin, at what energy
+   rows; beyond the paper) against INS+NHC, the spiking one against its twin, at what energy
    (:mod:`bgfn.report.odometer_verdict`).
 
 The recorded drives come first: a simulated IMU is kinder than a real one, so the decisive test is the real drive.

@@ -1,7 +1,7 @@
 """Were the runs that never learned short of data? Each one trained again on all its training windows.
 
 A profile may cap the training windows of a run (``train.optimizer.max_train_windows``; quick: 1000, evenly
-spaced in time, deviations row 63), so a run whose validation loss never beats its initial network
+spaced in time, (deviations page), so a run whose validation loss never beats its initial network
 (``best_epoch`` 0) might have learned from more. With ``train.recheck_all_windows: true``, every such run whose
 cap left windows out is trained once more, the same method, seed, learning rate and budget, on all of them,
 into ``results/<profile>/models/all_windows/<dataset>/`` (:func:`bgfn.train.checkpoints.all_windows_models_dir`; the

@@ -1,4 +1,4 @@
-"""Variants of a profile's learning problem, trained beside its main networks (issue 17, outcome 3).
+"""Variants of a profile's learning problem, trained beside its main networks.
 
 A profile names them at its top level (schema: :data:`bgfn.profile_schema.VARIANT`)::
 

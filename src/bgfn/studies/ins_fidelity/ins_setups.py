@@ -282,7 +282,7 @@ def sentences(table: pd.DataFrame) -> list[str]:
     return out
 
 
-#: How far our ``navego`` setup's INS error may lie from NaveGo's own (issue 26), as a ratio.
+#: How far our ``navego`` setup's INS error may lie from NaveGo's own, as a ratio.
 NAVEGO_TOLERANCE = 0.3
 
 
@@ -308,7 +308,7 @@ def _bias_states(row, ours, true: dict) -> str:
 
 
 def _against_navego(gap: pd.DataFrame) -> str:
-    """Our ``navego`` setup against NaveGo's own runs (issue 26: within 30 % of it?), when both are there: the INS
+    """Our ``navego`` setup against NaveGo's own runs (within 30 % of it?), when both are there: the INS
     ratio, both GPS-aided solutions' horizontal RMS (outages that start from far different states cannot agree) and
     the bias states step by step; then the same against NaveGo with its bias feedback made consistent."""
     rows = {r.setup: r for r in gap.itertuples(index=False)}

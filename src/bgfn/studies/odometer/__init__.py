@@ -7,9 +7,9 @@ the networks at other sizes (:mod:`~bgfn.studies.odometer.sizes`) and their ener
 (:mod:`~bgfn.studies.odometer.energy`). The filter aid itself is :mod:`bgfn.nav.odometer`.
 """
 
-from bgfn.studies.odometer.bars import (ODOMETER_COLUMNS, ODOMETER_METHODS, OdometerSection, odometer_lines,
-                                        odometer_rows, odometer_summary, odometer_table, run_odometer_bars,
-                                        run_odometer_section)
+from bgfn.studies.odometer.bars import (ODOMETER_COLUMNS, ODOMETER_METHODS, odometer_rows, odometer_summary,
+                                        run_odometer_bars)
+from bgfn.studies.odometer.section import OdometerSection, odometer_lines, odometer_table, run_odometer_section
 from bgfn.studies.odometer.energy import OdometerEnergy, odometer_energy
 
 __all__ = [

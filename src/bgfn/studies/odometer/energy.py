@@ -1,4 +1,4 @@
-"""The energy of the learned odometers (beyond the paper, issue 24): ``BGFN-ODO`` against its ANN twin
+"""The energy of the learned odometers (beyond the paper): ``BGFN-ODO`` against its ANN twin
 ``Transformer-ODO``, counted by the same rules as the paper's model (:mod:`bgfn.energy.rules`).
 
 Which networks: the odometers that notebook 04 trained (:mod:`bgfn.studies.odometer.bars`) on the first dataset of

@@ -1,5 +1,5 @@
 """Why a learned odometer loses where an oracle speed with as much white noise wins: its speed error in the outages
-split into an offset that lasts the outage and a fluctuation around it (beyond the paper; issue 24).
+split into an offset that lasts the outage and a fluctuation around it (beyond the paper).
 
 The filter averages a white error away: ``n`` speeds of white noise ``sigma`` leave ``sigma / sqrt(n)`` of it,
 which is why the oracle speed (:mod:`bgfn.studies.odometer.bars`, ``ORACLE-SPEED``) helps up to a noise of metres per

@@ -1,4 +1,4 @@
-"""How the simple learned odometer's speed error falls with its training windows (beyond the paper; issue 24).
+"""How the simple learned odometer's speed error falls with its training windows (beyond the paper).
 
 The learned odometers of :mod:`bgfn.studies.odometer.bars` train per fold of the sweep's outage starts, outside that
 fold's outages +- ``train.margin_s``. On a short drive a fold holds out much of it: with 2 folds each odometer

@@ -1,5 +1,5 @@
 """Does a learned odometer know when it is wrong? Its predicted std against its speed error in the outages (beyond
-the paper; issue 24).
+the paper).
 
 The design of the odometer rows (TLIO, OdoNet; :mod:`bgfn.studies.odometer.bars`) lets each network predict the std
 of its own speed, and the filter weighs every speed by it (R = std^2 times one calibration factor,

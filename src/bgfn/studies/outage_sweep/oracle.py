@@ -1,32 +1,14 @@
-"""Oracle rows (beyond the paper, issue 17): how accurate must the increments be for the pseudo-GPS to help?
+"""Oracle rows (beyond the paper): how accurate must the increments be for the pseudo-GPS to help?
 
-A stand-in network, :class:`OracleIncrements`, returns the *true* ``delta_p_gps`` of every GNSS interval (the
-reference's antenna increments, :mod:`bgfn.studies.outage_sweep.increments`) plus white noise of std ``sigma`` per increment
-and horizontal axis. It goes through :func:`bgfn.evaluate.run_outages` exactly like a trained network: the same
-outage start states, pseudo-GPS epochs, running sum of Eq. (pred-gps) from the filter's antenna position at the
-start, and fix std (``evaluate.pseudo_gps``). Since the increments are summed, their errors random-walk: after
-``k`` increments the pseudo fix is off by ``sigma sqrt(k)`` per axis (plus the start error every method shares).
-
-For every test (each dataset of the tables and of the sweep, keyed by dataset like every other table) the
-oracle runs in the paper's outages and in the sweep's starts (:func:`bgfn.studies.outage_sweep.sweep.sweep_plan`, the same starts,
-so its numbers sit beside the sweep medians) for the grid ``evaluate.oracle.sigmas_m`` and noise seeds
-``evaluate.oracle.seeds`` (sigma = 0 once: nothing random), together with the standalone INS in the same
-windows. Results:
-
-- ``outage_oracle.csv`` (:data:`ORACLE_COLUMNS`): per dataset, windows (``outage``: the paper's ``1``, ``2``,
-  or ``sweep``), duration and sigma, the median max horizontal error with its bootstrap interval (over starts,
-  clustered by start as :func:`bgfn.studies.outage_sweep.sweep.sweep_summary` does; over the noise seeds in a single outage);
-- ``outage_oracle_breakeven.csv`` (:data:`BREAKEVEN_COLUMNS`): the **break-even sigma**, where the oracle curve
-  crosses a learning-free baseline (INS; INS+NHC or any other ``INS...`` row when the sweep or the tables hold
-  one), interpolated linearly between grid points (:func:`crossing_sigma`), and each network's own increment
-  error in the same windows (per-axis RMSE against the true increments: the ``increment_rmse_m`` of the sweep,
-  or of the tables' runs) with its distance from the break-even, and its *equivalent sigma* (the oracle noise
-  that gives the network's own aided error: larger than its RMSE when its errors are correlated rather than
-  white, since correlated errors add up faster in the sum).
-
-The noise is a fixed draw per (dataset, seed) on the drive's grid of GNSS intervals (:func:`oracle_noise`), the
-same standard normals scaled by every sigma (common random numbers: the curve moves with sigma only); a run sees
-the draws of the intervals it crosses, whatever else is computed with it.
+A stand-in network, :class:`OracleIncrements`, returns the *true* ``delta_p_gps`` of every GNSS interval plus white
+noise of std ``sigma`` per increment and axis, and runs through :func:`bgfn.evaluate.run_outages` like a trained
+network (Eq. pred-gps: after ``k`` summed increments the pseudo fix is off by ``sigma sqrt(k)`` per axis). It runs in
+the paper's outages and the sweep's starts for the grid ``evaluate.oracle.sigmas_m``, beside the standalone INS:
+``outage_oracle.csv`` (:data:`ORACLE_COLUMNS`: medians with bootstrap intervals clustered by start) and
+``outage_oracle_breakeven.csv`` (:data:`BREAKEVEN_COLUMNS`: the sigma where the oracle curve crosses a learning-free
+baseline, :func:`crossing_sigma`, beside each network's own increment error and its *equivalent sigma*, larger
+than its RMSE when its errors are correlated). The noise is one draw per (dataset, seed) on the drive's grid of
+GNSS intervals, scaled by every sigma (common random numbers, :func:`oracle_noise`).
 """
 
 from __future__ import annotations

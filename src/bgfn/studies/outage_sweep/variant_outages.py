@@ -1,5 +1,5 @@
 """The learning-problem variants (:mod:`bgfn.train.variants`) in the paper's two outages: one table,
-``tables/outage_variants.csv``, of every test, outage, variant and method (issue 17, outcome 3).
+``tables/outage_variants.csv``, of every test, outage, variant and method.
 
 Each network runs the prediction mode of the main tables (:func:`bgfn.evaluate.hybrid.run_outages`, the
 profile's ``evaluate.pseudo_gps``) from the same GPS-aided states (:func:`bgfn.evaluate.hybrid.navigation_context`);

@@ -195,7 +195,7 @@ def test_is_network():
     assert not orc.is_network("INS") and not orc.is_network("INS+NHC") and not orc.is_network("GPS")
 
 
-# ----------------------------------------------------------------------------------------------- notebook 04
+# ----------------------------------------------------------------------------------------------- notebook 06
 class _Speed:
     """Fake network: dead reckoning at a fixed speed along the input yaw (a poor increment predictor)."""
 

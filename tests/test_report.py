@@ -502,8 +502,8 @@ def test_sections_name_the_notebook_of_a_missing_input(tmp_path):
     res = results(tmp_path)
     assert "notebook 02" in report.kf_section(res)[0] and "kf_baseline.json" in report.kf_section(res)[0]
     assert "notebook 03" in report.training_section(res)[0]
-    assert "notebook 04" in report.sweep_section(res)[0]
-    assert "notebook 04" in report.odometer_section(res)[0] and "outage_odometer_summary.csv" in \
+    assert "notebook 06" in report.sweep_section(res)[0]
+    assert "notebook 07" in report.odometer_section(res)[0] and "outage_odometer_summary.csv" in \
         report.odometer_section(res)[0]
     energy = report.energy_section(res)
     assert "energy.json` is missing" in energy[1] and "notebook 05" in energy[1]

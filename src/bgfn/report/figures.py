@@ -66,9 +66,9 @@ EXTRA_FIGURES: tuple[dict[str, str], ...] = (
        "caption": f"The position errors among different algorithms during outage {k} of the recorded car drive "
                   "(not in the paper; the rule cruise_and_manoeuvre makes outage 1 the cruise and outage 2 the "
                   "manoeuvre, as in the paper's field test)."} for k in (1, 2)),
-    {"label": "outage sweep", "file": "outage_sweep_{dataset}.png", "by": "notebook 04", "datasets": "sweep",
+    {"label": "outage sweep", "file": "outage_sweep_{dataset}.png", "by": "notebook 06", "datasets": "sweep",
      "caption": "Max horizontal error over many outage starts and durations ({dataset})."},
-    {"label": "the filter's consistency in outages", "file": "outage_nees_{dataset}.png", "by": "notebook 04",
+    {"label": "the filter's consistency in outages", "file": "outage_nees_{dataset}.png", "by": "notebook 06",
      "datasets": "sweep",
      "caption": "Median NEES of the horizontal position at the outage end against the filter's own covariance, "
                 "per method and duration ({dataset}); a consistent filter stays near the dashed median line."},
@@ -142,7 +142,7 @@ def draw_diagrams(cfg: dict, evaluation: dict | None, figures_dir: str | Path) -
 
 
 def _datasets(res: ProfileResults) -> dict[str, list[str]]:
-    """The dataset lists ``{dataset}`` figures expand over: ``all`` trained, ``sweep`` swept (notebook 04)."""
+    """The dataset lists ``{dataset}`` figures expand over: ``all`` trained, ``sweep`` swept (notebook 06)."""
     return {"all": res.cfg["train"].get("datasets", []),
             "sweep": (res.evaluation or {}).get("evaluate", {}).get("sweep", {}).get("datasets", [])}
 

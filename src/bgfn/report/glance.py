@@ -15,15 +15,18 @@ from bgfn.report.reading import read_json, rel
 from bgfn.report.sentences import energy_sentences, summary_sentence
 from bgfn.report.profile_comparison import reference_sentences
 
-#: The JSON files of notebooks 02-05 (what each holds).
+#: The JSON files of notebooks 02-08 (what each holds).
 RUN_FILES: dict[str, str] = {RUN_RECORDS["kf_baseline"]: "notebook 02, Kalman filter baseline",
                              RUN_RECORDS["training"]: "notebook 03, training",
                              RUN_RECORDS["evaluation"]: "notebook 04, outage evaluation",
-                             RUN_RECORDS["energy"]: "notebook 05, energy estimate"}
+                             RUN_RECORDS["energy"]: "notebook 05, energy estimate",
+                             RUN_RECORDS["sweep"]: "notebook 06, outage sweep (beyond the paper)",
+                             RUN_RECORDS["odometer"]: "notebook 07, learned odometer (beyond the paper)",
+                             RUN_RECORDS["ins_fidelity"]: "notebook 08, the INS's fidelity (beyond the paper)"}
 
 
 def run_header(profile: str, cfg: dict, results: str | Path, current: dict | None = None) -> list[str]:
-    """Markdown lines: the profile of this page and, per JSON file of notebooks 02-05, whether it is there and
+    """Markdown lines: the profile of this page and, per JSON file of notebooks 02-08, whether it is there and
     what produced it."""
     results = Path(results)
     lines = [f"Profile **`{profile}`** (`params/{profile}.yaml`): {cfg.get('description', '')}",

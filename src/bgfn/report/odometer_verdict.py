@@ -1,11 +1,11 @@
 """The learned odometer in the verdict (beyond the paper): its rows in the verdict table, the sixth
 question ("does a learned odometer help?") and its clause in each dataset's headline.
 
-Read from notebook 04's odometer tables (:mod:`bgfn.studies.odometer.bars`: ``outage_odometer.csv`` with one row per
+Read from notebook 07's odometer tables (:mod:`bgfn.studies.odometer.bars`: ``outage_odometer.csv`` with one row per
 start, seed and duration, ``outage_odometer_summary.csv`` with the medians, the ratio to INS+NHC per start and the
 Wilcoxon p against it, ``outage_odometer_paper.csv`` with the rows in each drive's two evaluation outages,
 ``outage_odometer_curve.csv`` with RIDGE-ODO's speed error against its training windows,
-``outage_odometer_uncertainty.csv`` with each network's predicted std against its speed error), notebook 05's
+``outage_odometer_uncertainty.csv`` with each network's predicted std against its speed error), notebook 07's
 ``energy_odometer.csv`` (:mod:`bgfn.studies.odometer.energy`), and a run at another model size made on another machine
 (``data/measured/odometer_sizes.csv``, :mod:`bgfn.studies.odometer.sizes`: the paper's size on a GPU). Nothing here
 is typed by hand; a missing table leaves its cells empty and its sentence says so.
@@ -54,7 +54,7 @@ class OdometerInputs:
 
     rows: pd.DataFrame | None       # outage_odometer.csv
     summary: pd.DataFrame | None    # outage_odometer_summary.csv
-    energy: pd.DataFrame | None     # energy_odometer.csv (only the dataset notebook 05 measured)
+    energy: pd.DataFrame | None     # energy_odometer.csv (only the dataset notebook 07 measured)
     paper: pd.DataFrame | None = None   # outage_odometer_paper.csv (the two evaluation outages)
     curve: pd.DataFrame | None = None   # outage_odometer_curve.csv (RIDGE-ODO against its training windows)
     uncertainty: pd.DataFrame | None = None   # outage_odometer_uncertainty.csv (each network's std against its error)
@@ -133,7 +133,7 @@ class OdometerInputs:
         return float(diff.median()), 1.0 if (diff == 0).all() else wilcoxon_p(diff)
 
     def energy_uj(self, method: str) -> float:
-        """Energy per prediction of ``method``'s odometer (µJ), NaN when notebook 05 did not measure it."""
+        """Energy per prediction of ``method``'s odometer (µJ), NaN when notebook 07 did not measure it."""
         if self.energy is None or not len(self.energy):
             return float("nan")
         sel = self.energy[(self.energy["model"] == method) & (self.energy["layer"] == "total")]
@@ -175,7 +175,7 @@ def curve_sentence(odo: OdometerInputs) -> str:
             f"of {int(lo['folds'])} learns from {hi['n_train']:.0f} windows per fold instead of {lo['n_train']:.0f} "
             f"({hi['n_train'] / lo['n_train']:.1f} times as many), and its speed RMSE in its "
             f"{hi['duration_s']:g} s outages goes from {lo['outage_speed_rmse_mps']:.2f} to "
-            f"{hi['outage_speed_rmse_mps']:.2f} m/s (notebook 04's learning curve).")
+            f"{hi['outage_speed_rmse_mps']:.2f} m/s (notebook 07's learning curve).")
 
 
 def offset_sentence(odo: OdometerInputs, duration: float) -> str:
@@ -253,7 +253,7 @@ def size_sentence(odo: OdometerInputs, durations) -> str:
 
 def odometer_rows(odo: OdometerInputs, durations) -> list[dict]:
     """The verdict table's odometer rows: the held speed, every learned odometer (in the two evaluation outages when
-    notebook 04 ran them there, ``evaluate.odometer.paper_outages``, and in the sweep), then the oracle speed at
+    notebook 07 ran them there, ``evaluate.odometer.paper_outages``, and in the sweep), then the oracle speed at
     BGFN-ODO's own speed RMSE (sweep only); ``p``: Wilcoxon of the row against INS+NHC over the starts."""
     if not odo.measured:
         return []
@@ -330,7 +330,7 @@ def twin_comparison(odo: OdometerInputs, duration: float) -> str:
 def _energy(odo: OdometerInputs) -> str:
     e_snn, e_ann = odo.energy_uj("BGFN-ODO"), odo.energy_uj("Transformer-ODO")
     if not np.isfinite(e_snn):
-        return "its energy was not measured for this drive (notebook 05 audits one drive's odometers)"
+        return "its energy was not measured for this drive (notebook 07 audits one drive's odometers)"
     if not np.isfinite(e_ann):
         return f"at {e_snn:.3g} µJ per prediction"
     return (f"at {e_snn:.3g} µJ per prediction against the twin's {e_ann:.3g} µJ "
@@ -342,7 +342,7 @@ def answer_odometer(odo: OdometerInputs, durations) -> str:
     how far is it from an oracle speed, at what energy."""
     q = "Does a learned odometer help?"
     if not odo.measured:
-        return f"{q} Not measured: notebook 04's odometer bars have not run for this drive (`evaluate.odometer`)."
+        return f"{q} Not measured: notebook 07's odometer bars have not run for this drive (`evaluate.odometer`)."
     d_long = max(durations)
     nhc = nhc_label("INS")
 

@@ -67,12 +67,14 @@ class ProfileResults:
         The percentages the paper states in its text (:func:`bgfn.paper.claims`).
     kf, training, evaluation, energy : dict or None
         ``kf_baseline.json`` (02), ``training.json`` (03), ``outage_evaluation.json`` (04), ``energy.json`` (05).
+    sweep_record : dict or None
+        ``outage_sweep.json`` (06): the sweep's sizes, wall times and run metadata.
     ours, published : dict
         ``{test: table}`` of :data:`bgfn.paper.TESTS`: our outage table (notebook 04) and the paper's beside it
         (:func:`bgfn.paper.published_values`: for the real drive, the paper's field test).
     training_summary, training_times, sweep, sweep_pairs : DataFrame or None
         ``tables/training_summary.csv``, ``tables/training_times.csv`` (03), ``tables/outage_sweep_summary.csv``
-        and ``tables/outage_sweep_pairs.csv`` (04).
+        and ``tables/outage_sweep_pairs.csv`` (06).
     """
 
     profile: str
@@ -90,6 +92,7 @@ class ProfileResults:
     training_times: pd.DataFrame | None
     sweep: pd.DataFrame | None
     sweep_pairs: pd.DataFrame | None
+    sweep_record: dict | None = None
 
     def table(self, name: str) -> Path:
         """Path of ``results/<profile>/tables/<name>``."""
@@ -116,4 +119,5 @@ def read_results(profile: str, out: str | Path | None = None) -> ProfileResults:
         published={t: paper.published_values(t) for t in paper.TESTS},   # the real drive: the field test's
         training_summary=read_csv(tables / SHARED_TABLES["training_summary"]),
         training_times=read_csv(tables / SHARED_TABLES["training_times"]),
-        sweep=read_csv(tables / SHARED_TABLES["sweep_summary"]), sweep_pairs=read_csv(tables / SHARED_TABLES["sweep_pairs"]))
+        sweep=read_csv(tables / SHARED_TABLES["sweep_summary"]), sweep_pairs=read_csv(tables / SHARED_TABLES["sweep_pairs"]),
+        sweep_record=read_json(out / RUN_RECORDS["sweep"]))

@@ -137,14 +137,14 @@ def training_section(res: ProfileResults) -> list:
 
 
 def odometer_section(res: ProfileResults) -> list:
-    """The bars a learned odometer must clear (notebook 04, :mod:`bgfn.studies.odometer.bars`): median max horizontal
+    """The bars a learned odometer must clear (notebook 07, :mod:`bgfn.studies.odometer.bars`): median max horizontal
     error per dataset, method (the oracle speed per sigma) and duration, its lines, then per dataset (recorded drives
     first) the odometers' speed in a few outages, the error growth over the outage and the speed error's offset per
     outage beside its fluctuation."""
     file = res.table(SHARED_TABLES["odometer_summary"])
     summary = read_csv(file)
     if summary is None or summary.empty:
-        return [missing_note(file, "the odometer bars", "notebook 04, `evaluate.odometer`")]
+        return [missing_note(file, "the odometer bars", "notebook 07, `evaluate.odometer`")]
     wide = odometer_table(summary)
     figures = [res.out / "figures" / f"{stem}_{dataset_id(d)}.png" for d in recorded_first(summary["dataset"].unique())
                for stem in ("odometer_speed", "odometer_growth", "odometer_errors")]
@@ -154,15 +154,15 @@ def odometer_section(res: ProfileResults) -> list:
 
 
 def sweep_section(res: ProfileResults) -> list:
-    """The outage sweep (notebook 04) as ``median [interval]`` per duration, its source, the paired
+    """The outage sweep (notebook 06) as ``median [interval]`` per duration, its source, the paired
     comparisons (:func:`bgfn.studies.outage_sweep.sweep.describe_sweep`) when their table is there."""
     file = res.table(SHARED_TABLES["sweep_summary"])
     st = sweep_table(res.sweep)
     if st is None:
-        return [missing_note(file, "the outage sweep", "notebook 04, `evaluate.sweep`")]
+        return [missing_note(file, "the outage sweep", "notebook 06, `evaluate.sweep`")]
     sw = (res.evaluation or {}).get("evaluate", {}).get("sweep", {})
     pieces = [compact(st.style, f"Median max horizontal error (m) [95 % interval], profile {res.profile}"),
-              provenance(file, (res.evaluation or {}).get("meta"), res.current,
+              provenance(file, (res.sweep_record or {}).get("meta"), res.current,
                          datasets=[f"`{d}`" for d in sw.get("datasets", [])], seeds=sw.get("seeds"),
                          starts=sw.get("n_starts"), folds=sw.get("folds"))]
     if res.sweep_pairs is not None:

@@ -235,7 +235,7 @@ def answer_accuracy(inp: VerdictInputs) -> str:
     """Question 1: the break-even increment error against BGFN's own, in the sweep at 30 s (else the outages)."""
     be = inp.breakeven
     if be is None or not len(be):
-        return "How accurate must the increments be? Not measured: notebook 04's oracle has not run for this drive."
+        return "How accurate must the increments be? Not measured: notebook 06's oracle has not run for this drive."
     sel = be[(be["method"] == SUBJECT) & (be["baseline"] == "INS")]
     sweep = sel[(sel["outage"].astype(str) == "sweep") & np.isclose(sel["duration_s"].astype(float), 30.0)]
     r = (sweep if len(sweep) else sel).iloc[0] if len(sel) else None
@@ -257,7 +257,7 @@ def answer_accuracy(inp: VerdictInputs) -> str:
 
 
 def answer_free_aids(table: pd.DataFrame, drift: pd.DataFrame | None = None) -> str:
-    """Question 2: INS+NHC against INS and BGFN, and whether BGFN adds to NHC; ``drift`` (notebook 02's
+    """Question 2: INS+NHC against INS and BGFN, and whether BGFN adds to NHC; ``drift`` (notebook 08's
     ``kf_ins_drift.csv``) puts the paper's two outages beside the drive's starts where they rank INS+NHC otherwise
     (:func:`drift_clause`)."""
     ins, nhc, bgfn, both = (_row(table, k) for k in ("INS", "INS+NHC", "BGFN", "BGFN+NHC"))
@@ -469,7 +469,7 @@ def headline(inp: VerdictInputs, table: pd.DataFrame) -> str:
 
 def drift_clause(drift: pd.DataFrame | None, ins_m: float, aided_m: float, duration_s: float = 30.0) -> str:
     """Where the aided INS is worse than standalone INS in the paper's two outages but better from the drive's
-    starts (notebook 02's ``kf_ins_drift.csv``, median at ``duration_s``), the clause that says so: two outages
+    starts (notebook 08's ``kf_ins_drift.csv``, median at ``duration_s``), the clause that says so: two outages
     are a small sample of a drive, and a reader should not take their order for the aid's (empty otherwise)."""
     if drift is None or drift.empty or not (np.isfinite(ins_m) and np.isfinite(aided_m)) or aided_m <= ins_m:
         return ""

@@ -1,7 +1,7 @@
 """How rough an IMU is beyond its vibration: Allan deviation at rest, the bias's wander between stops, and the
 yaw-rate residual while driving; measured alike on a recorded drive and on the simulated stand-in.
 
-The stand-in ``turin-sim-mpu6000`` must drift as a real MEMS IMU in a car does (notebook 02 compares the
+The stand-in ``turin-sim-mpu6000`` must drift as a real MEMS IMU in a car does (notebook 08 compares the
 drift). Which error terms set the drift? A 9-minute recorded drive cannot give the classic hour-long static
 Allan curve, so three measurements that a drive does allow, each run on the stand-in too (where the truth is
 known, so the method's own bias shows):

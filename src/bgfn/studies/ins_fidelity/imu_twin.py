@@ -1,4 +1,4 @@
-"""Is the stand-in's IMU as rough as a real one? The recorded drive against its trajectory twin (notebook 02).
+"""Is the stand-in's IMU as rough as a real one? The recorded drive against its trajectory twin (notebook 08).
 
 The stand-in ``turin-sim-mpu6000`` simulates a consumer MEMS IMU; its INS drift decides how hard the paper's field
 test is. Measured at rest (:mod:`bgfn.studies.ins_fidelity.imu_roughness`: Allan deviation, the bias between stops) the recorded
@@ -20,7 +20,7 @@ The twin needs more than its simulated instability ``m`` (the terms the filter d
 the two in quadrature, ``e_twin^2 = m^2 + x^2``, the simulated instability that gives the twin the recorded
 drive's ``e_rec`` is ``sqrt(e_rec^2 - x^2)`` (:func:`implied_setting`). From the MPU-6000 profile's 0.01 deg/s,
 :func:`settle_setting` repeats that step until it moves the setting by less than 10 %; the profile carries the
-result, and notebook 02 checks it on every run (:func:`twin_lines`: the twin's effective instability against the
+result, and notebook 08 checks it on every run (:func:`twin_lines`: the twin's effective instability against the
 recorded drive's, with the profile's setting).
 """
 
@@ -99,7 +99,7 @@ def twin_check(cfg: dict, recorded, stand_in, seeds=TWIN_SEEDS, scan: pd.DataFra
     seeds : sequence of int
         Seeds of the twin's IMU errors.
     scan : DataFrame, optional
-        The recorded drive's :func:`bgfn.studies.ins_fidelity.nees.consistency_scan` (notebook 02 has run it; default: run here).
+        The recorded drive's :func:`bgfn.studies.ins_fidelity.nees.consistency_scan` (notebook 08 has run it; default: run here).
     gyro_dps : float, optional
         Simulate the twin with this gyro bias instability (deg/s, every axis) instead of the stand-in's.
     report : callable, optional

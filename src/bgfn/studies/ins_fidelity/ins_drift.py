@@ -1,8 +1,8 @@
-"""Standalone-INS drift over the outage sweep's starts, drive against drive (notebook 02).
+"""Standalone-INS drift over the outage sweep's starts, drive against drive (notebook 08).
 
 How far does the INS alone drift in an outage of 10, 30, 60 s? Two outages per drive (the paper's tables) say
 little; the sweep's starts (:func:`bgfn.studies.outage_sweep.sweep.sweep_plan`: evenly spread over the drive, the same starts
-notebook 04 evaluates every network in) say it for the whole drive. Notebook 02 puts the drives side by side:
+notebook 06 evaluates every network in) say it for the whole drive. Notebook 02 puts the drives side by side:
 the simulated field-test stand-in ``turin-sim-mpu6000``, whose MEMS error model was set from levels measured
 on the recorded drive (:mod:`bgfn.data.imu_levels`), against that recorded drive ``rtklib-drive0708`` --
 does the stand-in drift as a real MEMS IMU does? -- and the INS with the vehicle constraints (``INS+NHC``,
@@ -28,7 +28,7 @@ from bgfn.paper import nhc_label, test_of
 from bgfn.parallel import Runner
 
 #: The stand-in drifts "as a real MEMS IMU does" when its median INS drift lies within this factor of the recorded
-#: drive's at every duration (notebook 02; the stand-in's error model: :mod:`bgfn.studies.ins_fidelity.imu_twin`).
+#: drive's at every duration (notebook 08; the stand-in's error model: :mod:`bgfn.studies.ins_fidelity.imu_twin`).
 DRIFT_TOLERANCE = 1.5
 #: Columns of the per-run rows (``tables/kf_ins_drift_runs.csv``).
 DRIFT_RUN_COLUMNS: tuple[str, ...] = ("dataset", "test", "start_s", "duration_s", "method", "max_h_m", "final_h_m")

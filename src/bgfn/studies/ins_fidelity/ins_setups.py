@@ -117,7 +117,7 @@ def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None
     windows : sequence of (start, duration)
         The outages, s (:func:`bgfn.nav.outages.outage_windows`).
     baseline : Baseline, optional
-        The run with ``cfg`` as it is (notebook 02 has it already): reused for the setup it matches.
+        The run with ``cfg`` as it is (notebook 08 has it already): reused for the setup it matches.
 
     Returns
     -------
@@ -126,7 +126,7 @@ def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None
     """
     test = paper.test_of(drive.name)
     checked = check_windows(windows, float(drive.reference["time"].iloc[0]), float(drive.imu["time"].iloc[-1]),
-                            f"{drive.name}: profile outage_windows", sort=False)      # Outage k as in notebook 02
+                            f"{drive.name}: profile outage_windows", sort=False)      # Outage k as in notebook 08
     lever = drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0])
     true = _max_bias(drive.imu_bias, "gyro")            # NaN for a recorded IMU (its biases are unknown)
     true_accel = _max_bias(drive.imu_bias, "accel")

@@ -16,7 +16,7 @@ Per dataset, method and duration (the sweep) or outage (the paper's two): the me
 inside the 95 % bound, and a word: *consistent* when the median lies within a factor :data:`FACTOR` of 1.39,
 *overconfident* above, *underconfident* below.
 
-Which setting explains an inconsistent filter? :func:`consistency_scan` (notebook 02) runs the standalone INS from
+Which setting explains an inconsistent filter? :func:`consistency_scan` (notebook 08) runs the standalone INS from
 the sweep's starts of each recorded drive (a simulated IMU's error model is known exactly) with the gyro bias
 instability of the filter's error model set to each value of a grid: the INS drift of a MEMS IMU over tens of
 seconds is the heading error its gyro biases build, and a filter that under-states them is overconfident.

@@ -392,7 +392,7 @@ def speed_lr_search(tc: dict, profile: str, dataset: str, methods, data: dict[in
 
 def run_odometer_bars(cfg: dict, profile: str, datasets, ecfg: dict, runner: Runner | None = None,
                       report: Callable[[str], None] | None = None) -> tuple[pd.DataFrame, dict]:
-    """:func:`odometer_rows` of every dataset (notebook 04); the rows in dataset order and the facts."""
+    """:func:`odometer_rows` of every dataset (notebook 07); the rows in dataset order and the facts."""
     parts, facts = [], {}
     for name in datasets:
         rows, facts[name] = odometer_rows(cfg, profile, name, ecfg, runner)

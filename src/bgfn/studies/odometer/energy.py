@@ -1,7 +1,7 @@
 """The energy of the learned odometers (beyond the paper): ``BGFN-ODO`` against its ANN twin
 ``Transformer-ODO``, counted by the same rules as the paper's model (:mod:`bgfn.energy.rules`).
 
-Which networks: the odometers that notebook 04 trained (:mod:`bgfn.studies.odometer.bars`) on the first dataset of
+Which networks: the odometers that notebook 07 trained (:mod:`bgfn.studies.odometer.bars`) on the first dataset of
 ``evaluate.odometer.datasets`` (null: the sweep's), recorded drives first, in sweep fold 0, with the first of
 ``evaluate.odometer.network_seeds``. Which windows: ``energy.max_windows`` IMU windows of the odometer's length
 (``evaluate.odometer.window_s``) evenly spaced over that drive: an odometer reads the raw body-frame IMU only, so
@@ -38,7 +38,7 @@ FOLD = 0
 
 def odometer_dataset(cfg: dict, profile: str | None = None) -> str | None:
     """The dataset whose odometers are measured: the first of the odometer bars' drives
-    (:func:`bgfn.config.odometer_datasets`), recorded drives first, that is a car (notebook 04 trains no odometer
+    (:func:`bgfn.config.odometer_datasets`), recorded drives first, that is a car (notebook 07 trains no odometer
     for another platform; checked on the drive when ``profile`` is given); None when the profile trains no
     odometer network."""
     ecfg = cfg.get("evaluate") or {}
@@ -119,7 +119,7 @@ def odometer_energy(profile: str, cfg: dict, e_mac: float, e_ac: float, batch_si
     Raises
     ------
     FileNotFoundError
-        BGFN-ODO's checkpoint is missing (notebook 04 writes it); the message names the file.
+        BGFN-ODO's checkpoint is missing (notebook 07 writes it); the message names the file.
     bgfn.errors.DataError
         BGFN-ODO never improved on its initial weights (unless ``energy.allow_untrained``).
     """
@@ -132,7 +132,7 @@ def odometer_energy(profile: str, cfg: dict, e_mac: float, e_ac: float, batch_si
     paths = {m: folder / checkpoint_name(m, seed) for m in MEASURED if m in oc["methods"]}
     if "bgfn" not in paths or not paths["bgfn"].is_file():
         raise FileNotFoundError(f"BGFN-ODO's checkpoint not found: {folder / checkpoint_name('bgfn', seed)} -- "
-                                f"notebook 04_outage_evaluation.ipynb trains it (evaluate.odometer.methods)")
+                                f"notebook 07_learned_odometer.ipynb trains it (evaluate.odometer.methods)")
     paths = {m: p for m, p in paths.items() if p.is_file()}
     allow = bool((cfg.get("energy") or {}).get("allow_untrained", False))
     for m in SPIKING:

@@ -4,7 +4,7 @@ split into an offset that lasts the outage and a fluctuation around it (beyond t
 The filter averages a white error away: ``n`` speeds of white noise ``sigma`` leave ``sigma / sqrt(n)`` of it,
 which is why the oracle speed (:mod:`bgfn.studies.odometer.bars`, ``ORACLE-SPEED``) helps up to a noise of metres per
 second. An offset shared by every epoch of an outage it cannot average: an offset ``b`` alone moves the solution
-``b t`` along the track. This module measures both on notebook 04's honest speed series (``speed_series`` of
+``b t`` along the track. This module measures both on notebook 07's honest speed series (``speed_series`` of
 :func:`bgfn.studies.odometer.bars.odometer_rows`: each sweep outage predicted by its own fold's odometer, the networks'
 first seed), per odometer and duration ``D`` (the first ``D`` seconds of each outage):
 
@@ -111,7 +111,7 @@ def plot_error_parts(table: pd.DataFrame, dataset: str, bars: dict):
 
 
 def error_parts_lines(table: pd.DataFrame) -> list[str]:
-    """Per dataset and duration: each odometer's offset and fluctuation in the outages (notebook 04)."""
+    """Per dataset and duration: each odometer's offset and fluctuation in the outages (notebook 07)."""
     if table is None or table.empty:
         return []
     lines = []

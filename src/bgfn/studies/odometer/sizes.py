@@ -5,7 +5,7 @@ cores. Whether their failure against INS+NHC is a matter of size is a question f
 4 blocks, batch 8, up to 1000 epochs: the profile ``paper-odometer``), which takes minutes on a GPU and hours
 here. Such a run is made once, elsewhere, and kept:
 
-1. ``python -m bgfn odometers --profile paper-odometer`` runs notebook 04's odometer bars alone and writes the
+1. ``python -m bgfn odometers --profile paper-odometer`` runs notebook 07's odometer bars alone and writes the
    tables under ``results/paper-odometer/`` and the run's facts (:func:`write_run_facts`: device, wall time,
    jobs, torch) to ``odometer_run.json`` there;
 2. ``python -m bgfn odometers --profile paper-odometer --record`` keeps the summary (every row but the oracle's

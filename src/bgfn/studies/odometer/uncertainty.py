@@ -6,7 +6,7 @@ of its own speed, and the filter weighs every speed by it (R = std^2 times one c
 :mod:`bgfn.nav.odometer`). That helps only if the std ranks the errors: small where the speed is good, large where
 it is not. The calibration factor cannot repair a std that does not; it only scales all of them.
 
-This module checks the premise on the honest series of notebook 04's speed figure (``speed_series`` of
+This module checks the premise on the honest series of notebook 07's speed figure (``speed_series`` of
 :func:`bgfn.studies.odometer.bars.odometer_rows`: each outage of the sweep predicted by its own fold's odometer, the
 networks' first seed): the epochs of each odometer inside the outages are ranked by their predicted std and split
 into :data:`DEFAULT_GROUPS` groups of equal size, and each group's speed RMSE and share within +-2 sigma are set side

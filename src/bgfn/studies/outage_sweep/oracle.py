@@ -419,7 +419,7 @@ def describe_oracle(breakeven: pd.DataFrame) -> list[str]:
     return lines
 
 
-# ----------------------------------------------------------------------------------------------- notebook 04
+# ----------------------------------------------------------------------------------------------- notebook 06
 @dataclass
 class OracleResult:
     """The oracle rows of every test (:func:`run_oracle`).
@@ -526,7 +526,7 @@ def plot_oracle(table: pd.DataFrame, levels: pd.DataFrame, breakeven: pd.DataFra
 def run_oracle(cfg: dict, profile: str, setup, out=None, results: dict | None = None,
                sweep: pd.DataFrame | None = None, figures: bool = True,
                report: Callable[[str], None] | None = None, runner: Runner | None = None) -> OracleResult:
-    """The oracle rows of every dataset of notebook 04 (module docstring), their tables and figures.
+    """The oracle rows of every dataset of notebooks 04 and 06 (module docstring), their tables and figures.
 
     Parameters
     ----------

@@ -1,5 +1,5 @@
 """Outage sweep (beyond the paper): many starts and durations, networks trained without the outages they are
-tested on (k-fold), bootstrap intervals and paired tests, and the lines and tables notebook 04 shows of it."""
+tested on (k-fold), bootstrap intervals and paired tests, and the lines and tables notebook 06 shows of it."""
 
 from __future__ import annotations
 
@@ -360,7 +360,7 @@ def describe_sweep_size(sweep: pd.DataFrame) -> str:
 
 
 def pairs_style(pairs: pd.DataFrame):
-    """:func:`sweep_comparisons` styled for notebook 04 (win rate and ratios with two decimals, p with two digits)."""
+    """:func:`sweep_comparisons` styled for notebook 06 (win rate and ratios with two decimals, p with two digits)."""
     return pairs.style.format({"win_rate": "{:.2f}", "median_diff_m": "{:+.1f}", "median_ratio": "{:.2f}",
                                "p_value": "{:.2g}", "p_value_by_start": "{:.2g}"}).hide(axis="index")
 

@@ -41,7 +41,7 @@ def load_variant_network(path):
     """The network at ``path`` (:func:`bgfn.evaluate.networks.load_model`); DataError when notebook 03 has not
     trained it."""
     if not Path(path).exists():
-        raise DataError(path, "checkpoint", "a variant's network (notebook 03 trains it: train_variants)", "missing")
+        raise DataError(path, "checkpoint", "a variant's network (notebook 06 trains it: train_variants)", "missing")
     return load_model(path)
 
 

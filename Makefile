@@ -72,7 +72,7 @@ PARAMS := params/$(PROFILE).yaml $(BASE1:%=params/%.yaml) $(BASE2:%=params/%.yam
 RES := results/$(PROFILE)
 EXEC := $(NOTEBOOKS:%=$(RES)/notebooks/%.ipynb)
 SRC := $(shell find src/bgfn -name '*.py' -not -path '*/__pycache__/*' | sort)
-BOOK_SRC := $(shell find book \( -path book/_build -o -path book/notebooks -o -path book/_generated \) -prune \
+BOOK_SRC := $(shell find book \( -path book/_build -o -path book/notebooks -o -path book/_generated -o -path book/api \) -prune \
               -o -type f -print | sort)
 BOOK_STAMP := book/_build/.built-$(PROFILE)
 BOOK_HTML := book/_build/html/index.html
@@ -237,10 +237,11 @@ _notebooks: $(EXEC)
 # ---------------------------------------------------------------- book
 # The book shows the executed notebooks of $(PROFILE) (copied to the gitignored book/notebooks/) and the
 # profile's tables/figures (copied to book/_generated/, for pages that include them). book/_config.yml has
-# execute_notebooks: 'off'. Warnings are errors.
+# execute_notebooks: 'off'. The code page's module pages are written from the docstrings into book/api/ at each
+# build (removed first: a moved module leaves no page). Warnings are errors.
 define build_book
 	@echo "==> book from $(RES)/notebooks"
-	@rm -rf book/notebooks book/_generated && mkdir -p book/notebooks book/_generated
+	@rm -rf book/notebooks book/_generated book/api && mkdir -p book/notebooks book/_generated
 	@cp $(EXEC) book/notebooks/
 	@$(PY) -m bgfn.report.book_notebooks book/notebooks/*.ipynb   # one parameters cell: the run's values
 	@for d in tables figures; do if [ -d "$(RES)/$$d" ]; then cp -r "$(RES)/$$d" book/_generated/; fi; done
@@ -320,7 +321,7 @@ clean-debris:
 	  -print -delete | sed 's/^/    removed debris of an interrupted run: /'; fi
 
 clean:
-	rm -rf results book/_build book/notebooks book/_generated
+	rm -rf results book/_build book/notebooks book/_generated book/api
 
 distclean: clean
 	rm -rf $(VENV) data/processed

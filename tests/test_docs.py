@@ -2,17 +2,25 @@
 
 from __future__ import annotations
 
+import importlib.util
 import re
+import subprocess
+import sys
 
 import nbformat
 import pytest
+import yaml
 
 from bgfn.config import PROJECT_ROOT
 
 SRC = PROJECT_ROOT / "src" / "bgfn"
+BOOK = PROJECT_ROOT / "book"
+README = PROJECT_ROOT / "README.md"
 NOTEBOOKS = sorted((PROJECT_ROOT / "notebooks").glob("*.ipynb"))
 #: A notebook is prose, a parameters cell and calls into the package.
 MAX_CODE_LINES = 80
+#: A newcomer reads the README in two minutes; measurements and their history go to benchmarks/MEASUREMENTS.md.
+MAX_README_LINES = 120
 
 
 def _block(path, heading: str) -> str:
@@ -61,12 +69,105 @@ def test_the_papers_notebooks_come_first_and_hold_no_study():
 
 
 def test_readme_layout_names_every_package_and_top_level_module():
-    block = _block(PROJECT_ROOT / "README.md", "## Layout")
+    block = _block(README, "## Layout")
     for package, stem in _modules():
         name = f"{package}/" if package else f"{stem}.py"
         assert name in block, f"README.md's layout block does not name {name}"
-    words = {5: "five", 6: "six", 7: "seven", 8: "eight"}
-    assert f"built from {words[len(NOTEBOOKS)]} ordered notebooks" in (PROJECT_ROOT / "README.md").read_text()
+
+
+def test_readme_is_short_and_leaves_measurements_to_their_page():
+    text = README.read_text(encoding="utf-8")
+    assert len(text.splitlines()) <= MAX_README_LINES, f"README.md: keep it to {MAX_README_LINES} lines"
+    history = re.findall(r"`[0-9a-f]{7,40}`|\b20\d\d-\d\d-\d\d\b|CPU family", text)
+    assert not history, f"README.md: commits, dates and machines belong in benchmarks/MEASUREMENTS.md: {history}"
+    links = [link for link in re.findall(r"\]\(([^)#\s]+)", text) if not re.match(r"[a-z]+://", link)]
+    assert "benchmarks/MEASUREMENTS.md" in links and "CONTRIBUTING.md" in links
+    missing = [link for link in links if not (PROJECT_ROOT / link).exists()]
+    assert not missing, f"README.md links to missing files: {missing}"
+
+
+# ----------------------------------------------------------------------------------------------- the code page
+def _dotted_modules() -> list[str]:
+    """Every module and package of bgfn, dotted, from the files (``__main__`` is private: no page)."""
+    names = []
+    for p in sorted(SRC.rglob("*.py")):
+        if "__pycache__" in p.parts or p.name == "__main__.py":
+            continue
+        parts = p.relative_to(SRC.parent).with_suffix("").parts
+        names.append(".".join(parts[:-1] if p.name == "__init__.py" else parts))
+    return names
+
+
+def code_label(module: str) -> str:
+    """The label of a module's page (book/_templates/autosummary/module.rst): ``code-`` and the name, '.' '_' -> '-'."""
+    return "code-" + module.replace(".", "-").replace("_", "-")
+
+
+def _code_toctree() -> str:
+    """The folder the code page's recursive autosummary writes its module pages to, checked on the way."""
+    code = (BOOK / "code.md").read_text(encoding="utf-8")
+    m = re.search(r"^\.\. autosummary::\n((?:[ \t]+\S.*\n|\n)+)", code, re.M)
+    assert m, "book/code.md: no autosummary directive"
+    body = m.group(1)
+    assert ":recursive:" in body and body.split()[-1] == "bgfn", "book/code.md: autosummary, recursive, over bgfn"
+    return re.search(r":toctree:\s*(\S+)", body).group(1)
+
+
+def test_code_page_is_generated_at_build_time():
+    sphinx = yaml.safe_load((BOOK / "_config.yml").read_text())["sphinx"]
+    assert {"sphinx.ext.autodoc", "sphinx.ext.autosummary", "sphinx.ext.napoleon"} <= set(sphinx["extra_extensions"])
+    assert sphinx["config"]["autosummary_generate"] is True
+    folder = _code_toctree()
+    # the generated pages are never committed, and each build starts without the last one's
+    assert f"book/{folder}/" in (PROJECT_ROOT / ".gitignore").read_text().splitlines()
+    assert f"rm -rf book/notebooks book/_generated book/{folder}" in (PROJECT_ROOT / "Makefile").read_text()
+
+
+def test_code_page_has_a_labelled_page_for_every_module(tmp_path):
+    _code_toctree()
+    # autosummary's page generator, as the book build runs it (with the book's extension), in a process of its own
+    generate = ("import sys; sys.path.insert(0, sys.argv[1]); import code_page; code_page.prefer_modules(); "
+                "from sphinx.ext.autosummary.generate import main; main(sys.argv[2:])")
+    run = subprocess.run([sys.executable, "-c", generate, str(BOOK / "_ext"), "-o", str(tmp_path),
+                          "-t", str(BOOK / "_templates"), str(BOOK / "code.md")],
+                         capture_output=True, text=True, cwd=PROJECT_ROOT)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert "failed to import" not in run.stdout + run.stderr, (run.stdout + run.stderr)[-2000:]
+    for module in _dotted_modules():
+        page = tmp_path / f"{module}.rst"
+        assert page.is_file(), f"the code page has no page for {module}"
+        text = page.read_text()
+        assert f".. _{code_label(module)}:" in text and f".. automodule:: {module}" in text, text[:300]
+
+
+def test_book_links_to_code_name_existing_modules():
+    labels = {code_label(m) for m in _dotted_modules()}
+    pages = {p.name: p.read_text(encoding="utf-8") for p in sorted(BOOK.glob("*.md"))}
+    for nb in NOTEBOOKS:
+        pages[nb.name] = "\n".join(c.source for c in nbformat.read(nb, as_version=4).cells if c.cell_type == "markdown")
+    stale = [f"{page}: {target}" for page, text in pages.items()
+             for target in re.findall(r"<(code-[\w-]+)>`", text) if target not in labels]
+    assert not stale, "links to the code page that name no module of bgfn:\n  " + "\n  ".join(stale)
+
+
+def _code_page_extension():
+    spec = importlib.util.spec_from_file_location("code_page", BOOK / "_ext" / "code_page.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_docstrings_absolute_values_and_spilling_tables_are_made_literal():
+    pd = _code_page_extension()
+    assert pd._escape_bars("max |east| and |north|, ``|x|``") == r"max \|east\| and \|north\|, ``|x|``"
+    assert pd._escape_bars("| a line block |") == "| a line block |"
+    assert pd._escape_bars("|north| first") == r"\|north\| first"
+    good = ["=====  =====", "key    value", "=====  =====", ""]
+    assert pd._literal_tables(good) == good
+    spill = ["text", "", "=====  =====", "key    value", "a_long_key  value", "=====  =====", "", "after"]
+    out = pd._literal_tables(spill)
+    assert out[:4] == ["text", "", "::", ""] and out[4:8] == ["   " + line for line in spill[2:6]]
+    assert out[-1] == "after"
 
 
 def test_contributing_layout_names_every_module():

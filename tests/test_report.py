@@ -273,14 +273,8 @@ def test_book_pages_type_no_results():
                      "a paper/profile *setting* to ALLOWED with its reason):\n  " + "\n  ".join(bad))
 
 
-def test_book_references_to_code_and_files_exist():
-    code = (BOOK / "code.md").read_text(encoding="utf-8")
-    labels = set(re.findall(r"^\(([\w-]+)\)=\s*$", code, re.M))
-    for page, text in book_texts().items():
-        for target in re.findall(r"\{ref\}`[^`<]*<(code-[\w-]+)>`", text):
-            assert target in labels, f"{page}: {{ref}} to missing label {target} (add it to book/code.md)"
-    for inc in re.findall(r"```\{literalinclude\}\s+(\S+)", code):
-        assert (BOOK / inc).resolve().is_file(), f"book/code.md includes a missing file {inc}"
+def test_book_figures_exist():
+    # (links to the code page: tests/test_docs.py)
     for page in BOOK.glob("*.md"):
         if page.name == "README.md":                            # not part of the book
             continue
@@ -340,20 +334,6 @@ def test_check_book_finds_broken_images_anchors_and_bare_results(tmp_path):
     assert "empty file _images/a.png" in problems
     assert "notebooks/10_results.html (results page): no <table>" in problems
     assert cb.main([str(tmp_path)]) == 1
-
-
-def test_source_code_page_lists_every_module():
-    code = (BOOK / "code.md").read_text(encoding="utf-8")
-    modules = [p.relative_to(PROJECT_ROOT).as_posix() for p in sorted((PROJECT_ROOT / "src" / "bgfn").rglob("*.py"))
-               if p.name not in ("__init__.py", "__main__.py")]
-    missing = [m for m in modules if f"../{m}" not in code]
-    assert not missing, f"add these modules to book/code.md: {missing}"
-    # every entry is whole (a merge once left dropdowns open, which the book build only warns about) and once
-    labels = re.findall(r"^\((code-[^)]+)\)=$", code, flags=re.M)
-    assert len(labels) == len(set(labels)), "book/code.md: a module's label appears twice"
-    includes = re.findall(r"```\{literalinclude\} (\S+)\n(.*?)\n```\n````", code, flags=re.S)
-    assert len(includes) == code.count("{literalinclude}") == len(labels), "book/code.md: an unclosed source block"
-    assert all(opts == ":language: python\n:linenos:" for _, opts in includes)
 
 
 def test_variant_tables_put_profiles_side_by_side():

@@ -53,7 +53,9 @@ def test_the_package_keeps_its_contracts(tmp_path):
     ({"nav/planted_a.py": "from bgfn.nav import planted_b\n",
       "nav/planted_b.py": "def f():\n    from bgfn.nav import planted_a\n    return planted_a\n"}, "No import cycle"),
     # the filter engine importing an aid
-    ({"nav/filter.py": "+from bgfn.nav import constraints\n"}, "The filter engine imports no aid"),
+    ({"nav/engine.py": "+from bgfn.nav import gnss_aid\n"}, "The filter engine imports no aid"),
+    # the filter run importing a vehicle aid
+    ({"nav/filter.py": "+from bgfn.nav import constraints\n"}, "imports no vehicle aid"),
 ])
 def test_the_check_fails_on_a_planted_import(tmp_path, planted, broken):
     src = _copy(tmp_path)

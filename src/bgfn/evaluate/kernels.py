@@ -62,7 +62,7 @@ def compile_kernels(nav_section: dict | None = None) -> float:
     ctx = navigation_context(drive, nav_section, [start])                     # the evaluation's context
     epochs = np.arange(start - 5.0, start + OUTAGE[1] + 5.0, 1.0)
     track = no.SpeedTrack(epochs, np.full(epochs.size, 8.0), np.full(epochs.size, 0.5))
-    run_outages(ctx, window, None, "INS", None, None, constraints=no.Odometer(ctx.constraints, track))
+    run_outages(ctx, window, None, "INS", None, None, aids=[ctx.constraints, no.Odometer(ctx.constraints, track)])
     compile_lif_kernels()
     return time.perf_counter() - t0
 

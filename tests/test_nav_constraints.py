@@ -242,8 +242,8 @@ def test_zupt_holds_the_position_at_a_stop_where_the_ins_drifts():
     assert con.still[standing[1:]].all()                          # IMU rows are the reference rows after the first
     assert (con.aid[standing[1:]] == cn.AID_ZUPT).sum() == 39     # one per second, 22 s .. 60 s
     drift = {}
-    for name, c in (("INS", None), ("ZUPT", con)):
-        res = run_filter(imu, init, noise, aids=[c])
+    for name, aids in (("INS", []), ("ZUPT", [con])):
+        res = run_filter(imu, init, noise, aids=aids)
         p = res.trajectory[["lat", "lon"]].to_numpy()[standing]
         ned = np.column_stack([(p[:, 0] - p[0, 0]) * 6.37e6, (p[:, 1] - p[0, 1]) * 6.37e6 * np.cos(p[0, 0])])
         drift[name] = np.hypot(*ned.T).max()

@@ -20,7 +20,8 @@ from bgfn.nav import baseline, ins_setups, metrics, sim
 from bgfn.nav import error_model as em
 from bgfn.nav import navego_setup as ns
 from bgfn.nav import state as st
-from bgfn.nav.filter import noise_arrays, run_filter, run_outage
+from bgfn.nav.engine import noise_arrays
+from bgfn.nav.filter import run_filter, run_outage
 from bgfn.nav.outages import OutageWindow
 from synthetic_drive import demo_drive
 

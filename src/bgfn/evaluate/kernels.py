@@ -1,6 +1,6 @@
 """Compile the navigation's numba kernels (and BGFN's LIF kernels) into numba's cache before the notebooks call them.
 
-Every kernel of the filter engine and its aids (:mod:`bgfn.nav.strapdown`, :mod:`bgfn.nav.filter`,
+Every kernel of the filter engine and its aids (:mod:`bgfn.nav.strapdown`, :mod:`bgfn.nav.engine`,
 :mod:`bgfn.nav.error_model`, :mod:`bgfn.nav.constraints`, ...) is ``numba.njit(cache=True)``: numba compiles it on
 its first call and writes the machine code beside the source (``__pycache__``), where every later process, the
 parallel runner's workers included, loads it in a fraction of a second. On a fresh clone that first call came in

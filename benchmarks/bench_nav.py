@@ -28,7 +28,7 @@ import numpy as np
 import pandas as pd
 
 from bgfn.io import update_json
-from bgfn.nav.baseline import filter_setup, nav_config
+from bgfn.nav.baseline import initial_and_noise, nav_config
 from bgfn.nav.filter import run_filter
 from bgfn.train.speed import bench_file, interleaved_times, paired_ratio, ratio_text
 
@@ -78,7 +78,7 @@ def main() -> int:
     n_pyins = int(os.environ.get("BENCH_PYINS_REPEATS", 3))
     name, imu, gnss5, meta, drive = _load()
     gnss1 = gnss5.iloc[::max(1, int(round(len(gnss5) / (imu["time"].iloc[-1] - imu["time"].iloc[0]))))]
-    init, noise = filter_setup(drive, nav_config({}))
+    init, noise = initial_and_noise(drive, nav_config({}))
     lever = meta.get("lever_arm_m", [0.0, 0.0, 0.0])
 
     def ours(g):

@@ -118,13 +118,13 @@ def test_hybrid_equals_run_filter_fed_with_the_same_fixes(ctx5):
 
 
 def test_constrained_runs_equal_the_filters_with_the_same_constraints(ctx5):
-    """INS+NHC and a network's +NHC run (the stepping kernels driven by bgfn.evaluate) are run_outage / run_filter
+    """INS+NHC and a network's +NHC run (the engine stepped by bgfn.evaluate) are run_outage / run_filter
     with the same constraints and fixes; the vehicle frame is the GPS-aided run's estimate at the start."""
     s, d = WINDOWS[1]
     con = ctx5.constraints
     assert con is not None and np.count_nonzero(con.aid) > 0
-    run = ev.run_outages(ctx5, [(s, d)], None, "INS+NHC", None, constraints=con)[0]
-    ref = run_outage(ctx5.drive.imu, ctx5.state_at(s), OutageWindow(s, d), ctx5.noise, ctx5.lever, aid=con)
+    run = ev.run_outages(ctx5, [(s, d)], None, "INS+NHC", None, aids=[con])[0]
+    ref = run_outage(ctx5.drive.imu, ctx5.state_at(s), OutageWindow(s, d), ctx5.noise, ctx5.lever, aids=[con])
     np.testing.assert_allclose(run.trajectory[["lat", "lon"]].to_numpy(), ref.trajectory[["lat", "lon"]].to_numpy(),
                                rtol=0, atol=1e-12)
     np.testing.assert_allclose(run.trajectory[["v_n", "v_e", "yaw"]].to_numpy(),
@@ -132,11 +132,11 @@ def test_constrained_runs_equal_the_filters_with_the_same_constraints(ctx5):
     ins = ev.run_outages(ctx5, [(s, d)], None)[0]
     assert not np.allclose(ins.trajectory["lat"], run.trajectory["lat"], rtol=0, atol=1e-12)
     f = Heading(window=20)
-    hyb = ev.run_outages(ctx5, [(s, d)], f, "BGFN+NHC", 0, {"std_m": 1.5, "fusion_rate_hz": 1.0}, constraints=con)[0]
+    hyb = ev.run_outages(ctx5, [(s, d)], f, "BGFN+NHC", 0, {"std_m": 1.5, "fusion_rate_hz": 1.0}, aids=[con])[0]
     fx = hyb.pseudo.rename(columns={"std_m": "std_n"}).assign(std_e=lambda x: x["std_n"], std_d=np.nan)
     ref = run_filter(ctx5.drive.imu, ctx5.state_at(s), ctx5.noise, None, ctx5.lever, [(s, d)],
                      pseudo_gps=TablePseudoGps(fx), t_end=s + d, pseudo_rate_hz=1.0,
-                     aid=con.frozen(ctx5.state_at(s).time))
+                     aids=[con.frozen(ctx5.state_at(s).time)])
     np.testing.assert_allclose(hyb.trajectory[["lat", "lon", "h"]].to_numpy(),
                                ref.trajectory[["lat", "lon", "h"]].to_numpy(), rtol=0, atol=1e-11)
     np.testing.assert_allclose(hyb.trajectory[["v_n", "v_e", "roll", "yaw"]].to_numpy(),
@@ -153,7 +153,7 @@ def test_tables_have_the_nhc_rows_of_every_method(drive5):
     assert res.constraints["aid_epochs"] > 0
     ins_nhc = [r for r in res.runs if r.method == "INS+NHC" and r.start == WINDOWS[0][0]][0]
     ctx = ev.navigation_context(drive5, NAV, [s for s, _ in WINDOWS])
-    again = ev.run_outages(ctx, [WINDOWS[0]], None, "INS+NHC", None, ecfg["pseudo_gps"], constraints=ctx.constraints)
+    again = ev.run_outages(ctx, [WINDOWS[0]], None, "INS+NHC", None, ecfg["pseudo_gps"], aids=[ctx.constraints])
     pd.testing.assert_frame_equal(ins_nhc.trajectory, again[0].trajectory, check_exact=True)
     (line, _) = ev.describe_tables([res])
     assert "INS+NHC" in line and "BGFN+NHC" in line and "INS+NHC)" in line
@@ -219,8 +219,8 @@ def test_evaluation_never_reads_gnss_inside_an_outage(drive5):
         for name, drv in (("with", drive5), ("nan", blind)):
             ctx = ev.navigation_context(drv, NAV, [s])
             runs = ev.run_outages(ctx, [(s, d)], None) + ev.run_outages(ctx, [(s, d)], Heading(), "BGFN", 0)
-            runs += (ev.run_outages(ctx, [(s, d)], None, "INS+NHC", constraints=ctx.constraints)       # the vehicle
-                     + ev.run_outages(ctx, [(s, d)], Heading(), "BGFN+NHC", 0, constraints=ctx.constraints))  # frame too
+            runs += (ev.run_outages(ctx, [(s, d)], None, "INS+NHC", aids=[ctx.constraints])       # the vehicle
+                     + ev.run_outages(ctx, [(s, d)], Heading(), "BGFN+NHC", 0, aids=[ctx.constraints]))  # frame too
             out[name] = [r.trajectory for r in runs] + [r.pseudo for r in runs[1:]], ev.gps_run(ctx, s, d).trajectory
         for a, b in zip(out["with"][0], out["nan"][0]):
             pd.testing.assert_frame_equal(a, b, check_exact=True)

@@ -48,8 +48,8 @@ def test_the_warm_up_compiles_what_a_drive_then_needs():
     sig = json.loads(done.stdout.strip().splitlines()[-1])
     assert not any(sig["before"].values())                       # a fresh process: nothing compiled or loaded yet
     # the filter engine's and the aids' kernels that Python calls (the others are inlined into them)
-    for name in ("bgfn.nav.filter.propagate_steps", "bgfn.nav.filter.sequential_update", "bgfn.nav.filter.feedback",
-                 "bgfn.nav.filter.update_position", "bgfn.nav.constraints.nhc_measurement",
+    for name in ("bgfn.nav.engine.propagate_steps", "bgfn.nav.engine.fuse", "bgfn.nav.gnss_aid.position_measurement",
+                 "bgfn.nav.constraints.nhc_measurement",
                  "bgfn.nav.constraints.vehicle_velocity_rows"):
         assert sig["warm"][name], name
     assert sig["after"] == sig["warm"]                           # nothing new to compile for the drive

@@ -203,7 +203,7 @@ def test_alignment_mode_reference_auto_gnss(rest_drive):
     auto = baseline.run_drive(sighted, NAV).trajectory
     refmode = baseline.run_drive(sighted, {**NAV, "alignment": {"mode": "reference"}}).trajectory
     pd.testing.assert_frame_equal(auto, refmode)                      # auto = today's start when there is an attitude
-    forced = baseline.setup_filter(sighted, baseline.nav_config({**NAV, "alignment": {"mode": "gnss"}}))
+    forced = baseline.prepare_filter(sighted, baseline.nav_config({**NAV, "alignment": {"mode": "gnss"}}))
     assert forced.alignment is not None and forced.initial.time > REST_S
     assert baseline.filter_start(sighted, NAV) == ref["time"].iloc[0]
     assert baseline.filter_start(drive, NAV) == forced.initial.time

@@ -1,6 +1,8 @@
 """The vehicle constraints (bgfn.nav.constraints): NHC and ZUPT measurements, the stillness detector, the vehicle
 frame, and what they do to an unaided INS on simulated drives (bgfn.nav.sim)."""
 
+from types import SimpleNamespace
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -204,7 +206,7 @@ def test_nhc_bounds_the_cross_track_drift_of_a_lateral_tilt(bias):
     init, noise = _start(ref)
     con = cn.build_constraints(imu, EKINOX, _body_frame())
     ins = _cross_along(run_filter(imu, init, noise), ref)[0]
-    aided = _cross_along(run_filter(imu, init, noise, aid=con), ref)[0]
+    aided = _cross_along(run_filter(imu, init, noise, aids=[con]), ref)[0]
     assert np.abs(ins).max() > 15.0 and abs(ins[-1]) > 15.0
     assert np.abs(aided).max() < 2.0
 
@@ -219,7 +221,7 @@ def test_nhc_turns_the_velocity_with_a_heading_drift():
     init, noise = _start(ref)
     con = cn.build_constraints(imu, EKINOX, _body_frame())
     cross_ins, _, e_ins = _cross_along(run_filter(imu, init, noise), ref)
-    cross_nhc, _, e_nhc = _cross_along(run_filter(imu, init, noise, aid=con), ref)
+    cross_nhc, _, e_nhc = _cross_along(run_filter(imu, init, noise, aids=[con]), ref)
     assert np.abs(cross_ins).max() < 0.5
     assert abs(e_ins["yaw"].iloc[-1]) == pytest.approx(b * t_end, rel=0.05)       # the INS heading drifts, too
     assert abs(cross_nhc[-1]) == pytest.approx(v * b * t_end ** 2 / 2, rel=0.15)
@@ -240,8 +242,8 @@ def test_zupt_holds_the_position_at_a_stop_where_the_ins_drifts():
     assert con.still[standing[1:]].all()                          # IMU rows are the reference rows after the first
     assert (con.aid[standing[1:]] == cn.AID_ZUPT).sum() == 39     # one per second, 22 s .. 60 s
     drift = {}
-    for name, c in (("INS", None), ("ZUPT", con)):
-        res = run_filter(imu, init, noise, aid=c)
+    for name, aids in (("INS", []), ("ZUPT", [con])):
+        res = run_filter(imu, init, noise, aids=aids)
         p = res.trajectory[["lat", "lon"]].to_numpy()[standing]
         ned = np.column_stack([(p[:, 0] - p[0, 0]) * 6.37e6, (p[:, 1] - p[0, 1]) * 6.37e6 * np.cos(p[0, 0])])
         drift[name] = np.hypot(*ned.T).max()
@@ -259,16 +261,16 @@ def test_zupt_is_refused_at_speed():
     init, noise = _start(ref)
     con = cn.build_constraints(imu, EKINOX, _body_frame())
     assert con.still[300:].all()                                  # the detector is fooled
-    _, along, _ = _cross_along(run_filter(imu, init, noise, aid=con), ref)
+    _, along, _ = _cross_along(run_filter(imu, init, noise, aids=[con]), ref)
     assert np.abs(along).max() < 5.0                              # no ZUPT: no stop forced on a moving car
     ungated = cn.build_constraints(imu, EKINOX, _body_frame(zupt_max_speed_mps=100.0))
-    _, along_bad, _ = _cross_along(run_filter(imu, init, noise, aid=ungated), ref)
+    _, along_bad, _ = _cross_along(run_filter(imu, init, noise, aids=[ungated]), ref)
     assert np.abs(along_bad).max() > 100.0
 
 
 # ----------------------------------------------------------------------------------------------- plumbing
 def test_constraints_without_epochs_change_nothing():
-    """The constrained path with no aid epoch is the plain filter, bit for bit (and None is the default)."""
+    """The constrained path with no aid epoch is the plain filter, bit for bit (and no aid is the default)."""
     ref = sim.demo_trajectory(60.0)
     imu = _imu(ref, gyro_z=1e-4)
     init, noise = _start(ref)
@@ -276,11 +278,11 @@ def test_constraints_without_epochs_change_nothing():
     con = cn.build_constraints(imu, EKINOX, _body_frame())
     idle = cn.Constraints(con.config, con.imu_time, np.zeros_like(con.aid), con.still, con.mount_time, con.mount)
     a = run_filter(imu, init, noise, gnss, outage_windows=[(20.0, 20.0)])
-    b = run_filter(imu, init, noise, gnss, outage_windows=[(20.0, 20.0)], aid=idle)
+    b = run_filter(imu, init, noise, gnss, outage_windows=[(20.0, 20.0)], aids=[idle])
     for x, y in ((a.trajectory, b.trajectory), (a.bias, b.bias), (a.sd, b.sd), (a.updates, b.updates)):
         pd.testing.assert_frame_equal(x, y, check_exact=True)
     np.testing.assert_array_equal(a.P_updates, b.P_updates)
-    c = run_filter(imu, init, noise, gnss, outage_windows=[(20.0, 20.0)], aid=con)
+    c = run_filter(imu, init, noise, gnss, outage_windows=[(20.0, 20.0)], aids=[con])
     assert not np.allclose(c.trajectory["lat"], a.trajectory["lat"], rtol=0, atol=1e-12)
     # the bias table follows the constraints' updates too: it changes at the aid epochs
     jumps = np.flatnonzero(np.any(np.diff(c.bias.iloc[:, 1:].to_numpy(), axis=0) != 0, axis=1)) + 1
@@ -315,7 +317,7 @@ def test_baseline_has_the_ins_nhc_row_beside_the_ins_row():
     assert list(b.outage_table["method"]) == ["INS", "INS", "INS+NHC", "INS+NHC"]
     con = baseline.outage_constraints(drive, cfg, b.full)
     again = run_outage(drive.imu, b.states["outage_2"], windows[1], b.noise, drive.meta["lever_arm_m"],
-                       aid=con)
+                       aids=[con])
     e = b.outage_errors["outage_2"]
     np.testing.assert_array_equal(e.loc[e["method"] == "INS+NHC", "north"].to_numpy(),
                                   metrics.navigation_errors(again.trajectory, drive.reference)["north"].to_numpy())
@@ -326,7 +328,7 @@ def test_baseline_has_the_ins_nhc_row_beside_the_ins_row():
         "outage", "INS_east_m", "INS_north_m", "INS+NHC_east_m", "INS+NHC_north_m"]
     assert b.constraints["aid_epochs"] == int(np.count_nonzero(con.aid))
     # the GPS-aided run is the paper's filter unless the profile asks: its states do not move
-    plain = run_filter(drive.imu, *baseline.filter_setup(drive, cfg), drive.gnss, drive.meta["lever_arm_m"])
+    plain = run_filter(drive.imu, *baseline.initial_and_noise(drive, cfg), drive.gnss, drive.meta["lever_arm_m"])
     pd.testing.assert_frame_equal(plain.trajectory, b.full.trajectory, check_exact=True)
     with_gps = baseline.run_baseline(drive, baseline.nav_config({"constraints_in_gps_run": True}), windows)
     assert not np.allclose(with_gps.full.trajectory["lat"], b.full.trajectory["lat"], rtol=0, atol=1e-12)
@@ -348,10 +350,10 @@ def test_the_platform_decides_which_aids_run():
     assert walker.summary()["platform"] == "walker" and walker.config.describe().startswith("platform walker: ZUPT")
     # a still epoch at speed (the detector fooled): a car gets the NHC instead, a walker no aid at all
     for platform, expect in (("walker", None), ("car", 2)):
-        sched = cn.build_constraints(imu, EKINOX, _body_frame(), platform=platform).schedule(
-            imu["time"].to_numpy(float))
-        k = int(sched.rows[sched.aid[sched.rows] == cn.AID_ZUPT][0])
-        m = sched.measurement(k, None, np.array([5.0, 0.0, 0.0]), np.eye(3))
+        t = imu["time"].to_numpy(float)
+        sched = cn.build_constraints(imu, EKINOX, _body_frame(), platform=platform).schedule(np.r_[t[0] - 0.01, t])
+        i = int(np.flatnonzero(sched.aid[sched.rows - 1] == cn.AID_ZUPT)[0])
+        m = sched.measurement(i, SimpleNamespace(v=np.array([5.0, 0.0, 0.0]), c=np.eye(3)))
         assert (m is None) if expect is None else (len(m.dz) == expect)
     with pytest.raises(DataError, match="platform"):
         cn.build_constraints(imu, EKINOX, _body_frame(), platform="boat")

@@ -219,7 +219,8 @@ def test_innovation_gate_rejects_a_jump_as_if_the_fix_were_missing(drive300):
 
 
 def test_gate_nis_is_the_sum_of_the_sequential_nis(drive300):
-    from bgfn.nav.filter import position_measurement, position_nis, update_position
+    from bgfn.nav.engine import fuse, measurement_nis
+    from bgfn.nav.gnss_aid import position_measurement
 
     ref, _, imu, errs, _, gnss = drive300
     init, noise = _setup(ref, errs)
@@ -228,15 +229,15 @@ def test_gate_nis_is_the_sum_of_the_sequential_nis(drive300):
     std = np.array([1.0, 1.0, 2.0])
     dz, H = np.empty(3), np.empty((3, 15))
     position_measurement(state.pos, state.v, state.c_bn, LEVER, fix, 0.0, dz, H)
-    batch, dof = position_nis(state.P, H, dz, std)
+    batch, dof = measurement_nis(state.P, H, dz, std)
     S = H @ state.P @ H.T + np.diag(std ** 2)
     assert dof == 3 and batch == pytest.approx(dz @ np.linalg.solve(S, dz), rel=1e-12)
     args = [a.copy() for a in (state.pos, state.v, state.c_bn, state.accel_bias, state.gyro_bias, state.P)]
-    sequential, accepted = update_position(*args, LEVER, fix, std, 0.0, np.empty(3), 0.0)
+    sequential, accepted = fuse(*args, H, dz, std, 0.0, np.empty(3))
     assert accepted and sequential == pytest.approx(batch, rel=1e-9)
     # a gate below it rejects the fix and leaves the state untouched
     args = [a.copy() for a in (state.pos, state.v, state.c_bn, state.accel_bias, state.gyro_bias, state.P)]
-    nis, accepted = update_position(*args, LEVER, fix, std, 0.0, np.empty(3), 0.5 * batch)
+    nis, accepted = fuse(*args, H, dz, std, 0.5 * batch, np.empty(3))
     assert not accepted and nis == pytest.approx(batch)
     np.testing.assert_array_equal(args[0], state.pos)
     np.testing.assert_array_equal(args[5], state.P)

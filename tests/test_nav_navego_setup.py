@@ -21,7 +21,8 @@ from bgfn.studies.ins_fidelity import ins_setups
 from bgfn.nav import error_model as em
 from bgfn.nav import navego_setup as ns
 from bgfn.nav import state as st
-from bgfn.nav.filter import noise_arrays, run_filter, run_outage
+from bgfn.nav.engine import noise_arrays
+from bgfn.nav.filter import run_filter, run_outage
 from bgfn.nav.outages import OutageWindow
 from synthetic_drive import demo_drive
 
@@ -96,7 +97,7 @@ def test_shipped_setup_is_the_filter_as_it_was(drive):
     cfg = baseline.nav_config(NAV)
     assert cfg["ins_tuning"] == "shipped"
     assert baseline.filter_imu(drive, cfg) is drive.imu
-    initial, noise = baseline.filter_setup(drive, cfg)
+    initial, noise = baseline.initial_and_noise(drive, cfg)
     expected = st.noise_from_imu_errors(drive.meta["imu_errors"], "random_walk", 1.0)
     for f in ("gyro_noise", "accel_noise", "gyro_bias_walk", "accel_bias_walk", "gyro_bias_tau", "accel_bias_tau",
               "gyro_bias_std", "accel_bias_std"):
@@ -114,7 +115,7 @@ def test_navego_setup_removes_the_static_biases_and_starts_at_the_dynamic_ones(d
         for i, a in enumerate("xyz"):
             np.testing.assert_array_equal(imu[f"{s}_{a}"], drive.imu[f"{s}_{a}"] - errs[f"{s}_bias_fixed"][i])
     np.testing.assert_array_equal(imu["time"], drive.imu["time"])
-    initial, noise = baseline.filter_setup(drive, cfg)
+    initial, noise = baseline.initial_and_noise(drive, cfg)
     np.testing.assert_array_equal(initial.gyro_bias, errs["gyro_bias_instability"])
     np.testing.assert_array_equal(initial.accel_bias, errs["accel_bias_instability"])
     np.testing.assert_allclose(np.sqrt(np.diag(initial.P)[em.BG]), errs["gyro_bias_instability"], rtol=1e-12)
@@ -139,7 +140,7 @@ def test_removing_a_static_bias_stops_the_drift_of_a_stationary_ins():
     end = {}
     for tuning in ns.INS_TUNINGS:
         cfg = baseline.nav_config({**NAV, "ins_tuning": tuning})
-        initial, noise = baseline.filter_setup(drive, cfg)
+        initial, noise = baseline.initial_and_noise(drive, cfg)
         res = run_outage(baseline.filter_imu(drive, cfg), initial, window, noise)
         end[tuning] = metrics.navigation_errors(res.trajectory, ref).iloc[-1]
     # shipped: the bias is not known, the position runs off as b t^2 / 2 (9 m north, -13.5 m east)

@@ -10,7 +10,8 @@ from bgfn.nav import constraints as cn
 from bgfn.nav import error_model as em
 from bgfn.nav import odometer as od
 from bgfn.nav import transform
-from bgfn.nav.filter import AidMeasurement, gated_std, run_filter
+from bgfn.nav.engine import Measurement, gated_std
+from bgfn.nav.filter import run_filter
 from test_nav_constraints import EKINOX, RATE, _body_frame, _cross_along, _imu, _road, _start
 
 SPEED = 12.0
@@ -18,7 +19,7 @@ SPEED = 12.0
 
 def _along_error(imu, ref, aid):
     init, noise = _start(ref)
-    return _cross_along(run_filter(imu, init, noise, aid=aid), ref)[1]
+    return _cross_along(run_filter(imu, init, noise, aids=od.aid_list(aid)), ref)[1]
 
 
 def _track(ref, speed, std, rate=1.0):
@@ -103,7 +104,7 @@ def test_gated_std_drops_only_the_rows_beyond_their_threshold():
     out = gated_std(P, H, np.array([5.0, 5.0, 0.05]), std, np.array([0.0, 10.0, 10.0]))
     # s = 0.01 + 0.01 = 0.02: row 1 (25 / 0.02 = 1250 > 10) out; row 0 has no gate; row 2 (0.125) in
     assert np.isfinite(out[0]) and np.isnan(out[1]) and out[2] == 0.1
-    assert AidMeasurement(np.zeros(1), H[:1], std[:1]).gate is None
+    assert Measurement(np.zeros(1), H[:1], std[:1]).gate is None
 
 
 def test_speed_track_lookup_and_bad_input():

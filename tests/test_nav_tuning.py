@@ -81,7 +81,7 @@ NAV = {"init": {"position_std_m": 0.5, "height_std_m": 1.0, "velocity_std_mps": 
 
 def test_auto_finds_the_true_noise_factor_and_makes_the_nis_consistent(quiet_drive, tmp_path):
     cfg = baseline.nav_config({**NAV, "noise_scale": "auto"})
-    setup = baseline.setup_filter(quiet_drive, cfg)
+    setup = baseline.prepare_filter(quiet_drive, cfg)
     t = setup.tuning
     assert SCALE_BAND[0] < t.scale < SCALE_BAND[1], t.runs
     assert consistency.verdict(t.mean_nis_at_one, t.dof) == "overconfident" and t.mean_nis_at_one > 2 * t.dof
@@ -102,9 +102,9 @@ def test_auto_finds_the_true_noise_factor_and_makes_the_nis_consistent(quiet_dri
 
 
 def test_a_numeric_factor_runs_no_search(quiet_drive):
-    setup = baseline.setup_filter(quiet_drive, baseline.nav_config({**NAV, "noise_scale": 3.0}))
+    setup = baseline.prepare_filter(quiet_drive, baseline.nav_config({**NAV, "noise_scale": 3.0}))
     assert setup.tuning is None and setup.noise_scale == 3.0 and setup.lines("quiet") == []
-    walk = baseline.setup_filter(quiet_drive, baseline.nav_config(
+    walk = baseline.prepare_filter(quiet_drive, baseline.nav_config(
         {**NAV, "noise_scale": 3.0, "noise_search": {"bias_walk": True}}))
     assert np.allclose(walk.noise.gyro_bias_walk, 3.0 * setup.noise.gyro_bias_walk)
     for bad in ("fast", -1.0, 0.0, True):

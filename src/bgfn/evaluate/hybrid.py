@@ -16,7 +16,9 @@ from bgfn.learning import (ANGULAR_RATE_CHANNELS, ATTITUDE_CHANNELS, CHANNELS, D
                            IMU_CHANNELS, SPECIFIC_FORCE_CHANNELS, YAW_CHANNEL, WindowSet, encode_yaw, heading_velocity,
                            with_derived_channels)
 from bgfn.nav import baseline, earth, error_model as em, metrics, navego_setup, transform
-from bgfn.nav.filter import noise_arrays, propagate, run_filter, update_position
+from bgfn.nav.engine import Stepper
+from bgfn.nav.filter import run_filter
+from bgfn.nav.gnss_aid import position_fix
 from bgfn.nav.outages import epochs_before
 from bgfn.nav.strapdown import trajectory_frame
 
@@ -120,7 +122,7 @@ def navigation_context(drive, nav_section: dict | None, starts: Sequence[float])
         Outage starts, s.
     """
     cfg = baseline.nav_config(nav_section)
-    initial, noise = baseline.filter_setup(drive, cfg)
+    initial, noise = baseline.initial_and_noise(drive, cfg)
     filter_imu = baseline.filter_imu(drive, cfg)     # drive.imu, or without NaveGo's static biases
     lever = np.asarray(drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0]), dtype=float)
     starts = sorted({float(s) for s in starts})
@@ -132,7 +134,7 @@ def navigation_context(drive, nav_section: dict | None, starts: Sequence[float])
     snaps = {f"start_{i}": float(t) for i, t in enumerate(epochs_before(imu_time, starts, drive.name))}
     full = run_filter(filter_imu, initial, noise, drive.gnss, lever, snapshots=snaps,
                       gate_probability=cfg["innovation_gate"], source=drive.name,
-                      aid=baseline.gps_constraints(drive, cfg, initial, noise))
+                      aids=baseline.gps_aids(drive, cfg, initial, noise))
     states = {s: full.states[f"start_{i}"] for i, s in enumerate(starts)}
     imu = drive.imu[list(CHANNELS[IMU_CHANNELS])].to_numpy(float)          # [M, 6] in the input layout
     tr = full.trajectory
@@ -206,18 +208,15 @@ def _extra_columns(options: dict) -> tuple[str, ...]:
 
 
 class _Run:
-    """Closed-loop filter of one outage run, advanced epoch by epoch.
+    """One outage run of the closed-loop filter, advanced pseudo epoch by pseudo epoch, and its network inputs.
 
-    It drives the stepping kernels of :mod:`bgfn.nav.filter` (``propagate_steps``, ``update_position``) directly, because
-    the network inputs at a pseudo epoch need the attitude the run itself computed up to that epoch, and one
-    ``run_filter`` call per epoch costs ~2 ms of pandas overhead (the sweep has ~10^5 epochs).
-    ``tests/test_evaluate.py`` checks that the result equals ``run_filter`` / ``run_outage`` fed the same fixes.
-    With ``constraints`` (an aid of the engine, :class:`bgfn.nav.filter.Aid`) the prediction fuses their
-    updates at their epochs (:func:`bgfn.nav.filter.propagate`), the vehicle frame held at its estimate at the start.
+    The filter is the engine's :class:`~bgfn.nav.engine.Stepper` (with ``aids``, e.g. the vehicle constraints, their
+    vehicle frame held at its estimate at the start); this class keeps the network inputs, because those at a
+    pseudo epoch need the attitude the run itself computed up to that epoch. ``tests/test_evaluate.py`` checks
+    that the result equals ``run_filter`` / ``run_outage`` fed the same fixes.
     """
 
-    def __init__(self, ctx: NavContext, start: float, duration: float, n_window: int, extra: tuple,
-                 constraints=None):
+    def __init__(self, ctx: NavContext, start: float, duration: float, n_window: int, extra: tuple, aids=()):
         self.start, self.duration, self.end = float(start), float(duration), float(start) + float(duration)
         s = ctx.state_at(start)
         self.state0 = s
@@ -226,22 +225,7 @@ class _Run:
         if len(sel) == 0:
             raise DataError(ctx.drive.name, "imu", f"IMU rows inside the outage [{start}, {self.end}]", "none")
         self.time = t_all[sel]
-        self.dt = np.diff(np.concatenate([[s.time], self.time]))
         self.times = np.concatenate([[s.time], self.time])          # output rows
-        n = len(self.times)
-        self.pos, self.v = s.pos.astype(float).copy(), s.v.astype(float).copy()
-        self.c = np.ascontiguousarray(s.c_bn, dtype=float).copy()
-        self.ba, self.bg = s.accel_bias.astype(float).copy(), s.gyro_bias.astype(float).copy()
-        self.P = np.ascontiguousarray(s.P, dtype=float).copy()
-        self.q = noise_arrays(ctx.noise)
-        self.out_pos, self.out_v = np.empty((n, 3)), np.empty((n, 3))
-        self.out_c, self.out_sd = np.empty((n, 3, 3)), np.empty((n, em.N_STATES))
-        self.out_pos[0], self.out_v[0], self.out_c[0] = self.pos, self.v, self.c
-        self.out_sd[0] = np.sqrt(np.maximum(np.diag(self.P), 0.0))
-        self.row = 0
-        self.schedule = None
-        if constraints is not None:
-            self.schedule = constraints.schedule(self.time, ctx.drive.name, hold_at=s.time)
         self.lever = ctx.lever
         self.p0 = s.antenna_position(ctx.lever)                     # P_GPS0 of Eq. (pred-gps)
         # Input features [roll, pitch, yaw, f, w, extra]: N samples up to the start from the GPS-aided run,
@@ -265,45 +249,51 @@ class _Run:
         if not np.all(np.isfinite(self.feat[: self.n_window])):
             raise DataError(ctx.drive.name, "attitude", "the GPS-aided solution before the outage start", "NaN")
         # the strapdown of this run reads the same IMU samples as its network inputs
-        self.gyro = np.ascontiguousarray(self.feat[self.n_window:, ANGULAR_RATE_CHANNELS])
-        self.accel = np.ascontiguousarray(self.feat[self.n_window:, SPECIFIC_FORCE_CHANNELS])
+        gyro = np.ascontiguousarray(self.feat[self.n_window:, ANGULAR_RATE_CHANNELS])
+        accel = np.ascontiguousarray(self.feat[self.n_window:, SPECIFIC_FORCE_CHANNELS])
         if ctx.imu_static is not None:      # nav.ins_tuning: navego reads the IMU without its static biases
-            self.gyro = self.gyro - ctx.imu_static[ANGULAR_RATE_CHANNELS]
-            self.accel = self.accel - ctx.imu_static[SPECIFIC_FORCE_CHANNELS]
+            gyro = gyro - ctx.imu_static[ANGULAR_RATE_CHANNELS]
+            accel = accel - ctx.imu_static[SPECIFIC_FORCE_CHANNELS]
+        self.nav = Stepper(self.times, np.diff(self.times), gyro, accel, s, ctx.noise, aids, ctx.drive.name,
+                           hold_at=s.time)
+
+    @property
+    def row(self) -> int:
+        """Output row of the run's current solution."""
+        return self.nav.row
 
     def _fill(self, r0: int, r1: int) -> None:
         """Features of output rows r0..r1 (inclusive, >= 1) from the current solution."""
         if r1 < r0:
             return
-        roll, pitch, yaw = transform.euler_from_dcm(self.out_c[r0:r1 + 1])
+        roll, pitch, yaw = transform.euler_from_dcm(self.nav.out_c[r0:r1 + 1])
         k0, k1 = self.n_window + r0 - 1, self.n_window + r1
         self.feat[k0:k1, ATTITUDE_CHANNELS] = np.column_stack([roll, pitch, yaw])
-        v = self.out_v[r0:r1 + 1]
+        v = self.nav.out_v[r0:r1 + 1]
         for i, c in enumerate(self.extra):
             if c in ("v_n", "v_e", "v_d"):
                 self.feat[k0:k1, EXTRA_START + i] = v[:, ("v_n", "v_e", "v_d").index(c)]
             elif c in DERIVED_CHANNELS:                  # (v_along, v_cross), in that order
                 self.feat[k0:k1, EXTRA_START + i] = heading_velocity(v[:, 0], v[:, 1], yaw)[DERIVED_CHANNELS.index(c)]
             else:
-                self.feat[k0:k1, EXTRA_START + i] = self.out_pos[r0:r1 + 1, ("lat", "lon", "h").index(c)]
+                self.feat[k0:k1, EXTRA_START + i] = self.nav.out_pos[r0:r1 + 1, ("lat", "lon", "h").index(c)]
 
-    def propagate_to(self, r: int) -> None:
-        """Prediction (strapdown + covariance, Eq. eq3) up to output row ``r``."""
-        r = min(int(r), len(self.times) - 1)
-        if r > self.row:
-            propagate(self.row, r, self.dt, self.gyro, self.accel, (self.pos, self.v, self.c, self.ba, self.bg, self.P),
-                      self.q, (self.out_pos, self.out_v, self.out_c, self.out_sd), self.schedule)
-            self._fill(self.row + 1, r)
-            self.row = r
+    def propagate_to(self, t: float) -> None:
+        """Prediction (strapdown + covariance, Eq. eq3) up to the epoch of time ``t``, the aids fused on the way."""
+        r0 = self.nav.row
+        self.nav.propagate_to(t)
+        self._fill(r0 + 1, self.nav.row)
 
     def update(self, t_m: float, fix: np.ndarray, std: np.ndarray) -> None:
         """Eq. (eq4) position update with a pseudo fix of time ``t_m`` at the current row, then feedback."""
-        innov = np.empty(3)
-        update_position(self.pos, self.v, self.c, self.ba, self.bg, self.P, self.lever, np.asarray(fix, float),
-                        np.asarray(std, float), float(self.times[self.row] - t_m), innov, 0.0)   # never gated
-        self.out_pos[self.row], self.out_v[self.row], self.out_c[self.row] = self.pos, self.v, self.c
-        if self.row >= 1:        # later windows see the corrected solution, as the training attitude does
-            self._fill(self.row, self.row)
+        r = self.nav.row
+        sd = self.nav.out_sd[r].copy()
+        self.nav.update(position_fix(self.nav, self.lever, fix, std, t_m))      # never gated
+        # the std of a pseudo epoch's row stays the prediction's: the NEES at a window's end (window_metrics)
+        # has always compared the error with it
+        self.nav.out_sd[r] = sd
+        if r >= 1:        # later windows see the corrected solution, as the training attitude does
+            self._fill(r, r)
 
     def window(self, t_end: float) -> tuple[np.ndarray, float, float]:
         """The ``N`` latest samples with time <= ``t_end``: features [N, C], last sample time, yaw there."""
@@ -315,24 +305,19 @@ class _Run:
         return x, float(self.t_feat[last]), float(x[-1, YAW_CHANNEL])
 
     def trajectory(self) -> pd.DataFrame:
-        return trajectory_frame(self.times, self.out_pos, self.out_v, self.out_c)
+        return trajectory_frame(self.times, self.nav.out_pos, self.nav.out_v, self.nav.out_c)
 
     def position_sd(self) -> pd.DataFrame:
         """The filter's horizontal position std (m) at every output row, from its latitude and longitude error
         states (rad) through the radii of curvature."""
-        lat, h = self.out_pos[:, 0], self.out_pos[:, 2]
+        lat, h = self.nav.out_pos[:, 0], self.nav.out_pos[:, 2]
         r_m, r_n = earth.curvature_radii(lat)
-        return pd.DataFrame({"time": self.times, "sd_north_m": self.out_sd[:, em.DLAT] * (r_m + h),
-                             "sd_east_m": self.out_sd[:, em.DLON] * (r_n + h) * np.cos(lat)})
-
-
-def _rows_at(times: np.ndarray, t) -> np.ndarray:
-    """Output row where an event of time ``t`` is applied: the first row with time >= t (as run_filter)."""
-    return np.searchsorted(times, np.asarray(t, dtype=float) - 1e-9, side="left")
+        return pd.DataFrame({"time": self.times, "sd_north_m": self.nav.out_sd[:, em.DLAT] * (r_m + h),
+                             "sd_east_m": self.nav.out_sd[:, em.DLON] * (r_n + h) * np.cos(lat)})
 
 
 def run_outages(ctx: NavContext, windows, predictor=None, method: str = "INS", seed: int | None = None,
-                pseudo: dict | None = None, errors: bool = True, constraints=None) -> list[OutageRun]:
+                pseudo: dict | None = None, errors: bool = True, aids=()) -> list[OutageRun]:
     """Prediction mode over outage ``windows`` from the GPS-aided states (module docstring, step 2).
 
     Parameters
@@ -356,8 +341,9 @@ def run_outages(ctx: NavContext, windows, predictor=None, method: str = "INS", s
         ``fusion_rate_hz``.
     errors : bool
         Compute the errors against the reference.
-    constraints : bgfn.nav.constraints.Constraints, optional
-        Fuse the vehicle constraints too (``ctx.constraints``: the ``+NHC`` rows); None: the paper's filter.
+    aids : sequence of bgfn.nav.engine.Aid
+        Further aids fused at their epochs (``[ctx.constraints]``: the ``+NHC`` rows; an odometer after them,
+        :func:`bgfn.nav.odometer.aid_list`); empty: the paper's filter.
 
     Returns
     -------
@@ -369,7 +355,7 @@ def run_outages(ctx: NavContext, windows, predictor=None, method: str = "INS", s
     opts = dict(getattr(predictor, "options", {}) or {}) if predictor is not None else {}
     n_window = int(opts.get("window", 1)) if predictor is not None else 1
     extra = _extra_columns(opts) if predictor is not None else ()
-    runs = [_Run(ctx, s, d, n_window, extra, constraints) for s, d in windows]
+    runs = [_Run(ctx, s, d, n_window, extra, aids) for s, d in windows]
     inc_s = ctx.gnss_interval_s
     from_val = isinstance(pcfg["std_m"], str)
     if from_val and (pcfg["std_m"] != "validation" or predictor is not None
@@ -397,7 +383,7 @@ def run_outages(ctx: NavContext, windows, predictor=None, method: str = "INS", s
             for i in active:
                 r = runs[i]
                 t_k = r.start + k / f
-                r.propagate_to(int(_rows_at(r.times, t_k)))
+                r.propagate_to(t_k)
                 for j in range(1, m + 1):                            # GNSS intervals ending in (t_{k-1}, t_k]
                     u = r.start + ((k - 1) * m + j) * inc_s
                     x, t_last, yaw_last = r.window(u - inc_s if align_next else u)
@@ -425,7 +411,7 @@ def run_outages(ctx: NavContext, windows, predictor=None, method: str = "INS", s
                 fixes[i].append((t_k, p[0], p[1], p[2], cum[i][0], cum[i][1], sd))
     out = []
     for i, r in enumerate(runs):
-        r.propagate_to(len(r.times) - 1)
+        r.propagate_to(r.times[-1])
         traj = r.trajectory()
         run = OutageRun(method, seed, r.start, r.duration, traj,
                         pd.DataFrame(incs[i], columns=["time", "dn", "de"]),

@@ -1,6 +1,6 @@
 """Compile the navigation's numba kernels (and BGFN's LIF kernels) into numba's cache before the notebooks call them.
 
-Every kernel of the filter engine and its aids (:mod:`bgfn.nav.strapdown`, :mod:`bgfn.nav.filter`,
+Every kernel of the filter engine and its aids (:mod:`bgfn.nav.strapdown`, :mod:`bgfn.nav.engine`,
 :mod:`bgfn.nav.error_model`, :mod:`bgfn.nav.constraints`, ...) is ``numba.njit(cache=True)``: numba compiles it on
 its first call and writes the machine code beside the source (``__pycache__``), where every later process, the
 parallel runner's workers included, loads it in a fraction of a second. On a fresh clone that first call came in
@@ -62,7 +62,7 @@ def compile_kernels(nav_section: dict | None = None) -> float:
     ctx = navigation_context(drive, nav_section, [start])                     # the evaluation's context
     epochs = np.arange(start - 5.0, start + OUTAGE[1] + 5.0, 1.0)
     track = no.SpeedTrack(epochs, np.full(epochs.size, 8.0), np.full(epochs.size, 0.5))
-    run_outages(ctx, window, None, "INS", None, None, constraints=no.Odometer(ctx.constraints, track))
+    run_outages(ctx, window, None, "INS", None, None, aids=[ctx.constraints, no.Odometer(ctx.constraints, track)])
     compile_lif_kernels()
     return time.perf_counter() - t0
 

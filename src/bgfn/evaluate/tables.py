@@ -127,12 +127,12 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
     aids = ctx.constraints if (ecfg.get("nhc_rows", True) if nhc_rows is None else nhc_rows) else None
     runs = run_outages(ctx, windows, None, "INS", None, ecfg["pseudo_gps"])
     if aids is not None:
-        runs += run_outages(ctx, windows, None, nhc_label("INS"), None, ecfg["pseudo_gps"], constraints=aids)
+        runs += run_outages(ctx, windows, None, nhc_label("INS"), None, ecfg["pseudo_gps"], aids=[aids])
     runs += [gps_run(ctx, s, d) for s, d in windows]
     for (method, seed), model in models.items():
         runs += run_outages(ctx, windows, model, METHOD_LABELS[method], seed, ecfg["pseudo_gps"])
         if aids is not None:
-            runs += run_outages(ctx, windows, model, nhc_label(method), seed, ecfg["pseudo_gps"], constraints=aids)
+            runs += run_outages(ctx, windows, model, nhc_label(method), seed, ecfg["pseudo_gps"], aids=[aids])
     outage_no = {s: i + 1 for i, (s, _) in enumerate(windows)}
     rows = [{"outage": outage_no[r.start], "start_s": r.start, "method": r.method, "seed": r.seed,
              **window_metrics(r.errors, r.start, r.duration, r.sd)} for r in runs]

@@ -21,19 +21,25 @@ Modules (pyins style, one concept each; SI units, radians, NED, tables as in CON
 - :mod:`~bgfn.nav.state` -- ``FilterState`` (time, pos, v, c_bn, accel_bias, gyro_bias, P),
   ``FilterNoise`` and ``noise_from_imu_errors(meta['imu_errors'])``, ``initial_covariance``,
   ``initial_state``, ``save_states`` / ``load_states`` (.npz format in the module docstring).
+- :mod:`~bgfn.nav.engine` -- the filter engine: ``Stepper(times, dt, gyro, accel, initial, noise, aids)`` with
+  ``propagate_to(t)`` (Eq. eq3) and ``update(Measurement)`` (Eq. eq4 and feedback); the ``Aid`` interface (an
+  aid names its epochs and answers with a ``Measurement(dz, H, std)``); the numba kernels.
+- :mod:`~bgfn.nav.gnss_aid` -- position fixes as aids: ``GnssFixes`` (with the innovation gate,
+  ``gate_thresholds``) and ``PseudoGps`` (Eq. pred-gps inside the outage windows); ``position_fix``.
 - :mod:`~bgfn.nav.filter` -- ``run_filter(imu, initial, noise, gnss, lever_arm, outage_windows,
-  pseudo_gps, t_end, snapshots) -> FilterResult`` and ``run_outage(imu, start_state, window, noise,
-  lever_arm, pseudo_gps)`` (one outage from a saved state).
+  pseudo_gps, t_end, snapshots, aids=[...]) -> FilterResult`` and ``run_outage(imu, start_state, window, noise,
+  lever_arm, pseudo_gps, aids=[...])`` (one outage from a saved state): the engine with these aids.
 - :mod:`~bgfn.nav.outages` -- ``OutageWindow``, ``check_windows``, ``outage_windows(profile, drive, dataset)``
   (the profile's one key: one list, or per dataset a list or a rule), the pseudo-GPS hook (``PseudoFix``,
   ``PseudoGpsContext``, ``IncrementPseudoGps`` = Eq. pred-gps, ``TablePseudoGps``).
 - :mod:`~bgfn.nav.outage_rules` -- ``pick_windows(rule, reference, margin_s)``: a drive's outages picked by a
   rule (``cruise_and_manoeuvre``: one cruising, one manoeuvring, as the paper's field test).
-- :mod:`~bgfn.nav.constraints` -- the vehicle constraints of the ``+NHC`` rows, an aid of the filter engine
-  (``Aid``: it answers the engine's "which measurement after this step?"): NHC and ZUPT velocity updates
-  (``nhc_measurement``, ``zupt_measurement``), the stillness detector ``stillness``, the vehicle frame
-  ``mounting_track``; ``build_constraints(imu, imu_errors, config, trajectory) -> Constraints``, which
-  ``run_filter`` / ``run_outage`` take as ``aid``.
+- :mod:`~bgfn.nav.constraints` -- the vehicle constraints of the ``+NHC`` rows, an aid of the filter engine:
+  NHC and ZUPT velocity updates (``nhc_measurement``, ``zupt_measurement``), the stillness detector
+  ``stillness``, the vehicle frame ``mounting_track``; ``build_constraints(imu, imu_errors, config, trajectory)
+  -> Constraints``, which ``run_filter`` / ``run_outage`` take in ``aids``.
+- :mod:`~bgfn.nav.odometer` -- ``Odometer(vehicle, SpeedTrack)``: a forward speed as an aid, joint with the
+  vehicle constraints' NHC rows (``aids=[constraints, odometer]``, ``aid_list``).
 - :mod:`~bgfn.nav.outages` -- ``OutageWindow``, ``check_windows``, ``outage_windows(profile, drive)`` (the profile's one key),
   the pseudo-GPS hook (``PseudoFix``, ``PseudoGpsContext``, ``IncrementPseudoGps`` = Eq. pred-gps,
   ``TablePseudoGps``).
@@ -46,7 +52,7 @@ Modules (pyins style, one concept each; SI units, radians, NED, tables as in CON
 - :mod:`~bgfn.nav.tuning` -- ``search_noise_scale(mean_nis, options) -> NoiseTuning`` (``nav.noise_scale: auto``).
 - :mod:`~bgfn.nav.consistency` -- ``nis_summary(updates)``, ``verdict``, ``nis_line``, ``nis_table``.
 - :mod:`~bgfn.nav.baseline` -- notebook 02: ``nav_config``, ``run_drive(drive, nav_section)``,
-  ``setup_filter(drive, cfg) -> FilterSetup`` (start and noise), ``filter_start``,
+  ``prepare_filter(drive, cfg) -> FilterSetup`` (start and noise; ``initial_and_noise`` without the record), ``filter_start``,
   ``run_baseline(drive, cfg, windows)``, ``ins_layout``, ``save_baseline``; :mod:`~bgfn.nav.plots` -- its figures.
 - :mod:`~bgfn.nav.navego_setup` -- the filter set up as NaveGo v1.4's ``ins_gnss.m`` (``nav.ins_tuning: navego``):
   ``navego_noise``, ``static_biases``, ``initial_bias_estimates``, ``remove_static_biases``.

@@ -20,7 +20,7 @@ outages are the profile's ``outage_windows`` (:func:`bgfn.nav.outages.outage_win
   exceeds the ``p`` quantile of chi-square is not fused (:func:`bgfn.nav.filter.run_filter`);
 - ``nhc``, ``zupt``: the vehicle constraints of the ``INS+NHC`` rows (:mod:`bgfn.nav.constraints`; ZUPT whenever
   the stillness detector fires, the label says NHC anyway); ``constraints_in_gps_run``: false (the paper's
-  GPS-aided filter) or true (the GPS-aided run applies them too, :func:`gps_constraints`).
+  GPS-aided filter) or true (the GPS-aided run applies them too, :func:`gps_aids`).
 """
 
 from __future__ import annotations
@@ -40,7 +40,8 @@ from . import constraints as cn, metrics, navego_setup
 from .alignment import ALIGNMENT_DEFAULTS, MODES, Alignment, align
 from .consistency import nis_line, nis_summary
 from .error_model import PHI_D, STATE_NAMES
-from .filter import FilterResult, gate_thresholds, run_filter, run_outage
+from .filter import FilterResult, run_filter, run_outage
+from .gnss_aid import gate_thresholds
 from .outages import check_windows, epochs_before
 from .state import FilterNoise, FilterState, initial_covariance, initial_state, noise_from_imu_errors, save_states
 from .tuning import NOISE_SEARCH_DEFAULTS, NoiseTuning, search_noise_scale
@@ -105,8 +106,9 @@ def noise_scale_of(cfg: dict, dataset: str):
     return spec.get(dataset, spec[DEFAULT_DATASET_KEY]) if isinstance(spec, dict) else spec
 
 
-def gps_constraints(drive, cfg: dict, initial: FilterState, noise: FilterNoise):
-    """The vehicle constraints of the GPS-aided run: None unless ``constraints_in_gps_run``.
+def gps_aids(drive, cfg: dict, initial: FilterState, noise: FilterNoise) -> list:
+    """The aids of the GPS-aided run beside the GNSS fixes: the vehicle constraints with ``constraints_in_gps_run``,
+    none otherwise (the paper's filter).
 
     When asked, a first GPS-aided pass without them gives the vehicle frame (its causal running estimate,
     :func:`bgfn.nav.constraints.mounting_track`), then the constraints hold the whole drive's detector and aid
@@ -114,10 +116,10 @@ def gps_constraints(drive, cfg: dict, initial: FilterState, noise: FilterNoise):
     :func:`bgfn.evaluate.navigation_context`) so that they agree.
     """
     if not cfg["constraints_in_gps_run"]:
-        return None
+        return []
     first = run_filter(filter_imu(drive, cfg), initial, noise, drive.gnss, drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0]),
                        gate_probability=cfg["innovation_gate"], source=drive.name)
-    return outage_constraints(drive, cfg, first)
+    return [outage_constraints(drive, cfg, first)]
 
 
 def outage_constraints(drive, cfg: dict, solution: FilterResult):
@@ -146,15 +148,15 @@ def run_drive(drive, section: dict | None = None, snapshots: dict | None = None)
     FilterResult
     """
     cfg = nav_config(section)
-    initial, noise = filter_setup(drive, cfg)
+    initial, noise = initial_and_noise(drive, cfg)
     return run_filter(filter_imu(drive, cfg), initial, noise, drive.gnss, _lever(drive), snapshots=snapshots,
                       gate_probability=cfg["innovation_gate"], source=drive.name,
-                      aid=gps_constraints(drive, cfg, initial, noise))
+                      aids=gps_aids(drive, cfg, initial, noise))
 
 
 @dataclass
 class FilterSetup:
-    """Where and how the filter of a drive starts (:func:`setup_filter`).
+    """Where and how the filter of a drive starts (:func:`prepare_filter`).
 
     Attributes
     ----------
@@ -238,7 +240,7 @@ def _initial(drive, cfg: dict, noise: FilterNoise) -> tuple[FilterState, Alignme
     return initial, alignment
 
 
-def setup_filter(drive, cfg: dict) -> FilterSetup:
+def prepare_filter(drive, cfg: dict) -> FilterSetup:
     """Initial state and noise of a drive's filter (``nav.alignment``, ``nav.noise_scale``).
 
     With ``noise_scale: auto`` the factor comes from :func:`bgfn.nav.tuning.search_noise_scale` over GPS-aided runs
@@ -274,8 +276,8 @@ def setup_filter(drive, cfg: dict) -> FilterSetup:
     return FilterSetup(initial, _noise(drive, cfg, tuning.scale), tuning.scale, alignment, tuning)
 
 
-def filter_setup(drive, cfg: dict) -> tuple[FilterState, FilterNoise]:
-    """Initial filter state and noise for a drive (:func:`setup_filter` without its record).
+def initial_and_noise(drive, cfg: dict) -> tuple[FilterState, FilterNoise]:
+    """Initial filter state and noise for a drive (:func:`prepare_filter` without its record).
 
     With ``ins_tuning: navego`` the noise and the bias priors are NaveGo's (:func:`bgfn.nav.navego_setup.navego_noise`)
     and the bias estimates start at the dynamic-bias values; the filter must then read :func:`filter_imu`.
@@ -292,7 +294,7 @@ def filter_setup(drive, cfg: dict) -> tuple[FilterState, FilterNoise]:
         At the reference's first row, or at the self-alignment's epoch (``nav.alignment``).
     noise : FilterNoise
     """
-    s = setup_filter(drive, cfg)
+    s = prepare_filter(drive, cfg)
     return s.initial, s.noise
 
 
@@ -385,7 +387,7 @@ def run_baseline(drive, cfg: dict, windows) -> Baseline:
     -------
     Baseline
     """
-    setup = setup_filter(drive, cfg)
+    setup = prepare_filter(drive, cfg)
     initial, noise = setup.initial, setup.noise
     # the filter may start after the reference's first row (self-alignment): outages must come after its start;
     # the given order is kept (Outage k as in notebook 04)
@@ -397,14 +399,14 @@ def run_baseline(drive, cfg: dict, windows) -> Baseline:
     starts = epochs_before(drive.imu["time"], [w.start for w in windows], drive.name)
     full = run_filter(imu, initial, noise, drive.gnss, lever, snapshots=dict(zip(names, starts)),
                       gate_probability=cfg["innovation_gate"], source=drive.name,
-                      aid=gps_constraints(drive, cfg, initial, noise))
+                      aids=gps_aids(drive, cfg, initial, noise))
     errors = metrics.navigation_errors(full.trajectory, drive.reference, drive.meta)
     aids = outage_constraints(drive, cfg, full)
     rows, outage_errors = [], {}
     for n, w in zip(names, windows):
         parts = []
-        for method, con in (("INS", None), (INS_NHC, aids)):
-            res = run_outage(imu, full.states[n], w, noise, lever, source=drive.name, aid=con)
+        for method, with_aids in (("INS", []), (INS_NHC, [aids])):
+            res = run_outage(imu, full.states[n], w, noise, lever, source=drive.name, aids=with_aids)
             e = metrics.navigation_errors(res.trajectory, drive.reference, drive.meta)
             e.insert(1, "t_rel", e["time"] - w.start)
             e.insert(0, "method", method)
@@ -507,7 +509,7 @@ def gate_comparison(drive, cfg: dict, windows, probability: float, baseline: Bas
     windows : sequence of (start, duration)
         The outages, s (as for :func:`run_baseline`).
     probability : float
-        Chi-square probability of the gate (:func:`bgfn.nav.filter.gate_thresholds`).
+        Chi-square probability of the gate (:func:`bgfn.nav.gnss_aid.gate_thresholds`).
     baseline : Baseline, optional
         The run with ``cfg`` as it is (notebook 02 has it already): reused for the setting it matches.
 

@@ -1,7 +1,7 @@
 """Consistency of a GPS-aided run: the normalized innovation squared (NIS) of its GNSS fixes against chi-square.
 
 For a filter whose ``Q`` and ``R`` describe its errors, the NIS of a fix with ``k`` used axes,
-``dz^T (H P H^T + R)^-1 dz`` (Eq. eq4's innovation and its covariance, :func:`bgfn.nav.filter.position_nis`), is
+``dz^T (H P H^T + R)^-1 dz`` (Eq. eq4's innovation and its covariance, :func:`bgfn.nav.engine.measurement_nis`), is
 chi-square with ``k`` degrees of freedom: mean ``k``, 5 % of the fixes above its 95 % quantile. A mean far above
 ``k`` is an *overconfident* filter (its covariance too small: IMU noise too low for the drive, GNSS stds too small),
 far below an *underconfident* one. Notebook 02 prints the verdict of every GPS-aided run so that a user sees it.

@@ -1,9 +1,9 @@
 """Learning-free outage aids of a road vehicle: non-holonomic constraints (NHC) and zero-velocity updates (ZUPT).
 
-Beyond the paper (issue 17, the classic aids a learned one must beat or add to). Both are velocity measurements
-of the 15-state filter, an *aid* of the engine :mod:`bgfn.nav.filter` (:class:`Constraints` is its
-:class:`~bgfn.nav.filter.Aid`): after each aided IMU step the engine asks which measurement to fuse, and fuses it
-with the same sequential Joseph update and closed-loop feedback as a position fix. The *aid epochs* are the first
+Beyond the paper (the classic aids a learned one must beat or add to). Both are velocity measurements of the
+15-state filter, one *aid* of the engine :mod:`bgfn.nav.engine` (:class:`Constraints` is an
+:class:`~bgfn.nav.engine.Aid`): at each aid epoch the engine asks which measurement to fuse, and fuses it with the
+same sequential Joseph update and closed-loop feedback as a position fix. The *aid epochs* are the first
 IMU row at or after every multiple of ``1 / nhc_rate_hz`` of the time of week (the same epochs in every run of a
 drive).
 
@@ -54,7 +54,7 @@ import pandas as pd
 from ..errors import DataError
 from ..schema import ACCEL_COLUMNS, GYRO_COLUMNS
 from . import error_model as em
-from .filter import AidMeasurement
+from .engine import Measurement
 from .transform import dcm_from_euler
 
 #: What happens at an IMU step (the aid schedule, one code per step).
@@ -334,7 +334,7 @@ def vehicle_rotation(tangents) -> np.ndarray:
 
 @dataclass
 class Constraints:
-    """The vehicle constraints of one drive, ready for :func:`bgfn.nav.filter.run_filter`.
+    """The vehicle constraints of one drive, an aid of :func:`bgfn.nav.filter.run_filter`.
 
     Attributes
     ----------
@@ -391,13 +391,13 @@ class Constraints:
                             "an epoch it does not have")
         return np.ascontiguousarray(self.aid[i]), np.ascontiguousarray(self.mounting_at(time))
 
-    def schedule(self, time, source: str = "imu", hold_at: float | None = None) -> "VehicleSchedule":
-        """The :class:`~bgfn.nav.filter.AidSchedule` of the IMU steps ending at ``time`` (s): NHC or ZUPT at each
-        aid epoch, the vehicle frame held at its value at ``hold_at`` (an outage) when given."""
+    def schedule(self, times, source: str = "imu", hold_at: float | None = None) -> "VehicleSchedule":
+        """The :class:`~bgfn.nav.engine.AidSchedule` of a run with epochs ``times`` (s; row 0 the initial state):
+        NHC or ZUPT at each aid epoch, the vehicle frame held at its value at ``hold_at`` (an outage) when given."""
         con = self if hold_at is None else self.frozen(hold_at if self.freeze_at is None
                                                        else min(hold_at, self.freeze_at))
-        aid, mount = con.steps(time, source)
-        return VehicleSchedule(np.flatnonzero(aid != AID_NONE), aid, mount, self.config)
+        aid, mount = con.steps(np.asarray(times, dtype=float)[1:], source)      # after each IMU step
+        return VehicleSchedule(np.flatnonzero(aid != AID_NONE) + 1, aid, mount, self.config)
 
     def summary(self) -> dict:
         """JSON-ready facts: aid epochs, ZUPT epochs, the share of still IMU rows, the final mounting angles (deg)."""
@@ -493,12 +493,12 @@ def zupt_measurement(v, dz, H):
 
 @dataclass(frozen=True)
 class VehicleSchedule:
-    """The vehicle constraints bound to one run's IMU steps: what the filter engine asks after each aided step.
+    """The vehicle constraints bound to one run's IMU steps: what the filter engine asks at each aid epoch.
 
     Attributes
     ----------
     rows : ndarray of int
-        Steps with an aid epoch (:class:`~bgfn.nav.filter.AidSchedule`).
+        Output rows of the aid epochs (:class:`~bgfn.nav.engine.AidSchedule`; row ``k + 1`` follows step ``k``).
     aid : ndarray of int8 [n]
         ``AID_NHC`` / ``AID_ZUPT`` / ``AID_NONE`` per step.
     mount : ndarray [n, 2]
@@ -510,27 +510,38 @@ class VehicleSchedule:
     aid: np.ndarray
     mount: np.ndarray
     config: ConstraintConfig
+    joint = False
 
-    def measurement(self, k: int, pos, v, c) -> AidMeasurement | None:
-        """NHC (the vehicle-frame lateral and vertical velocity are zero) or, at a still epoch while the speed is
-        at most ``zupt_max_speed_mps``, ZUPT (the NED velocity is zero)."""
+    def kind(self, k: int, v) -> int:
+        """The aid of step ``k`` at velocity ``v`` (NED, m/s): ZUPT at a still epoch while the speed is at most
+        ``zupt_max_speed_mps``, else NHC where the platform has it, else none."""
         kind = self.aid[k]
-        if kind == AID_NONE:
-            return None
         if kind == AID_ZUPT and np.sqrt(v @ v) > self.config.zupt_max_speed_mps:
             # a vibration-free IMU at constant speed reads as still: no ZUPT at speed (NHC where the platform has it)
             kind = AID_NHC if self.config.nhc else AID_NONE
-            if kind == AID_NONE:
-                return None
+        return kind
+
+    def vehicle_rotation(self, k: int) -> np.ndarray:
+        """``R_vb`` in force at step ``k`` (:func:`vehicle_rotation_nb`)."""
+        r_vb = np.empty((3, 3))
+        vehicle_rotation_nb(self.mount[k, 0], self.mount[k, 1], r_vb)
+        return r_vb
+
+    def measurement(self, i: int, nav) -> Measurement | None:
+        """NHC (the vehicle-frame lateral and vertical velocity are zero) or ZUPT (the NED velocity is zero) at the
+        ``i``-th aid epoch, from the current solution of ``nav`` (:class:`bgfn.nav.engine.Stepper`)."""
+        k = int(self.rows[i]) - 1
+        kind = self.kind(k, nav.v)
+        if kind == AID_NONE:
+            return None
         n = em.N_STATES
         if kind == AID_ZUPT:
             dz, H = np.empty(3), np.empty((3, n))
-            zupt_measurement(v, dz, H)
-            return AidMeasurement(dz, H, np.full(3, self.config.zupt_std_mps))
-        dz, H, r_vb = np.empty(2), np.empty((2, n)), np.empty((3, 3))
-        vehicle_rotation_nb(self.mount[k, 0], self.mount[k, 1], r_vb)
-        nhc_measurement(v, c, r_vb, dz, H)
-        return AidMeasurement(dz, H, np.full(2, self.config.nhc_std_mps))
+            zupt_measurement(nav.v, dz, H)
+            return Measurement(dz, H, np.full(3, self.config.zupt_std_mps))
+        dz, H = np.empty(2), np.empty((2, n))
+        nhc_measurement(nav.v, nav.c, self.vehicle_rotation(k), dz, H)
+        return Measurement(dz, H, np.full(2, self.config.nhc_std_mps))
 
 
 __all__ = ["AID_NHC", "AID_NONE", "AID_ZUPT", "ConstraintConfig", "Constraints", "DEFAULT_PLATFORM", "NHC_DEFAULTS",

@@ -1,9 +1,9 @@
 """An odometer as an aid of the filter engine: the forward speed in the vehicle frame, with its uncertainty.
 
-Beyond the paper (issue 24; the design of OdoNet, TLIO and AI-IMU: the network predicts a quantity that does not
-accumulate, with its own uncertainty, and the filter owns the fusion). At every aid epoch of the vehicle
-constraints (:mod:`bgfn.nav.constraints`: the NHC rows, or ZUPT where the vehicle stands still) the odometer
-adds the forward row of the vehicle-frame velocity::
+Beyond the paper (the design of OdoNet, TLIO and AI-IMU: the network predicts a quantity that does not
+accumulate, with its own uncertainty, and the filter owns the fusion). At every NHC epoch of the vehicle
+(:mod:`bgfn.nav.constraints`: its aid epochs, its vehicle frame) the odometer measures the forward row of the
+vehicle-frame velocity::
 
     z = v^v_x = speed + w,   w ~ N(0, kappa std^2)
 
@@ -11,13 +11,15 @@ adds the forward row of the vehicle-frame velocity::
 
 With ``M = R_vb C_bn^T`` (NED -> vehicle frame) the computed value is ``v^v_computed = v^v_true + M dV - M [v x] phi``
 (the same linearization as the NHC rows), so the forward row of ``H`` is ``M_x`` on ``dV`` and ``-(M [v x])_x`` on
-``phi``. The three rows are fused one after the other by the engine (:func:`bgfn.nav.filter.sequential_update`).
-At a ZUPT epoch the velocity is zero in every axis and no speed row is added.
+``phi``. The odometer is an aid of its own (:class:`Odometer`); put after the vehicle constraints in the aid list
+it is *joint*: its row joins their NHC rows at the epoch, measured from the same state and fused as one update
+(:class:`bgfn.nav.engine.AidSchedule`). At a ZUPT epoch the velocity is zero in every axis and no speed row is
+added.
 
 The speed and its std come from a :class:`SpeedTrack` (a learned odometer's predictions at the aid epochs, the
 speed held from the outage start, an oracle ...): at an epoch, the track's last value at or before it, no older
 than ``max_age_s``. A row whose normalized innovation squared exceeds the ``gate_probability`` quantile of
-chi-square with one degree of freedom is left out (:attr:`bgfn.nav.filter.AidMeasurement.gate`), so one wild
+chi-square with one degree of freedom is left out (:attr:`bgfn.nav.engine.Measurement.gate`), so one wild
 prediction cannot pull the solution away. :func:`speed_errors` scores a track against the true speed inside an
 outage (its RMSE and the share of epochs within its +-2 sigma).
 """
@@ -31,9 +33,8 @@ from scipy.stats import chi2
 
 from ..errors import DataError
 from . import error_model as em
-from .constraints import (AID_ZUPT, TIME_TOL, Constraints, VehicleSchedule, vehicle_rotation_nb,
-                          vehicle_velocity_rows)
-from .filter import AidMeasurement
+from .constraints import AID_NHC, TIME_TOL, Constraints, VehicleSchedule, vehicle_velocity_rows
+from .engine import Measurement
 
 #: Default chi-square probability of the forward-speed row's gate (one degree of freedom).
 DEFAULT_GATE_PROBABILITY = 0.999
@@ -130,12 +131,13 @@ def forward_speed_row(v: np.ndarray, c: np.ndarray, r_vb: np.ndarray) -> tuple[f
 
 @dataclass(frozen=True)
 class Odometer:
-    """The vehicle constraints plus a forward speed (module docstring): an :class:`~bgfn.nav.filter.Aid`.
+    """A forward speed in the vehicle frame (module docstring): an :class:`~bgfn.nav.engine.Aid`.
 
     Attributes
     ----------
-    constraints : Constraints
-        NHC/ZUPT and the vehicle frame (:func:`bgfn.nav.constraints.build_constraints`).
+    vehicle : Constraints
+        The vehicle the speed is measured in: its aid epochs and frame (:func:`bgfn.nav.constraints.build_constraints`).
+        Its NHC/ZUPT rows are the constraints' own aid: ``aids=[vehicle, odometer]`` fuses both.
     track : SpeedTrack
     gate_probability : float or None
         Chi-square probability of the speed row's gate (None: no gate).
@@ -143,15 +145,15 @@ class Odometer:
         Oldest speed an epoch uses, s.
     """
 
-    constraints: Constraints
+    vehicle: Constraints
     track: SpeedTrack
     gate_probability: float | None = DEFAULT_GATE_PROBABILITY
     max_age_s: float = DEFAULT_MAX_AGE_S
 
-    def schedule(self, time, source: str = "imu", hold_at: float | None = None) -> "OdometerSchedule":
-        """The vehicle constraints' schedule (:meth:`Constraints.schedule`) with the speed in force at each step."""
-        vehicle = self.constraints.schedule(time, source, hold_at)
-        speed, std = self.track.at(time, self.max_age_s)
+    def schedule(self, times, source: str = "imu", hold_at: float | None = None) -> "OdometerSchedule":
+        """The vehicle's aid epochs (:meth:`Constraints.schedule`) with the speed in force after each IMU step."""
+        vehicle = self.vehicle.schedule(times, source, hold_at)
+        speed, std = self.track.at(np.asarray(times, dtype=float)[1:], self.max_age_s)
         std = self.track.fused_std(std)                       # R = kappa std^2 (SpeedTrack's docstring)
         p = self.gate_probability
         if p is not None and not 0.0 < p < 1.0:
@@ -159,27 +161,35 @@ class Odometer:
         return OdometerSchedule(vehicle.rows, vehicle, speed, std, float(chi2.ppf(p, 1)) if p else 0.0)
 
     def summary(self) -> dict:
-        """The constraints' summary and how many epochs have a speed."""
-        return {**self.constraints.summary(), "speed_epochs": int(np.count_nonzero(np.isfinite(self.track.speed)))}
+        """The vehicle constraints' summary and how many epochs have a speed."""
+        return {**self.vehicle.summary(), "speed_epochs": int(np.count_nonzero(np.isfinite(self.track.speed)))}
 
 
 @dataclass(frozen=True)
 class OdometerSchedule:
-    """The odometer bound to one run's IMU steps: the vehicle constraints' measurement plus the speed row."""
+    """The odometer bound to one run's IMU steps: the speed row at the vehicle's NHC epochs, joint with the
+    constraints' rows (:class:`~bgfn.nav.engine.AidSchedule`)."""
 
     rows: np.ndarray
     vehicle: VehicleSchedule
     speed: np.ndarray
     std: np.ndarray
     gate: float
+    joint = True
 
-    def measurement(self, k: int, pos, v, c) -> AidMeasurement | None:
-        """NHC (+ the forward speed when one is in force) or ZUPT at the aid epoch after step ``k``."""
-        m = self.vehicle.measurement(k, pos, v, c)
-        if m is None or self.vehicle.aid[k] == AID_ZUPT and m.dz.size == 3 or not np.isfinite(self.speed[k]):
-            return m
-        r_vb = np.empty((3, 3))
-        vehicle_rotation_nb(self.vehicle.mount[k, 0], self.vehicle.mount[k, 1], r_vb)
-        computed, row = forward_speed_row(np.asarray(v, float), np.asarray(c, float), r_vb)
-        return AidMeasurement(np.append(m.dz, computed - self.speed[k]), np.vstack([m.H, row]),
-                              np.append(m.std, self.std[k]), np.append(np.zeros(m.dz.size), self.gate))
+    def measurement(self, i: int, nav) -> Measurement | None:
+        """The forward speed at the ``i``-th aid epoch when one is in force and the vehicle takes NHC there (no
+        speed row at a ZUPT epoch or where neither applies)."""
+        k = int(self.rows[i]) - 1
+        if self.vehicle.kind(k, nav.v) != AID_NHC or not np.isfinite(self.speed[k]):
+            return None
+        computed, row = forward_speed_row(np.asarray(nav.v, float), np.asarray(nav.c, float),
+                                          self.vehicle.vehicle_rotation(k))
+        return Measurement(np.array([computed - self.speed[k]]), row[None, :], np.array([self.std[k]]),
+                           np.array([self.gate]))
+
+
+def aid_list(aid) -> list:
+    """The aid list that fuses ``aid`` as it is meant: an :class:`Odometer` after its vehicle's constraints (the
+    speed row joins their NHC rows), any other aid alone."""
+    return [aid.vehicle, aid] if isinstance(aid, Odometer) else [aid]

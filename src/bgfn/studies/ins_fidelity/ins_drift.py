@@ -86,7 +86,7 @@ def drive_drift_rows(cfg: dict, drive, durations: list[float], pseudo: dict,
     runs = run_outages(ctx, windows, None, "INS", None, pseudo)
     if nhc and ctx.constraints is not None:
         runs += run_outages(ctx, windows, None, nhc_label("INS"), None, pseudo,
-                            constraints=ctx.constraints)
+                            aids=[ctx.constraints])
     rows = []
     for r in runs:
         for du in durations:

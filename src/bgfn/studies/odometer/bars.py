@@ -124,7 +124,7 @@ class OdometerRun:
 
 def odometer_run(ctx, run: OdometerRun, pseudo: dict) -> list:
     """The outage runs of one :class:`OdometerRun` (no network: the aid alone)."""
-    return run_outages(ctx, run.windows, None, run.method, None, pseudo, constraints=run.aid)
+    return run_outages(ctx, run.windows, None, run.method, None, pseudo, aids=no.aid_list(run.aid))
 
 
 def reference_speed(drive, time) -> np.ndarray:

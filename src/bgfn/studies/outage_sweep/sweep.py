@@ -102,7 +102,7 @@ def sweep_run(run: SweepRun) -> tuple[dict, list, float, float]:
     runs = list(run_outages(run.ctx, run.windows, model, METHOD_LABELS[run.method], run.seed, run.pseudo_gps))
     if run.nhc:
         runs += run_outages(run.ctx, run.windows, model, nhc_label(run.method), run.seed, run.pseudo_gps,
-                            constraints=run.ctx.constraints)
+                            aids=[run.ctx.constraints])
     return card, runs, tb - ta, time.perf_counter() - tb
 
 
@@ -138,7 +138,7 @@ class _Sweep:
         for r in run_outages(ctx, windows_all, None, "INS", None, ecfg["pseudo_gps"]):
             self.add(r, self.fold_of[r.start])
         if aids is not None:
-            for r in run_outages(ctx, windows_all, None, nhc_label("INS"), None, ecfg["pseudo_gps"], constraints=aids):
+            for r in run_outages(ctx, windows_all, None, nhc_label("INS"), None, ecfg["pseudo_gps"], aids=[aids]):
                 self.add(r, self.fold_of[r.start])
         for s in plan["start_s"]:
             self.add(gps_run(ctx, s, dmax), self.fold_of[s])

@@ -222,7 +222,7 @@ def test_the_odometer_answer_says_whether_more_training_windows_made_the_speed_f
     assert verdict_sentences(inp, verdict_table(inp))[5].endswith(
         " Would more of this drive help? RIDGE-ODO refitted with the starts in 20 folds instead of 2 learns from 250 "
         "windows per fold instead of 125 (2.0 times as many), and its speed RMSE in its 120 s outages goes from 2.30 "
-        "to 2.20 m/s (notebook 04's learning curve).")
+        "to 2.20 m/s (notebook 07's learning curve).")
 
 
 def test_the_odometer_answer_says_whether_bgfn_odos_std_ranks_its_errors():
@@ -323,3 +323,54 @@ def test_headline_says_when_the_two_outages_rank_the_aided_ins_behind_ins_but_th
     free = answer_free_aids(verdict_table(inp), drift)
     assert "INS+NHC 30.0 m, worse than standalone INS in these two outages though not over the drive" in free
     assert "(median max error, 30 s); BGFN 60.0 m" in free
+
+
+# ----------------------------------------------------------------------------------------------- the first screen
+def test_short_answers_say_the_verdict_in_three_lines_with_the_numbers_of_the_long_ones():
+    from bgfn.report.verdict_page import MAX_BULLET_CHARS, QUESTIONS, answer_bullets, short_answers
+
+    inp = _inputs(odometer=_odometer())
+    table = verdict_table(inp)
+    short = short_answers(inp, table)
+    assert [k for k, _ in QUESTIONS] == list(short)
+    # BGFN's 2.5 m per increment misses the 1.9 m break-even; BGFN+NHC (76 m at 30 s) does not beat INS+NHC (5 m)
+    assert short["accuracy"].startswith("no") and "2.5 m" in short["accuracy"] and "1.9 m" in short["accuracy"]
+    assert short["free_aids"].startswith("no") and "5.0 m" in short["free_aids"] and "76.0 m" in short["free_aids"]
+    assert "2e-10" in short["free_aids"]
+    # velocity: the honest velocity variant 8 and 16 m in the two outages (mean 12) against the main 40 and 80 (60)
+    assert "60.0 m to 12.0 m" in short["speed"]
+    html = answer_bullets(short)
+    items = html.split("<li>")[1:]
+    assert len(items) == 6 and all('href="0' in i for i in items)
+    assert all(len(i) <= MAX_BULLET_CHARS + 60 for i in items), [len(i) for i in items]   # + the link's markup
+
+
+def test_the_better_aid_reads_yes():
+    from bgfn.report.verdict_page import short_accuracy, short_free_aids
+
+    summary = pd.DataFrame([{"dataset": "d", "duration_s": du, "method": m, "median_m": v}
+                            for du in (30.0, 60.0) for m, v in
+                            {"INS": 19.0, "INS+NHC": 5.0, "BGFN": 85.0, "BGFN+NHC": 4.0}.items()])
+    inp = _inputs(sweep_summary=summary)
+    assert short_free_aids(verdict_table(inp)).startswith("yes")
+    be = inp.breakeven.assign(increment_rmse_m=1.0)                                    # below the 1.9 m bar
+    assert short_accuracy(_inputs(breakeven=be)).startswith("yes")
+
+
+def test_duration_curves_take_the_sweeps_intervals_and_bootstrap_the_odometers_by_start():
+    from bgfn.report.duration_curves import CURVE_COLUMNS, duration_curves, plot_duration_curves
+
+    sweep = pd.DataFrame([{"dataset": "d", "duration_s": du, "method": m, "n": 6, "n_starts": 3,
+                           "median_m": v * du, "ci_lo_m": v * du * 0.8, "ci_hi_m": v * du * 1.2}
+                          for du in (30.0, 60.0) for m, v in {"INS": 2.0, "INS+NHC": 0.5, "GPS": 0.1}.items()]
+                         + [{"dataset": "other", "duration_s": 30.0, "method": "INS", "n": 1, "n_starts": 1,
+                             "median_m": 1.0, "ci_lo_m": 1.0, "ci_hi_m": 1.0}])
+    odo = pd.DataFrame([{"dataset": "d", "start_s": s, "duration_s": du, "method": "RIDGE-ODO", "seed": 0,
+                         "max_h_m": s / 10 + du} for s in (100.0, 200.0, 300.0) for du in (30.0, 60.0)])
+    c = duration_curves("d", sweep, odo, n_boot=200, seed=1)
+    assert list(c.columns) == list(CURVE_COLUMNS)
+    assert list(dict.fromkeys(c["method"])) == ["INS", "INS+NHC", "RIDGE-ODO"]          # no GPS, no other drive
+    r = c[(c["method"] == "RIDGE-ODO") & (c["duration_s"] == 30.0)].iloc[0]
+    assert r["median_m"] == pytest.approx(50.0) and r["ci_lo_m"] <= 50.0 <= r["ci_hi_m"] and r["n_starts"] == 3
+    assert plot_duration_curves(c, "d").axes[0].get_yscale() == "log"
+    assert duration_curves("d", None, None).empty

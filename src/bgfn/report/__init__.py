@@ -44,6 +44,7 @@ from bgfn.report.tables import (REFERENCE_LABELS, TABLE_STYLES, TRAINING_COLUMNS
 from bgfn.report.profile_comparison import (compared_profiles, profile_tables, reference_sentences, variant_outage_table,
                                   variant_sentences, variant_sweep_table, variant_training_table, variants_section)
 from bgfn.report.verdict import Verdict, VerdictInputs, verdict_of, verdict_table
+from bgfn.report.verdict_page import HtmlPiece, header_details, short_answers, verdict_top
 
 __all__ = [
     "BASELINES", "EXTRA_METHODS", "EXTRA_TAGS", "PAPER_FIGURES",
@@ -58,7 +59,8 @@ __all__ = [
     "compared_profiles", "profile_tables", "variant_training_table", "variant_outage_table", "variant_sentences",
     "variant_sweep_table", "REFERENCE_LABELS", "TRAINING_COLUMNS",
     # the page as sections of pieces to display (notebook 10)
-    "Verdict", "VerdictInputs", "verdict_of", "verdict_table",
+    "Verdict", "VerdictInputs", "verdict_of", "verdict_table", "HtmlPiece", "header_details", "short_answers",
+    "verdict_top",
     "ProfileResults", "read_results", "OutageSection", "header_section", "outage_section", "energy_section",
     "kf_section", "training_section", "sweep_section", "odometer_section", "variants_section", "paper_figure_section",
     "extra_figure_section", "draw_diagrams", "bullets", "run_meta",

@@ -31,6 +31,7 @@ from typing import Any
 
 import yaml
 
+from bgfn import settings
 from bgfn.errors import DataError
 
 
@@ -60,12 +61,12 @@ DATA_DIR: Path = PROJECT_ROOT / "data"
 
 #: Profiles shipped with the artifact (users may add their own ``params/<name>.yaml``).
 PROFILES: tuple[str, ...] = ("smoke", "quick", "full", "paper")
-#: Top-level keys every profile file must define (``outage_windows``: the evaluation outages, one list or per
-#: dataset a list or a rule, read by :func:`bgfn.nav.outages.outage_windows`, shared by notebooks 01-04).
-SCALAR_KEYS: tuple[str, ...] = ("profile", "description", "seed", "outage_windows")
+#: Top-level keys a profile's chain must set (``outage_windows``: the evaluation outages, one list or per dataset a
+#: list or a rule, read by :func:`bgfn.nav.outages.outage_windows`, shared by notebooks 01-04); every other key has
+#: its default in :mod:`bgfn.settings`.
+REQUIRED_KEYS: tuple[str, ...] = settings.REQUIRED
 #: One section per notebook: 01 data, 02 nav (KF baseline), 03 train, 04 evaluate, 05 energy.
 SECTION_KEYS: tuple[str, ...] = ("data", "nav", "train", "evaluate", "energy")
-REQUIRED_KEYS: tuple[str, ...] = SCALAR_KEYS + SECTION_KEYS
 #: Files of ``results/<profile>/`` that one notebook writes and a later notebook or the results page reads: the
 #: one place their names are spelled. Run records (``results/<profile>/<name>``):
 RUN_RECORDS: dict[str, str] = {
@@ -127,12 +128,12 @@ def odometer_network_seeds(odometer: dict | None, dataset: str) -> list[int]:
     """The seeds the odometer networks of ``dataset`` train with: ``evaluate.odometer.network_seeds``, one list for
     every drive or per drive with a ``default`` list for every drive not named (one rule for notebook 04, which
     trains them, and notebook 05, which measures the first)."""
-    seeds = (odometer or {}).get("network_seeds", [0])
+    seeds = odometer["network_seeds"]
     if isinstance(seeds, dict):
         seeds = seeds.get(dataset, seeds.get(DEFAULT_DATASET_KEY))
     if not seeds:
         raise DataError("evaluate.odometer", "network_seeds", f"seeds for {dataset} (or a 'default' list)",
-                        repr((odometer or {}).get("network_seeds")))
+                        repr(odometer["network_seeds"]))
     return [int(s) for s in seeds]
 
 
@@ -284,16 +285,10 @@ def read_profile(profile: str) -> dict[str, Any]:
                         f"missing {', '.join(missing)}")
     if cfg["profile"] != profile:
         raise DataError(path, "profile", f"the file's own name {profile!r}", repr(cfg["profile"]))
-    if not isinstance(cfg["description"], str):
-        raise DataError(path, "description", "a string", type(cfg["description"]).__name__)
-    if isinstance(cfg["seed"], bool) or not isinstance(cfg["seed"], int) or cfg["seed"] < 0:
-        raise DataError(path, "seed", "a non-negative integer", repr(cfg["seed"]))
-    for key in SECTION_KEYS:
-        if cfg[key] is None:  # a section holding only comments
-            cfg[key] = {}
-        if not isinstance(cfg[key], dict):
-            raise DataError(path, key, "a mapping (section of keys)", type(cfg[key]).__name__)
-    return copy.deepcopy(cfg)
+    try:
+        return settings.complete(cfg)
+    except settings.ProfileError as exc:
+        raise DataError(file_setting(profile, exc.path), exc.path, exc.expected, exc.found) from None
 
 
 def variant_config(cfg: dict, name: str) -> dict:

@@ -174,7 +174,7 @@ def load_measured(profile: str, cfg: dict | None = None, methods=MEASURED) -> Me
         t.model.eval()
     cards = {m: json.loads(card_path(p).read_text()) if card_path(p).exists() else {} for m, p in paths.items()}
     cfg = cfg if cfg is not None else read_profile(profile)
-    allow = bool((cfg.get("energy") or {}).get("allow_untrained", False))
+    allow = bool(cfg["energy"]["allow_untrained"])
     for m in methods:
         if m in SPIKING:        # firing rates depend on the weights; the twin's MAC count does not
             check_trained(cards[m], card_path(paths[m]), allow)

@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import paper
+from .. import paper, settings
 from ..config import DEFAULT_DATASET_KEY
 from ..errors import DataError
 from ..io import atomic_write_csv
@@ -45,21 +45,8 @@ from .outages import check_windows, epochs_before
 from .state import FilterNoise, FilterState, initial_covariance, initial_state, noise_from_imu_errors, save_states
 from .tuning import NOISE_SEARCH_DEFAULTS, NoiseTuning, search_noise_scale
 
-#: Defaults of the ``nav:`` profile section.
-NAV_DEFAULTS: dict = {
-    "datasets": ["turin-sim-ekinox", "turin-sim-mpu6000"],
-    "init": {"position_std_m": 1.0, "height_std_m": 3.0, "velocity_std_mps": 0.1, "level_std_deg": 0.5,
-             "azimuth_std_deg": 2.0},
-    "alignment": dict(ALIGNMENT_DEFAULTS),
-    "bias_model": "random_walk",
-    "noise_scale": 1.0,
-    "noise_search": dict(NOISE_SEARCH_DEFAULTS),
-    "innovation_gate": None,
-    "ins_tuning": navego_setup.DEFAULT_TUNING,
-    "nhc": dict(cn.NHC_DEFAULTS),
-    "zupt": dict(cn.ZUPT_DEFAULTS),
-    "constraints_in_gps_run": False,
-}
+#: Defaults of the ``nav:`` profile section (their home: :class:`bgfn.settings.Nav`).
+NAV_DEFAULTS: dict = settings.defaults("nav")
 #: ``nav.noise_scale`` that asks for the factor from the data.
 AUTO = "auto"
 #: Label of the standalone INS with the vehicle constraints (:func:`bgfn.paper.nhc_label`).
@@ -202,7 +189,7 @@ def _has_attitude(drive) -> bool:
 
 
 def _navego(cfg: dict) -> bool:
-    return cfg.get("ins_tuning", navego_setup.DEFAULT_TUNING) == "navego"
+    return cfg["ins_tuning"] == "navego"
 
 
 def _noise(drive, cfg: dict, scale: float) -> FilterNoise:

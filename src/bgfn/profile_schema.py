@@ -155,8 +155,9 @@ def _check_variants(cfg: dict) -> None:
                                    "variant trains", "set")
         try:
             validate(variant_config(cfg, name))
-        except ProfileError as exc:
-            raise ProfileError(f"{where}.{exc.path}", exc.expected, exc.found) from None
+        except ProfileError as exc:     # the key as the profile spells it, in the path and in a "did you mean"
+            raise ProfileError(f"{where}.{exc.path}", exc.expected.replace("did you mean ", f"did you mean {where}."),
+                               exc.found) from None
     bad = [m for m in (cfg.get("variant_runs") or {}).get("methods") or [] if m not in METHOD_LABELS]
     if bad:
         raise ProfileError("variant_runs.methods", f"method ids among {', '.join(METHOD_LABELS)}", fmt(bad))

@@ -14,7 +14,7 @@ from __future__ import annotations
 import copy
 import difflib
 import math
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, get_args, get_origin
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
@@ -416,9 +416,15 @@ def _path(loc) -> str:
 
 
 def _model_at(model: type[BaseModel], keys) -> type[BaseModel] | None:
-    for key in keys:
+    """The model of the section at ``keys`` (a mapping of named sections, such as ``variants``, passed through)."""
+    keys = list(keys)
+    while keys:
+        key = keys.pop(0)
         field = next((f for n, f in model.model_fields.items() if (f.alias or n) == key), None)
         sub = field.annotation if field else None
+        if get_origin(sub) is dict and keys:
+            sub = get_args(sub)[1]
+            keys.pop(0)
         if not (isinstance(sub, type) and issubclass(sub, BaseModel)):
             return None
         model = sub
@@ -447,7 +453,7 @@ def _error(model: type[BaseModel], err: dict, prefix: str) -> ProfileError:
         bound = next(iter(ctx.values()))
         return ProfileError(path, f"a number {_BOUND[kind]} {bound:g}", found)
     if kind == "literal_error":
-        return ProfileError(path, f"one of {ctx.get('expected')}", found)
+        return ProfileError(path, f"one of {str(ctx.get('expected')).replace(' or ', ', ')}", found)
     if kind in ("too_short", "too_long"):
         n = ctx.get("min_length") if kind == "too_short" else ctx.get("max_length")
         return ProfileError(path, f"a list of {'at least' if kind == 'too_short' else 'at most'} {n} item(s)", found)

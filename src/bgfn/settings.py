@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import copy
 import difflib
+import json
 import math
 from typing import Annotated, Any, Literal, get_args, get_origin
 
@@ -578,3 +579,21 @@ def complete(cfg: dict) -> dict:
     check_model(Profile, out)
     _check_free(out)
     return out
+
+
+def listing(model: type[BaseModel] = Profile, indent: str = "") -> list[str]:
+    """Every key of ``model`` as YAML lines: its default and, as a comment, its description."""
+    out = []
+    for name, field in model.model_fields.items():
+        key, sub = field.alias or name, field.annotation
+        if isinstance(sub, type) and issubclass(sub, BaseModel):
+            out += [f"{indent}{key}:{'':<{max(1, 40 - len(indent) - len(key))}}# {field.description}",
+                    *listing(sub, indent + "  ")]
+            continue
+        value = "(required)" if field.is_required() else json.dumps(field.get_default(call_default_factory=True))
+        out.append(f"{indent}{key}: {value}  # {field.description}")
+    return out
+
+
+if __name__ == "__main__":   # python -m bgfn.settings: every key, its default and its meaning
+    print("\n".join(listing()))

@@ -558,7 +558,8 @@ def test_runs_that_never_improved_are_trained_again_on_all_windows_only_when_the
     assert lines[0].startswith(f"trained again on all their training windows, {improved} of 1 runs")
     assert lines[1] == f"  toy mlp seed 0: {n // 4} -> {n} windows, best epoch 0 -> {pair['all']['best_epoch']}"
     assert T.recheck_lines(table.iloc[:0], tc)[0].startswith("no run to recheck")
-    assert T.recheck_lines(table, {"recheck_all_windows": False})[0] == "not rechecked (train.recheck_all_windows is false)"
+    off = {"recheck_all_windows": False}
+    assert T.recheck_lines(table, off)[0] == "not rechecked (train.recheck_all_windows is false)"
 
 
 def test_recheck_runs_first_keeps_the_lowest_seed_of_each_dataset_and_method():

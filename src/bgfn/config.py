@@ -12,9 +12,10 @@ that papermill overrides, then::
 Outputs go to ``out / "tables" / "<name>.csv"``, ``out / "figures" / "<name>.png"`` and
 ``out / "<name>.json"`` (metrics), always through :mod:`bgfn.io` (atomic writes).
 
-This module only finds and merges profiles (:func:`read_profile`, the ``base:`` chain) and knows paths: it is a
-core fact and imports nothing of the package above it. The check of every key against the schema is the edge's
-(:mod:`bgfn.profile_schema`, whose ``load_profile`` reads with :func:`read_profile`, then validates).
+This module finds and merges profiles (:func:`read_profile`, the ``base:`` chain, laid over the defaults and checked
+key by key by :mod:`bgfn.settings`) and knows paths: it is a core fact and imports nothing of the package above it.
+The facts that tie keys together are the edge's (:mod:`bgfn.profile_schema`, whose ``load_profile`` reads with
+:func:`read_profile`, then checks them).
 """
 
 from __future__ import annotations
@@ -227,8 +228,9 @@ def profile_chain(profile: str) -> list[Path]:
 
 
 def read_profile(profile: str) -> dict[str, Any]:
-    """Read ``params/<profile>.yaml`` and merge its ``base:`` chain; the structure is checked, not the keys' values
-    (:func:`bgfn.profile_schema.load_profile` adds that check: call it where a checked profile is needed).
+    """Read ``params/<profile>.yaml``, merge its ``base:`` chain over the defaults and check every key
+    (:func:`bgfn.settings.complete`); :func:`bgfn.profile_schema.load_profile` adds the facts that tie keys together:
+    call it where a checked profile is needed.
 
     A profile may name another one as ``base:``; it then holds only what differs: its sections are laid
     over the base's key by key (:func:`merge_sections`), so ``params/quick-heading.yaml`` lists only the
@@ -250,17 +252,18 @@ def read_profile(profile: str) -> dict[str, Any]:
     Returns
     -------
     dict
-        The parsed YAML (merged over its bases): ``profile`` (str, equal to the file name), ``description``
-        (str), ``seed`` (int), ``outage_windows`` (a list of [start, duration], s, or a mapping dataset -> such a list
-        or a rule, with ``default``) and one mapping per notebook section (``data``, ``nav``, ``train``,
-        ``evaluate``, ``energy``; an empty section is returned as ``{}``). A fresh copy on every call.
+        The parsed YAML merged over its bases and the defaults: ``profile`` (str, equal to the file name),
+        ``description`` (str), ``seed`` (int), ``outage_windows`` (a list of [start, duration], s, or a mapping
+        dataset -> such a list or a rule, with ``default``) and every section with every key
+        (:class:`bgfn.settings.Profile`). A fresh copy on every call.
 
     Raises
     ------
     bgfn.errors.DataError
-        Unknown profile (missing file), unreadable YAML, a missing required top-level key or a wrong type of
-        one, a key that moved (:data:`MOVED_KEYS`, the message names the new one), a ``base:`` that does not
-        exist or leads back to the profile. The message names the file.
+        Unknown profile (missing file), unreadable YAML, a missing required top-level key, a key that moved
+        (:data:`MOVED_KEYS`, the message names the new one), a ``base:`` that does not exist or leads back to the
+        profile, a key unknown or of the wrong type (the closest valid key suggested). The message names the
+        file that set the key.
     """
     chain = _read_chain(profile)
     path = chain[0][0]

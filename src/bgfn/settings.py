@@ -548,8 +548,8 @@ def _fill_rules(cfg: dict) -> None:
     spec = cfg.get("outage_windows")
     if isinstance(spec, dict):
         for key, entry in spec.items():
-            if isinstance(entry, dict):
-                spec[key] = {"rule": entry.get("rule"), **defaults_of(OutageRule), **entry}
+            if isinstance(entry, dict) and "rule" in entry:
+                spec[key] = {"rule": entry["rule"], **defaults_of(OutageRule), **entry}
 
 
 def defaults_of(model: type[BaseModel]) -> dict:

@@ -1,6 +1,6 @@
 """Notebook 02 workflow: the KF baseline on a drive (full GPS/INS run, standalone INS in the outages).
 
-The ``nav:`` section of ``params/<profile>.yaml`` configures it (keys and defaults in ``NAV_DEFAULTS``); the
+The ``nav:`` section of ``params/<profile>.yaml`` configures it (keys and defaults: :class:`bgfn.settings.Nav`); the
 outages are the profile's ``outage_windows`` (:func:`bgfn.nav.outages.outage_windows`).
 
 - ``datasets``: drive names for :func:`bgfn.data.load_drive` (the profile's ``data:`` section crops them);
@@ -59,7 +59,9 @@ def nav_config(section: dict | None) -> dict:
     for key, value in (section or {}).items():
         if key not in cfg:
             raise DataError("params nav", key, f"one of {sorted(cfg)}", "unknown key")
-        if isinstance(cfg[key], dict):                           # init, alignment, noise_search, nhc, zupt: key by key
+        if key == "noise_scale":                                 # a number, 'auto', or per dataset over the default's
+            cfg[key] = ({**cfg[key], **value} if isinstance(value, dict) and isinstance(cfg[key], dict) else value)
+        elif isinstance(cfg[key], dict):                         # init, alignment, noise_search, nhc, zupt: key by key
             unknown = set(value or {}) - set(cfg[key])
             if unknown:
                 raise DataError(f"params nav.{key}", sorted(unknown)[0], f"one of {sorted(cfg[key])}",

@@ -1,6 +1,6 @@
 """Variants of a profile's learning problem, trained beside its main networks (issue 17, outcome 3).
 
-A profile names them at its top level (schema: :data:`bgfn.profile_schema.VARIANT`)::
+A profile names them at its top level (:class:`bgfn.settings.Variant`)::
 
     variants:                                  # name -> overrides of the train: section
       velocity: {train: {extra_channels: [v_along, v_cross], ...}}     # params/quick-heading.yaml's inputs

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from bgfn import config
+from bgfn import config, settings
 from bgfn.errors import DataError
 from bgfn.profile_schema import load_profile
 
@@ -90,19 +90,21 @@ def _complete(name):
 
 def test_missing_required_key_names_file_and_key(tmp_path, monkeypatch):
     cfg = _complete("mine")
-    del cfg["train"]
+    del cfg["outage_windows"]
     path = _write_profile(tmp_path, monkeypatch, "mine", cfg)
     with pytest.raises(DataError) as err:
         load_profile("mine")
     assert err.value.source == str(path)
-    assert err.value.field == "train"
+    assert err.value.field == "outage_windows"
 
 
-def test_empty_section_reads_as_mapping(tmp_path, monkeypatch):
-    _write_profile(tmp_path, monkeypatch, "mine", _complete("mine"))
+def test_an_empty_or_left_out_section_reads_as_its_defaults(tmp_path, monkeypatch):
+    cfg = _complete("mine")
+    del cfg["energy"]
+    _write_profile(tmp_path, monkeypatch, "mine", cfg)
     cfg = load_profile("mine")
-    assert cfg["data"] == {}
-    assert cfg["train"] == {"window": 2}
+    assert cfg["data"] == settings.defaults("data") and cfg["energy"] == settings.defaults("energy")
+    assert cfg["train"] == {**settings.defaults("train"), "window": 2}
     cfg["train"]["window"] = 99  # a caller's edit must not leak into the next load
     assert load_profile("mine")["train"]["window"] == 2
 
@@ -183,8 +185,9 @@ def test_a_variant_profile_holds_only_its_changes(tmp_path, monkeypatch):
     cfg = load_profile("variant")
     assert cfg["profile"] == "variant" and cfg["description"] == "v" and cfg["seed"] == 1 and "base" not in cfg
     # mappings merge key by key, lists and scalars replace, an empty section changes nothing
-    assert cfg["train"] == {"window": 2, "lr": {"bgfn": 1e-3, "mlp": 3e-3}, "extra_channels": []}
-    assert cfg["data"] == {"seed": 5}
+    lr = {**settings.defaults("train")["lr"], "bgfn": 1e-3, "mlp": 3e-3}     # over the defaults, as over a base
+    assert cfg["train"] == {**settings.defaults("train"), "window": 2, "lr": lr, "extra_channels": []}
+    assert cfg["data"] == {**settings.defaults("data"), "seed": 5}
     assert load_profile("mine")["train"]["lr"]["mlp"] == 1e-3            # the base is untouched
     assert [p.name for p in config.profile_chain("variant")] == ["variant.yaml", "mine.yaml"]
 

@@ -205,7 +205,7 @@ def test_profile_data_section_sets_the_parameters(env, tmp_path, monkeypatch):
 
     d = load_drive("turin-sim-mpu6000", profile="smoke", cache=False, **env)
     smoke = load_profile("smoke")["data"]
-    assert d.meta["params"]["seed"] == smoke["seed"]
+    assert smoke["seed"] is None and d.meta["params"]["seed"] == load_profile("smoke")["seed"]   # null: the profile's
     assert d.reference["time"].iloc[0] == smoke["t_start"] and d.reference["time"].iloc[-1] == smoke["t_end"]
     assert d.meta["params"]["gnss_correlated_tau_s"] == smoke["turin-sim-mpu6000"]["gnss_correlated_tau_s"]
     # explicit overrides win over the profile

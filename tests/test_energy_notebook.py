@@ -120,7 +120,8 @@ def _measured_checkpoints(tmp_path, monkeypatch, dataset: str, seed: int):
 
 
 def test_load_measured_reads_dataset_seed_and_cards(tmp_path, monkeypatch):
-    cfg = {"energy": {"dataset": "drive-b", "seed": 2}, "train": {"datasets": ["drive-a"], "seeds": [0]}}
+    cfg = {"energy": {"dataset": "drive-b", "seed": 2, "allow_untrained": False},
+           "train": {"datasets": ["drive-a"], "seeds": [0]}}
     folder = _measured_checkpoints(tmp_path, monkeypatch, "drive-b", 2)
     (folder / "bgfn_seed2.json").write_text(json.dumps({"best_epoch": 7, "val_rmse_m": 1.25}))
     measured = energy.load_measured("smoke", cfg)
@@ -216,7 +217,8 @@ def test_the_energy_network_is_the_median_seed_and_must_be_trained(tmp_path, mon
     # seeds 4 and 5 never improved on their initial network: the median is taken among the others
     assert median_seed("p", "d", [0, 1, 2, 4, 5]) == 2
     assert median_seed("p", "d", [4, 5, 7]) == 5                # none trained: all cards (then refused)
-    cfg = {"energy": {"dataset": None, "seed": None}, "train": {"datasets": ["d"], "seeds": [0, 1, 2]}}
+    cfg = {"energy": {"dataset": None, "seed": None, "allow_untrained": False},
+           "train": {"datasets": ["d"], "seeds": [0, 1, 2]}}
     assert energy_checkpoint("p", "bgfn", cfg).name == "bgfn_seed2.pt"
     assert energy_checkpoint("p", "bgfn", {**cfg, "energy": {"seed": 0}}).name == "bgfn_seed0.pt"
     # the dataset: the first of train.datasets where some seed's BGFN learned ('u' has only an untrained one)
@@ -242,7 +244,7 @@ def test_only_the_spiking_network_must_have_learned(tmp_path, monkeypatch):
     untrained BGFN refused."""
     from bgfn.errors import DataError
 
-    cfg = {"energy": {"dataset": "d", "seed": 0}, "train": {"datasets": ["d"], "seeds": [0]}}
+    cfg = {"energy": {"dataset": "d", "seed": 0, "allow_untrained": False}, "train": {"datasets": ["d"], "seeds": [0]}}
     folder = _measured_checkpoints(tmp_path, monkeypatch, "d", 0)
     (folder / "transformer_seed0.json").write_text(json.dumps({"best_epoch": 0}))
     (folder / "bgfn_seed0.json").write_text(json.dumps({"best_epoch": 4}))

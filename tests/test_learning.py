@@ -104,7 +104,7 @@ def test_no_window_touches_an_outage(tables):
 
 def test_normalization_uses_training_windows_only(tables):
     imu, att, gnss = tables
-    data = L.build_learning_data(imu, att, gnss, [], window=100, val_fraction=0.3)
+    data = L.build_learning_data(imu, att, gnss, [], window=100, val_fraction=0.3, target_screen_sigma=None)
     x = data.train.x.reshape(-1, 9).astype(float)
     assert np.allclose(data.norm.x_mean, x.mean(0)) and np.allclose(data.norm.x_std[3:6], x.std(0)[3:6])
     assert np.allclose(data.norm.y_mean, data.train.y.mean(0))
@@ -114,7 +114,7 @@ def test_normalization_uses_training_windows_only(tables):
     inside = (gnss2["time"] > lo + 5) & (gnss2["time"] < hi - 5)
     assert inside.sum() > 5
     gnss2.loc[inside, "lat"] += 1e-3
-    data2 = L.build_learning_data(imu, att, gnss2, [], window=100, val_fraction=0.3)
+    data2 = L.build_learning_data(imu, att, gnss2, [], window=100, val_fraction=0.3, target_screen_sigma=None)
     assert np.allclose(data2.norm.y_mean, data.norm.y_mean) and np.allclose(data2.norm.y_std, data.norm.y_std)
     z = data.norm.x(data.train.x)
     assert np.allclose(z.reshape(-1, 9).mean(0)[3:], 0.0, atol=1e-3)

@@ -129,7 +129,7 @@ def test_training_time_is_the_span_outside_the_widened_windows():
 # ----------------------------------------------------------------------------------------------- the reader
 def test_the_reader_takes_the_datasets_entry_or_the_default():
     prof = {"profile": "p", "outage_windows": {"default": [[1100.0, 30.0]], "other": [[1200.0, 20.0]],
-                                               "sim": dict(RULE)}}
+                                               "sim": dict(RULE)}, "train": {"margin_s": 30.0}}
     assert outages.outage_windows(prof) == [(1100.0, 30.0)]
     assert outages.outage_windows(prof, dataset="turin") == [(1100.0, 30.0)]
     assert outages.outage_windows(prof, dataset="other") == [(1200.0, 20.0)]
@@ -140,7 +140,7 @@ def test_the_reader_takes_the_datasets_entry_or_the_default():
     with pytest.raises(DataError, match="a rule picks the windows") as err:
         outages.outage_windows(prof, dataset="sim")
     assert err.value.field == "outage_windows.sim"
-    # the rule's training check uses train.margin_s (default 30 s; here 200 s leaves too little)
+    # the rule's training check uses train.margin_s (here 200 s leaves too little)
     with pytest.raises(DataError, match="min_training_s"):
         outages.outage_windows({**prof, "train": {"margin_s": 200.0}}, d)
     lines = outages.describe_windows(prof, d)
@@ -155,9 +155,9 @@ def test_the_reader_takes_the_datasets_entry_or_the_default():
 
 
 def test_a_rule_in_a_profile_file_is_checked_with_the_schema(params):
-    from bgfn.profile_schema import OUTAGE_RULE
+    from bgfn.settings import OutageRule
 
-    assert set(OUTAGE_RULE.fields) == {"rule", *R.RULE_DEFAULTS["cruise_and_manoeuvre"]}
+    assert set(OutageRule.model_fields) == {"rule", *R.RULE_DEFAULTS["cruise_and_manoeuvre"]}
     def load(text):
         (params / "mine.yaml").write_text(f"profile: mine\nbase: smoke\ndescription: v\n{text}\n")
         return load_profile("mine")

@@ -26,6 +26,12 @@ def test_oracle_speed_is_the_truth_plus_seeded_white_noise_and_a_walk():
     assert np.std(np.diff(walk.speed)) == pytest.approx(0.1, rel=0.03)       # 0.1 m/s per sqrt(s) at 1 Hz
 
 
+#: The odometer settings these small cases run with: the defaults' walk rows, ensembles, error correlation, ridge
+#: curve and the evaluation outages as one more fold would add rows and runs that they do not test.
+PLAIN = {"datasets": None, "paper_outages": False, "walk_mps_per_sqrt_s": 0.0, "curve_folds": [], "ensemble": False,
+         "correlation": False, "calibration_blocks": False, "train": None}
+
+
 def test_the_odometers_budget_lies_over_the_sweeps_key_by_key():
     ev_cfg = {"sweep": {"train": {"size": "smoke", "optimizer": {"epochs": 20, "patience": 5}}},
               "odometer": {"train": {"optimizer": {"epochs": 60}}}}
@@ -84,7 +90,7 @@ def test_rows_of_a_synthetic_drive(monkeypatch, tmp_path):
     cfg = load_profile("smoke")
     cfg = {**cfg, "nav": NAV, "train": {**cfg["train"], "window": 50, "margin_s": 5.0}}
     ecfg = ev.evaluate_config({"sweep": {"n_starts": 2, "folds": 2, "durations_s": [10.0, 30.0], "warmup_s": 30.0},
-                               "odometer": {"sigmas_mps": [0.1, 1.0], "seeds": [0, 1], "methods": ["mlp"]}},
+                               "odometer": {**PLAIN, "sigmas_mps": [0.1, 1.0], "seeds": [0, 1], "methods": ["mlp"]}},
                               cfg["train"])
     rows, facts = O.odometer_rows(cfg, "t", "synthetic", ecfg, drive=drive)
     assert list(rows.columns) == list(O.ODOMETER_COLUMNS)
@@ -139,7 +145,7 @@ def test_the_two_evaluation_outages_are_one_more_fold_at_their_own_duration(monk
     cfg = {**cfg, "nav": NAV, "train": {**cfg["train"], "window": 50, "margin_s": 5.0},
            "outage_windows": [[110.0, 20.0], [70.0, 15.0]]}           # outage 1 is the later one
     ecfg = ev.evaluate_config({"sweep": {"n_starts": 2, "folds": 2, "durations_s": [10.0, 30.0], "warmup_s": 30.0},
-                               "odometer": {"sigmas_mps": [0.5], "seeds": [0], "methods": ["mlp"],
+                               "odometer": {**PLAIN, "sigmas_mps": [0.5], "seeds": [0], "methods": ["mlp"],
                                             "paper_outages": True}}, cfg["train"])
     rows, facts = O.odometer_rows(cfg, "t", "synthetic", ecfg, drive=drive)
     paper = rows[rows["fold"] == O.PAPER_FOLD]
@@ -165,7 +171,7 @@ def test_a_drive_left_out_of_network_datasets_gets_the_bars_but_no_network(monke
     cfg = load_profile("smoke")
     cfg = {**cfg, "nav": NAV, "train": {**cfg["train"], "window": 50, "margin_s": 5.0}}
     ecfg = ev.evaluate_config({"sweep": {"n_starts": 2, "folds": 2, "durations_s": [10.0], "warmup_s": 30.0},
-                               "odometer": {"sigmas_mps": [0.5], "seeds": [0], "methods": ["mlp"],
+                               "odometer": {**PLAIN, "sigmas_mps": [0.5], "seeds": [0], "methods": ["mlp"],
                                             "network_datasets": ["another-drive"]}}, cfg["train"])
     rows, facts = O.odometer_rows(cfg, "t", "synthetic", ecfg, drive=drive)
     assert set(rows["method"]) == {"INS+NHC", "INS+NHC+HOLD", "RIDGE-ODO", "ORACLE-SPEED"}

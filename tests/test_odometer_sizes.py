@@ -75,7 +75,7 @@ def test_the_run_facts_name_the_commit_given_by_the_environment_first(monkeypatc
     monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)
     monkeypatch.setenv("BGFN_COMMIT", "feed123")     # a copy on another machine: its git, if any, is not ours
     cfg = {"evaluate": {"sweep": {"train": {"size": "paper"}},
-                        "odometer": {"train": {"optimizer": {"epochs": 1000, "batch_size": 8}}}}}
+                        "odometer": {"train": {"optimizer": {"epochs": 1000, "batch_size": 8}}, "correlation": False}}}
     cfg["evaluate"]["odometer"]["inputs"] = "imu"
     facts = json.loads(S.write_run_facts("paper", cfg, 0.0, "1 job").read_text())
     assert (facts["commit"], facts["size"], facts["inputs"], facts["epochs_max"], facts["batch_size"],

@@ -8,7 +8,8 @@ import pytest
 from bgfn import config
 from bgfn.config import odometer_network_seeds
 from bgfn.errors import DataError
-from bgfn.profile_schema import SCHEMA, load_profile, with_overrides
+from bgfn import settings
+from bgfn.profile_schema import load_profile, with_overrides
 
 pytestmark = pytest.mark.usefixtures("repo_untouched")
 
@@ -102,30 +103,111 @@ def test_noise_scale_auto_and_alignment_options_are_accepted(params):
 
 
 def test_an_error_in_the_base_names_the_base_file(params):
-    quick = params / "quick.yaml"                                 # mine -> smoke -> quick, which sets margin_s
-    quick.write_text(quick.read_text().replace("  margin_s: 30.0", "  margin_s: -1.0"))
+    quick = params / "quick.yaml"                                 # mine -> smoke -> quick, which sets batch_size
+    quick.write_text(quick.read_text().replace("batch_size: 32", "batch_size: 0"))
     (params / "mine.yaml").write_text("profile: mine\nbase: smoke\ndescription: v\ntrain: {window: 40}\n")
     with pytest.raises(DataError) as err:
         load_profile("mine")
-    assert err.value.source == str(quick) and err.value.field == "train.margin_s"
+    assert err.value.source == str(quick) and err.value.field == "train.optimizer.batch_size"
+    assert "a number >= 1" in str(err.value)
 
 
-def test_every_shipped_profile_uses_only_schema_keys():
-    # and the schema knows every key the code reads defaults for (no drift between schema and defaults)
+def test_every_shipped_profile_loads_and_the_modules_defaults_are_the_settings():
+    # one home for every default: the modules' tables of defaults are the settings' own, not copies that may drift
     from bgfn.evaluate import EVALUATE_DEFAULTS
     from bgfn.learning import LEARNING_DEFAULTS
+    from bgfn.nav import constraints as cn
     from bgfn.nav.baseline import NAV_DEFAULTS
-    from bgfn.train import LR_SEARCH_DEFAULTS, OPTIMIZER_DEFAULTS
+    from bgfn.nav.outage_rules import RULE_DEFAULTS
+    from bgfn.parallel import PARALLEL_DEFAULTS
+    from bgfn.train import LR_SEARCH_DEFAULTS, OPTIMIZER_DEFAULTS, VARIANT_RUN_DEFAULTS
 
     for name in config.available_profiles():
         load_profile(name)
-    f = SCHEMA.fields
-    assert set(NAV_DEFAULTS) <= set(f["nav"].fields)
-    assert set(EVALUATE_DEFAULTS) <= set(f["evaluate"].fields)
-    assert set(EVALUATE_DEFAULTS["sweep"]) <= set(f["evaluate"].fields["sweep"].fields)
-    assert set(LEARNING_DEFAULTS) <= set(f["train"].fields)
-    assert set(OPTIMIZER_DEFAULTS) == set(f["train"].fields["optimizer"].fields)
-    assert set(LR_SEARCH_DEFAULTS) == set(f["train"].fields["lr_search"].fields)
+    d = settings.defaults()
+    assert NAV_DEFAULTS == d["nav"] and EVALUATE_DEFAULTS == d["evaluate"] and PARALLEL_DEFAULTS == d["parallel"]
+    assert LEARNING_DEFAULTS == {k: d["train"][k] for k in LEARNING_DEFAULTS}
+    assert OPTIMIZER_DEFAULTS == d["train"]["optimizer"] and LR_SEARCH_DEFAULTS == d["train"]["lr_search"]
+    assert VARIANT_RUN_DEFAULTS == d["variant_runs"]
+    assert RULE_DEFAULTS["cruise_and_manoeuvre"] == settings.defaults_of(settings.OutageRule)
+    assert cn.NHC_DEFAULTS == d["nav"]["nhc"] and cn.ZUPT_DEFAULTS == d["nav"]["zupt"]
+
+
+def test_the_settings_choices_are_the_modules_choices():
+    from typing import get_args
+
+    from bgfn.learning.odometry import ODOMETER_INPUTS
+    from bgfn.nav import constraints as cn, navego_setup
+    from bgfn.paper import METHOD_LABELS
+    from bgfn.parallel import BACKENDS
+
+    def choices(model, key):
+        return set(get_args(model.model_fields[key].annotation))
+
+    assert choices(settings.Nhc, "mounting") == set(cn.MOUNTINGS)
+    assert choices(settings.Nhc, "mounting_weight") == set(cn.MOUNTING_WEIGHTS)
+    assert choices(settings.Odometer, "inputs") == set(ODOMETER_INPUTS)
+    assert choices(settings.Nav, "ins_tuning") == set(navego_setup.INS_TUNINGS)
+    assert choices(settings.Parallel, "backend") == set(BACKENDS)
+    assert set(get_args(settings.Method)) == set(METHOD_LABELS) == set(settings.METHODS)
+
+
+def test_a_misspelt_key_in_the_profile_file_gets_did_you_mean(params):
+    (params / "mine.yaml").write_text("profile: mine\nbase: quick\ndescription: v\n"
+                                      "evaluate: {odometer: {corelation: false}}\n")
+    with pytest.raises(DataError) as err:
+        load_profile("mine")
+    assert err.value.source == str(params / "mine.yaml") and err.value.field == "evaluate.odometer.corelation"
+    assert "did you mean evaluate.odometer.correlation?" in str(err.value)
+
+
+def test_a_wrong_type_names_the_dotted_key_the_file_and_what_was_expected(params):
+    (params / "mine.yaml").write_text("profile: mine\nbase: quick\ndescription: v\n"
+                                      "nav: {zupt: {window_s: two}}\nenergy: {batch_size: 1.5}\n")
+    with pytest.raises(DataError) as err:
+        load_profile("mine")
+    assert err.value.source == str(params / "mine.yaml") and err.value.field == "nav.zupt.window_s"
+    assert "a number" in str(err.value) and "'two'" in str(err.value)
+    (params / "mine.yaml").write_text("profile: mine\nbase: quick\ndescription: v\nenergy: {batch_size: 1.5}\n")
+    with pytest.raises(DataError, match="energy.batch_size.*an integer.*1.5"):
+        load_profile("mine")
+
+
+def test_a_fold_networks_train_section_is_checked_as_a_train_section(params):
+    (params / "mine.yaml").write_text("profile: mine\nbase: quick\ndescription: v\n"
+                                      "evaluate: {sweep: {train: {optimizer: {epoch: 3}}}}\n")
+    with pytest.raises(DataError) as err:
+        load_profile("mine")
+    assert err.value.field == "evaluate.sweep.train.optimizer.epoch" and "did you mean" in str(err.value)
+
+
+def test_a_profile_without_a_base_gets_the_defaults_quick_no_longer_lists(params):
+    # quick lists only what differs; a key it leaves out has its old value as the default
+    (params / "bare.yaml").write_text("profile: bare\ndescription: v\nseed: 1\noutage_windows: [[138906.0, 30.0]]\n")
+    bare, quick = load_profile("bare"), load_profile("quick")
+    for section in ("nav", "energy", "parallel"):
+        assert bare[section] == quick[section], section
+    assert bare["evaluate"]["odometer"]["correlation"] is True and bare["evaluate"]["sweep"]["datasets"] == [
+        "rtklib-drive0708"]
+    assert bare["train"]["optimizer"]["epochs"] == 1000 != quick["train"]["optimizer"]["epochs"]   # quick's reduction
+    assert bare["data"]["seed"] is None and bare["data"]["imu_rate_hz"] == quick["data"]["imu_rate_hz"] == 100.0
+
+
+def test_quick_lists_only_what_differs_from_the_defaults():
+    import yaml
+
+    text = (config.PARAMS_DIR / "quick.yaml").read_text()
+    assert len(text.splitlines()) <= 80
+    d = settings.defaults()
+
+    def same(own, base, where):
+        for key, value in own.items():
+            if isinstance(value, dict) and isinstance(base.get(key), dict):
+                same(value, base[key], f"{where}{key}.")
+            else:
+                assert base.get(key, object()) != value, f"{where}{key} repeats its default"
+
+    same({k: v for k, v in yaml.safe_load(text).items() if k in d}, d, "")
 
 
 def test_notebook_parameters_are_checked_like_the_profile():

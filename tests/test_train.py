@@ -313,7 +313,8 @@ def test_next_learning_rate_steps_past_an_edge_only():
 def test_learning_rate_search_extends_past_the_grid_edge(data, tmp_path):
     # two rates far too small for 4 epochs: the larger wins, at the grid's top edge
     cfg = {**_cfg(epochs=4), "sizes": {"mlp": {"s": {"n_recent": 5, "hidden": 16}}}, "size": "s"}
-    plain = T.search_learning_rates(data, ["mlp"], {**cfg, "lr_search": {"grid": [1e-5, 1e-4], "fraction": 0.25}})
+    plain = T.search_learning_rates(data, ["mlp"], {**cfg, "lr_search": {"grid": [1e-5, 1e-4], "fraction": 0.25,
+                                                                         "extend": 0}})
     assert plain["lr"].tolist() == [1e-5, 1e-4] and plain.loc[plain["selected"], "lr"].item() == 1e-4
     ext = T.search_learning_rates(data, ["mlp"], {**cfg, "lr_search": {"grid": [1e-5, 1e-4], "fraction": 0.25,
                                                                        "extend": 2}})
@@ -413,7 +414,8 @@ def test_profile_search_selects_per_dataset(data, models_in_tmp):
     cfgs = T.selected_train_configs(plan.train_cfg, table, ["a", "b"])
     assert T.chosen_learning_rates(cfgs, ["mlp"]) == {"a": {"mlp": 3e-3}, "b": {"mlp": 3e-3}}   # lr 0 learns nothing
     # no grid: no search, the profile's rates for every dataset
-    assert T.search_profile_learning_rates(plan.profile, {"a": data}, ["mlp"], _toy_plan().train_cfg) is None
+    no_grid = _toy_plan(lr_search={"grid": None}).train_cfg
+    assert T.search_profile_learning_rates(plan.profile, {"a": data}, ["mlp"], no_grid) is None
     plain = T.selected_train_configs(plan.train_cfg, None, ["a", "b"])
     assert plain == {"a": plan.train_cfg, "b": plan.train_cfg}
 
@@ -531,7 +533,7 @@ def test_runs_that_never_improved_are_trained_again_on_all_windows_only_when_the
     monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)
     n = len(data.train)
     tc = {"size": "s", "sizes": {"mlp": {"s": {"n_recent": 5, "hidden": 16}}}, "lr": {"mlp": 3e-3},
-          **_cfg(epochs=2, max_train_windows=n // 4), "recheck_all_windows": True}
+          **_cfg(epochs=2, max_train_windows=n // 4), "recheck_all_windows": True, "recheck_runs": "all"}
     prepared = {"toy": T.TrainingDataset("toy", None, None, data), "small": T.TrainingDataset("small", None, None,
                                                                                                 SimpleNamespace(train=[0] * 10))}
     cfgs = {"toy": tc, "small": tc}
@@ -556,7 +558,8 @@ def test_runs_that_never_improved_are_trained_again_on_all_windows_only_when_the
     assert lines[0].startswith(f"trained again on all their training windows, {improved} of 1 runs")
     assert lines[1] == f"  toy mlp seed 0: {n // 4} -> {n} windows, best epoch 0 -> {pair['all']['best_epoch']}"
     assert T.recheck_lines(table.iloc[:0], tc)[0].startswith("no run to recheck")
-    assert T.recheck_lines(table, {})[0] == "not rechecked (train.recheck_all_windows is false)"
+    off = {"recheck_all_windows": False}
+    assert T.recheck_lines(table, off)[0] == "not rechecked (train.recheck_all_windows is false)"
 
 
 def test_recheck_runs_first_keeps_the_lowest_seed_of_each_dataset_and_method():

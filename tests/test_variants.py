@@ -245,7 +245,7 @@ def test_search_budget_caps_epochs_and_patience_for_every_method():
 def test_a_capped_search_is_the_prefix_of_the_full_budget(data):
     sizes = {"sizes": {"mlp": {"s": {"n_recent": 5, "hidden": 16}}}, "size": "s"}
     opt = {"optimizer": {"epochs": 6, "batch_size": 16, "lr": 3e-3, "patience": 50, "schedule": "none"}}
-    grid = {"grid": [1e-3, 1e-2], "fraction": 0.25}
+    grid = {"grid": [1e-3, 1e-2], "fraction": 0.25, "extend": 0}
     capped = T.search_learning_rates(data, ["mlp"], {**opt, **sizes, "lr_search": {**grid, "epochs": 3}})
     assert capped["epochs_run"].tolist() == [3, 3] and capped["selected"].sum() == 1
     # same seed, same tuning split: a capped tuning run is the first epochs of the full one, so its tuning loss

@@ -12,9 +12,10 @@ that papermill overrides, then::
 Outputs go to ``out / "tables" / "<name>.csv"``, ``out / "figures" / "<name>.png"`` and
 ``out / "<name>.json"`` (metrics), always through :mod:`bgfn.io` (atomic writes).
 
-This module only finds and merges profiles (:func:`read_profile`, the ``base:`` chain) and knows paths: it is a
-core fact and imports nothing of the package above it. The check of every key against the schema is the edge's
-(:mod:`bgfn.profile_schema`, whose ``load_profile`` reads with :func:`read_profile`, then validates).
+This module finds and merges profiles (:func:`read_profile`, the ``base:`` chain, laid over the defaults and checked
+key by key by :mod:`bgfn.settings`) and knows paths: it is a core fact and imports nothing of the package above it.
+The facts that tie keys together are the edge's (:mod:`bgfn.profile_schema`, whose ``load_profile`` reads with
+:func:`read_profile`, then checks them).
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ from typing import Any
 
 import yaml
 
+from bgfn import settings
 from bgfn.errors import DataError
 
 
@@ -60,12 +62,12 @@ DATA_DIR: Path = PROJECT_ROOT / "data"
 
 #: Profiles shipped with the artifact (users may add their own ``params/<name>.yaml``).
 PROFILES: tuple[str, ...] = ("smoke", "quick", "full", "paper")
-#: Top-level keys every profile file must define (``outage_windows``: the evaluation outages, one list or per
-#: dataset a list or a rule, read by :func:`bgfn.nav.outages.outage_windows`, shared by notebooks 01-04).
-SCALAR_KEYS: tuple[str, ...] = ("profile", "description", "seed", "outage_windows")
+#: Top-level keys a profile's chain must set (``outage_windows``: the evaluation outages, one list or per dataset a
+#: list or a rule, read by :func:`bgfn.nav.outages.outage_windows`, shared by notebooks 01-04); every other key has
+#: its default in :mod:`bgfn.settings`.
+REQUIRED_KEYS: tuple[str, ...] = settings.REQUIRED
 #: One section per notebook: 01 data, 02 nav (KF baseline), 03 train, 04 evaluate, 05 energy.
 SECTION_KEYS: tuple[str, ...] = ("data", "nav", "train", "evaluate", "energy")
-REQUIRED_KEYS: tuple[str, ...] = SCALAR_KEYS + SECTION_KEYS
 #: Files of ``results/<profile>/`` that one notebook writes and a later notebook or the results page reads: the
 #: one place their names are spelled. Run records (``results/<profile>/<name>``):
 RUN_RECORDS: dict[str, str] = {
@@ -130,12 +132,12 @@ def odometer_network_seeds(odometer: dict | None, dataset: str) -> list[int]:
     """The seeds the odometer networks of ``dataset`` train with: ``evaluate.odometer.network_seeds``, one list for
     every drive or per drive with a ``default`` list for every drive not named (one rule for notebook 04, which
     trains them, and notebook 05, which measures the first)."""
-    seeds = (odometer or {}).get("network_seeds", [0])
+    seeds = odometer["network_seeds"]
     if isinstance(seeds, dict):
         seeds = seeds.get(dataset, seeds.get(DEFAULT_DATASET_KEY))
     if not seeds:
         raise DataError("evaluate.odometer", "network_seeds", f"seeds for {dataset} (or a 'default' list)",
-                        repr((odometer or {}).get("network_seeds")))
+                        repr(odometer["network_seeds"]))
     return [int(s) for s in seeds]
 
 
@@ -229,8 +231,9 @@ def profile_chain(profile: str) -> list[Path]:
 
 
 def read_profile(profile: str) -> dict[str, Any]:
-    """Read ``params/<profile>.yaml`` and merge its ``base:`` chain; the structure is checked, not the keys' values
-    (:func:`bgfn.profile_schema.load_profile` adds that check: call it where a checked profile is needed).
+    """Read ``params/<profile>.yaml``, merge its ``base:`` chain over the defaults and check every key
+    (:func:`bgfn.settings.complete`); :func:`bgfn.profile_schema.load_profile` adds the facts that tie keys together:
+    call it where a checked profile is needed.
 
     A profile may name another one as ``base:``; it then holds only what differs: its sections are laid
     over the base's key by key (:func:`merge_sections`), so ``params/quick-heading.yaml`` lists only the
@@ -252,17 +255,18 @@ def read_profile(profile: str) -> dict[str, Any]:
     Returns
     -------
     dict
-        The parsed YAML (merged over its bases): ``profile`` (str, equal to the file name), ``description``
-        (str), ``seed`` (int), ``outage_windows`` (a list of [start, duration], s, or a mapping dataset -> such a list
-        or a rule, with ``default``) and one mapping per notebook section (``data``, ``nav``, ``train``,
-        ``evaluate``, ``energy``; an empty section is returned as ``{}``). A fresh copy on every call.
+        The parsed YAML merged over its bases and the defaults: ``profile`` (str, equal to the file name),
+        ``description`` (str), ``seed`` (int), ``outage_windows`` (a list of [start, duration], s, or a mapping
+        dataset -> such a list or a rule, with ``default``) and every section with every key
+        (:class:`bgfn.settings.Profile`). A fresh copy on every call.
 
     Raises
     ------
     bgfn.errors.DataError
-        Unknown profile (missing file), unreadable YAML, a missing required top-level key or a wrong type of
-        one, a key that moved (:data:`MOVED_KEYS`, the message names the new one), a ``base:`` that does not
-        exist or leads back to the profile. The message names the file.
+        Unknown profile (missing file), unreadable YAML, a missing required top-level key, a key that moved
+        (:data:`MOVED_KEYS`, the message names the new one), a ``base:`` that does not exist or leads back to the
+        profile, a key unknown or of the wrong type (the closest valid key suggested). The message names the
+        file that set the key.
     """
     chain = _read_chain(profile)
     path = chain[0][0]
@@ -287,16 +291,10 @@ def read_profile(profile: str) -> dict[str, Any]:
                         f"missing {', '.join(missing)}")
     if cfg["profile"] != profile:
         raise DataError(path, "profile", f"the file's own name {profile!r}", repr(cfg["profile"]))
-    if not isinstance(cfg["description"], str):
-        raise DataError(path, "description", "a string", type(cfg["description"]).__name__)
-    if isinstance(cfg["seed"], bool) or not isinstance(cfg["seed"], int) or cfg["seed"] < 0:
-        raise DataError(path, "seed", "a non-negative integer", repr(cfg["seed"]))
-    for key in SECTION_KEYS:
-        if cfg[key] is None:  # a section holding only comments
-            cfg[key] = {}
-        if not isinstance(cfg[key], dict):
-            raise DataError(path, key, "a mapping (section of keys)", type(cfg[key]).__name__)
-    return copy.deepcopy(cfg)
+    try:
+        return settings.complete(cfg)
+    except settings.ProfileError as exc:
+        raise DataError(file_setting(profile, exc.path), exc.path, exc.expected, exc.found) from None
 
 
 def variant_config(cfg: dict, name: str) -> dict:

@@ -39,10 +39,11 @@ from joblib import Parallel, delayed, parallel_config
 from joblib.externals.loky import process_executor
 from tqdm import tqdm
 
+from bgfn import settings
 from bgfn.errors import DataError
 
 #: The ``parallel:`` section's keys and defaults (jobs null: the cores of this machine).
-PARALLEL_DEFAULTS: dict[str, Any] = {"jobs": None, "backend": "loky", "scheduler": None}
+PARALLEL_DEFAULTS: dict[str, Any] = settings.defaults("parallel")   # their home: bgfn.settings.Parallel
 #: The backends :class:`Runner` knows.
 BACKENDS = ("loky", "dask")
 #: Environment variables that override the profile (make passes ``JOBS=`` / ``DASK_SCHEDULER=`` as these).

@@ -102,7 +102,7 @@ def profile_overrides(name: str, profile: str) -> dict:
     """
     cfg = read_profile(profile)
     data = cfg["data"]
-    out = {"seed": data.get("seed", cfg["seed"])}
+    out = {"seed": cfg["seed"] if data["seed"] is None else data["seed"]}   # data.seed null: the profile's
     own = DATASETS.get(name, {})
     out.update({k: data[k] for k in COMMON_PARAMS if k in data and k != "seed" and k in own
                 and not (k in _NOT_IN_KEY and name in OWN_CLOCK)})

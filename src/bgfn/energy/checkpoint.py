@@ -47,7 +47,7 @@ def energy_checkpoint(profile: str, method: str, cfg: dict | None = None, datase
     if dataset is None:
         raise ValueError(f"profile {profile!r}: no dataset (energy.dataset and train.datasets are empty)")
     seed = seed if seed is not None else ecfg.get("seed")
-    seed = seed if seed is not None else median_seed(profile, dataset, tcfg.get("seeds") or [0])
+    seed = seed if seed is not None else median_seed(profile, dataset, tcfg["seeds"])
     path = checkpoint_path(profile, dataset, method, int(seed), create=False)
     if must_exist and not path.is_file():
         raise FileNotFoundError(
@@ -63,7 +63,7 @@ def energy_dataset(profile: str, train_cfg: dict, method: str = "bgfn") -> str |
     the first dataset when none has such a card (its network is then refused), None without datasets."""
     datasets = list(train_cfg.get("datasets") or [])
     for dataset in datasets:
-        cards = (_card(profile, dataset, method, seed) for seed in train_cfg.get("seeds") or [0])
+        cards = (_card(profile, dataset, method, seed) for seed in train_cfg["seeds"])
         if any(c is not None and int(c.get("best_epoch", 1)) >= 1 for c in cards):
             return dataset
     return datasets[0] if datasets else None
@@ -174,7 +174,7 @@ def load_measured(profile: str, cfg: dict | None = None, methods=MEASURED) -> Me
         t.model.eval()
     cards = {m: json.loads(card_path(p).read_text()) if card_path(p).exists() else {} for m, p in paths.items()}
     cfg = cfg if cfg is not None else read_profile(profile)
-    allow = bool((cfg.get("energy") or {}).get("allow_untrained", False))
+    allow = bool(cfg["energy"]["allow_untrained"])
     for m in methods:
         if m in SPIKING:        # firing rates depend on the weights; the twin's MAC count does not
             check_trained(cards[m], card_path(paths[m]), allow)

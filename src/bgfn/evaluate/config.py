@@ -7,6 +7,7 @@ import copy
 from dataclasses import dataclass, field
 from typing import Any, Sequence
 
+from bgfn import settings
 from bgfn.data import acquire
 from bgfn.errors import DataError
 from bgfn.nav import outages
@@ -39,51 +40,9 @@ TABLE_FILES: dict[str, str] = {test: spec["file"] for test, spec in TESTS.items(
 REAL_IMU_DATASETS: dict[str, tuple[str, str]] = {"turin-sim-ekinox": ("navego-ekinox", "ekinox_imu.mat"),
                                                  "turin-sim-mpu6000": ("navego-mpu6000", "mpu6000_imu.mat")}
 
-#: Defaults of the ``evaluate:`` section (every key of a profile's section must be one of these).
-EVALUATE_DEFAULTS: dict[str, Any] = {
-    "datasets": ["turin-sim-ekinox", "turin-sim-mpu6000"],
-    "real_imu": False,
-    "methods": ["bgfn", "transformer", "at_lstm", "mlp"],
-    "seeds": None,                       # None: train.seeds
-    "seed_aggregate": "median",          # 'median' over seeds, or 'first' (the first seed)
-    "pseudo_gps": {"std_m": None, "std_growth_m_per_s": 0.0, "fusion_rate_hz": 1.0},
-    "series_rate_hz": 10.0,
-    "train_missing": True,
-    "nhc_rows": True,                    # INS+NHC and <METHOD>+NHC rows (bgfn.nav.constraints)
-    "sweep": {
-        "datasets": ["turin-sim-mpu6000"],
-        "n_starts": 20,
-        "durations_s": [10.0, 30.0, 60.0, 120.0],
-        "folds": 2,
-        "seeds": [0, 1, 2],
-        "warmup_s": 60.0,
-        "train": {},
-        "n_boot": 2000,
-        "level": 0.95,
-        "boot_seed": 0,
-    },
-    # the pseudo-GPS from the true increments plus noise (bgfn.studies.outage_sweep.oracle)
-    "oracle": {"sigmas_m": [0.0, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0], "seeds": [0, 1],
-               "durations_s": [30.0, 60.0]},
-    # the bars of a learned odometer in the sweep's windows (bgfn.studies.odometer.bars): datasets ([] none; null:
-    # the sweep's), the IMU window of the ridge odometer, the oracle speed's noise grid and random walk, the held speed's std, the ridge penalty, the gate;
-    # paper_outages: also in each drive's two evaluation outages (the profile's outage_windows), as one more fold;
-    # lr_search: each odometer network's learning rate per fold from train.lr_search's grid (false: train.lr);
-    # network_datasets: the drives whose networks train as odometers (null: every drive of the bars);
-    # correlation: the learned odometers fused with R = kappa std^2, kappa the integrated autocorrelation of their
-    # validation errors up to correlation_max_lag_s (bgfn.learning.odometry.error_correlation; false: fused as white);
-    # calibration_blocks: every other validation block calibrates the odometers' std and kappa, the others stop the
-    # networks' training (false: all the blocks do both);
-    # curve_folds: the ridge refitted with the sweep's starts in each of these numbers of folds (bgfn.studies.odometer.ridge_curve;
-    # more than the starts: one per start)
-    "odometer": {"datasets": None, "methods": ["bgfn", "transformer", "at_lstm", "mlp"], "network_seeds": [0],
-                 "network_datasets": None,
-                 "paper_outages": False, "window_s": 2.0, "sigmas_mps": [0.05, 0.1, 0.2, 0.5, 1.0, 2.0], "walk_mps_per_sqrt_s": 0.0,
-                 "seeds": [0], "hold_std_mps": 1.0, "ridge_alpha": 1.0, "gate_probability": 0.999,
-                 "lr_search": False, "inputs": "band_frames", "val_blocks": 4, "curve_folds": [], "train": None,
-                 "ensemble": False, "ensemble_recalibrate": False, "correlation": False,
-                 "correlation_max_lag_s": 10.0, "calibration_blocks": False},
-}
+#: Defaults of the ``evaluate:`` section, every key of it (their home, with each key's meaning:
+#: :class:`bgfn.settings.Evaluate`).
+EVALUATE_DEFAULTS: dict[str, Any] = settings.defaults("evaluate")
 
 
 def merge_checked(base: dict, upd: dict, where: str, strict: bool = True) -> dict:
@@ -236,5 +195,5 @@ def evaluation_setup(cfg: dict) -> EvaluationSetup:
             lines.append(f"{name}: rule {entry['rule']} (picked from the drive)")
         elif outages.outage_windows(cfg, dataset=name) != default:
             lines.append(f"{name}: {[list(w) for w in outages.outage_windows(cfg, dataset=name)]}")
-    return EvaluationSetup(cfg.get("profile", ""), cfg.get("description", ""), ecfg, names, notes, sweep_names,
+    return EvaluationSetup(cfg["profile"], cfg["description"], ecfg, names, notes, sweep_names,
                            sweep_notes, default, lines, Runner.of(cfg))

@@ -124,7 +124,7 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
     if models is None:
         models = ensure_models(cfg, profile, dataset, ctx, ecfg["methods"], ecfg["seeds"], windows,
                                ecfg["train_missing"], progress)
-    aids = ctx.constraints if (ecfg.get("nhc_rows", True) if nhc_rows is None else nhc_rows) else None
+    aids = ctx.constraints if (ecfg["nhc_rows"] if nhc_rows is None else nhc_rows) else None
     runs = run_outages(ctx, windows, None, "INS", None, ecfg["pseudo_gps"])
     if aids is not None:
         runs += run_outages(ctx, windows, None, nhc_label("INS"), None, ecfg["pseudo_gps"], aids=[aids])

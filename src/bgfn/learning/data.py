@@ -7,18 +7,18 @@ from dataclasses import dataclass, field
 
 import pandas as pd
 
+from bgfn import settings
 from bgfn.errors import DataError
 from bgfn.learning.normalize import Normalizer
 from bgfn.learning.references import reference_columns, reference_rmse
 from bgfn.learning.split import block_label, split_windows
 from bgfn.learning.targets import TARGET_FRAMES
 from bgfn.learning.windows import WindowSet, make_windows
-from bgfn.nav.outages import DEFAULT_MARGIN_S
 
 #: Defaults of the learning-problem keys of a profile's ``train:`` section.
-LEARNING_DEFAULTS = {"window": 200, "alignment": "ending", "yaw_encoding": "unwrap", "target_frame": "ned",
-                     "extra_channels": [], "epoch_stride": 1, "margin_s": DEFAULT_MARGIN_S, "val_fraction": 0.2,
-                     "val_position": "middle", "target_screen_sigma": None, "protocol": "honest"}
+LEARNING_DEFAULTS = {k: settings.defaults("train")[k] for k in (   # their home: bgfn.settings.Train
+    "window", "alignment", "yaw_encoding", "target_frame", "extra_channels", "epoch_stride", "margin_s", "val_fraction",
+    "val_position", "target_screen_sigma", "protocol")}
 
 
 @dataclass
@@ -87,10 +87,10 @@ def inner_split(data: LearningData, fraction: float = 0.2, position=None) -> Lea
     Hyper-parameters chosen on it never see ``data.val``, the block every reported validation error comes from.
     """
     if position is None:
-        position = data.options.get("val_position", LEARNING_DEFAULTS["val_position"])
+        position = data.options["val_position"]
     tr, va, info = split_windows(data.train, (), margin_s=0.0, val_fraction=fraction, val_position=position)
     train, val = data.train.subset(tr), data.train.subset(va)
-    frame = data.options.get("target_frame", "ned")
+    frame = data.options["target_frame"]
     return LearningData(train=train, val=val, norm=Normalizer.fit(train, frame),
                         info={**info, "inner_of": data.info.get("val_block")}, options=dict(data.options))
 

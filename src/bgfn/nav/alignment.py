@@ -44,6 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from .. import settings
 from ..errors import DataError
 from . import earth, error_model as em, transform
 from .state import FilterNoise, FilterState, initial_covariance
@@ -53,20 +54,8 @@ from .state import FilterNoise, FilterState, initial_covariance
 #: attitude, else gnss.
 MODES = ("reference", "gnss", "auto")
 
-#: Defaults of the ``nav.alignment`` profile section.
-ALIGNMENT_DEFAULTS: dict = {
-    "mode": "auto",
-    "speed_threshold_mps": 3.0,
-    "heading_time_s": 10.0,
-    "level_time_s": 5.0,
-    "still_window_s": 1.0,
-    "still_min_s": 5.0,
-    "still_accel_std_mps2": 0.3,
-    "still_gyro_std_dps": 5.0,
-    "level_std_deg": 1.0,
-    "azimuth_std_deg": 2.0,
-    "velocity_std_mps": 0.2,
-}
+#: Defaults of the ``nav.alignment`` profile section (their home: :class:`bgfn.settings.Alignment`).
+ALIGNMENT_DEFAULTS: dict = settings.defaults("nav.alignment")
 
 #: Shortest GNSS interval the course and the speed are taken over, s: at 5 Hz a 0.2 s difference of metre-level
 #: fixes would give speeds with several m/s of noise.

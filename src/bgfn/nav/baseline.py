@@ -1,6 +1,6 @@
 """Notebook 02 workflow: the KF baseline on a drive (full GPS/INS run, standalone INS in the outages).
 
-The ``nav:`` section of ``params/<profile>.yaml`` configures it (keys and defaults in ``NAV_DEFAULTS``); the
+The ``nav:`` section of ``params/<profile>.yaml`` configures it (keys and defaults: :class:`bgfn.settings.Nav`); the
 outages are the profile's ``outage_windows`` (:func:`bgfn.nav.outages.outage_windows`).
 
 - ``datasets``: drive names for :func:`bgfn.data.load_drive` (the profile's ``data:`` section crops them);
@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import paper
+from .. import paper, settings
 from ..config import DEFAULT_DATASET_KEY
 from ..errors import DataError
 from ..io import atomic_write_csv
@@ -46,21 +46,8 @@ from .outages import check_windows, epochs_before
 from .state import FilterNoise, FilterState, initial_covariance, initial_state, noise_from_imu_errors, save_states
 from .tuning import NOISE_SEARCH_DEFAULTS, NoiseTuning, search_noise_scale
 
-#: Defaults of the ``nav:`` profile section.
-NAV_DEFAULTS: dict = {
-    "datasets": ["turin-sim-ekinox", "turin-sim-mpu6000"],
-    "init": {"position_std_m": 1.0, "height_std_m": 3.0, "velocity_std_mps": 0.1, "level_std_deg": 0.5,
-             "azimuth_std_deg": 2.0},
-    "alignment": dict(ALIGNMENT_DEFAULTS),
-    "bias_model": "random_walk",
-    "noise_scale": 1.0,
-    "noise_search": dict(NOISE_SEARCH_DEFAULTS),
-    "innovation_gate": None,
-    "ins_tuning": navego_setup.DEFAULT_TUNING,
-    "nhc": dict(cn.NHC_DEFAULTS),
-    "zupt": dict(cn.ZUPT_DEFAULTS),
-    "constraints_in_gps_run": False,
-}
+#: Defaults of the ``nav:`` profile section (their home: :class:`bgfn.settings.Nav`).
+NAV_DEFAULTS: dict = settings.defaults("nav")
 #: ``nav.noise_scale`` that asks for the factor from the data.
 AUTO = "auto"
 #: Label of the standalone INS with the vehicle constraints (:func:`bgfn.paper.nhc_label`).
@@ -73,7 +60,9 @@ def nav_config(section: dict | None) -> dict:
     for key, value in (section or {}).items():
         if key not in cfg:
             raise DataError("params nav", key, f"one of {sorted(cfg)}", "unknown key")
-        if isinstance(cfg[key], dict):                           # init, alignment, noise_search, nhc, zupt: key by key
+        if key == "noise_scale":                                 # a number, 'auto', or per dataset over the default's
+            cfg[key] = ({**cfg[key], **value} if isinstance(value, dict) and isinstance(cfg[key], dict) else value)
+        elif isinstance(cfg[key], dict):                         # init, alignment, noise_search, nhc, zupt: key by key
             unknown = set(value or {}) - set(cfg[key])
             if unknown:
                 raise DataError(f"params nav.{key}", sorted(unknown)[0], f"one of {sorted(cfg[key])}",
@@ -204,7 +193,7 @@ def _has_attitude(drive) -> bool:
 
 
 def _navego(cfg: dict) -> bool:
-    return cfg.get("ins_tuning", navego_setup.DEFAULT_TUNING) == "navego"
+    return cfg["ins_tuning"] == "navego"
 
 
 def _noise(drive, cfg: dict, scale: float) -> FilterNoise:

@@ -75,8 +75,6 @@ from .state import FilterNoise, _vec3
 
 #: Values of the profile key ``nav.ins_tuning``: the shipped bias modelling, or NaveGo v1.4's setup.
 INS_TUNINGS: tuple[str, ...] = ("shipped", "navego")
-#: The default: every result as the shipped filter gives it.
-DEFAULT_TUNING = "shipped"
 _SENSORS = ("gyro", "accel")
 _AXES = ("x", "y", "z")
 
@@ -171,5 +169,5 @@ def remove_static_biases(imu: pd.DataFrame, gyro_static, accel_static) -> pd.Dat
     return out
 
 
-__all__ = ["INS_TUNINGS", "DEFAULT_TUNING", "check_tuning", "navego_noise", "static_biases",
+__all__ = ["INS_TUNINGS", "check_tuning", "navego_noise", "static_biases",
            "initial_bias_estimates", "remove_static_biases"]

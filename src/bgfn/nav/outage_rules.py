@@ -39,22 +39,13 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from .. import settings
 from ..errors import DataError
 from . import transform
 
-#: The rules a profile may name, with the defaults of their parameters (a profile entry may leave keys out).
-RULE_DEFAULTS: dict[str, dict[str, float]] = {
-    "cruise_and_manoeuvre": {
-        "duration_s": 30.0,                 # each outage, s (the paper: 30 s)
-        "step_s": 1.0,                      # grid of the speed / yaw-rate series and of the candidate starts, s
-        "warmup_s": 60.0,                   # no start earlier after the vehicle first moves, s
-        "min_speed_mps": 2.0,               # slower: not moving, the course rate is not a yaw rate, m/s
-        "cruise_max_yaw_rate_dps": 3.0,     # a cruise window's mean |yaw rate| at most, deg/s
-        "manoeuvre_min_yaw_rate_dps": 5.0,  # the manoeuvre window's mean |yaw rate| at least, deg/s
-        "gap_s": 30.0,                      # between the two windows at least, s
-        "min_training_s": 120.0,            # GPS time left to training outside the windows +- train.margin_s, s
-    },
-}
+#: The rules a profile may name, with the defaults of their parameters (a profile entry may leave keys out; each
+#: key's meaning and default: :class:`bgfn.settings.OutageRule`).
+RULE_DEFAULTS: dict[str, dict[str, float]] = {"cruise_and_manoeuvre": settings.defaults_of(settings.OutageRule)}
 #: Kinds of window a rule picks, in the order of its ``kinds``.
 KINDS: tuple[str, ...] = ("cruise", "manoeuvre")
 

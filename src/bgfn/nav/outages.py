@@ -113,9 +113,6 @@ def epochs_before(imu_time, starts, source: str = "outage_windows") -> np.ndarra
     return imu_time[before]
 
 
-#: Default of ``train.margin_s``: how far (s) training and validation data stay from an evaluation outage, and
-#: how much training data a rule's outages must leave (read here and by :data:`bgfn.learning.LEARNING_DEFAULTS`).
-DEFAULT_MARGIN_S = 30.0
 
 
 def outage_entry(profile: dict, dataset: str | None = None):
@@ -211,7 +208,7 @@ def picked_outages(profile: dict, drive, dataset: str | None = None):
     entry = outage_entry(profile, name)
     if not is_rule(entry):
         return None
-    margin = float((profile.get("train") or {}).get("margin_s", DEFAULT_MARGIN_S))
+    margin = float(profile["train"]["margin_s"])
     return outage_rules.pick_windows(entry, drive.reference, margin, f"{name}: profile outage_windows")
 
 

@@ -23,8 +23,10 @@ import math
 from dataclasses import dataclass, field
 from typing import Callable
 
+from .. import settings
+
 #: Defaults of the ``nav.noise_search`` profile section.
-NOISE_SEARCH_DEFAULTS: dict = {"range": [0.1, 1000.0], "max_runs": 8, "tolerance": 0.1, "bias_walk": False}
+NOISE_SEARCH_DEFAULTS: dict = settings.defaults("nav.noise_search")   # their home: bgfn.settings.NoiseSearch
 
 #: The log-log slope assumed before two runs give one, d log(mean NIS) / d log(s): position innovations grow
 #: about linearly with the noise density when the IMU noise dominates them.

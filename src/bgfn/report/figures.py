@@ -119,7 +119,7 @@ def draw_diagrams(cfg: dict, evaluation: dict | None, figures_dir: str | Path) -
     # the network input: Eq. (eq21)'s channels, then the profile's extra channels (as notebook 03 trains it)
     in_channels = len(CHANNELS) + len(tc.get("extra_channels") or [])
     model = build_model("bgfn", size_config(tc, "bgfn"), in_channels=in_channels)
-    imu_rate = cfg["data"].get("imu_rate_hz", 100.0)
+    imu_rate = cfg["data"]["imu_rate_hz"]
     gnss_rates = {d: cfg["data"][d]["gnss_rate_hz"] for d in cfg["data"].get("datasets", [])
                   if isinstance(cfg["data"].get(d), dict) and "gnss_rate_hz" in cfg["data"][d]}
     pseudo = (evaluation or {}).get("evaluate", {}).get("pseudo_gps") or cfg["evaluate"].get("pseudo_gps") or {}
@@ -129,7 +129,7 @@ def draw_diagrams(cfg: dict, evaluation: dict | None, figures_dir: str | Path) -
         "lif_neuron.png": drawings.plot_lif(drawings.simulate_lif(drawings.default_lif_current(),
                                                                   **drawings.lif_settings(model))),
         "diagram_hybrid_system.png": drawings.plot_hybrid_system(int(tc["window"]), gnss_rates,
-                                                                 float(pseudo.get("fusion_rate_hz", 1.0)),
+                                                                 float(pseudo["fusion_rate_hz"]),
                                                                  pseudo.get("std_m"), imu_rate),
         "diagram_bgfn_architecture.png": drawings.plot_bgfn_architecture(
             drawings.architecture_spec(model, int(tc["window"]))),

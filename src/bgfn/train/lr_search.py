@@ -18,6 +18,7 @@ from typing import Any, Callable
 
 import pandas as pd
 
+from bgfn import settings
 from bgfn.config import results_dir
 from bgfn.errors import DataError
 from bgfn.learning import LearningData, inner_split
@@ -31,8 +32,7 @@ from bgfn.train.tasks import TrainingRun, train_runs
 #: tried beyond it, one grid step (the ratio of the two rates at that end) at a time, so no method's choice
 #: is cut off by the grid's ends. ``epochs``, ``patience``, ``max_train_windows``, ``max_val_windows``: the budget of
 #: one tuning run (null: the optimizer's), the same for every method and rate.
-LR_SEARCH_DEFAULTS: dict[str, Any] = {"grid": None, "fraction": 0.2, "seed": 0, "extend": 0, "epochs": None,
-                                      "patience": None, "max_train_windows": None, "max_val_windows": None}
+LR_SEARCH_DEFAULTS: dict[str, Any] = settings.defaults("train.lr_search")   # their home: bgfn.settings.LrSearch
 #: The keys of ``train.lr_search`` that replace the optimizer's in a tuning run.
 SEARCH_BUDGET_KEYS: tuple[str, ...] = ("epochs", "patience", "max_train_windows", "max_val_windows")
 #: The saved search of notebook 03 (``results/<profile>/tables/``): one row per dataset, method and rate.

@@ -32,7 +32,7 @@ class IncrementObjective:
     metric_key = "val_rmse_m"
 
     def __init__(self, data: LearningData):
-        self.data, self.frame = data, data.options.get("target_frame", "ned")
+        self.data, self.frame = data, data.options["target_frame"]
 
     def targets(self, ws) -> torch.Tensor:
         """Normalized targets [M, 2] of the windows ``ws`` (in the target frame)."""

@@ -12,26 +12,11 @@ from typing import Any
 
 import numpy as np
 
+from bgfn import settings
 from bgfn.errors import DataError
 
-#: Defaults of the optimization keys (``train.optimizer`` of a profile).
-OPTIMIZER_DEFAULTS: dict[str, Any] = {
-    "epochs": 1000,             # paper: 1000
-    "batch_size": 8,            # paper: 8
-    "lr": 1.0e-3,
-    "weight_decay": 1.0e-2,
-    "schedule": "plateau",      # 'plateau' (ReduceLROnPlateau on val loss), 'cosine' or 'none'
-    "lr_factor": 0.5,
-    "lr_patience": 5,
-    "min_lr": 1.0e-5,
-    "patience": 20,             # early stopping: epochs without a better validation loss
-    "min_delta": 1.0e-4,        # relative improvement that counts as better
-    "grad_clip": 1.0,           # max global gradient norm (0: off)
-    "max_train_windows": None,  # evenly spaced subsample of the training windows (None: all)
-    "max_val_windows": None,
-    "eval_batch_size": 64,
-    "num_threads": None,        # torch CPU threads (None: torch's default)
-}
+#: Defaults of the optimization keys (``train.optimizer``; their home: :class:`bgfn.settings.Optimizer`).
+OPTIMIZER_DEFAULTS: dict[str, Any] = settings.defaults("train.optimizer")
 
 
 def train_subsection(train_cfg: dict | None, key: str, defaults: dict) -> dict:

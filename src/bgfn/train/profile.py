@@ -185,7 +185,7 @@ def ins_attitude(drive, cfg: dict):
     ``'reference'`` takes the truth attitude
     (debugging only: the outage evaluation feeds the INS attitude).
     """
-    src = (cfg.get("train") or {}).get("attitude_source", "kf")
+    src = cfg["train"]["attitude_source"]
     if src == "reference":
         return drive.reference.copy()
     if src != "kf":

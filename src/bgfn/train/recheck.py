@@ -31,8 +31,8 @@ RECHECK_RUNS = ("all", "first")
 
 
 def enabled(train_cfg: dict) -> bool:
-    """``train.recheck_all_windows`` of a ``train:`` section (default false)."""
-    return bool(train_cfg.get("recheck_all_windows", False))
+    """``train.recheck_all_windows`` of a ``train:`` section."""
+    return bool(train_cfg["recheck_all_windows"])
 
 
 def first_per_method(cards: list[dict]) -> list[dict]:
@@ -75,7 +75,7 @@ def recheck_all_windows(plan, cards: list[dict], prepared: dict, train_cfgs: dic
     """
     if not enabled(plan.train_cfg):
         return []
-    which = plan.train_cfg.get("recheck_runs", "all")
+    which = plan.train_cfg["recheck_runs"]
     if which not in RECHECK_RUNS:
         raise ValueError(f"train.recheck_runs must be one of {RECHECK_RUNS}, got {which!r}")
     capped, runs = capped_runs(cards, prepared, train_cfgs), []
@@ -114,7 +114,7 @@ def recheck_lines(table: pd.DataFrame, train_cfg: dict) -> list[str]:
     improved = int((table["best_epoch_all"] >= 1).sum())
     fit = float(table["train_loss_min_all"].median())
     which = (" (the first of each dataset and method, train.recheck_runs: first)"
-             if train_cfg.get("recheck_runs", "all") == "first" else "")
+             if train_cfg["recheck_runs"] == "first" else "")
     lines = [f"trained again on all their training windows, {improved} of {len(table)} runs that never improved on "
              f"their initial network{which} then did (median lowest training loss {fit:.2f}; predicting the "
              f"training mean: about 1):"]

@@ -1,6 +1,6 @@
 """Variants of a profile's learning problem, trained beside its main networks.
 
-A profile names them at its top level (schema: :data:`bgfn.profile_schema.VARIANT`)::
+A profile names them at its top level (:class:`bgfn.settings.Variant`)::
 
     variants:                                  # name -> overrides of the train: section
       velocity: {train: {extra_channels: [v_along, v_cross], ...}}     # params/quick-heading.yaml's inputs
@@ -21,6 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Callable
 
+from bgfn import settings
 from bgfn.config import MAIN_VARIANT, merge_sections, variant_config
 from bgfn.learning import LEARNING_DEFAULTS, LearningData, build_learning_data, learning_options
 from bgfn.parallel import Runner
@@ -30,7 +31,7 @@ from bgfn.train.tables import cards_table
 from bgfn.train.tasks import TrainingRun, train_runs
 
 #: Defaults of ``variant_runs`` (null datasets / methods: the ``train:`` section's).
-VARIANT_RUN_DEFAULTS: dict[str, Any] = {"datasets": None, "methods": None, "seeds": [0]}
+VARIANT_RUN_DEFAULTS: dict[str, Any] = settings.defaults("variant_runs")   # their home: bgfn.settings.VariantRuns
 
 
 def variant_train_section(train_cfg: dict, overrides: dict | None) -> dict:

@@ -133,7 +133,7 @@ def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None
     rows = []
     for tuning in navego_setup.INS_TUNINGS:
         c = {**cfg, "ins_tuning": tuning}
-        same = baseline is not None and tuning == cfg.get("ins_tuning", navego_setup.DEFAULT_TUNING)
+        same = baseline is not None and tuning == cfg["ins_tuning"]
         b = baseline if same else run_baseline(drive, c, windows)
         ins = b.outage_table
         if "method" in ins.columns:                   # the standalone INS only (not the INS+NHC rows)

@@ -172,8 +172,7 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
     ws = lo.speed_windows(drive.imu, epochs, window, np.interp(epochs, tt, speed))
     truth = reference_speed(drive, all_windows.t_end)
     gate = oc["gate_probability"]
-    margin = float((cfg.get("train") or {}).get("margin_s", 30.0))
-    val_fraction = float((cfg.get("train") or {}).get("val_fraction", 0.2))
+    margin, val_fraction = float(cfg["train"]["margin_s"]), float(cfg["train"]["val_fraction"])
     folds = {int(k): [(float(s), dmax) for s in plan.loc[plan["fold"] == k, "start_s"]]
              for k in sorted(plan["fold"].unique())}
     if paper:

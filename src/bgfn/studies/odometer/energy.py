@@ -134,7 +134,7 @@ def odometer_energy(profile: str, cfg: dict, e_mac: float, e_ac: float, batch_si
         raise FileNotFoundError(f"BGFN-ODO's checkpoint not found: {folder / checkpoint_name('bgfn', seed)} -- "
                                 f"notebook 07_learned_odometer.ipynb trains it (evaluate.odometer.methods)")
     paths = {m: p for m, p in paths.items() if p.is_file()}
-    allow = bool((cfg.get("energy") or {}).get("allow_untrained", False))
+    allow = bool(cfg["energy"]["allow_untrained"])
     for m in SPIKING:
         check_trained(json.loads(card_path(paths[m]).read_text()), card_path(paths[m]), allow)
     trained = {m: load_trained(p, device="cpu") for m, p in paths.items()}

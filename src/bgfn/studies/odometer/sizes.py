@@ -57,7 +57,7 @@ def write_run_facts(profile: str, cfg: dict, t0: float, jobs: str) -> Path:
     tc = (cfg["evaluate"]["odometer"].get("train") or {}).get("optimizer") or {}
     facts = {"profile": profile, "size": (cfg["evaluate"]["sweep"].get("train") or {}).get("size"),
              "inputs": cfg["evaluate"]["odometer"].get("inputs"),
-             "correlation": bool(cfg["evaluate"]["odometer"].get("correlation", False)),
+             "correlation": bool(cfg["evaluate"]["odometer"]["correlation"]),
              "epochs_max": tc.get("epochs"), "batch_size": tc.get("batch_size"), "device": device_name(),
              "wall_s": round(time.perf_counter() - t0, 1), "jobs": jobs, "torch": torch.__version__,
              "date": datetime.date.today().isoformat(), "commit": os.environ.get("BGFN_COMMIT") or git_commit()}

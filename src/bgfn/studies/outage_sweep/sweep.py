@@ -134,7 +134,7 @@ class _Sweep:
         self.truth = AntennaTruth.of(ctx)
         self.fold_of = dict(zip(plan["start_s"], plan["fold"]))
         windows_all = [(s, dmax) for s in plan["start_s"]]
-        self.aids = aids = ctx.constraints if ecfg.get("nhc_rows", True) else None
+        self.aids = aids = ctx.constraints if ecfg["nhc_rows"] else None
         for r in run_outages(ctx, windows_all, None, "INS", None, ecfg["pseudo_gps"]):
             self.add(r, self.fold_of[r.start])
         if aids is not None:
@@ -305,7 +305,7 @@ def describe_sweep_setup(train_section: dict, ecfg: dict, datasets) -> list[str]
              f"{sw['folds']} folds x seeds {sw['seeds']} x methods {[label(m) for m in ecfg['methods']]} + INS + GPS",
              f"fold networks: window {tc.get('window')} samples, size block {tc.get('size')!r}, optimizer {budget}"]
     lines += [f"  {label(m):>12}: {tc['sizes'][m][tc['size']]}" for m in ecfg["methods"]]
-    if ecfg.get("nhc_rows", True):
+    if ecfg["nhc_rows"]:
         lines.append("INS and every network also with the vehicle constraints (NHC, ZUPT when still): rows "
                      + ", ".join(nhc_label(m) for m in ["INS"] + list(ecfg["methods"])))
     return lines

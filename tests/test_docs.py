@@ -158,14 +158,14 @@ def _code_page_extension():
 
 
 def test_docstrings_absolute_values_and_spilling_tables_are_made_literal():
-    pd = _code_page_extension()
-    assert pd._escape_bars("max |east| and |north|, ``|x|``") == r"max \|east\| and \|north\|, ``|x|``"
-    assert pd._escape_bars("| a line block |") == "| a line block |"
-    assert pd._escape_bars("|north| first") == r"\|north\| first"
+    ext = _code_page_extension()
+    assert ext._escape_bars("max |east| and |north|, ``|x|``") == r"max \|east\| and \|north\|, ``|x|``"
+    assert ext._escape_bars("| a line block |") == "| a line block |"
+    assert ext._escape_bars("|north| first") == r"\|north\| first"
     good = ["=====  =====", "key    value", "=====  =====", ""]
-    assert pd._literal_tables(good) == good
+    assert ext._literal_tables(good) == good
     spill = ["text", "", "=====  =====", "key    value", "a_long_key  value", "=====  =====", "", "after"]
-    out = pd._literal_tables(spill)
+    out = ext._literal_tables(spill)
     assert out[:4] == ["text", "", "::", ""] and out[4:8] == ["   " + line for line in spill[2:6]]
     assert out[-1] == "after"
 

@@ -367,8 +367,8 @@ class Profile(Section):
 REQUIRED: tuple[str, ...] = tuple(k for k, f in Profile.model_fields.items() if f.is_required())
 
 
-def _dump(model: type[BaseModel]) -> dict:
-    """The defaults of ``model`` as plain data (mappings of sections, keys spelt as in YAML)."""
+def defaults_of(model: type[BaseModel]) -> dict:
+    """The defaults of ``model`` as plain data (mappings of sections, keys spelt as in YAML; required keys left out)."""
     out = {}
     for name, field in model.model_fields.items():
         if field.is_required():
@@ -378,7 +378,7 @@ def _dump(model: type[BaseModel]) -> dict:
         key = field.alias or name
         sub = field.annotation
         if isinstance(sub, type) and issubclass(sub, BaseModel) and out.get(key) == {}:
-            out[key] = _dump(sub)
+            out[key] = defaults_of(sub)
     return out
 
 
@@ -389,7 +389,7 @@ def defaults(path: str = "") -> dict:
     """The defaults of the section at dotted ``path`` (``""``: every section; ``"nav.alignment"``), a fresh copy."""
     global _DEFAULTS
     if _DEFAULTS is None:
-        _DEFAULTS = {k: v for k, v in _dump(Profile).items() if k != "datasets"}   # a file's own list, spread on read
+        _DEFAULTS = {k: v for k, v in defaults_of(Profile).items() if k != "datasets"}   # a file's own list, spread on read
     out = _DEFAULTS
     for key in [k for k in path.split(".") if k]:
         out = out[key]
@@ -550,11 +550,6 @@ def _fill_rules(cfg: dict) -> None:
         for key, entry in spec.items():
             if isinstance(entry, dict) and "rule" in entry:
                 spec[key] = {"rule": entry["rule"], **defaults_of(OutageRule), **entry}
-
-
-def defaults_of(model: type[BaseModel]) -> dict:
-    """The defaults of one model (its required keys left out)."""
-    return _dump(model)
 
 
 def complete(cfg: dict) -> dict:

@@ -22,7 +22,7 @@ from ..errors import DataError
 from ..schema import GNSS_FIX_COLUMNS
 from . import error_model as em
 from .engine import EPOCH_TOL, Measurement, Stepper
-from .outages import OutageWindow, PseudoGpsContext
+from .outages import PseudoGpsContext
 from .strapdown import radii_nb
 
 
@@ -134,19 +134,21 @@ class FixSchedule:
 
 
 class WindowStarts:
-    """Not a measurement source: it keeps the filter state at each outage's start (the row nearest to it) for
-    :class:`PseudoGps`. Put it in the list before the fixes of that epoch."""
+    """Not a measurement source: it keeps the filter state at each outage's start (at the epoch nearest to it) for
+    :class:`PseudoGps`, the start of its sums (Eq. pred-gps). It is its own schedule; in the aid list it comes
+    before the fixes, so that a fix of the start's epoch is not in the state it keeps."""
+
+    joint = False
 
     def __init__(self, windows):
         self.windows = tuple(windows)
+        self.rows = np.empty(0, dtype=np.int64)
         self.states: dict = {}
 
     def schedule(self, times, source: str = "imu", hold_at: float | None = None) -> "WindowStarts":
         self.rows = np.array([int(np.argmin(np.abs(times - w.start))) for w in self.windows], dtype=np.int64)
         self.states = {}
         return self
-
-    joint = False
 
     def measurement(self, i: int, nav: Stepper) -> None:
         self.states[self.windows[i]] = nav.state()

@@ -5,7 +5,7 @@ each method runs the outage without GNSS: INS predicts only, a network's increme
 fix (Eq. pred-gps) and fused like a GNSS fix. The ``+NHC`` rows add the vehicle constraints. Metrics per outage:
 max |east|, max |north| (the paper's tables), horizontal RMSE and final error; the median over training seeds.
 
-Modules, in the order of the protocol: :mod:`~bgfn.evaluate.config` (methods, columns, the ``evaluate:``
+Modules, in the order of the protocol: :mod:`~bgfn.evaluate.setup` (methods, columns, the ``evaluate:``
 settings), :mod:`~bgfn.evaluate.hybrid` (Eq. pred-gps, the GPS-aided run, the outage runs, their metrics),
 :mod:`~bgfn.evaluate.networks` (notebook 03's checkpoints), :mod:`~bgfn.evaluate.tables` (Tables 1-2),
 :mod:`~bgfn.evaluate.claims` (ours beside the paper's), :mod:`~bgfn.evaluate.pseudo_std` (the
@@ -15,7 +15,7 @@ sweep, the oracle, the learned odometer, the INS's fidelity) are in :mod:`bgfn.s
 """
 
 from bgfn.evaluate.claims import REDUCTION_COLUMNS, claim_lines, ours_above_paper, paper_table_title, reduction_table
-from bgfn.evaluate.config import (COLORS, EVALUATE_DEFAULTS, FIGURE_METHODS, METRIC_COLUMNS, REAL_IMU_DATASETS,
+from bgfn.evaluate.setup import (COLORS, EVALUATE_DEFAULTS, FIGURE_METHODS, METRIC_COLUMNS, REAL_IMU_DATASETS,
                                   SWEEP_COLUMNS, TABLE_COLUMNS, TABLE_FILES, TABLE_METHODS, EvaluationSetup,
                                   choose_datasets, evaluate_config, evaluation_setup)
 from bgfn.evaluate.hybrid import (NavContext, OutageRun, gps_run, navigation_context, pseudo_gps_positions, run_outages,

@@ -14,7 +14,7 @@ from typing import Mapping
 import pandas as pd
 
 from bgfn import paper
-from bgfn.evaluate.config import TABLE_METHODS
+from bgfn.evaluate.setup import TABLE_METHODS
 from bgfn.evaluate.tables import TableResult, error_reduction
 
 #: Columns of :func:`reduction_table`: ours, then the paper's (reduction against INS, %).

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from bgfn.errors import DataError
-from bgfn.evaluate.config import EVALUATE_DEFAULTS, merge_checked
+from bgfn.evaluate.setup import EVALUATE_DEFAULTS, merge_checked
 from bgfn.learning import (ANGULAR_RATE_CHANNELS, ATTITUDE_CHANNELS, CHANNELS, DERIVED_CHANNELS, EXTRA_START,
                            IMU_CHANNELS, SPECIFIC_FORCE_CHANNELS, YAW_CHANNEL, WindowSet, encode_yaw, heading_velocity,
                            with_derived_channels)

@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.patches import Patch
 
-from bgfn.evaluate.config import COLORS, FIGURE_METHODS, TABLE_METHODS
+from bgfn.evaluate.setup import COLORS, FIGURE_METHODS, TABLE_METHODS
 from bgfn.evaluate.tables import TableResult, representative_seeds
 from bgfn.nav import earth
 from bgfn.paper import NHC_SUFFIX, base_label, nhc_label

@@ -71,7 +71,7 @@ def pseudo_std_sensitivity(cfg: dict, profile: str, result: TableResult, ecfg: d
     result : TableResult
         The tables' run (:func:`bgfn.evaluate.tables.evaluate_dataset`); its drive is reused when it has one.
     ecfg : dict
-        The evaluation configuration of the tables (:func:`bgfn.evaluate.config.evaluate_config`).
+        The evaluation configuration of the tables (:func:`bgfn.evaluate.setup.evaluate_config`).
     """
     seed = ecfg["seeds"][0]
     alt_cfg = {**ecfg, "pseudo_gps": {**ecfg["pseudo_gps"], "std_m": "validation"}}

@@ -12,7 +12,7 @@ import pandas as pd
 
 from bgfn import paper
 from bgfn.config import RUN_RECORDS, run_metadata
-from bgfn.evaluate.config import EvaluationSetup
+from bgfn.evaluate.setup import EvaluationSetup
 from bgfn.evaluate.tables import TableResult
 from bgfn.io import atomic_write_json
 

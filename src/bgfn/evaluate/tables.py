@@ -17,7 +17,7 @@ import pandas as pd
 from bgfn.data import load_drive
 from bgfn.data.gnss import fix_errors
 from bgfn.data.names import dataset_id
-from bgfn.evaluate.config import METRIC_COLUMNS, TABLE_COLUMNS, TABLE_FILES, TABLE_METHODS, evaluate_config
+from bgfn.evaluate.setup import METRIC_COLUMNS, TABLE_COLUMNS, TABLE_FILES, TABLE_METHODS, evaluate_config
 from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
 from bgfn.evaluate.networks import ensure_models
 from bgfn.io import atomic_write_bytes, atomic_write_csv

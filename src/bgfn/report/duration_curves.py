@@ -7,7 +7,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from bgfn.evaluate.config import COLORS
+from bgfn.evaluate.setup import COLORS
 from bgfn.studies.odometer.bars import HOLD, RIDGE
 from bgfn.studies.outage_sweep.sweep import sweep_summary
 

@@ -21,7 +21,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from bgfn.evaluate.config import evaluate_config
+from bgfn.evaluate.setup import evaluate_config
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.studies.outage_sweep.sweep import profile_sweep_plan
 from bgfn.paper import nhc_label, test_of

@@ -26,7 +26,7 @@ import pandas as pd
 from bgfn.config import SHARED_TABLES
 from bgfn.data import load_drive
 from bgfn.errors import DataError
-from bgfn.evaluate.config import COLORS
+from bgfn.evaluate.setup import COLORS
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.studies.outage_sweep.increments import AntennaTruth, increment_rmse
 from bgfn.studies.outage_sweep.sweep import profile_sweep_plan

@@ -15,7 +15,7 @@ import pandas as pd
 from bgfn import train
 from bgfn.data import load_drive
 from bgfn.errors import DataError
-from bgfn.evaluate.config import SEEDLESS_METHODS, SWEEP_COLUMNS, TABLE_METHODS, evaluate_config
+from bgfn.evaluate.setup import SEEDLESS_METHODS, SWEEP_COLUMNS, TABLE_METHODS, evaluate_config
 from bgfn.evaluate.hybrid import NavContext, gps_run, navigation_context, run_outages, window_metrics
 from bgfn.studies.outage_sweep.increments import AntennaTruth, increment_rmse
 from bgfn.evaluate.networks import load_model

@@ -20,7 +20,7 @@ from bgfn.config import MAIN_VARIANT
 from bgfn.data import load_drive
 from bgfn.data.names import dataset_id
 from bgfn.errors import DataError
-from bgfn.evaluate.config import evaluate_config
+from bgfn.evaluate.setup import evaluate_config
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.evaluate.networks import load_model
 from bgfn.nav import outages

@@ -154,7 +154,7 @@ class FilterSetup:
     noise : FilterNoise
     noise_scale : float
         The factor on the white-noise densities in ``noise`` (the profile's number, or the one found).
-    alignment : Alignment or None
+    alignment : bgfn.nav.alignment.Alignment or None
         The self-alignment (:mod:`bgfn.nav.alignment`); None when the filter starts from the reference.
     tuning : NoiseTuning or None
         The noise search (:mod:`bgfn.nav.tuning`); None when ``noise_scale`` is a number.

@@ -79,7 +79,8 @@ def plot_biases(bias: pd.DataFrame, true_bias: pd.DataFrame | None = None, title
                         label=f"{axis} simulated")
         ax.set_ylabel(f"{sensor} bias ({unit})")
         ax.grid(alpha=0.3)
-        ax.legend(ncol=3, fontsize=8)
+        # a fixed corner: "best" searches every point of a whole drive's traces, which matplotlib warns is slow
+        ax.legend(ncol=3, fontsize=8, loc="upper right")
     axes[-1].set_xlabel(f"time since {t0:.0f} s")
     if title:
         axes[0].set_title(title)

@@ -355,6 +355,8 @@ def test_the_better_aid_reads_yes():
     assert short_free_aids(verdict_table(inp)).startswith("yes")
     be = inp.breakeven.assign(increment_rmse_m=1.0)                                    # below the 1.9 m bar
     assert short_accuracy(_inputs(breakeven=be)).startswith("yes")
+    never = short_accuracy(_inputs(breakeven=be.assign(crossing="never_below")))   # the oracle never beats INS
+    assert never.startswith("no") and "at no noise level" in never and "n/a" not in never
 
 
 def test_duration_curves_take_the_sweeps_intervals_and_bootstrap_the_odometers_by_start():

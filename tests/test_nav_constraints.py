@@ -15,6 +15,7 @@ from bgfn.nav import constraints as cn
 from bgfn.nav import error_model as em
 from bgfn.nav import state as st
 from bgfn.nav.filter import run_filter, run_outage
+from bgfn.report import aid_words
 
 RATE = 100.0
 #: Road azimuth of the straight drives, rad.
@@ -361,7 +362,7 @@ def test_the_platform_decides_which_aids_run():
 
 def test_the_aided_rows_words_name_exactly_the_platforms_aids():
     for platform in cn.PLATFORM_AIDS:
-        words = cn.aided_ins_words(platform)
-        assert [a for a in cn.AID_WORDS if cn.AID_WORDS[a] in words] == list(cn.platform_aids(platform))
-    assert cn.aided_ins_words("car") == "INS with non-holonomic constraints and zero-velocity updates"
-    assert cn.aided_ins_words("a unicycle") == cn.aided_ins_words("car")          # unknown: read as the default platform
+        words = aid_words.aided_ins_words(platform)
+        assert [a for a in aid_words.AID_WORDS if aid_words.AID_WORDS[a] in words] == list(cn.platform_aids(platform))
+    assert aid_words.aided_ins_words("car") == "INS with non-holonomic constraints and zero-velocity updates"
+    assert aid_words.aided_ins_words("a unicycle") == aid_words.aided_ins_words("car")   # unknown: the default platform

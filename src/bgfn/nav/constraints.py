@@ -82,9 +82,7 @@ PLATFORM_AIDS: dict[str, tuple[bool, bool]] = {"car": (True, True), "walker": (F
 DEFAULT_PLATFORM = "car"
 
 
-#: The aids in words (:func:`aided_ins_words`).
-AID_WORDS: dict[str, str] = {"NHC": "non-holonomic constraints", "ZUPT": "zero-velocity updates"}
-#: Why a platform goes without an aid (:meth:`ConstraintConfig.describe`, :func:`aided_ins_words`).
+#: Why a platform goes without an aid (:meth:`ConstraintConfig.describe`; the words: :mod:`bgfn.report.aid_words`).
 PLATFORM_NOTES: dict[str, str] = {"car": "", "walker": " (no NHC: a walker steps sideways)",
                                   "other": " (neither: no motion model is known)"}
 
@@ -92,15 +90,6 @@ PLATFORM_NOTES: dict[str, str] = {"car": "", "walker": " (no NHC: a walker steps
 def platform_aids(platform: str) -> tuple[str, ...]:
     """The names of the aids ``platform`` takes, in order (``("NHC", "ZUPT")`` for a car; :data:`PLATFORM_AIDS`)."""
     return tuple(a for a, on in zip(("NHC", "ZUPT"), PLATFORM_AIDS[platform]) if on)
-
-
-def aided_ins_words(platform: str) -> str:
-    """What the learning-free aided row (``INS+NHC``) is on ``platform``, in words: "INS with non-holonomic
-    constraints and zero-velocity updates" for a car; a platform this module does not know reads as a car's."""
-    platform = platform if platform in PLATFORM_AIDS else DEFAULT_PLATFORM
-    aids = platform_aids(platform)
-    return (("INS with " + " and ".join(AID_WORDS[a] for a in aids)) if aids else "INS with no constraint") \
-        + PLATFORM_NOTES[platform]
 
 
 @dataclass(frozen=True)

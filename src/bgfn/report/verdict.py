@@ -31,8 +31,8 @@ from bgfn.config import MAIN_VARIANT, RUN_RECORDS, SHARED_TABLES
 from bgfn.data.names import dataset_id
 from bgfn.data.registry import recorded_first
 from bgfn.evaluate.tables import table_paths
-from bgfn.nav.constraints import aided_ins_words
 from bgfn.studies.ins_fidelity.ins_setups import NAVEGO_CONSISTENT, NAVEGO_RUN, gap_explained
+from bgfn.report.aid_words import aided_ins_words
 from bgfn.report.odometer_verdict import (OdometerInputs, answer_odometer, odometer_headline, odometer_rows,
                                           read_odometer_inputs, same_dataset)
 from bgfn.report.reading import read_csv, read_json

@@ -313,7 +313,7 @@ def test_headline_says_when_the_two_outages_rank_the_aided_ins_behind_ins_but_th
     inp = _inputs(seeds=seeds, sweep_summary=None, sweep_pairs=None, breakeven=None, ins_drift=drift)
     line = headline(inp, verdict_table(inp))
     assert "zero-velocity updates 30.0 m, worse than standalone INS in these two outages though not over" in line
-    assert "from notebook 02's 20 starts it is 6.5 m against INS's 70.4 m (median max error, 30 s)." in line
+    assert "from notebook 08's 20 starts it is 6.5 m against INS's 70.4 m (median max error, 30 s)." in line
     # where the starts agree with the two outages, or the aid is the better one there, nothing is added
     worse = drift.assign(median_max_h_m=lambda d: np.where(d["method"] == "INS+NHC", 99.0, d["median_max_h_m"]))
     assert headline(_inputs(seeds=seeds, sweep_summary=None, sweep_pairs=None, breakeven=None, ins_drift=worse),

@@ -398,7 +398,7 @@ def _numbers(node) -> list[float]:
 def answer_ins_tuning(inp: VerdictInputs) -> str:
     """Question 5: the INS row under NaveGo v1.4's bias modelling beside ours and the paper's."""
     if inp.ins_tuning is None or not len(inp.ins_tuning):
-        return "Is the INS row comparable? Not measured: notebook 02's INS-setup table has not run." + \
+        return "Is the INS row comparable? Not measured: notebook 08's INS-setup table has not run." + \
             consistency_sentence(inp)
     gap = gap_explained(inp.ins_tuning)
     g = gap[gap["setup"] == "navego"]
@@ -481,7 +481,7 @@ def drift_clause(drift: pd.DataFrame | None, ins_m: float, aided_m: float, durat
     if not aided < ins:
         return ""
     n = int(at["n_starts"].iloc[0])
-    return (f", worse than standalone INS in these two outages though not over the drive: from notebook 02's {n} "
+    return (f", worse than standalone INS in these two outages though not over the drive: from notebook 08's {n} "
             f"starts it is {_m(aided)} against INS's {_m(ins)} (median max error, {duration_s:g} s)")
 
 

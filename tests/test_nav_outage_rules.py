@@ -13,6 +13,7 @@ from bgfn.errors import DataError
 from bgfn.nav import outage_rules as R
 from bgfn.nav import outages, sim
 from bgfn.profile_schema import load_profile, with_overrides
+from bgfn.report import nav_words
 
 RULE = {"rule": "cruise_and_manoeuvre", "duration_s": 30.0, "step_s": 1.0, "warmup_s": 60.0, "min_speed_mps": 2.0,
         "cruise_max_yaw_rate_dps": 3.0, "manoeuvre_min_yaw_rate_dps": 5.0, "gap_s": 30.0, "min_training_s": 120.0}
@@ -57,7 +58,7 @@ def test_the_rule_finds_the_straight_fast_part_and_the_turning_part():
     assert man["mean_abs_yaw_rate_dps"] > 12.0 and man["mean_speed_mps"] == pytest.approx(5.0, abs=0.2)
     # 600 s minus the two windows widened by 30 s on each side (apart: 160 s between their starts)
     assert picked.training_s == pytest.approx(600.0 - 2 * 90.0)
-    assert picked.lines()[0].startswith("outage 1 (cruise): 30 s from 1225.0 s, mean speed")
+    assert nav_words.picked_outage_lines(picked)[0].startswith("outage 1 (cruise): 30 s from 1225.0 s, mean speed")
     # deterministic, and independent of the reference's rate (the rule works on its own 1 s grid)
     assert R.pick_windows(RULE, ref, margin_s=30.0).windows == picked.windows
     assert R.pick_windows(RULE, drive_reference(rate_hz=100.0), margin_s=30.0).windows == picked.windows
@@ -143,10 +144,10 @@ def test_the_reader_takes_the_datasets_entry_or_the_default():
     # the rule's training check uses train.margin_s (here 200 s leaves too little)
     with pytest.raises(DataError, match="min_training_s"):
         outages.outage_windows({**prof, "train": {"margin_s": 200.0}}, d)
-    lines = outages.describe_windows(prof, d)
+    lines = nav_words.describe_windows(prof, d)
     assert lines[0].startswith("sim: outages (start, duration) s [[1225.0, 30.0], [1385.0, 30.0]] (rule")
     assert lines[1].startswith("  outage 1 (cruise)") and lines[2].startswith("  outage 2 (manoeuvre)")
-    assert outages.describe_windows(prof, d, "other")[0].endswith("(listed in the profile)")
+    assert nav_words.describe_windows(prof, d, "other")[0].endswith("(listed in the profile)")
     # without a default a dataset the mapping does not name is an error naming the key
     with pytest.raises(DataError, match="'default' entry") as err:
         outages.outage_windows({"profile": "p", "outage_windows": {"sim": [[1100.0, 30.0]]}}, dataset="x")

@@ -14,6 +14,7 @@ from bgfn.data import imu_errors as ie
 from bgfn.errors import DataError
 from bgfn.nav import baseline, consistency, sim
 from bgfn.nav.tuning import NOISE_SEARCH_DEFAULTS, search_noise_scale
+from bgfn.report import nav_words
 
 LEVER = [0.5, -0.3, -1.2]
 TRUE_SCALE = 10.0
@@ -44,7 +45,7 @@ def test_search_finds_the_root_in_a_few_runs(root):
 def test_search_stops_at_the_range_and_says_so(root, bound):
     t = search_noise_scale(_model(root))
     assert t.at_bound and t.scale == pytest.approx(bound)
-    assert "bound" in t.line("x")
+    assert "bound" in nav_words.tuning_line(t, "x")
 
 
 def test_search_respects_its_run_budget():
@@ -103,7 +104,7 @@ def test_auto_finds_the_true_noise_factor_and_makes_the_nis_consistent(quiet_dri
 
 def test_a_numeric_factor_runs_no_search(quiet_drive):
     setup = baseline.prepare_filter(quiet_drive, baseline.nav_config({**NAV, "noise_scale": 3.0}))
-    assert setup.tuning is None and setup.noise_scale == 3.0 and setup.lines("quiet") == []
+    assert setup.tuning is None and setup.noise_scale == 3.0 and nav_words.setup_lines(setup, "quiet") == []
     walk = baseline.prepare_filter(quiet_drive, baseline.nav_config(
         {**NAV, "noise_scale": 3.0, "noise_search": {"bias_walk": True}}))
     assert np.allclose(walk.noise.gyro_bias_walk, 3.0 * setup.noise.gyro_bias_walk)
@@ -125,7 +126,7 @@ def test_nis_summary_of_chi_square_fixes_is_consistent_and_scaled_ones_are_not()
     assert s["verdict"] == "consistent" and s["fixes"] == 4000 and s["dof"] == 3.0
     over = consistency.nis_summary(_updates(22.0 * nis))              # a real MEMS drive with datasheet noise
     assert over["verdict"] == "overconfident" and over["above_chi2_95"] > 0.5
-    assert "overconfident" in consistency.nis_line("d", over) and "noise_scale: auto" in consistency.nis_line("d", over)
+    assert "overconfident" in nav_words.nis_line("d", over) and "noise_scale: auto" in nav_words.nis_line("d", over)
     assert consistency.nis_summary(_updates(0.1 * nis))["verdict"] == "underconfident"
     # pseudo fixes are not GNSS fixes
     assert consistency.nis_summary(_updates(nis, kind="pseudo"))["verdict"] == "no fixes"

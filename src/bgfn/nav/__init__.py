@@ -50,7 +50,7 @@ Modules (pyins style, one concept each; SI units, radians, NED, tables as in CON
   filter's start without a reference attitude), ``rest_end``, ``level_from_specific_force``,
   ``level_by_velocity_matching``.
 - :mod:`~bgfn.nav.tuning` -- ``search_noise_scale(mean_nis, options) -> NoiseTuning`` (``nav.noise_scale: auto``).
-- :mod:`~bgfn.nav.consistency` -- ``nis_summary(updates)``, ``verdict``, ``nis_line``, ``nis_table``.
+- :mod:`~bgfn.nav.consistency` -- ``nis_summary(updates)``, ``verdict``, ``nis_table``.
 - :mod:`~bgfn.nav.baseline` -- notebook 02: ``nav_config``, ``run_drive(drive, nav_section)``,
   ``prepare_filter(drive, cfg) -> FilterSetup`` (start and noise; ``initial_and_noise`` without the record), ``filter_start``,
   ``run_baseline(drive, cfg, windows)``, ``ins_layout``, ``save_baseline``; :mod:`~bgfn.nav.plots` -- its figures.

@@ -107,15 +107,6 @@ class Alignment:
     azimuth_std: float
     velocity_std: np.ndarray
 
-    def line(self, name: str = "") -> str:
-        """One plain sentence: when and how the filter was aligned."""
-        rest = f"rest until {self.rest_end:.1f} s" if self.rest_end is not None else "no rest at the start"
-        return (f"{name + ': ' if name else ''}aligned at {self.state.time:.2f} s ({rest}; level from "
-                f"{self.level_source.replace('_', ' ')}, heading from the {self.course_source.replace('_', ' ')} "
-                f"since {self.moving_from:.1f} s): roll {np.degrees(self.roll):.2f}, pitch "
-                f"{np.degrees(self.pitch):.2f}, yaw {np.degrees(self.yaw):.2f} deg (std level "
-                f"{np.degrees(self.level_std):.2f}, azimuth {np.degrees(self.azimuth_std):.2f} deg)")
-
 
 def level_from_specific_force(f_b) -> tuple[float, float]:
     """Roll and pitch of a body whose specific force is ``f_b = C_bn^T (-g^n)`` (at rest, or gravity alone).

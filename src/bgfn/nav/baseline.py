@@ -38,7 +38,7 @@ from ..errors import DataError
 from ..io import atomic_write_csv
 from . import constraints as cn, metrics, navego_setup
 from .alignment import ALIGNMENT_DEFAULTS, MODES, Alignment, align
-from .consistency import nis_line, nis_summary
+from .consistency import nis_summary
 from .error_model import PHI_D, STATE_NAMES
 from .filter import FilterResult, run_filter, run_outage
 from .gnss_aid import gate_thresholds
@@ -165,11 +165,6 @@ class FilterSetup:
     noise_scale: float
     alignment: Alignment | None = None
     tuning: NoiseTuning | None = None
-
-    def lines(self, name: str) -> list[str]:
-        """Plain sentences for notebook 02: the alignment and the noise search, when there were any."""
-        out = [self.alignment.line(name)] if self.alignment is not None else []
-        return out + ([self.tuning.line(name)] if self.tuning is not None else [])
 
     def record(self) -> dict:
         """JSON-ready record (``kf_baseline.json``)."""
@@ -343,21 +338,6 @@ class Baseline:
     noise: FilterNoise
     setup: FilterSetup | None = None
     constraints: dict | None = None
-
-    def lines(self) -> list[str]:
-        """Notebook 02's sentences of this run: the self-alignment and the noise search (when they ran) and the
-        NIS verdict of the GPS-aided run (:func:`bgfn.nav.consistency.nis_line`)."""
-        setup = self.setup.lines(self.drive_name) if self.setup is not None else []
-        return setup + [nis_line(self.drive_name, nis_summary(self.full.updates))] + self.aid_lines()
-
-    def aid_lines(self) -> list[str]:
-        """Which aids the ``INS+NHC`` rows ran, and why (the drive's platform), with their epoch counts."""
-        c = self.constraints
-        if not c:
-            return []
-        what = cn.ConstraintConfig(platform=c.get("platform", cn.DEFAULT_PLATFORM)).describe()
-        return [f"{self.drive_name}: the INS+NHC rows' aids -- {what}; {c['aid_epochs']} aid epochs over the drive, "
-                f"{c['zupt_epochs']} of them ZUPT (still {100 * c['still_fraction']:.0f} % of the IMU rows)"]
 
 
 def run_baseline(drive, cfg: dict, windows) -> Baseline:

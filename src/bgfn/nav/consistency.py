@@ -55,19 +55,6 @@ def nis_summary(updates: pd.DataFrame, kind: str = "gnss") -> dict:
             "above_chi2_95": above, "verdict": verdict(mean, mean_dof)}
 
 
-def nis_line(name: str, summary: dict) -> str:
-    """One plain sentence of a :func:`nis_summary`."""
-    if not summary["fixes"]:
-        return f"{name}: no GNSS fixes fused, no NIS"
-    hint = {"overconfident": ": the filter trusts its prediction more than the fixes allow (IMU noise too low "
-                             "for this drive, or GNSS stds too small? try nav.noise_scale: auto)",
-            "underconfident": ": the innovations are smaller than the filter expects (GNSS stds or IMU noise set "
-                              "larger than the drive's)"}.get(summary["verdict"], "")
-    return (f"{name}: mean NIS {summary['mean_nis']:.2f} over {summary['fixes']} GNSS fixes (dof "
-            f"{summary['dof']:.0f}; {100 * summary['above_chi2_95']:.0f} % above the chi-square 95 % quantile, "
-            f"5 % expected): {summary['verdict']}{hint}")
-
-
 def nis_table(runs: dict) -> pd.DataFrame:
     """One row per run: ``{(dataset, run label): FilterResult.updates}`` -> columns :data:`NIS_COLUMNS`."""
     rows = [{"dataset": d, "run": label, **nis_summary(upd)} for (d, label), upd in runs.items()]

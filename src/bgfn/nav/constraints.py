@@ -82,7 +82,7 @@ PLATFORM_AIDS: dict[str, tuple[bool, bool]] = {"car": (True, True), "walker": (F
 DEFAULT_PLATFORM = "car"
 
 
-#: Why a platform goes without an aid (:meth:`ConstraintConfig.describe`; the words: :mod:`bgfn.report.aid_words`).
+#: Why a platform goes without an aid (the words: :func:`bgfn.report.aid_words.constraint_words`).
 PLATFORM_NOTES: dict[str, str] = {"car": "", "walker": " (no NHC: a walker steps sideways)",
                                   "other": " (neither: no motion model is known)"}
 
@@ -140,12 +140,6 @@ class ConstraintConfig:
     def zupt(self) -> bool:
         """Whether the platform takes zero-velocity updates (:data:`PLATFORM_AIDS`)."""
         return PLATFORM_AIDS[self.platform][1]
-
-    def describe(self) -> str:
-        """Which aids run, and why (the platform)."""
-        aids = platform_aids(self.platform)
-        return (f"platform {self.platform}: " + (" and ".join(aids) if aids else "no vehicle constraint")
-                + PLATFORM_NOTES[self.platform])
 
     def __post_init__(self):
         for name in ("nhc_std_mps", "nhc_rate_hz", "zupt_std_mps", "window_s"):

@@ -74,12 +74,6 @@ class PickedOutages:
     training_s: float
     rule: dict = field(default_factory=dict)
 
-    def lines(self) -> list[str]:
-        """One line per window: its kind, time, mean speed and mean |yaw rate|."""
-        return [f"outage {k + 1} ({r.kind}): {self.rule['duration_s']:g} s from {r.start_s:.1f} s, mean speed "
-                f"{r.mean_speed_mps:.1f} m/s, mean |yaw rate| {r.mean_abs_yaw_rate_dps:.1f} deg/s"
-                for k, r in enumerate(self.scores.itertuples(index=False))]
-
 
 def rule_params(rule: dict, source: str = "outage_windows") -> dict:
     """``rule`` with the defaults of its ``rule:`` filled in; unknown rules and keys are errors.

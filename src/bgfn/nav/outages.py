@@ -212,17 +212,6 @@ def picked_outages(profile: dict, drive, dataset: str | None = None):
     return outage_rules.pick_windows(entry, drive.reference, margin, f"{name}: profile outage_windows")
 
 
-def describe_windows(profile: dict, drive, dataset: str | None = None) -> list[str]:
-    """Lines for a notebook: the outages of one drive and, for a rule, what it picked and why."""
-    name = dataset if dataset is not None else drive.name
-    windows = outage_windows(profile, drive, name)
-    picked = picked_outages(profile, drive, name)
-    head = f"{name}: outages (start, duration) s {[list(w) for w in windows]}"
-    if picked is None:
-        return [head + " (listed in the profile)"]
-    return [head + f" (rule {picked.rule['rule']})"] + [f"  {line}" for line in picked.lines()]
-
-
 class PseudoFix(NamedTuple):
     """A pseudo-GPS antenna position with its NED standard deviations (NaN std: axis not used)."""
 

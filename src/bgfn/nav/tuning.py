@@ -71,14 +71,6 @@ class NoiseTuning:
                 "dof": self.dof, "runs": [[s, n] for s, n in self.runs], "at_bound": self.at_bound,
                 "bias_walk": self.bias_walk}
 
-    def line(self, name: str = "") -> str:
-        """One plain sentence: the factor found and the mean NIS before and after."""
-        what = "white noise and bias walk" if self.bias_walk else "white noise"
-        bound = " (at the bound of nav.noise_search.range)" if self.at_bound else ""
-        return (f"{name + ': ' if name else ''}noise scale auto: {what} x {self.scale:.3g}{bound} after "
-                f"{len(self.runs)} filter runs; mean NIS {self.mean_nis_at_one:.2f} -> {self.mean_nis:.2f} "
-                f"(dof {self.dof:.0f})")
-
 
 def search_noise_scale(mean_nis: Callable[[float], tuple[float, float]], options: dict | None = None) -> NoiseTuning:
     """The factor ``s`` whose run has ``mean NIS = dof`` (module docstring).

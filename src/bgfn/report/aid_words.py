@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from bgfn.nav.constraints import DEFAULT_PLATFORM, PLATFORM_AIDS, PLATFORM_NOTES, platform_aids
+from bgfn.nav.constraints import DEFAULT_PLATFORM, PLATFORM_AIDS, PLATFORM_NOTES, ConstraintConfig, platform_aids
 
 #: The aids in words (:func:`aided_ins_words`).
 AID_WORDS: dict[str, str] = {"NHC": "non-holonomic constraints", "ZUPT": "zero-velocity updates"}
@@ -15,3 +15,10 @@ def aided_ins_words(platform: str) -> str:
     aids = platform_aids(platform)
     return (("INS with " + " and ".join(AID_WORDS[a] for a in aids)) if aids else "INS with no constraint") \
         + PLATFORM_NOTES[platform]
+
+
+def constraint_words(config: ConstraintConfig) -> str:
+    """Which aids run, and why (the platform of a :class:`bgfn.nav.constraints.ConstraintConfig`)."""
+    aids = platform_aids(config.platform)
+    return (f"platform {config.platform}: " + (" and ".join(aids) if aids else "no vehicle constraint")
+            + PLATFORM_NOTES[config.platform])

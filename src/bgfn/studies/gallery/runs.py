@@ -3,10 +3,11 @@ and run through the navigation part of the chain with the profile a user would w
 
 For each log: what the loader decided (the clocks: the GNSS-IMU offset it estimated or applied; the mounting it
 rotated out; the platform), what the filter decided (self-alignment, noise scale, which aids run and why: notebook
-02's sentences, :meth:`bgfn.nav.baseline.Baseline.lines`), the outages its profile's rule picked, and the results:
+02's facts, :class:`bgfn.nav.baseline.Baseline`), the outages its profile's rule picked, and the results:
 the GPS-aided horizontal RMS and max against the reference, the standalone INS and the INS with the platform's aids
 in those outages. The networks' rows of such a log come from ``make reproduce PROFILE=<its profile>`` (the whole
 chain, minutes to tens of minutes); the gallery keeps to what runs in seconds so that every build shows it.
+:mod:`bgfn.report.gallery_words` puts the decisions in words.
 """
 
 from __future__ import annotations
@@ -19,9 +20,10 @@ import pandas as pd
 
 from bgfn.data import load_drive
 from bgfn.studies.gallery.logs import GalleryLog
-from bgfn.nav.baseline import nav_config, run_baseline
+from bgfn.nav.baseline import Baseline, nav_config, run_baseline
 from bgfn.nav.constraints import DEFAULT_PLATFORM, platform_aids
-from bgfn.nav.outages import describe_windows, outage_windows
+from bgfn.nav.outage_rules import PickedOutages
+from bgfn.nav.outages import outage_windows, picked_outages
 
 #: Columns of ``tables/gallery.csv``.
 GALLERY_COLUMNS: tuple[str, ...] = ("log", "kind", "platform", "duration_s", "imu_rows", "gnss_fixes", "noise_scale",
@@ -30,16 +32,20 @@ GALLERY_COLUMNS: tuple[str, ...] = ("log", "kind", "platform", "duration_s", "im
 
 @dataclass
 class GalleryRun:
-    """One log's run: its profile text, ``meta.yaml``, the decisions in words, its rows (:data:`GALLERY_COLUMNS`), and
-    the loaded drive with its outages (for the figures)."""
+    """One log's run: its profile text, ``meta.yaml``, its rows (:data:`GALLERY_COLUMNS`), the loaded drive with its
+    outages (for the figures), and what the loader and the filter decided (the drive's ``meta``, the KF baseline
+    run, what the profile's rule picked, None for a list; :func:`bgfn.report.gallery_words.gallery_decisions`
+    words them). ``entry`` is the drive's name in the profile (its folder)."""
 
     log: GalleryLog
     profile_text: str
     meta_text: str
-    decisions: list
     rows: pd.DataFrame
     drive: object = None
     windows: list | None = None
+    baseline: Baseline | None = None
+    picked: PickedOutages | None = None
+    entry: str = ""
 
 
 def run_log(log: GalleryLog, folder: Path, cfg: dict) -> GalleryRun:
@@ -49,14 +55,6 @@ def run_log(log: GalleryLog, folder: Path, cfg: dict) -> GalleryRun:
     drive = load_drive(folder)
     windows = outage_windows(cfg, drive, str(folder))
     b = run_baseline(drive, nav_config(cfg["nav"]), windows)
-    decisions = []
-    if "gnss_offset" in drive.meta:            # the clocks (with gnss_latency_s: auto, the latency taken off)
-        decisions.append(f"{drive.name}: {drive.meta['gnss_offset']['line']}")
-    mounting = drive.meta.get("imu_mounting_deg") or [0.0, 0.0, 0.0]
-    if np.any(mounting):
-        decisions.append(f"{drive.name}: IMU rows rotated into the body frame by the mounting "
-                         f"{[float(x) for x in mounting]} deg (roll, pitch, yaw) of meta.yaml")
-    decisions += describe_windows(cfg, drive, str(folder)) + b.lines()
     base = {"log": drive.name, "kind": log.kind, "platform": drive.meta.get("platform", DEFAULT_PLATFORM),
             "duration_s": float(drive.imu["time"].iloc[-1] - drive.imu["time"].iloc[0]), "imu_rows": len(drive.imu),
             "gnss_fixes": len(drive.gnss), "noise_scale": float(b.setup.noise_scale) if b.setup is not None else 1.0,
@@ -69,8 +67,8 @@ def run_log(log: GalleryLog, folder: Path, cfg: dict) -> GalleryRun:
             rows.append({**base, "outage": k, "start_s": float(start),
                          "method": "INS" if r["method"] == "INS" else aided, "max_h_m": float(r["max_horizontal"])})
     meta_text = (folder / "meta.yaml").read_text(encoding="utf-8")
-    return GalleryRun(log, log.profile_text(folder), meta_text, decisions,
-                      pd.DataFrame(rows, columns=list(GALLERY_COLUMNS)), drive, list(windows))
+    return GalleryRun(log, log.profile_text(folder), meta_text, pd.DataFrame(rows, columns=list(GALLERY_COLUMNS)),
+                      drive, list(windows), b, picked_outages(cfg, drive, str(folder)), str(folder))
 
 
 def _aided_label(platform: str) -> str:

@@ -25,6 +25,7 @@ from bgfn.nav.filter import run_filter, run_outage
 from bgfn.nav.outages import OutageWindow, TablePseudoGps
 from synthetic_drive import demo_drive
 from bgfn.profile_schema import with_overrides
+from bgfn.report import evaluation_words
 
 WINDOWS = [(60.0, 20.0), (110.0, 20.0)]
 NAV = {"init": {"position_std_m": 1.0, "height_std_m": 2.0, "velocity_std_mps": 0.1, "level_std_deg": 0.2,
@@ -155,7 +156,7 @@ def test_tables_have_the_nhc_rows_of_every_method(drive5):
     ctx = ev.navigation_context(drive5, NAV, [s for s, _ in WINDOWS])
     again = ev.run_outages(ctx, [WINDOWS[0]], None, "INS+NHC", None, ecfg["pseudo_gps"], aids=[ctx.constraints])
     pd.testing.assert_frame_equal(ins_nhc.trajectory, again[0].trajectory, check_exact=True)
-    (line, _) = ev.describe_tables([res])
+    (line, _) = evaluation_words.describe_tables([res])
     assert "INS+NHC" in line and "BGFN+NHC" in line and "INS+NHC)" in line
     lay = ev.ours_above_paper(ev.TableResult("turin-sim-ekinox", "dataset", res.per_seed, res.table, []))
     assert ("BGFN+NHC", "East") in lay.columns and np.isnan(lay.loc[("Outage 1", "paper"), ("BGFN+NHC", "East")])
@@ -467,17 +468,17 @@ def test_describe_tables_says_where_gps_is_not_the_lower_bound():
         rows.append({"outage": 2, "method": m, "max_east_m": e, "max_north_m": 11.0 if m != "GPS" else 1.0,
                      "rmse_h_m": 6.0 if m != "GPS" else 1.5, "final_h_m": 11.0 if m != "GPS" else 1.7})
     res = ev.TableResult("turin-sim-ekinox", "dataset", pd.DataFrame(), pd.DataFrame(rows), [], {})
-    (line,) = ev.describe_tables([res])
+    (line,) = evaluation_words.describe_tables([res])
     assert "not the lower bound" in line and "INS max east 0.8 < GPS 1.6 m" in line
     assert "BGFN max east" not in line                       # only cells below the GPS row are named
     assert "fixes in this window" not in line               # their errors unknown: not claimed
     fixes = pd.DataFrame({"outage": [1, 2], "start_s": [0.0, 100.0], "n_fixes": [150, 150],
                           "max_east_m": [2.9, 1.64], "max_north_m": [1.9, 1.1]})
     res.gnss_errors = fixes
-    (line,) = ev.describe_tables([res])
+    (line,) = evaluation_words.describe_tables([res])
     assert line.endswith("the fixes in this window are off by up to 1.6 m east and 1.1 m north.")
     rows[0]["max_east_m"] = 2.0
-    (line,) = ev.describe_tables([ev.TableResult("x", "dataset", pd.DataFrame(), pd.DataFrame(rows), [], {})])
+    (line,) = evaluation_words.describe_tables([ev.TableResult("x", "dataset", pd.DataFrame(), pd.DataFrame(rows), [], {})])
     assert "lower bound" not in line
 
 
@@ -547,7 +548,7 @@ def test_evaluation_setup_applies_the_notebook_parameters_over_the_profile(monke
     assert setup.config["sweep"]["n_starts"] == section["sweep"]["n_starts"]       # the other sweep keys stay
     assert setup.config["methods"] == section["methods"] and setup.datasets == section["datasets"]
     assert setup.windows == outage_windows(cfg) and repr(section) == before         # the profile is not modified
-    lines = setup.describe()
+    lines = evaluation_words.setup_lines(setup)
     assert lines[0].startswith("profile 'smoke': ") and "seeds: [3, 4]" in lines[2]
     assert lines[3].startswith(f"outages (start, duration) s: {[list(w) for w in outage_windows(cfg)]}")
     # the recorded drive's outages come from the profile's rule, said beside the default list
@@ -559,7 +560,7 @@ def test_evaluation_setup_applies_the_notebook_parameters_over_the_profile(monke
     real = ev.evaluation_setup(with_overrides(cfg, {"evaluate.real_imu": True,
                                                  "evaluate.sweep.datasets": ["turin-sim-mpu6000"]}))
     assert real.datasets == section["datasets"] and len(real.notes) == 2 and real.sweep_notes == real.notes[1:]
-    assert [ln for ln in real.describe() if ln.startswith("real_imu:")] == [f"real_imu: {n}" for n in real.notes]
+    assert [ln for ln in evaluation_words.setup_lines(real) if ln.startswith("real_imu:")] == [f"real_imu: {n}" for n in real.notes]
 
 
 def test_reductions_beside_the_paper_and_its_quoted_claims():
@@ -570,7 +571,7 @@ def test_reductions_beside_the_paper_and_its_quoted_claims():
     assert row["east_%"] == pytest.approx(80.0) and row["north_%"] == pytest.approx(50.0)   # 100 (10-2)/10, (8-4)/8
     assert row["paper east_%"] == pytest.approx(100 * (23.1 - 4.7) / 23.1)                   # its Table 1
     assert red.loc[red["method"] == "Transformer", "paper east_%"].isna().all()             # not in the paper
-    lines = ev.claim_lines({"turin-sim-ekinox": red})
+    lines = evaluation_words.claim_lines({"turin-sim-ekinox": red})
     c = paper.claims()["bgfn_reduction_vs_ins_pct"]
     assert lines == [f"BGFN vs INS, dataset test, outage 1: paper quotes {c['dataset_outage1']['east']} % east / "
                      f"{c['dataset_outage1']['north']} % north; ours 80.0 % east / 50.0 % north",
@@ -578,8 +579,8 @@ def test_reductions_beside_the_paper_and_its_quoted_claims():
                      f"{c['field_outage2']['north']} % north; not evaluated"]
     # a test's first dataset answers for it
     other = ev.reduction_table(_table_result("navego-ekinox", bgfn=(5.0, 4.0)))
-    assert ev.claim_lines({"turin-sim-ekinox": red, "navego-ekinox": other})[0].endswith("ours 80.0 % east / 50.0 % north")
-    assert ev.claim_lines({"navego-ekinox": other})[0].endswith("ours 50.0 % east / 50.0 % north")
+    assert evaluation_words.claim_lines({"turin-sim-ekinox": red, "navego-ekinox": other})[0].endswith("ours 80.0 % east / 50.0 % north")
+    assert evaluation_words.claim_lines({"navego-ekinox": other})[0].endswith("ours 50.0 % east / 50.0 % north")
     lay = ev.ours_above_paper(res)
     assert lay.loc[("Outage 1", "paper"), ("BGFN", "East")] == 4.7
     assert lay.loc[("Outage 2", "ours"), ("INS", "North")] == 8.0

@@ -13,7 +13,7 @@ from bgfn.errors import DataError
 from bgfn.nav import outage_rules as R
 from bgfn.nav import outages, sim
 from bgfn.profile_schema import load_profile, with_overrides
-from bgfn.report import nav_words
+from bgfn.report import evaluation_words, nav_words
 
 RULE = {"rule": "cruise_and_manoeuvre", "duration_s": 30.0, "step_s": 1.0, "warmup_s": 60.0, "min_speed_mps": 2.0,
         "cruise_max_yaw_rate_dps": 3.0, "manoeuvre_min_yaw_rate_dps": 5.0, "gap_s": 30.0, "min_training_s": 120.0}
@@ -232,5 +232,5 @@ def test_training_and_evaluation_take_each_datasets_outages():
     prof["outage_windows"] = {**prof["outage_windows"], "sim": dict(RULE), "other": [[138800.0, 10.0]]}
     setup = ev.evaluation_setup(with_overrides(prof, {"evaluate.sweep.datasets": []}))
     assert setup.windows == default
-    assert setup.describe()[3] == (f"outages (start, duration) s: {[list(w) for w in default]}; sim: rule "
+    assert evaluation_words.setup_lines(setup)[3] == (f"outages (start, duration) s: {[list(w) for w in default]}; sim: rule "
                                    "cruise_and_manoeuvre (picked from the drive); other: [[138800.0, 10.0]]")

@@ -11,6 +11,7 @@ from bgfn import learning as L, train as T
 from bgfn.errors import DataError
 from bgfn.parallel import PROGRESS_ENV, Runner, RunProgress, dispatch_order
 from bgfn.profile_schema import load_profile
+from bgfn.report.run_words import runner_words
 
 
 # ----------------------------------------------------------------------------------------------- settings
@@ -21,7 +22,7 @@ def test_the_profile_says_where_the_runs_go_and_the_environment_wins():
     assert Runner.of({"parallel": {"jobs": 3}}, environ={"BGFN_JOBS": ""}).jobs == 3   # make's empty JOBS=
     dask = Runner.of({}, environ={"DASK_SCHEDULER": "tcp://10.0.0.1:8786"})
     assert (dask.backend, dask.scheduler) == ("dask", "tcp://10.0.0.1:8786")
-    assert "10.0.0.1" in dask.describe() and "2 processes" in Runner(2).describe()
+    assert "10.0.0.1" in runner_words(dask) and "2 processes" in runner_words(Runner(2))
 
 
 @pytest.mark.parametrize("section, environ, key", [

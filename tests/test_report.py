@@ -20,6 +20,7 @@ import pytest
 
 from bgfn import paper, report
 from bgfn.config import PROJECT_ROOT
+from bgfn.report import evaluation_words
 from bgfn.report.book_notebooks import main as book_main
 from bgfn.report.book_notebooks import one_parameters_cell, rewrite, warnings_in
 
@@ -470,7 +471,7 @@ def test_the_real_drive_stands_beside_the_papers_field_test(tmp_path):
     assert "(paper's field test: " in report.comparison_sentences("real", OURS, res.published["real"])[0]
     # notebook 04's claim lines quote the paper's own tests only; notebook 02's INS row says whose it is
     reductions = {"rtklib-drive0708": report.reduction_comparison(OURS, res.published["real"], res.claims, "real")}
-    claimed = ev.claim_lines({})
+    claimed = evaluation_words.claim_lines({})
     assert len(claimed) == 2 and all("real drive" not in line for line in claimed)   # dataset 1, field 2
     beside = baseline.ins_layout(pd.DataFrame({"max_abs_east": [1.0, 2.0], "max_abs_north": [3.0, 4.0]}),
                                  "rtklib-drive0708")

@@ -39,6 +39,7 @@ from bgfn.io import atomic_write_text
 from bgfn.parallel import Runner
 from bgfn.profile_schema import load_profile, with_overrides
 from bgfn.report import walltimes as walltimes_module
+from bgfn.report.run_words import runner_words
 from bgfn.train.runs import train_profile
 
 
@@ -107,10 +108,10 @@ def odometers(argv) -> int:
         return 2
     t0 = time.perf_counter()
     runner = setup.runner if a.jobs is None else Runner.of(cfg, environ={})
-    print(f"profile {a.profile!r}: runs {runner.describe()}", flush=True)
+    print(f"profile {a.profile!r}: runs {runner_words(runner)}", flush=True)
     section = run_odometer_section(cfg, a.profile, setup, results_dir(a.profile), runner, report=print)
     print(section.markdown())
-    print("wrote", odometer_sizes.write_run_facts(a.profile, cfg, t0, runner.describe()))
+    print("wrote", odometer_sizes.write_run_facts(a.profile, cfg, t0, runner_words(runner)))
     return 0
 
 
@@ -142,7 +143,7 @@ def main(argv=None) -> int:
     except DataError as exc:
         print(f"error: profile {a.profile!r}: {exc}", file=sys.stderr)
         return 2
-    print(f"profile {a.profile!r}: runs {runner.describe()}")
+    print(f"profile {a.profile!r}: runs {runner_words(runner)}")
     train_profile(cfg, a.device, echo=print, variants=a.variants, runner=runner)
     return 0
 

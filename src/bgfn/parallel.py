@@ -89,12 +89,6 @@ class Runner:
                             f"(or {SCHEDULER_ENV}=...)", repr(scheduler))
         return cls(int(jobs) if jobs is not None else machine_cores(), backend, scheduler)
 
-    def describe(self) -> str:
-        """How the runs are spread, in a few words."""
-        if self.backend == "dask":
-            return f"on the Dask cluster at {self.scheduler}"
-        return "one after the other (1 job)" if self.jobs == 1 else f"{self.jobs} processes on this machine (loky)"
-
     def start(self, *modules: str) -> "Runner":
         """Start the pool's worker processes now, in the background, each importing ``modules`` (those whose
         functions the runs call, e.g. ``"bgfn.train"``); returns the runner.

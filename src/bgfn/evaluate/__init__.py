@@ -14,7 +14,7 @@ tables again with each network's own pseudo-fix std, which the paper does not st
 sweep, the oracle, the learned odometer, the INS's fidelity) are in :mod:`bgfn.studies`.
 """
 
-from bgfn.evaluate.claims import REDUCTION_COLUMNS, claim_lines, ours_above_paper, paper_table_title, reduction_table
+from bgfn.evaluate.claims import REDUCTION_COLUMNS, ours_above_paper, paper_table_title, reduction_table
 from bgfn.evaluate.setup import (COLORS, EVALUATE_DEFAULTS, FIGURE_METHODS, METRIC_COLUMNS, REAL_IMU_DATASETS,
                                   SWEEP_COLUMNS, TABLE_COLUMNS, TABLE_FILES, TABLE_METHODS, EvaluationSetup,
                                   choose_datasets, evaluate_config, evaluation_setup)
@@ -25,18 +25,18 @@ from bgfn.evaluate.pseudo_std import (SENSITIVITY_COLUMNS, Sensitivity, pseudo_s
                                       sensitivity_table)
 from bgfn.evaluate.plots import outage_figures, plot_gps_row, plot_outage, plot_sweep_boxes
 from bgfn.evaluate.record import RECORD_FILE, evaluation_record, write_evaluation_record
-from bgfn.evaluate.tables import (TableResult, aggregate_seeds, describe_tables, error_reduction, error_series,
+from bgfn.evaluate.tables import (TableResult, aggregate_seeds, error_reduction, error_series,
                                   evaluate_dataset, fix_error_table, keep_results, kept_results, KEPT_RESULTS,
                                   representative_seeds, run_tables, save_table_result, table_file, table_paths)
 
 __all__ = [
-    "REDUCTION_COLUMNS", "claim_lines", "ours_above_paper", "paper_table_title", "reduction_table", "COLORS",
+    "REDUCTION_COLUMNS", "ours_above_paper", "paper_table_title", "reduction_table", "COLORS",
     "EVALUATE_DEFAULTS", "FIGURE_METHODS", "METRIC_COLUMNS", "REAL_IMU_DATASETS", "SWEEP_COLUMNS", "TABLE_COLUMNS",
     "TABLE_FILES", "TABLE_METHODS", "EvaluationSetup", "choose_datasets", "evaluate_config", "evaluation_setup",
     "NavContext", "OutageRun", "gps_run", "navigation_context", "pseudo_gps_positions", "run_outages",
     "window_metrics", "ensure_models", "load_model", "outage_figures", "plot_gps_row", "plot_outage",
     "plot_sweep_boxes", "RECORD_FILE", "evaluation_record", "write_evaluation_record", "TableResult",
-    "aggregate_seeds", "describe_tables", "error_reduction", "error_series", "evaluate_dataset", "fix_error_table",
+    "aggregate_seeds", "error_reduction", "error_series", "evaluate_dataset", "fix_error_table",
     "SENSITIVITY_COLUMNS", "Sensitivity", "pseudo_std_sensitivity", "save_sensitivity", "sensitivity_table",
     "KEPT_RESULTS", "keep_results", "kept_results", "representative_seeds", "run_tables", "save_table_result", "table_file", "table_paths",
 ]

@@ -1,15 +1,13 @@
 """Our outage tables beside the paper's: its Tables 1-2 (``tab-out1-exin``, ``tab-real``) in its layout, the
-error reductions against INS beside the ones its tables give, and the two reductions its text quotes. Our real
-drive (test ``real``) has no table in the paper: its field test stands beside it
-(:func:`bgfn.paper.published_values`), labelled as such.
+error reductions against INS beside the ones its tables give (the two reductions its text quotes, beside ours:
+:func:`bgfn.report.evaluation_words.claim_lines`). Our real drive (test ``real``) has no table in the paper: its
+field test stands beside it (:func:`bgfn.paper.published_values`), labelled as such.
 
 The paper's values are read through :mod:`bgfn.paper` (``data/paper/outage_max_errors.csv`` and
 ``claims.yaml``); they are shown beside ours, never used to choose anything.
 """
 
 from __future__ import annotations
-
-from typing import Mapping
 
 import pandas as pd
 
@@ -76,40 +74,3 @@ def reduction_table(result: TableResult, reference: str = "INS") -> pd.DataFrame
                                  "east_pct": pd.Series(dtype=float), "north_pct": pd.Series(dtype=float)})).rename(
         columns={"east_pct": "paper east_%", "north_pct": "paper north_%"})
     return ours.merge(theirs, on=["outage", "method"], how="left")[list(REDUCTION_COLUMNS)]
-
-
-def claim_lines(reductions: Mapping[str, pd.DataFrame]) -> list[str]:
-    """One line per reduction the paper quotes in its text (``claims.yaml``: BGFN against INS in the dataset
-    test's outage 1, the field test's outage 2) with ours beside it.
-
-    Parameters
-    ----------
-    reductions : mapping
-        ``{dataset: reduction_table(...)}``; a test's first dataset answers for it.
-
-    Returns
-    -------
-    list of str
-        ``BGFN vs INS, <test title>, outage <k>: paper quotes E % east / N % north; ours ...`` (``not
-        evaluated`` when no dataset of that test, or no BGFN row, was run); the quotes are of the paper's own
-        tests, so a test it has no table of (the real drive) gets no line.
-    """
-    claims = paper.claims()
-    by_test: dict[str, pd.DataFrame] = {}
-    for name, red in reductions.items():
-        by_test.setdefault(paper.test_of(name) or name, red)
-    lines = []
-    for test, spec in paper.TESTS.items():
-        if not paper.has_own_values(test):
-            continue
-        for outage in sorted({int(o) for o in paper.outage_table(test)["outage"]}):
-            stated = paper.claim_for(claims, test, outage)
-            if stated is None:
-                continue
-            red = by_test.get(test)
-            row = red[(red["outage"] == outage) & (red["method"] == "BGFN")] if red is not None else None
-            got = (f"ours {row['east_%'].item():.1f} % east / {row['north_%'].item():.1f} % north"
-                   if row is not None and len(row) else "not evaluated")
-            lines.append(f"BGFN vs INS, {spec['title']}, outage {outage}: paper quotes {stated['east']} % east / "
-                         f"{stated['north']} % north; {got}")
-    return lines

@@ -147,23 +147,6 @@ class EvaluationSetup:
     outage_lines: list = field(default_factory=list)
     runner: Runner = field(default_factory=Runner)
 
-    def describe(self) -> list[str]:
-        """Lines saying what is evaluated: profile, IMUs, datasets, methods, seeds, outages, pseudo-GPS."""
-        ecfg = self.config
-        lines = [f"profile {self.profile!r}: {self.description}"]
-        if ecfg["real_imu"]:
-            lines += [f"real_imu: {line}" for line in dict.fromkeys(self.notes + self.sweep_notes)]
-        else:
-            lines.append("real_imu: false -> simulated IMUs (set real_imu=True to use NaveGo's recorded IMU "
-                         "files when present)")
-        lines.append(f"tables: {self.datasets} | methods: {ecfg['methods']} | seeds: {ecfg['seeds']} | "
-                     f"seed aggregate: {ecfg['seed_aggregate']}")
-        lines.append(f"outages (start, duration) s: {[list(w) for w in self.windows]}"
-                     + "".join(f"; {line}" for line in self.outage_lines))
-        lines.append(f"pseudo-GPS: {ecfg['pseudo_gps']}")
-        lines.append(f"independent runs: {self.runner.describe()}")
-        return lines
-
 
 #: Notebook 04's parameters and the profile keys they set (:func:`bgfn.profile_schema.with_overrides`, in the
 #: notebook's first cell; ``sweep_datasets`` ``[]`` skips the sweep).

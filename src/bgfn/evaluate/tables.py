@@ -1,5 +1,5 @@
 """The paper's Tables 1-2 (``tab-out1-exin``, ``tab-real``): every method in the evaluation outages, the seed
-aggregate, the result files, and plain-language lines computed from the numbers. The paper's own values beside
+aggregate, the result files (in words: :mod:`bgfn.report.evaluation_words`). The paper's own values beside
 ours are :mod:`bgfn.evaluate.claims`."""
 
 from __future__ import annotations
@@ -300,47 +300,3 @@ def error_reduction(table: pd.DataFrame, reference: str = "INS") -> pd.DataFrame
             rows.append({"outage": int(o), "method": r["method"], "east_pct": 100.0 * (re_ - r["max_east_m"]) / re_,
                          "north_pct": 100.0 * (rn - r["max_north_m"]) / rn})
     return pd.DataFrame(rows, columns=["outage", "method", "east_pct", "north_pct"])
-
-
-def describe_tables(results) -> list[str]:
-    """Plain-language lines on the outage tables (what beats what), computed from the numbers."""
-    lines = []
-    for r in results:
-        red = error_reduction(r.table).set_index(["outage", "method"])
-        for o, g in r.table.groupby("outage"):
-            g = g.set_index("method")
-            score = (g["max_east_m"] + g["max_north_m"]) / 2.0
-            learned = [m for m in ("MLP", "AT-LSTM", "BGFN", "Transformer") if m in g.index]
-            best = min(learned, key=lambda m: score[m]) if learned else None
-            txt = (f"{r.dataset} ({r.test} test), outage {o}: max east/north error INS "
-                   f"{g.loc['INS', 'max_east_m']:.1f}/{g.loc['INS', 'max_north_m']:.1f} m, GPS "
-                   f"{g.loc['GPS', 'max_east_m']:.1f}/{g.loc['GPS', 'max_north_m']:.1f} m")
-            if "BGFN" in g.index:
-                e, n = red.loc[(o, "BGFN"), "east_pct"], red.loc[(o, "BGFN"), "north_pct"]
-                txt += (f"; BGFN {g.loc['BGFN', 'max_east_m']:.1f}/{g.loc['BGFN', 'max_north_m']:.1f} m "
-                        f"({e:+.0f} % / {n:+.0f} % reduction against INS)")
-                beats = [m for m in ["INS"] + learned if m != "BGFN" and score["BGFN"] < score[m]]
-                loses = [m for m in ["INS"] + learned if m != "BGFN" and score["BGFN"] >= score[m]]
-                txt += (f"; on the mean of the two max errors BGFN beats {', '.join(beats) or 'none'} and does "
-                        f"not beat {', '.join(loses) or 'any'}")
-            if best is not None:
-                txt += f"; best network: {best}"
-            ins_nhc, bgfn_nhc = nhc_label("INS"), nhc_label("BGFN")
-            if ins_nhc in g.index:      # the learning-free aid a learned one must beat or add to
-                txt += (f"; with the vehicle constraints INS+NHC {g.loc[ins_nhc, 'max_east_m']:.1f}/"
-                        f"{g.loc[ins_nhc, 'max_north_m']:.1f} m ({'better' if score[ins_nhc] < score['INS'] else 'not better'}"
-                        " than INS)")
-                if bgfn_nhc in g.index:
-                    txt += (f", BGFN+NHC {g.loc[bgfn_nhc, 'max_east_m']:.1f}/{g.loc[bgfn_nhc, 'max_north_m']:.1f} m "
-                            f"({'beats' if score[bgfn_nhc] < score[ins_nhc] else 'does not beat'} INS+NHC)")
-            below = [f"{m} {c.replace('_m', '').replace('_', ' ')} {g.loc[m, c]:.1f} < GPS {g.loc['GPS', c]:.1f} m"
-                     for c in METRIC_COLUMNS for m in g.index if m != "GPS" and g.loc[m, c] < g.loc["GPS", c]]
-            if below:   # the GPS row follows the GNSS fixes, whose own error against the reference can exceed a drift
-                txt += ("; the GPS row is not the lower bound in every cell (" + "; ".join(below)
-                        + "): the GPS-aided solution follows the GNSS fixes' own error against the reference")
-                fixes = r.gnss_errors.set_index("outage") if r.gnss_errors is not None else pd.DataFrame()
-                if o in fixes.index and fixes.loc[o, "n_fixes"] > 0:
-                    txt += (f", and the fixes in this window are off by up to {fixes.loc[o, 'max_east_m']:.1f} m "
-                            f"east and {fixes.loc[o, 'max_north_m']:.1f} m north")
-            lines.append(txt + ".")
-    return lines

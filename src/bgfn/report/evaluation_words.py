@@ -1,0 +1,114 @@
+"""The paper's outage evaluation in words (notebook 04): what a run evaluates, what beats what in Tables 1-2, and
+the reductions the paper's text quotes beside ours."""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+import pandas as pd
+
+from bgfn import paper
+from bgfn.evaluate.setup import METRIC_COLUMNS, EvaluationSetup
+from bgfn.evaluate.tables import error_reduction
+from bgfn.paper import nhc_label
+from bgfn.report.run_words import runner_words
+
+
+def setup_lines(setup: EvaluationSetup) -> list[str]:
+    """Lines saying what notebook 04's :class:`~bgfn.evaluate.setup.EvaluationSetup` evaluates: profile, IMUs,
+    datasets, methods, seeds, outages, pseudo-GPS."""
+    ecfg = setup.config
+    lines = [f"profile {setup.profile!r}: {setup.description}"]
+    if ecfg["real_imu"]:
+        lines += [f"real_imu: {line}" for line in dict.fromkeys(setup.notes + setup.sweep_notes)]
+    else:
+        lines.append("real_imu: false -> simulated IMUs (set real_imu=True to use NaveGo's recorded IMU "
+                     "files when present)")
+    lines.append(f"tables: {setup.datasets} | methods: {ecfg['methods']} | seeds: {ecfg['seeds']} | "
+                 f"seed aggregate: {ecfg['seed_aggregate']}")
+    lines.append(f"outages (start, duration) s: {[list(w) for w in setup.windows]}"
+                 + "".join(f"; {line}" for line in setup.outage_lines))
+    lines.append(f"pseudo-GPS: {ecfg['pseudo_gps']}")
+    lines.append(f"independent runs: {runner_words(setup.runner)}")
+    return lines
+
+
+def describe_tables(results) -> list[str]:
+    """Plain-language lines on the outage tables (what beats what), computed from the numbers."""
+    lines = []
+    for r in results:
+        red = error_reduction(r.table).set_index(["outage", "method"])
+        for o, g in r.table.groupby("outage"):
+            g = g.set_index("method")
+            score = (g["max_east_m"] + g["max_north_m"]) / 2.0
+            learned = [m for m in ("MLP", "AT-LSTM", "BGFN", "Transformer") if m in g.index]
+            best = min(learned, key=lambda m: score[m]) if learned else None
+            txt = (f"{r.dataset} ({r.test} test), outage {o}: max east/north error INS "
+                   f"{g.loc['INS', 'max_east_m']:.1f}/{g.loc['INS', 'max_north_m']:.1f} m, GPS "
+                   f"{g.loc['GPS', 'max_east_m']:.1f}/{g.loc['GPS', 'max_north_m']:.1f} m")
+            if "BGFN" in g.index:
+                e, n = red.loc[(o, "BGFN"), "east_pct"], red.loc[(o, "BGFN"), "north_pct"]
+                txt += (f"; BGFN {g.loc['BGFN', 'max_east_m']:.1f}/{g.loc['BGFN', 'max_north_m']:.1f} m "
+                        f"({e:+.0f} % / {n:+.0f} % reduction against INS)")
+                beats = [m for m in ["INS"] + learned if m != "BGFN" and score["BGFN"] < score[m]]
+                loses = [m for m in ["INS"] + learned if m != "BGFN" and score["BGFN"] >= score[m]]
+                txt += (f"; on the mean of the two max errors BGFN beats {', '.join(beats) or 'none'} and does "
+                        f"not beat {', '.join(loses) or 'any'}")
+            if best is not None:
+                txt += f"; best network: {best}"
+            ins_nhc, bgfn_nhc = nhc_label("INS"), nhc_label("BGFN")
+            if ins_nhc in g.index:      # the learning-free aid a learned one must beat or add to
+                txt += (f"; with the vehicle constraints INS+NHC {g.loc[ins_nhc, 'max_east_m']:.1f}/"
+                        f"{g.loc[ins_nhc, 'max_north_m']:.1f} m ({'better' if score[ins_nhc] < score['INS'] else 'not better'}"
+                        " than INS)")
+                if bgfn_nhc in g.index:
+                    txt += (f", BGFN+NHC {g.loc[bgfn_nhc, 'max_east_m']:.1f}/{g.loc[bgfn_nhc, 'max_north_m']:.1f} m "
+                            f"({'beats' if score[bgfn_nhc] < score[ins_nhc] else 'does not beat'} INS+NHC)")
+            below = [f"{m} {c.replace('_m', '').replace('_', ' ')} {g.loc[m, c]:.1f} < GPS {g.loc['GPS', c]:.1f} m"
+                     for c in METRIC_COLUMNS for m in g.index if m != "GPS" and g.loc[m, c] < g.loc["GPS", c]]
+            if below:   # the GPS row follows the GNSS fixes, whose own error against the reference can exceed a drift
+                txt += ("; the GPS row is not the lower bound in every cell (" + "; ".join(below)
+                        + "): the GPS-aided solution follows the GNSS fixes' own error against the reference")
+                fixes = r.gnss_errors.set_index("outage") if r.gnss_errors is not None else pd.DataFrame()
+                if o in fixes.index and fixes.loc[o, "n_fixes"] > 0:
+                    txt += (f", and the fixes in this window are off by up to {fixes.loc[o, 'max_east_m']:.1f} m "
+                            f"east and {fixes.loc[o, 'max_north_m']:.1f} m north")
+            lines.append(txt + ".")
+    return lines
+
+
+def claim_lines(reductions: Mapping[str, pd.DataFrame]) -> list[str]:
+    """One line per reduction the paper quotes in its text (``claims.yaml``: BGFN against INS in the dataset
+    test's outage 1, the field test's outage 2) with ours beside it.
+
+    Parameters
+    ----------
+    reductions : mapping
+        ``{dataset: reduction_table(...)}``; a test's first dataset answers for it.
+
+    Returns
+    -------
+    list of str
+        ``BGFN vs INS, <test title>, outage <k>: paper quotes E % east / N % north; ours ...`` (``not
+        evaluated`` when no dataset of that test, or no BGFN row, was run); the quotes are of the paper's own
+        tests, so a test it has no table of (the real drive) gets no line.
+    """
+    claims = paper.claims()
+    by_test: dict[str, pd.DataFrame] = {}
+    for name, red in reductions.items():
+        by_test.setdefault(paper.test_of(name) or name, red)
+    lines = []
+    for test, spec in paper.TESTS.items():
+        if not paper.has_own_values(test):
+            continue
+        for outage in sorted({int(o) for o in paper.outage_table(test)["outage"]}):
+            stated = paper.claim_for(claims, test, outage)
+            if stated is None:
+                continue
+            red = by_test.get(test)
+            row = red[(red["outage"] == outage) & (red["method"] == "BGFN")] if red is not None else None
+            got = (f"ours {row['east_%'].item():.1f} % east / {row['north_%'].item():.1f} % north"
+                   if row is not None and len(row) else "not evaluated")
+            lines.append(f"BGFN vs INS, {spec['title']}, outage {outage}: paper quotes {stated['east']} % east / "
+                         f"{stated['north']} % north; {got}")
+    return lines

@@ -36,8 +36,9 @@ import torch
 from bgfn.profile_schema import load_profile
 from bgfn.io import update_json
 from bgfn.models import METHODS, build_model, count_parameters
+from bgfn.report.training_words import ratio_text
 from bgfn.train.speed import (bench_file, ceiling_spread, interleaved_profiles, interleaved_times, matmul_calls,
-                              matmul_replay, median_profile, median_time, paired_ratio, quartiles, ratio_text,
+                              matmul_replay, median_profile, median_time, paired_ratio, quartiles,
                               training_step, training_throughput, twin_ratios)
 
 SIZES = ("quick", "paper")

@@ -30,7 +30,8 @@ import pandas as pd
 from bgfn.io import update_json
 from bgfn.nav.baseline import initial_and_noise, nav_config
 from bgfn.nav.filter import run_filter
-from bgfn.train.speed import bench_file, interleaved_times, paired_ratio, ratio_text
+from bgfn.report.training_words import ratio_text
+from bgfn.train.speed import bench_file, interleaved_times, paired_ratio
 
 DATASET = "turin-sim-ekinox"
 

@@ -13,7 +13,7 @@ from bgfn.errors import DataError
 from bgfn.nav import outage_rules as R
 from bgfn.nav import outages, sim
 from bgfn.profile_schema import load_profile, with_overrides
-from bgfn.report import evaluation_words, nav_words
+from bgfn.report import evaluation_words, nav_words, training_words
 
 RULE = {"rule": "cruise_and_manoeuvre", "duration_s": 30.0, "step_s": 1.0, "warmup_s": 60.0, "min_speed_mps": 2.0,
         "cruise_max_yaw_rate_dps": 3.0, "manoeuvre_min_yaw_rate_dps": 5.0, "gap_s": 30.0, "min_training_s": 120.0}
@@ -226,7 +226,7 @@ def test_training_and_evaluation_take_each_datasets_outages():
     d = drive()
     assert plan.windows_of("sim", d) == [(1225.0, 30.0), (1385.0, 30.0)]
     assert plan.windows_of("turin") == [(1100.0, 30.0)]
-    assert "turin: [(1100.0, 30.0)]; sim: rule cruise_and_manoeuvre (picked from the drive)" in plan.describe()
+    assert "turin: [(1100.0, 30.0)]; sim: rule cruise_and_manoeuvre (picked from the drive)" in training_words.plan_text(plan)
     # notebook 04's setup: the default list, and a line for each dataset with its own entry
     prof = with_overrides(load_profile("smoke"), {"evaluate.datasets": ["turin-sim-ekinox", "sim", "other"]})
     prof["outage_windows"] = {**prof["outage_windows"], "sim": dict(RULE), "other": [[138800.0, 10.0]]}

@@ -199,7 +199,8 @@ def test_interleaved_timing_alternates_and_discards_the_warm_up():
 
 
 def test_a_paired_ratio_is_unreliable_when_its_spread_exceeds_the_difference():
-    from bgfn.train.speed import paired_ratio, quartiles, ratio_text
+    from bgfn.report.training_words import ratio_text
+    from bgfn.train.speed import paired_ratio, quartiles
 
     assert quartiles([1, 2, 3, 4, 5]) == {"median": 3.0, "q25": 2.0, "q75": 4.0}
     clear = paired_ratio([1.0, 1.0, 1.0, 1.0, 1.0], [2.0, 2.1, 1.9, 2.0, 2.2])    # ~0.5, spread ~0.02

@@ -16,6 +16,7 @@ from bgfn import learning as L
 from bgfn import models
 from bgfn import train as T
 from bgfn.errors import DataError
+from bgfn.report import training_words
 from bgfn.io import sources_hash
 from bgfn.train import loop, lr_search
 from bgfn.profile_schema import load_profile, with_overrides
@@ -374,7 +375,7 @@ def test_training_plan_takes_the_profile_unless_told():
     assert (mine.datasets, mine.methods, mine.seeds, mine.outage_windows) == (["turin-sim-mpu6000"], ["mlp"], [3],
                                                                              [(1.0, 2.0)])
     assert type(mine.seeds[0]) is int                      # the card and file name take a plain int
-    text = mine.describe()
+    text = training_words.plan_text(mine)
     assert "methods ['mlp'], seeds [3], size 'smoke'" in text and f"+- {tc['margin_s']} s" in text
 
 
@@ -479,9 +480,9 @@ def test_paper_training_estimate_is_epochs_times_windows_over_the_measured_rate(
     # BGFN: one epoch = 3600/10 + 1800/10 = 540 s; 3 seeds x 1000 epochs = 1.62e6 s = 450 h
     assert t.loc["bgfn", "epoch_s"] == pytest.approx(540.0) and t.loc["bgfn", "hours"] == pytest.approx(450.0)
     assert t.loc["mlp", "hours"] == pytest.approx(450.0 * 10 / 400) and t.loc["bgfn", "runs"] == 6
-    assert "at most 461.2 h" in T.estimate_lines(table)[0]
+    assert "at most 461.2 h" in training_words.estimate_lines(table)[0]
     assert T.paper_training_estimate({"a": 1}, paper, {"train_windows_per_s": {"bgfn": {"quick": 5.0}}}) is None
-    assert "make bench" in T.estimate_lines(None)[0]
+    assert "make bench" in training_words.estimate_lines(None)[0]
 
 
 def test_speed_lines_give_the_ratio_to_the_twin_and_the_ceiling_of_the_matrix_products():
@@ -489,18 +490,18 @@ def test_speed_lines_give_the_ratio_to_the_twin_and_the_ceiling_of_the_matrix_pr
              "train_step_profile": {"bgfn": {"paper": {"matmul_s": 0.5, "step_s": 0.7}},
                                     "transformer": {"paper": {"matmul_s": 0.1, "step_s": 0.2}}},
              "train_ratio_ceiling": {"paper": 0.2 / 0.5}}
-    lines = T.speed_lines(bench, {"train": {"sizes": {"bgfn": {"paper": {"time_steps": 4}}}}})
+    lines = training_words.speed_lines(bench, {"train": {"sizes": {"bgfn": {"paper": {"time_steps": 4}}}}})
     assert lines[0] == ("BGFN's training throughput over its ANN twin's (windows/s, both measured in one run): 0.85 "
                         "at the quick size, 0.25 at the paper size")
     assert "take 0.50 s of its 0.70 s, the twin's whole step 0.20 s" in lines[1]
     assert "at most 0.40 of the twin's throughput: with T_s = 4 SNN steps" in lines[1]
-    assert len(T.speed_lines({k: v for k, v in bench.items() if k != "train_ratio_ceiling"})) == 1   # older bench
+    assert len(training_words.speed_lines({k: v for k, v in bench.items() if k != "train_ratio_ceiling"})) == 1   # older bench
     # without the profiler: products replayed alone, 300 of 400 ms; the twin's step over them 0.4, of which 0.25
     replay = {"paper": {"matmul_ms": 300.0, "step_ms": 400.0, "matmul_share": {"median": 0.75},
                         "ceiling": {"median": 0.4}}}
-    third = T.speed_lines({**bench, "train_ceiling_replay": replay})[2]
+    third = training_words.speed_lines({**bench, "train_ceiling_replay": replay})[2]
     assert "take 300 ms of its 400 ms step (75 %); the ceiling they set is 0.40, of which BGFN reaches 62 %" in third
-    assert T.speed_lines({}) == [] and T.speed_lines(None) == []
+    assert training_words.speed_lines({}) == [] and training_words.speed_lines(None) == []
 
 
 def test_learning_check_names_the_runs_that_never_improved_on_their_initial_network():
@@ -511,15 +512,15 @@ def test_learning_check_names_the_runs_that_never_improved_on_their_initial_netw
     fitted = {**card("at_lstm", 2, 0), "history": [{"epoch": 0, "train_loss": None}, {"epoch": 1, "train_loss": 0.8},
                                                    {"epoch": 2, "train_loss": 0.456}, {"epoch": 3, "train_loss": 0.5}]}
     cards = [card("bgfn", 0, 3), card("mlp", 0, 0), card("mlp", 1, 1), fitted]
-    lines = T.learning_check(cards)
+    lines = training_words.learning_check(cards)
     assert lines[0] == "2 of 4 runs improved on their initial network (best epoch >= 1)"
     assert lines[1] == "  not improved: d mlp seed 0: the initial network is kept"
     # the lowest training loss of epochs >= 1 (epoch 0 has none), against the 1.0 of predicting the mean
     assert lines[2] == ("  not improved: d at_lstm seed 2: the initial network is kept; its training loss fell to "
                         "0.46 (predicting the training mean: about 1)")
-    lines = T.learning_check(cards[:3])
+    lines = training_words.learning_check(cards[:3])
     assert lines[2].startswith("1 runs kept their first training epoch") and lines[2].endswith("d mlp seed 1")
-    assert T.learning_check([card("bgfn", 0, 2)]) == ["1 of 1 runs improved on their initial network (best epoch >= 1)"]
+    assert training_words.learning_check([card("bgfn", 0, 2)]) == ["1 of 1 runs improved on their initial network (best epoch >= 1)"]
     # the table carries the initial network's validation error; an older card (no epoch 0) leaves it empty
     runs = T.cards_table([card("bgfn", 0, 3, initial=4.5), {**card("mlp", 0, 2), "history": [{"epoch": 1}]}, fitted])
     assert runs["val_rmse_initial_m"].tolist()[0] == 4.5 and runs["val_rmse_initial_m"].isna().tolist()[1]
@@ -553,13 +554,13 @@ def test_runs_that_never_improved_are_trained_again_on_all_windows_only_when_the
     assert not (tmp_path / "p" / "models" / "toy").exists()                         # reported networks untouched
     table = T.recheck_table([pair])
     assert list(table.columns) == list(T.RECHECK_COLUMNS) and table["n_train_all"].tolist() == [n]
-    lines = T.recheck_lines(table, tc)
+    lines = training_words.recheck_lines(table, tc)
     improved = int(pair["all"]["best_epoch"] >= 1)
     assert lines[0].startswith(f"trained again on all their training windows, {improved} of 1 runs")
     assert lines[1] == f"  toy mlp seed 0: {n // 4} -> {n} windows, best epoch 0 -> {pair['all']['best_epoch']}"
-    assert T.recheck_lines(table.iloc[:0], tc)[0].startswith("no run to recheck")
+    assert training_words.recheck_lines(table.iloc[:0], tc)[0].startswith("no run to recheck")
     off = {"recheck_all_windows": False}
-    assert T.recheck_lines(table, off)[0] == "not rechecked (train.recheck_all_windows is false)"
+    assert training_words.recheck_lines(table, off)[0] == "not rechecked (train.recheck_all_windows is false)"
 
 
 def test_recheck_runs_first_keeps_the_lowest_seed_of_each_dataset_and_method():
@@ -569,7 +570,7 @@ def test_recheck_runs_first_keeps_the_lowest_seed_of_each_dataset_and_method():
     cards = [card("a", "mlp", 2), card("a", "mlp", 1), card("a", "bgfn", 1), card("b", "mlp", 0), card("a", "mlp", 0)]
     # a/mlp: seed 0 (the last card), a/bgfn: its only run, b/mlp: its only run; in the cards' order
     assert T.first_per_method(cards) == [cards[2], cards[3], cards[4]]
-    lines = T.recheck_lines(pd.DataFrame({"dataset": ["a"], "method": ["mlp"], "seed": [0], "n_train": [10],
+    lines = training_words.recheck_lines(pd.DataFrame({"dataset": ["a"], "method": ["mlp"], "seed": [0], "n_train": [10],
                                           "n_train_all": [40], "best_epoch": [0], "best_epoch_all": [2],
                                           "train_loss_min_all": [0.5]}), {"recheck_all_windows": True,
                                                                           "recheck_runs": "first"})

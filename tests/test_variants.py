@@ -18,6 +18,7 @@ from bgfn import train as T
 from bgfn.errors import DataError
 from bgfn.config import MAIN_VARIANT, variant_config
 from bgfn.profile_schema import load_profile, with_overrides
+from bgfn.report import training_words
 
 torch.set_num_threads(1)
 
@@ -133,14 +134,14 @@ def test_variant_plan_takes_variant_runs_and_describes_each_variant():
     # variant_runs' own lists are cut to what notebook 03 trains (its parameters may narrow train:)
     smoke = T.VariantPlan.of(T.TrainingPlan.of(with_overrides(load_profile("smoke"), {"train.methods": ["mlp", "at_lstm"]})))
     assert (smoke.methods, smoke.datasets) == (["mlp"], ["turin-sim-mpu6000"])
-    assert T.describe_options(vplan.train_section(MAIN_VARIANT)) == {"inputs": "eq21", "protocol": "honest"}
+    assert T.variant_options(vplan.train_section(MAIN_VARIANT)) == {"inputs": "eq21", "protocol": "honest"}
     velocity = "eq21+v_along+v_cross; yaw relative; heading frame"
-    assert T.describe_options(vplan.train_section("velocity-leaky")) == {"inputs": velocity, "protocol": "leaky"}
+    assert T.variant_options(vplan.train_section("velocity-leaky")) == {"inputs": velocity, "protocol": "leaky"}
     folder = vplan.models_dir("leaky", "turin-sim-mpu6000", create=False)
     assert folder.parts[-4:] == ("models", "variants", "leaky", "turin-sim-mpu6000")
     assert vplan.models_dir(MAIN_VARIANT, "turin-sim-mpu6000", create=False).parts[-2:] == ("models",
                                                                                             "turin-sim-mpu6000")
-    assert f"velocity-leaky: inputs {velocity}, protocol leaky" in vplan.describe()
+    assert f"velocity-leaky: inputs {velocity}, protocol leaky" in training_words.variants_text(vplan)
 
 
 # ----------------------------------------------------------------------------------------------- outage table

@@ -279,7 +279,7 @@ def answer_free_aids(table: pd.DataFrame, drift: pd.DataFrame | None = None) -> 
     return f"Does it beat the learning-free aids? {text} {add}."
 
 
-#: The variants' ``inputs`` of Eq. (eq21) alone (:func:`bgfn.train.variants.describe_options`); more channels are
+#: The variants' ``inputs`` of Eq. (eq21) alone (:func:`bgfn.train.variants.variant_options`); more channels are
 #: written ``eq21+<channel>...``.
 EQ21_INPUTS = "eq21"
 

@@ -30,7 +30,7 @@ The command line ``python -m bgfn train --profile ...`` is the package's edge (:
 """
 
 from bgfn.learning import REFERENCES, VAL_POSITIONS
-from bgfn.train.estimate import estimate_lines, measure_paper_step, paper_training_estimate, speed_lines
+from bgfn.train.estimate import measure_paper_step, paper_training_estimate
 from bgfn.train.loop import set_seed, train_model
 from bgfn.train.memory import keep_freed_memory
 from bgfn.train.lr_search import (LR_SEARCH_COLUMNS, LR_SEARCH_DEFAULTS, LR_SEARCH_FILE, chosen_learning_rates,
@@ -43,19 +43,19 @@ from bgfn.train.plots import plot_motion_coverage, plot_training_curves, plot_va
 from bgfn.train.profile import (TrainingDataset, TrainingPlan, ins_attitude, prepare_datasets, prepare_learning_data,
                                 train_dataset, train_datasets, training_runs, val_position_table,
                                 val_position_tables)
-from bgfn.train.recheck import (RECHECK_COLUMNS, capped_runs, first_per_method, recheck_all_windows, recheck_lines,
+from bgfn.train.recheck import (RECHECK_COLUMNS, capped_runs, first_per_method, recheck_all_windows,
                                 recheck_table)
 from bgfn.train.runs import train_profile
-from bgfn.train.tables import (TIMING_COLUMNS, card_line, cards_table, learning_check, summary_table, timing_table,
+from bgfn.train.tables import (TIMING_COLUMNS, cards_table, summary_table, timing_table,
                                training_metrics, windows_table, without_timing)
 from bgfn.train.tasks import TrainingRun, expected_cost, run_summary, train_run, train_runs
 from bgfn.train.trained import TrainedModel, checkpoint_predictions, load_trained, pick_device, predict_normalized
-from bgfn.train.variants import (VARIANT_RUN_DEFAULTS, VariantPlan, describe_options, train_variants,
+from bgfn.train.variants import (VARIANT_RUN_DEFAULTS, VariantPlan, variant_options, train_variants,
                                  variant_cards_table, variant_learning_data, variant_runs, variant_train_section,
                                  wall_time_by_variant)
 
 __all__ = [
-    "estimate_lines", "measure_paper_step", "paper_training_estimate", "speed_lines",
+    "measure_paper_step", "paper_training_estimate",
     # options
     "OPTIMIZER_DEFAULTS", "train_subsection", "optimizer_options", "method_lr", "size_config", "even_subset",
     # the loop and a trained network
@@ -71,12 +71,12 @@ __all__ = [
     "TrainingPlan", "TrainingDataset", "prepare_datasets", "prepare_learning_data", "ins_attitude",
     "val_position_table", "val_position_tables", "train_dataset", "train_datasets", "training_runs", "train_profile",
     # tables and figures
-    "REFERENCES", "VAL_POSITIONS", "TIMING_COLUMNS", "cards_table", "learning_check", "summary_table", "without_timing",
-    "timing_table", "windows_table", "card_line", "training_metrics", "plot_training_curves",
+    "REFERENCES", "VAL_POSITIONS", "TIMING_COLUMNS", "cards_table", "summary_table", "without_timing",
+    "timing_table", "windows_table", "training_metrics", "plot_training_curves",
     "plot_val_predictions", "plot_motion_coverage",
     # runs that never learned, trained again on all windows
-    "RECHECK_COLUMNS", "capped_runs", "first_per_method", "recheck_all_windows", "recheck_table", "recheck_lines",
+    "RECHECK_COLUMNS", "capped_runs", "first_per_method", "recheck_all_windows", "recheck_table",
     # input and protocol variants
-    "VARIANT_RUN_DEFAULTS", "VariantPlan", "describe_options", "variant_train_section", "variant_learning_data",
+    "VARIANT_RUN_DEFAULTS", "VariantPlan", "variant_options", "variant_train_section", "variant_learning_data",
     "train_variants", "variant_runs", "variant_cards_table", "wall_time_by_variant",
 ]

@@ -22,11 +22,11 @@ from bgfn.nav import outages
 from bgfn.nav.baseline import run_drive
 from bgfn.parallel import Runner
 from bgfn.train import checkpoints
-from bgfn.train.options import optimizer_options, size_config
+from bgfn.train.options import size_config
 from bgfn.train.tasks import TrainingRun, train_runs
 
-#: Learning options :meth:`TrainingPlan.describe` shows (the rest of :data:`bgfn.learning.LEARNING_DEFAULTS`
-#: is in the profile).
+#: Learning options :func:`bgfn.report.training_words.plan_text` shows (the rest of
+#: :data:`bgfn.learning.LEARNING_DEFAULTS` is in the profile).
 DESCRIBED_OPTIONS = ("window", "alignment", "yaw_encoding", "target_frame", "extra_channels", "val_position",
                      "target_screen_sigma", "protocol")
 
@@ -87,36 +87,10 @@ class TrainingPlan:
         """The profile's ``train:`` section."""
         return self.cfg["train"]
 
-    def describe(self) -> str:
-        """What is trained, on which data, with which budget (a few lines for the notebook)."""
-        tc = self.train_cfg
-        opts = learning_options(tc)
-        return "\n".join([
-            f"profile {self.cfg['profile']!r}: {self.cfg['description']}",
-            f"datasets {self.datasets}, methods {self.methods}, seeds {self.seeds}, size {tc.get('size')!r}",
-            (f"evaluation outages excluded from training (start, duration) s: {self._windows_text()} "
-             f"+- {opts['margin_s']} s" if opts["protocol"] == "honest" else
-             f"protocol {opts['protocol']!r}: the evaluation outages (start, duration) s {self._windows_text()} "
-             "are training windows too"),
-            f"optimizer: {optimizer_options(tc)}",
-            f"learning problem: { {k: opts[k] for k in DESCRIBED_OPTIONS} }",
-        ])
-
 
     def dataset_windows(self, name: str, prepared: "TrainingDataset") -> list:
         """The evaluation outages kept out of a prepared dataset: its own (``prepared.windows``), else the plan's."""
         return prepared.windows if prepared.windows is not None else self.windows_of(name, prepared.drive)
-
-    def _windows_text(self) -> str:
-        """The outages per dataset where the profile gives them per dataset, else the one list."""
-        if not self.per_dataset:
-            return str(self.outage_windows)
-        parts = []
-        for name in self.datasets:
-            entry = outages.outage_entry(self.cfg, name)
-            parts.append(f"{name}: " + (f"rule {entry['rule']} (picked from the drive)" if outages.is_rule(entry)
-                                        else str(outages.outage_windows(self.cfg, dataset=name))))
-        return "; ".join(parts)
 
 
 @dataclass

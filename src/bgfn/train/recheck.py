@@ -8,7 +8,8 @@ into ``results/<profile>/models/all_windows/<dataset>/`` (:func:`bgfn.train.chec
 reported networks are not touched). ``train.recheck_runs: first`` trains again only the first such run (in seed
 order) of each dataset and method: the question is whether the method learns from the windows the cap left out,
 which one run answers; ``all`` (default) trains every such run. The table
-(:func:`recheck_table`) and the lines of notebook 03 (:func:`recheck_lines`) say whether it then improved.
+(:func:`recheck_table`) and the lines of notebook 03 (:func:`bgfn.report.training_words.recheck_lines`) say
+whether it then improved.
 """
 
 from __future__ import annotations
@@ -102,22 +103,3 @@ def recheck_table(pairs: list[dict]) -> pd.DataFrame:
              "train_loss_min_all": lowest_train_loss(a)}
             for c, a in ((p["capped"], p["all"]) for p in pairs)]
     return pd.DataFrame(rows, columns=list(RECHECK_COLUMNS))
-
-
-def recheck_lines(table: pd.DataFrame, train_cfg: dict) -> list[str]:
-    """Plain lines for notebook 03: how many of the rechecked runs improved on their initial network once
-    they had every training window (``train_cfg``: the ``train:`` section, whether the recheck is on)."""
-    if not enabled(train_cfg):
-        return ["not rechecked (train.recheck_all_windows is false)"]
-    if not len(table):
-        return ["no run to recheck: every run improved on its initial network, or trained on all its windows"]
-    improved = int((table["best_epoch_all"] >= 1).sum())
-    fit = float(table["train_loss_min_all"].median())
-    which = (" (the first of each dataset and method, train.recheck_runs: first)"
-             if train_cfg["recheck_runs"] == "first" else "")
-    lines = [f"trained again on all their training windows, {improved} of {len(table)} runs that never improved on "
-             f"their initial network{which} then did (median lowest training loss {fit:.2f}; predicting the "
-             f"training mean: about 1):"]
-    lines += [f"  {r.dataset} {r.method} seed {r.seed}: {r.n_train} -> {r.n_train_all} windows, best epoch "
-              f"{r.best_epoch} -> {r.best_epoch_all}" for r in table.itertuples()]
-    return lines

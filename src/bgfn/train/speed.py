@@ -129,12 +129,6 @@ def paired_ratio(numerator: list[float], denominator: list[float], reference: fl
             "unreliable": bool(q["q75"] - q["q25"] > abs(q["median"] - reference))}
 
 
-def ratio_text(r: dict) -> str:
-    """``0.52 [IQR 0.50-0.55, 15 rounds]`` and ``unreliable`` where :func:`paired_ratio` says so."""
-    return (f"{r['median']:.2f} [IQR {r['q25']:.2f}-{r['q75']:.2f}, {r['rounds']} rounds]"
-            + (" -- unreliable: the spread is wider than the difference" if r["unreliable"] else ""))
-
-
 def _infer(model: nn.Module, x: torch.Tensor) -> Callable[[], object]:
     model.eval()
 

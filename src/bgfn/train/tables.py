@@ -40,26 +40,6 @@ def lowest_train_loss(card: dict) -> float | None:
     return min(losses) if losses else None
 
 
-def learning_check(cards: list[dict]) -> list[str]:
-    """Did every run learn? Lines for notebook 03: how many runs improved on their initial network
-    (``best_epoch >= 1``; epoch 0 is the initial network), which did not and whether they fitted their training
-    windows all the same (:func:`lowest_train_loss`), and how many kept their first training epoch (their
-    validation loss only grew after one pass over the data)."""
-    done = [c for c in cards if c.get("best_epoch") is not None]
-    untrained = [c for c in done if int(c["best_epoch"]) < 1]
-    first = [c for c in done if int(c["best_epoch"]) == 1]
-    lines = [f"{len(done) - len(untrained)} of {len(done)} runs improved on their initial network (best epoch >= 1)"]
-    for c in untrained:
-        fit = lowest_train_loss(c)
-        fitted = "" if fit is None else f"; its training loss fell to {fit:.2f} (predicting the training mean: about 1)"
-        lines.append(f"  not improved: {c.get('dataset', '')} {c['method']} seed {c['seed']}: the initial network "
-                     f"is kept{fitted}")
-    if first:
-        lines.append(f"{len(first)} runs kept their first training epoch (validation loss grew after it): "
-                     + ", ".join(f"{c.get('dataset', '')} {c['method']} seed {c['seed']}" for c in first))
-    return lines
-
-
 #: Wall-clock columns of :func:`cards_table` / :func:`summary_table`: they vary from run to run, so the result
 #: tables are saved without them (:func:`without_timing`) and the times go to a table of their own.
 TIMING_COLUMNS = ("wall_time_s", "train_time_s_mean", "train_time_s_total")
@@ -93,14 +73,6 @@ def windows_table(prepared: dict) -> pd.DataFrame:
     (``prepared``: ``{dataset: TrainingDataset}`` of :func:`bgfn.train.profile.prepare_datasets`)."""
     return pd.DataFrame([{"dataset": name, "gnss_rate_hz": d.drive.meta.get("gnss_rate_hz"), **split_summary(d.data)}
                          for name, d in prepared.items()])
-
-
-def card_line(card: dict) -> str:
-    """One line per run: dataset, method, seed, epochs, wall time, validation RMSE and the references (m)."""
-    return (f"{card.get('dataset', ''):>18} {card['method']:>12} seed {card['seed']}: {card['epochs_run']:4d} epochs, "
-            f"{card['wall_time_s']:7.1f} s, val RMSE {card['val_rmse_m']:.3f} m "
-            f"(zero {card['val_rmse_zero_m']:.3f}, last increment {card['val_rmse_last_m']:.3f}, "
-            f"INS increment {card['val_rmse_ins_m']:.3f})")
 
 
 def training_metrics(plan, prepared: dict, runs: pd.DataFrame, summary: pd.DataFrame,

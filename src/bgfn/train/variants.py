@@ -40,7 +40,7 @@ def variant_train_section(train_cfg: dict, overrides: dict | None) -> dict:
     return merge_sections(train_cfg, (overrides or {}).get("train") or {})
 
 
-def describe_options(train_cfg: dict) -> dict:
+def variant_options(train_cfg: dict) -> dict:
     """What a variant changes in the learning problem, in a few words: ``inputs`` (``eq21``: the nine channels
     of Eq. (eq21), ``+<channel>`` per extra channel, ``; yaw <encoding>`` and ``; <frame> frame`` where they are
     not the paper's ``unwrap`` and ``ned``) and ``protocol`` (``honest`` / ``leaky``)."""
@@ -111,16 +111,6 @@ class VariantPlan:
             return checkpoints.models_dir(self.profile, dataset, create=create)
         return checkpoints.variant_models_dir(self.profile, name, dataset, create=create)
 
-    def describe(self) -> str:
-        """One line per variant (its inputs and protocol) and the networks each trains."""
-        lines = [f"variants {self.names or 'none'}: datasets {self.datasets}, methods {self.methods}, "
-                 f"seeds {self.seeds}, each with the learning rate the main search chose for its dataset and method"]
-        for name in [MAIN_VARIANT] + self.names:
-            tc = self.train_section(name)
-            what = describe_options(tc)
-            lines.append(f"  {name}: inputs {what['inputs']}, protocol {what['protocol']}")
-        return "\n".join(lines)
-
 
 def variant_learning_data(train_section: dict, prepared, outage_windows) -> LearningData:
     """The learning data of one variant on one prepared dataset (:class:`bgfn.train.profile.TrainingDataset`):
@@ -149,7 +139,7 @@ def variant_runs(vplan: VariantPlan, prepared: dict, train_cfgs: dict[str, dict]
             own = prepared[dataset].windows
             data = variant_learning_data(tc, prepared[dataset], vplan.outage_windows if own is None else own)
             out = vplan.models_dir(name, dataset)
-            extra = {"variant": name, **describe_options(tc), "dataset": dataset, "profile": vplan.profile,
+            extra = {"variant": name, **variant_options(tc), "dataset": dataset, "profile": vplan.profile,
                      "size": tc.get("size"), "lr_from": "main search"}
             runs += [TrainingRun(f"{name} {dataset} {method} seed {seed}", method, data, size_config(tc, method), tc,
                                  int(seed), out, device, extra) for method in vplan.methods for seed in vplan.seeds]

@@ -26,7 +26,7 @@ from bgfn.evaluate.networks import load_model
 from bgfn.nav import outages
 from bgfn.paper import METHOD_LABELS, test_of
 from bgfn.train.checkpoints import checkpoint_name
-from bgfn.train.variants import describe_options
+from bgfn.train.variants import variant_options
 
 #: Columns of ``tables/outage_variants.csv``.
 VARIANT_COLUMNS: tuple[str, ...] = ("dataset", "test", "outage", "start_s", "variant", "inputs", "protocol",
@@ -81,7 +81,7 @@ def variant_runs(vplan, drives: dict | None = None, loader=load_variant_network,
         runs = [(NO_VARIANT, {"inputs": NO_VARIANT, "protocol": NO_VARIANT}, r)
                 for r in run_outages(ctx, windows, None, "INS", None, ecfg["pseudo_gps"])]
         for name in [MAIN_VARIANT] + vplan.names:
-            what = describe_options(vplan.train_section(name))
+            what = variant_options(vplan.train_section(name))
             folder = vplan.models_dir(name, dataset, create=False)
             for method in vplan.methods:
                 for seed in vplan.seeds:

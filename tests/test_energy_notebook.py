@@ -13,6 +13,7 @@ import torch
 from bgfn import energy
 from bgfn.config import PROJECT_ROOT
 from bgfn.studies.odometer.energy import OdometerEnergy, odometer_dataset
+from bgfn.report.odometer_words import odometer_energy_lines
 from bgfn.energy.record import REPORTED_KEYS
 from bgfn.learning import WindowSet
 from bgfn.models import build_model
@@ -271,4 +272,4 @@ def test_the_odometer_audit_measures_the_recorded_drive_and_sums_by_hand():
     assert odo.reduction_pct == pytest.approx(100 * (1 - 260 / 1100))
     assert list(odo.table.columns[:2]) == ["dataset", "model"] and set(odo.table["dataset"]) == {"d"}
     alone = OdometerEnergy("d", 0, {}, {"bgfn": odo.tables["bgfn"]}, 0.1, 8)
-    assert np.isnan(alone.reduction_pct) and "no Transformer-ODO was trained" in alone.lines()[1]
+    assert np.isnan(alone.reduction_pct) and "no Transformer-ODO was trained" in odometer_energy_lines(alone)[1]

@@ -9,6 +9,7 @@ from bgfn import evaluate as ev
 from bgfn.studies.odometer import bars as O, section as OS
 from bgfn.nav import odometer as no
 from bgfn.profile_schema import load_profile
+from bgfn.report import odometer_words
 from synthetic_drive import demo_drive
 
 NAV = {"init": {"position_std_m": 1.0, "height_std_m": 2.0, "velocity_std_mps": 0.1, "level_std_deg": 0.2,
@@ -206,9 +207,9 @@ def test_network_table_sets_each_networks_validation_beside_its_own_folds_outage
     row = t.iloc[0]
     assert row["outage_speed_rmse_mps"] == pytest.approx(np.sqrt((9 + 16) / 2))  # RMS over the starts
     assert row["outage_coverage_2sigma"] == pytest.approx(0.75) and row["val_rmse_mps"] == 0.8
-    line, = OS.network_lines(t)
+    line, = odometer_words.network_lines(t)
     assert line.startswith("d, fold 0:") and "BGFN-ODO 0.80, then 3.54 m/s (75 % of outage epochs within" in line
-    assert OS.network_lines(None) == [] and OS.network_lines(t.iloc[:0]) == []
+    assert odometer_words.network_lines(None) == [] and odometer_words.network_lines(t.iloc[:0]) == []
 
 
 def test_the_ensemble_of_two_oppositely_biased_seeds_is_unbiased_with_the_mixtures_std():

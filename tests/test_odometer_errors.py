@@ -5,8 +5,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bgfn.studies.odometer.errors import (ERROR_COLUMNS, error_parts_lines, error_parts_table, offset_bar_mps,
-                                           plot_error_parts)
+from bgfn.studies.odometer.errors import ERROR_COLUMNS, error_parts_table, offset_bar_mps, plot_error_parts
+from bgfn.report.odometer_words import error_parts_lines
 from bgfn.report.odometer_verdict import OdometerInputs, fusion_words, offset_sentence
 
 

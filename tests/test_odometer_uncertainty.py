@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from bgfn.studies.odometer.uncertainty import ranks_errors, uncertainty_lines, uncertainty_table
+from bgfn.report.odometer_words import uncertainty_lines
+from bgfn.studies.odometer.uncertainty import ranks_errors, uncertainty_table
 
 
 def _series(informative: bool):

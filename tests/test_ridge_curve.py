@@ -8,6 +8,7 @@ import pytest
 
 from bgfn.studies.odometer import ridge_curve as RC
 from bgfn.learning import odometry as lo
+from bgfn.report import odometer_words
 
 RATE, WINDOW = 100.0, 200                                  # 2 s windows at 100 Hz, one per second
 STARTS = [100.0 + 40.0 * k for k in range(10)]             # ten 30 s outages, 40 s apart
@@ -71,7 +72,7 @@ def test_the_held_out_outages_never_train_their_own_ridge():
 
 def test_lines_name_the_folds_and_windows():
     ws = windows(speed)
-    line = RC.curve_lines(curve(ws, ws, ws.speed, 2, 5).reset_index())[0]
+    line = odometer_words.curve_lines(curve(ws, ws, ws.speed, 2, 5).reset_index())[0]
     assert line.startswith("synthetic: RIDGE-ODO's speed RMSE") and "2 folds" in line and "5 folds" in line
     with pytest.raises(Exception):
         RC.ridge_curve("synthetic", {2: pd.DataFrame(columns=["start_s", "fold"])}, ws, ws, ws.speed, 30.0, 5.0,

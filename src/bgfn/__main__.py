@@ -39,6 +39,7 @@ from bgfn.io import atomic_write_text
 from bgfn.parallel import Runner
 from bgfn.profile_schema import load_profile, with_overrides
 from bgfn.report import walltimes as walltimes_module
+from bgfn.report.odometer_words import odometer_markdown
 from bgfn.report.run_words import runner_words
 from bgfn.train.runs import train_profile
 
@@ -110,7 +111,7 @@ def odometers(argv) -> int:
     runner = setup.runner if a.jobs is None else Runner.of(cfg, environ={})
     print(f"profile {a.profile!r}: runs {runner_words(runner)}", flush=True)
     section = run_odometer_section(cfg, a.profile, setup, results_dir(a.profile), runner, report=print)
-    print(section.markdown())
+    print(odometer_markdown(section))
     print("wrote", odometer_sizes.write_run_facts(a.profile, cfg, t0, runner_words(runner)))
     return 0
 

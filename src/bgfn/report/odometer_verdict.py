@@ -21,7 +21,7 @@ import pandas as pd
 from bgfn.data.names import dataset_id
 from bgfn.studies.odometer.sizes import read_measured
 from bgfn.studies.odometer.errors import offset_bar_mps
-from bgfn.studies.odometer.uncertainty import uncertainty_sentence
+from bgfn.report.odometer_words import uncertainty_sentence
 from bgfn.studies.odometer.bars import HOLD, ORACLE, RIDGE
 from bgfn.paper import METHOD_LABELS, ensemble_label, nhc_label, odometer_label
 from bgfn.stats import wilcoxon_p

@@ -14,7 +14,8 @@ from bgfn.config import RUN_RECORDS, SHARED_TABLES
 from bgfn.data.names import dataset_id
 from bgfn.data.registry import recorded_first
 from bgfn.studies.outage_sweep.sweep import describe_sweep
-from bgfn.studies.odometer.section import odometer_lines, odometer_table
+from bgfn.report.odometer_words import odometer_lines
+from bgfn.studies.odometer.section import odometer_table
 from bgfn.report.glance import run_header
 from bgfn.report.provenance import cards_line, model_cards, outage_datasets, outage_provenance, provenance, short_source
 from bgfn.report.reading import ProfileResults, missing_note, read_csv

@@ -9,11 +9,11 @@ the networks at other sizes (:mod:`~bgfn.studies.odometer.sizes`) and their ener
 
 from bgfn.studies.odometer.bars import (ODOMETER_COLUMNS, ODOMETER_METHODS, odometer_rows, odometer_summary,
                                         run_odometer_bars)
-from bgfn.studies.odometer.section import OdometerSection, odometer_lines, odometer_table, run_odometer_section
+from bgfn.studies.odometer.section import OdometerSection, odometer_table, run_odometer_section
 from bgfn.studies.odometer.energy import OdometerEnergy, odometer_energy
 
 __all__ = [
-    "ODOMETER_COLUMNS", "ODOMETER_METHODS", "OdometerSection", "odometer_lines", "odometer_rows",
+    "ODOMETER_COLUMNS", "ODOMETER_METHODS", "OdometerSection", "odometer_rows",
     "odometer_summary", "odometer_table", "run_odometer_bars", "run_odometer_section", "OdometerEnergy",
     "odometer_energy",
 ]

@@ -99,19 +99,6 @@ class OdometerEnergy:
                          "sops": float(tot["sops"])})
         return pd.DataFrame(rows)
 
-    def lines(self) -> list[str]:
-        """Which networks, on which windows, and the reduction."""
-        e = {m: total_energy_uj(t) for m, t in self.tables.items()}
-        out = [f"{self.dataset}, sweep fold {FOLD}, seed {self.seed}: {self.n_windows} IMU windows evenly spaced over "
-               f"the drive; BGFN-ODO mean input firing rate {self.mean_rate:.3f}"]
-        if np.isfinite(self.reduction_pct):
-            out.append(f"BGFN-ODO {e['bgfn']:.4g} µJ, Transformer-ODO {e['transformer']:.4g} µJ per prediction: "
-                       f"{self.reduction_pct:.1f} % less energy for the spiking odometer")
-        else:
-            out.append(f"BGFN-ODO {e['bgfn']:.4g} µJ per prediction; no Transformer-ODO was trained "
-                       f"(evaluate.odometer.methods) to compare with")
-        return out
-
 
 def odometer_energy(profile: str, cfg: dict, e_mac: float, e_ac: float, batch_size: int = 32) -> OdometerEnergy | None:
     """Count the measured odometers (module docstring); None when the profile trains no odometer network.

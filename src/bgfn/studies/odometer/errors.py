@@ -108,16 +108,3 @@ def plot_error_parts(table: pd.DataFrame, dataset: str, bars: dict):
                  "and a fluctuation it can", fontsize=9)
     fig.tight_layout()
     return fig
-
-
-def error_parts_lines(table: pd.DataFrame) -> list[str]:
-    """Per dataset and duration: each odometer's offset and fluctuation in the outages (notebook 07)."""
-    if table is None or table.empty:
-        return []
-    lines = []
-    for (ds, d), g in table.groupby(["dataset", "duration_s"], sort=False):
-        lines.append(f"{ds}, the first {d:g} s of each outage: the learned speed's error as an offset per outage (RMS "
-                     "over the outages) and a fluctuation around it, with its integrated autocorrelation there: "
-                     + "; ".join(f"{r['method']} {r['offset_rms_mps']:.2f} and {r['fluctuation_mps']:.2f} m/s "
-                                 f"(kappa {r['outage_correlation']:.1f})" for _, r in g.iterrows()) + ".")
-    return lines

@@ -82,19 +82,6 @@ def ridge_curve(dataset: str, plans: dict[int, pd.DataFrame], ws: lo.SpeedWindow
     return pd.DataFrame(rows, columns=list(CURVE_COLUMNS))
 
 
-def curve_lines(curve: pd.DataFrame) -> list[str]:
-    """One sentence per dataset: the ridge's speed error in its outages as its training windows per fold grow."""
-    lines = []
-    for ds, g in curve.groupby("dataset", sort=False):
-        g = g.sort_values("folds")
-        lines.append(f"{ds}: RIDGE-ODO's speed RMSE in its own fold's {g['duration_s'].iloc[0]:g} s outages as the "
-                     "sweep's starts are split into more folds (each holding out less of the drive): "
-                     + "; ".join(f"{r.folds} folds, {r.n_train:.0f} training windows per fold: "
-                                 f"{r.outage_speed_rmse_mps:.2f} m/s ({100 * r.outage_coverage_2sigma:.0f} % "
-                                 "within +-2 sigma)" for r in g.itertuples()) + ".")
-    return lines
-
-
 def plot_curve(curve: pd.DataFrame):
     """RIDGE-ODO's speed RMSE in its outages (solid) and its validation std (dashed) against its training windows
     per fold, one colour per drive, each point labelled with its number of folds."""

@@ -1,5 +1,6 @@
-"""The learned odometer's section of notebook 07: its tables, figures and lines from the rows of
-:mod:`bgfn.studies.odometer.bars` (the bars a learned odometer must clear in the outage sweep's windows)."""
+"""The learned odometer's section of notebook 07: its tables and figures from the rows of
+:mod:`bgfn.studies.odometer.bars` (the bars a learned odometer must clear in the outage sweep's windows); in words:
+:mod:`bgfn.report.odometer_words`."""
 
 from __future__ import annotations
 
@@ -14,28 +15,25 @@ import pandas as pd
 
 from bgfn.config import SHARED_TABLES, odometer_datasets
 from bgfn.data import dataset_id
-from bgfn.studies.odometer.errors import (ERROR_COLUMNS, error_parts_lines, error_parts_table, offset_bar_mps,
-                                           plot_error_parts)
-from bgfn.studies.odometer.uncertainty import UNCERTAINTY_COLUMNS, uncertainty_lines, uncertainty_table
+from bgfn.studies.odometer.errors import ERROR_COLUMNS, error_parts_table, offset_bar_mps, plot_error_parts
+from bgfn.studies.odometer.uncertainty import UNCERTAINTY_COLUMNS, uncertainty_table
 from bgfn.evaluate.plots import finish_duration_axes
-from bgfn.studies.odometer.ridge_curve import CURVE_COLUMNS, curve_lines, plot_curve
+from bgfn.studies.odometer.ridge_curve import CURVE_COLUMNS, plot_curve
 from bgfn.io import atomic_write_csv, save_figure
 from bgfn.paper import ENSEMBLE_SUFFIX, nhc_label
 from bgfn.parallel import Runner
 
-from bgfn.studies.odometer.bars import (ENSEMBLE_ODOMETERS, HOLD, NETWORK_ODOMETERS, ODOMETER_METHODS, ORACLE,
-                                        ORACLE_WALK, PAPER_FOLD, RIDGE, network_table, odometer_summary,
-                                        paper_outage_table, run_odometer_bars)
+from bgfn.studies.odometer.bars import (ODOMETER_METHODS, ORACLE, ORACLE_WALK, PAPER_FOLD, network_table,
+                                        odometer_summary, paper_outage_table, run_odometer_bars)
 
 
 @dataclass
 class OdometerSection:
-    """The odometer bars of notebook 07: the rows, their summary (:func:`odometer_summary`), the lines
-    (:func:`odometer_lines`) and the facts per dataset."""
+    """The odometer bars of notebook 07: the rows, their summary (:func:`odometer_summary`) and the facts per
+    dataset (:func:`bgfn.report.odometer_words.odometer_markdown` words them)."""
 
     rows: pd.DataFrame
     summary: pd.DataFrame
-    lines: list
     facts: dict
     figures: list = field(default_factory=list)
     paper: pd.DataFrame | None = None
@@ -43,31 +41,6 @@ class OdometerSection:
     curve: pd.DataFrame | None = None
     uncertainty: pd.DataFrame | None = None
     errors: pd.DataFrame | None = None
-
-    def markdown(self) -> str:
-        """The summary at the sweep's durations as a Markdown table (:func:`odometer_table`), then the lines."""
-        if self.summary.empty:
-            return "No odometer bars (``evaluate.odometer.datasets`` is empty or the sweep has no dataset)."
-        wide = odometer_table(self.summary)
-        head = "| dataset | method | " + " | ".join(wide.columns) + " |"
-        body = [f"| {ds} | {m} | " + " | ".join(f"{v:.1f}" for v in r) + " |" for (ds, m), r in wide.iterrows()]
-        text = "\n".join(["Median max horizontal error (m) over the sweep's starts:", "", head,
-                           "|---" * (len(wide.columns) + 2) + "|", *body, ""] + [f"- {s}" for s in self.lines]
-                          + [f"- {s}" for s in network_lines(self.networks)]
-                          + [f"- {s}" for s in (uncertainty_lines(self.uncertainty) if self.uncertainty is not None
-                                                else [])]
-                          + [f"- {s}" for s in error_parts_lines(self.errors)]
-                          + [f"- {s}" for s in curve_lines(self.curve if self.curve is not None
-                                                           else pd.DataFrame(columns=list(CURVE_COLUMNS)))])
-        if self.paper is None or self.paper.empty:
-            return text
-        p = self.paper[self.paper["sigma_mps"].isna()]       # the oracle's grid: tables/outage_odometer_paper.csv
-        wide = p.pivot_table(index=["dataset", "method"], columns="outage", values="max_h_m", sort=False)
-        head = "| dataset | method | " + " | ".join(f"outage {c}" for c in wide.columns) + " |"
-        body = [f"| {ds} | {m} | " + " | ".join(f"{v:.1f}" for v in r) + " |" for (ds, m), r in wide.iterrows()]
-        return "\n".join([text, "", "Max horizontal error (m) in each drive's two evaluation outages (the paper's tables; "
-                          "the networks and the ridge trained with those outages +- margin held out, median over "
-                          "seeds):", "", head, "|---" * (len(wide.columns) + 2) + "|", *body])
 
 
 def odometer_table(summary: pd.DataFrame) -> pd.DataFrame:
@@ -136,26 +109,7 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
         figures.append(fig)
     if timings is not None:
         timings["odometer_s"] = time.perf_counter() - t0
-    return OdometerSection(rows, summary, odometer_lines(summary) if len(summary) else [], facts, figures, paper,
-                           networks, curve, uncertainty, errors)
-
-
-def network_lines(networks: pd.DataFrame | None) -> list[str]:
-    """Per dataset and fold: each network odometer's speed RMSE on its validation block against its own fold's
-    outages, with its share of outage epochs within +-2 sigma (medians over seeds, :func:`network_table`). A fold
-    whose validation block is easier than its outages gets too small a std there (the calibration shrinks it)."""
-    if networks is None or networks.empty:
-        return []
-    lines = []
-    cols = ["val_rmse_mps", "outage_speed_rmse_mps", "outage_coverage_2sigma"]
-    for (ds, fold), g in networks.groupby(["dataset", "fold"], sort=False):
-        med = g.groupby("method", sort=False)[cols].median()
-        lines.append(f"{ds}, fold {fold}: the network odometers' speed RMSE on the validation block their std was "
-                     "calibrated on, then in the fold's outages (median over seeds): "
-                     + "; ".join(f"{m} {r['val_rmse_mps']:.2f}, then {r['outage_speed_rmse_mps']:.2f} m/s "
-                                 f"({100 * r['outage_coverage_2sigma']:.0f} % of outage epochs within +-2 sigma)"
-                                 for m, r in med.iterrows()) + ".")
-    return lines
+    return OdometerSection(rows, summary, facts, figures, paper, networks, curve, uncertainty, errors)
 
 
 #: Colours of the speed bands (:func:`plot_speed_series`): the ridge, then the networks.
@@ -205,29 +159,3 @@ def plot_error_growth(summary: pd.DataFrame, dataset: str):
                     color="black" if method == nhc_label("INS") else None, label=method)
     return finish_duration_axes(fig, ax, "median max horizontal error (m)",
                                 f"{dataset}: error growth over the outage, sweep starts")
-
-
-def odometer_lines(summary: pd.DataFrame) -> list[str]:
-    """Per dataset and duration: INS+NHC, the held speed, the ridge odometer and the oracle's break-even."""
-    lines = []
-    for (ds, du), g in summary.groupby(["dataset", "duration_s"], sort=False):
-        by = {m: g[g["method"] == m] for m in ODOMETER_METHODS}
-        nhc = float(by[nhc_label("INS")]["max_h_m"].iloc[0]) if len(by[nhc_label("INS")]) else np.nan
-        part = [f"{ds}, {du:g} s outages (median max horizontal error): INS+NHC {nhc:.1f} m"]
-        for m in (HOLD, RIDGE, *NETWORK_ODOMETERS, *ENSEMBLE_ODOMETERS):
-            if len(by[m]):
-                row = by[m].iloc[0]
-                part.append(f"{m} {row['max_h_m']:.1f} m ({row['ratio_to_nhc']:.2f} of INS+NHC per start"
-                            + (f", Wilcoxon p = {row['p_vs_nhc']:.2g}" if "p_vs_nhc" in row else "")
-                            + (f"; speed RMSE {row['speed_rmse_mps']:.2f} m/s, 2-sigma coverage "
-                               f"{100 * row['coverage_2sigma']:.0f} %" if m != HOLD else "") + ")")
-        for m, what in ((ORACLE, "an oracle speed"), (ORACLE_WALK, "with a random walk")):
-            orc = by[m].sort_values("sigma_mps")
-            if len(orc):
-                best = orc.loc[orc["max_h_m"].idxmin()]
-                better = orc[orc["max_h_m"] < nhc]
-                part.append(f"{what} beats INS+NHC " + (f"up to a noise of {better['sigma_mps'].max():g} m/s"
-                                                         if len(better) else "at no noise level of the grid")
-                            + f" (its best: {best['max_h_m']:.1f} m at {best['sigma_mps']:g} m/s)")
-        lines.append("; ".join(part) + ".")
-    return lines

@@ -70,24 +70,3 @@ def ranks_errors(group_rows: pd.DataFrame) -> bool:
     g = group_rows.sort_values("group")
     rmse = g["speed_rmse_mps"].to_numpy(float)
     return bool(rmse.size >= 2 and rmse[0] == rmse.min() and rmse[-1] == rmse.max())
-
-
-def uncertainty_sentence(group_rows: pd.DataFrame) -> str:
-    """What one odometer's rows of :func:`uncertainty_table` say: whether its std ranks its errors
-    (:func:`ranks_errors`), the correlation, and the smallest- and largest-std groups' speed RMSE and coverage."""
-    g = group_rows.sort_values("group")
-    lo, hi = g.iloc[0], g.iloc[-1]
-    verdict = "ranks its errors" if ranks_errors(g) else "does not rank its errors"
-    part = {2: "half", 3: "third", 4: "quarter"}.get(len(g), f"1/{len(g)}")
-    return (f"its predicted std {verdict} in the outages (correlation of |error| and std "
-            f"{lo['corr_abs_error_std']:.2f}): the {part} of its epochs with the smallest std "
-            f"({lo['std_lo_mps']:.2f}-{lo['std_hi_mps']:.2f} m/s) has a speed RMSE of {lo['speed_rmse_mps']:.2f} m/s "
-            f"({100 * lo['coverage_2sigma']:.0f} % within 2 sigma), the one with the largest "
-            f"({hi['std_lo_mps']:.2f}-{hi['std_hi_mps']:.2f} m/s) {hi['speed_rmse_mps']:.2f} m/s "
-            f"({100 * hi['coverage_2sigma']:.0f} %)")
-
-
-def uncertainty_lines(table: pd.DataFrame) -> list[str]:
-    """One line per dataset and odometer (:func:`uncertainty_sentence`)."""
-    return [f"{method}, {ds}: {uncertainty_sentence(g)}"
-            for (ds, method), g in table.groupby(["dataset", "method"], sort=False)]

@@ -12,6 +12,7 @@ from bgfn.data import Drive
 from bgfn.studies.ins_fidelity import imu_roughness as R
 from bgfn.studies.ins_fidelity import imu_twin as T
 from bgfn.nav.earth import earth_rate_n
+from bgfn.report import ins_fidelity_words as words
 
 RATE = 100.0
 
@@ -92,7 +93,7 @@ def test_the_implied_setting_takes_the_unmodelled_terms_in_quadrature_and_the_li
                           "median_max_h_m": [50.0, 20.0, 22.0]})
     # the twin's unmodelled part: 0.03^2 - 0.01^2 = 0.0008; the setting: sqrt(0.08^2 - 0.0008)
     assert T.implied_setting(table) == pytest.approx(np.sqrt(0.0064 - 0.0008))
-    lines = T.twin_lines(table)
+    lines = words.twin_lines(table)
     assert "ratio 2.67" in lines[0] and "does not hold" in lines[1] and "smoother" in lines[1]
     table.loc[0, "effective_dps"] = 0.033
-    assert "holds" in T.twin_lines(table)[1] and "not" not in T.twin_lines(table)[1]
+    assert "holds" in words.twin_lines(table)[1] and "not" not in words.twin_lines(table)[1]

@@ -9,6 +9,7 @@ import pytest
 from bgfn import evaluate as ev, studies
 from bgfn.profile_schema import load_profile, with_overrides
 from bgfn.data import Drive
+from bgfn.report import ins_fidelity_words
 from synthetic_drive import demo_drive
 
 
@@ -55,16 +56,16 @@ def test_sentences_put_the_stand_in_beside_the_recorded_drive():
                             "duration_s": [30.0] * 4, "method": ["INS", "INS", "INS+NHC", "INS+NHC"],
                             "n_starts": [20, 18, 20, 18], "median_max_h_m": [10.0, 40.0, 4.0, 6.0],
                             "q25_max_h_m": [0.0] * 4, "q75_max_h_m": [0.0] * 4})
-    lines = studies.ins_fidelity.drift_sentences(summary, stand_in="sim", recorded="real")
+    lines = ins_fidelity_words.drift_sentences(summary, stand_in="sim", recorded="real")
     assert lines == ["30 s outages, median max horizontal error over up to 20 starts: INS 10.0 m on the stand-in "
                      "sim, 40.0 m on the recorded drive real (4.0 times); INS+NHC 4.0 m on the stand-in sim, 6.0 m "
                      "on the recorded drive real (1.5 times)",
                      "The stand-in's standalone INS drifts outside a factor 1.5 of the recorded drive's at 30 s (4.00) "
                      "(recorded over stand-in)."]
-    assert studies.ins_fidelity.drift_sentences(summary, stand_in="sim", recorded="absent") == []
+    assert ins_fidelity_words.drift_sentences(summary, stand_in="sim", recorded="absent") == []
     # INS 1.4 times (within 1.5): the verdict turns; INS+NHC plays no part in it
     summary.loc[1, "median_max_h_m"] = 14.0
-    assert studies.ins_fidelity.drift_sentences(summary, stand_in="sim", recorded="real")[-1] == (
+    assert ins_fidelity_words.drift_sentences(summary, stand_in="sim", recorded="real")[-1] == (
         "The stand-in's standalone INS drifts within a factor 1.5 of the recorded drive's at every duration.")
 
 

@@ -13,6 +13,7 @@ from bgfn.studies.ins_fidelity import nees as N
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.parallel import Runner
 from bgfn.profile_schema import load_profile
+from bgfn.report import ins_fidelity_words as words
 from synthetic_drive import demo_drive
 
 NAV = {"init": {"position_std_m": 1.0, "height_std_m": 2.0, "velocity_std_mps": 0.1, "level_std_deg": 0.2,
@@ -53,9 +54,9 @@ def test_the_summary_finds_the_consistent_and_the_overconfident_filter(tmp_path)
     paper = s[s["window"] != "sweep"].set_index("window")
     assert paper.loc["outage 1", "median_nees"] == 2.0 and paper.loc["outage 1", "duration_s"] == 30.0
     assert paper.loc["outage 2", "verdict"] == "overconfident"
-    lines = N.nees_lines(s)
+    lines = words.nees_lines(s)
     assert lines[0].startswith("d, NEES of the horizontal position") and "INS 30 s: median" in lines[0]
-    assert N.nees_section(tmp_path, results, _sweep()) == lines
+    assert N.nees_section(tmp_path, results, _sweep()).equals(s)
     assert (tmp_path / "tables" / "outage_nees.csv").is_file() and (tmp_path / "figures" / "outage_nees_d.png").is_file()
 
 
@@ -70,7 +71,7 @@ def test_the_scan_finds_a_larger_gyro_bias_instability_less_confident(monkeypatc
     assert list(scan.columns) == list(N.SCAN_COLUMNS) and scan["profile"].sum() == 1
     grid = scan[~scan["profile"]].set_index("gyro_bias_instability_dps")
     assert grid.loc[1.0, "median_nees"] < grid.loc[0.01, "median_nees"]
-    assert N.scan_lines(scan)[0].startswith("synthetic: with the profile's gyro bias instability")
+    assert words.scan_lines(scan)[0].startswith("synthetic: with the profile's gyro bias instability")
     assert N.consistency_scan(cfg, [dataclasses.replace(drive, name="turin-sim-mpu6000")]).empty
     # the points are independent runs: spread over 2 processes, the same table, row for row
     monkeypatch.delenv("BGFN_PROGRESS_LOG", raising=False)      # the progress lines come to `report`

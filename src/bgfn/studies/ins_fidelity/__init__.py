@@ -7,15 +7,14 @@ against its errors (:mod:`~bgfn.studies.ins_fidelity.nees`), the filter set up a
 """
 
 from bgfn.studies.ins_fidelity.imu_twin import (TWIN_COLUMNS, effective_instability, implied_setting, settle_setting,
-                                                twin_check, twin_lines, twin_section)
-from bgfn.studies.ins_fidelity.ins_drift import (DRIFT_COLUMNS, DRIFT_RUN_COLUMNS, drift_sentences, drift_starts,
+                                                twin_check, twin_section)
+from bgfn.studies.ins_fidelity.ins_drift import (DRIFT_COLUMNS, DRIFT_RUN_COLUMNS, drift_starts,
                                                  drift_summary, ins_drift_runs, plot_ins_drift)
-from bgfn.studies.ins_fidelity.nees import (NEES_COLUMNS, consistency_scan, nees_lines, nees_section, nees_summary,
-                                            scan_lines)
+from bgfn.studies.ins_fidelity.nees import (NEES_COLUMNS, consistency_scan, nees_section, nees_summary)
 
 __all__ = [
-    "TWIN_COLUMNS", "effective_instability", "implied_setting", "settle_setting", "twin_check", "twin_lines",
-    "twin_section", "DRIFT_COLUMNS", "DRIFT_RUN_COLUMNS", "drift_sentences", "drift_starts", "drift_summary",
-    "ins_drift_runs", "plot_ins_drift", "NEES_COLUMNS", "consistency_scan", "nees_lines", "nees_section",
-    "nees_summary", "scan_lines",
+    "TWIN_COLUMNS", "effective_instability", "implied_setting", "settle_setting", "twin_check",
+    "twin_section", "DRIFT_COLUMNS", "DRIFT_RUN_COLUMNS", "drift_starts", "drift_summary",
+    "ins_drift_runs", "plot_ins_drift", "NEES_COLUMNS", "consistency_scan", "nees_section",
+    "nees_summary",
 ]

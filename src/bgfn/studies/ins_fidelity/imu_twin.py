@@ -20,8 +20,8 @@ The twin needs more than its simulated instability ``m`` (the terms the filter d
 the two in quadrature, ``e_twin^2 = m^2 + x^2``, the simulated instability that gives the twin the recorded
 drive's ``e_rec`` is ``sqrt(e_rec^2 - x^2)`` (:func:`implied_setting`). From the MPU-6000 profile's 0.01 deg/s,
 :func:`settle_setting` repeats that step until it moves the setting by less than 10 %; the profile carries the
-result, and notebook 08 checks it on every run (:func:`twin_lines`: the twin's effective instability against the
-recorded drive's, with the profile's setting).
+result, and notebook 08 checks it on every run (:func:`bgfn.report.ins_fidelity_words.twin_lines`: the twin's
+effective instability against the recorded drive's, with the profile's setting).
 """
 
 from __future__ import annotations
@@ -184,37 +184,15 @@ def settle_setting(cfg: dict, recorded, stand_in, start_dps: float, seeds=TWIN_S
     return value, pd.DataFrame(steps, columns=["step", "model_dps", "recorded_dps", "twin_dps", "implied_dps"])
 
 
-def twin_lines(table: pd.DataFrame, tolerance: float = 1.25) -> list[str]:
-    """What the check says: the two effective instabilities, the drift on one road, and whether the stand-in's
-    setting holds (the twin within a factor ``tolerance`` of the recorded drive)."""
-    rec_e, twin_e, model = effective_levels(table)
-    rec = table[table["imu"] == "recorded"]
-    twin = table[table["imu"] != "recorded"]
-    drift = ", ".join(f"{du:g} s: {float(rec.loc[rec['duration_s'] == du, 'median_max_h_m'].iloc[0]):.1f} m recorded "
-                      f"against {float(twin.loc[twin['duration_s'] == du, 'median_max_h_m'].median()):.1f} m simulated"
-                      for du in sorted(rec["duration_s"].unique()))
-    if not (np.isfinite(rec_e) and np.isfinite(twin_e)):
-        return [f"The effective gyro bias instability lies outside the scan's grid for one IMU: no comparison ({drift})."]
-    ratio = rec_e / twin_e
-    holds = 1.0 / tolerance <= ratio <= tolerance
-    return [f"Effective gyro bias instability on the recorded drive's road: {rec_e:.3g} deg/s for its real IMU, "
-            f"{twin_e:.3g} deg/s for the stand-in's error model simulated with {model:.3g} deg/s (ratio {ratio:.2f}; "
-            f"median INS drift, each with its filter's own model: {drift}).",
-            ("The stand-in's setting holds: its simulated IMU is as rough as the recorded one within a factor "
-             f"{tolerance:g}." if holds else "The stand-in's setting does not hold: its simulated IMU is "
-             + ("smoother" if ratio > 1 else "rougher") + f" than the recorded one; the measurement implies "
-             f"{implied_setting(table):.3g} deg/s (evaluate.imu_twin.settle_setting).")]
-
-
 def twin_section(cfg: dict, drives, scan: pd.DataFrame, out: Path,
-                 report: Callable[[str], None] | None = None, runner: Runner | None = None) -> list[str]:
-    """Notebook 02's check: :func:`twin_check` of the first recorded drive (test ``real``) against the stand-in
-    (test ``field``) among ``drives``, written to ``tables/kf_imu_twin.csv``; its :func:`twin_lines` (empty without
-    such a pair)."""
+                 report: Callable[[str], None] | None = None, runner: Runner | None = None) -> pd.DataFrame | None:
+    """Notebook 08's check: :func:`twin_check` of the first recorded drive (test ``real``) against the stand-in
+    (test ``field``) among ``drives``, written to ``tables/kf_imu_twin.csv`` and returned (None without such a pair;
+    in words: :func:`bgfn.report.ins_fidelity_words.twin_lines`)."""
     recorded = next((d for d in drives if test_of(d.name) == "real"), None)
     stand_in = next((d for d in drives if test_of(d.name) == "field"), None)
     if recorded is None or stand_in is None:
-        return []
+        return None
     table = twin_check(cfg, recorded, stand_in, scan=scan, report=report, runner=runner)
     atomic_write_csv(Path(out) / "tables" / SHARED_TABLES["kf_imu_twin"], table, float_format="%.6g")
-    return twin_lines(table)
+    return table

@@ -104,35 +104,6 @@ def drift_summary(runs: pd.DataFrame) -> pd.DataFrame:
     return out[list(DRIFT_COLUMNS)]
 
 
-def drift_sentences(summary: pd.DataFrame, stand_in: str = "turin-sim-mpu6000",
-                    recorded: str = "rtklib-drive0708", tolerance: float = DRIFT_TOLERANCE) -> list[str]:
-    """One sentence per duration: the stand-in's median drift against the recorded drive's, INS and INS+NHC; then
-    whether the standalone INS of the stand-in lies within a factor ``tolerance`` of the recorded one everywhere.
-
-    Empty when either drive is missing from ``summary``.
-    """
-    have = set(summary["dataset"])
-    if stand_in not in have or recorded not in have:
-        return []
-    lines, outside = [], []
-    for du, g in summary.groupby("duration_s", sort=True):
-        parts = []
-        for method, gm in g.groupby("method", sort=False):
-            level = gm.set_index("dataset")["median_max_h_m"]
-            if stand_in in level and recorded in level:
-                a, b = float(level[stand_in]), float(level[recorded])
-                parts.append(f"{method} {a:.1f} m on the stand-in {stand_in}, {b:.1f} m on the recorded drive "
-                             f"{recorded} ({b / a:.1f} times)" if a > 0 else f"{method}: stand-in 0 m")
-                if method == "INS" and not (a > 0 and 1.0 / tolerance <= b / a <= tolerance):
-                    outside.append(f"{du:g} s ({b / a:.2f})" if a > 0 else f"{du:g} s")
-        n = int(g["n_starts"].max())
-        lines.append(f"{du:g} s outages, median max horizontal error over up to {n} starts: " + "; ".join(parts))
-    lines.append(f"The stand-in's standalone INS drifts within a factor {tolerance:g} of the recorded drive's at every "
-                 "duration." if not outside else f"The stand-in's standalone INS drifts outside a factor {tolerance:g} "
-                 f"of the recorded drive's at " + ", ".join(outside) + " (recorded over stand-in).")
-    return lines
-
-
 def plot_ins_drift(runs: pd.DataFrame, title: str = ""):
     """Max horizontal error of every start against the outage duration, one panel per method, a box per drive."""
     methods = list(dict.fromkeys(runs["method"]))

@@ -97,25 +97,6 @@ def nees_summary(sweep: pd.DataFrame | None, results: dict | None = None) -> pd.
     return pd.concat(parts, ignore_index=True)[list(NEES_COLUMNS)]
 
 
-def nees_lines(summary: pd.DataFrame, methods=("INS", "INS+NHC")) -> list[str]:
-    """Per dataset, whether the filter is consistent during outages: the INS rows (and INS+NHC) in the sweep at
-    each duration, else in the paper's outages."""
-    lines = []
-    for ds, g in summary.groupby("dataset", sort=False):
-        part = []
-        for m in methods:
-            h = g[(g["method"] == m) & (g["window"] == "sweep")]
-            h = h if len(h) else g[g["method"] == m]
-            if len(h):
-                part.append(f"{m} " + ", ".join(f"{r.window if r.window != 'sweep' else f'{r.duration_s:g} s'}: "
-                                                 f"median {r.median_nees:.3g}, {100 * r.inside_95:.0f} % inside, "
-                                                 f"{r.verdict}" for r in h.itertuples()))
-        if part:
-            lines.append(f"{ds}, NEES of the horizontal position at the outage end against the filter's covariance "
-                         f"(consistent: median {CHI2_MEDIAN:.2f}, 95 % below {CHI2_95:.2f}): " + "; ".join(part) + ".")
-    return lines
-
-
 def plot_nees(summary: pd.DataFrame, dataset: str):
     """Median NEES against the outage duration (the sweep), one line per method, with chi-square(2)'s median and
     95 % bound."""
@@ -130,16 +111,17 @@ def plot_nees(summary: pd.DataFrame, dataset: str):
                                 f"{dataset}: the filter's covariance against its errors at the outage end")
 
 
-def nees_section(out: str | Path, results: dict, sweep: pd.DataFrame | None) -> list[str]:
-    """Notebook 04: :func:`nees_summary` written to ``tables/outage_nees.csv``, one figure per sweep dataset
-    (``figures/outage_nees_<id>.png``), and :func:`nees_lines`."""
+def nees_section(out: str | Path, results: dict, sweep: pd.DataFrame | None) -> pd.DataFrame:
+    """Notebook 06: :func:`nees_summary` written to ``tables/outage_nees.csv``, one figure per sweep dataset
+    (``figures/outage_nees_<id>.png``); returns the summary (in words:
+    :func:`bgfn.report.ins_fidelity_words.nees_lines`)."""
     summary = nees_summary(sweep, results)
     atomic_write_csv(Path(out) / "tables" / SHARED_TABLES["nees"], summary, float_format="%.4f")
     for name in summary.loc[summary["window"] == "sweep", "dataset"].unique():
         fig = plot_nees(summary, name)
         save_figure(fig, Path(out) / "figures" / f"outage_nees_{dataset_id(name)}.png")
         plt.close(fig)
-    return nees_lines(summary)
+    return summary
 
 
 #: Gyro bias instabilities the scan tries, deg/s (half the MPU-6000 profile's 0.01 deg/s up to 0.3 deg/s; dense where the
@@ -191,17 +173,3 @@ def consistency_scan(cfg: dict, drives, durations=(30.0, 60.0), values_dps=SCAN_
     done = (runner or Runner()).map(scan_point, tasks, labels=labels, summary=line, desc="NEES scan",
                                     echo=report if report is not None else (lambda _line: None), bar=False)
     return pd.DataFrame([row for rows in done for row in rows], columns=list(SCAN_COLUMNS))
-
-
-def scan_lines(scan: pd.DataFrame) -> list[str]:
-    """Per recorded drive: the profile's setting and its word, and the values of the grid that are consistent."""
-    lines = []
-    for ds, g in scan.groupby("dataset", sort=False):
-        longest = g[g["duration_s"] == g["duration_s"].max()]
-        own = longest[longest["profile"]]
-        ok = longest.loc[longest["verdict"] == "consistent", "gyro_bias_instability_dps"]
-        lines.append(f"{ds}: with the profile's gyro bias instability ({own['gyro_bias_instability_dps'].iloc[0]:g} "
-                     f"deg/s) the INS is {own['verdict'].iloc[0]} at {longest['duration_s'].iloc[0]:g} s (median NEES "
-                     f"{own['median_nees'].iloc[0]:.3g}); consistent with "
-                     + (", ".join(f"{v:g}" for v in ok) + " deg/s" if len(ok) else "no value of the grid") + ".")
-    return lines

@@ -1,0 +1,98 @@
+"""How good and how honest our INS is, in words (notebooks 06 and 08): its drift on the stand-in against the recorded
+drive, the filter's NEES during outages, the gyro bias scan and the IMU twin's check."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from bgfn.studies.ins_fidelity.imu_twin import effective_levels, implied_setting
+from bgfn.studies.ins_fidelity.ins_drift import DRIFT_TOLERANCE
+from bgfn.studies.ins_fidelity.nees import CHI2_95, CHI2_MEDIAN
+
+
+def drift_sentences(summary: pd.DataFrame, stand_in: str = "turin-sim-mpu6000",
+                    recorded: str = "rtklib-drive0708", tolerance: float = DRIFT_TOLERANCE) -> list[str]:
+    """One sentence per duration: the stand-in's median drift against the recorded drive's, INS and INS+NHC; then
+    whether the standalone INS of the stand-in lies within a factor ``tolerance`` of the recorded one everywhere.
+
+    Empty when either drive is missing from ``summary``.
+    """
+    have = set(summary["dataset"])
+    if stand_in not in have or recorded not in have:
+        return []
+    lines, outside = [], []
+    for du, g in summary.groupby("duration_s", sort=True):
+        parts = []
+        for method, gm in g.groupby("method", sort=False):
+            level = gm.set_index("dataset")["median_max_h_m"]
+            if stand_in in level and recorded in level:
+                a, b = float(level[stand_in]), float(level[recorded])
+                parts.append(f"{method} {a:.1f} m on the stand-in {stand_in}, {b:.1f} m on the recorded drive "
+                             f"{recorded} ({b / a:.1f} times)" if a > 0 else f"{method}: stand-in 0 m")
+                if method == "INS" and not (a > 0 and 1.0 / tolerance <= b / a <= tolerance):
+                    outside.append(f"{du:g} s ({b / a:.2f})" if a > 0 else f"{du:g} s")
+        n = int(g["n_starts"].max())
+        lines.append(f"{du:g} s outages, median max horizontal error over up to {n} starts: " + "; ".join(parts))
+    lines.append(f"The stand-in's standalone INS drifts within a factor {tolerance:g} of the recorded drive's at every "
+                 "duration." if not outside else f"The stand-in's standalone INS drifts outside a factor {tolerance:g} "
+                 f"of the recorded drive's at " + ", ".join(outside) + " (recorded over stand-in).")
+    return lines
+
+
+def nees_lines(summary: pd.DataFrame, methods=("INS", "INS+NHC")) -> list[str]:
+    """Per dataset, whether the filter is consistent during outages: the INS rows (and INS+NHC) in the sweep at
+    each duration, else in the paper's outages."""
+    lines = []
+    for ds, g in summary.groupby("dataset", sort=False):
+        part = []
+        for m in methods:
+            h = g[(g["method"] == m) & (g["window"] == "sweep")]
+            h = h if len(h) else g[g["method"] == m]
+            if len(h):
+                part.append(f"{m} " + ", ".join(f"{r.window if r.window != 'sweep' else f'{r.duration_s:g} s'}: "
+                                                 f"median {r.median_nees:.3g}, {100 * r.inside_95:.0f} % inside, "
+                                                 f"{r.verdict}" for r in h.itertuples()))
+        if part:
+            lines.append(f"{ds}, NEES of the horizontal position at the outage end against the filter's covariance "
+                         f"(consistent: median {CHI2_MEDIAN:.2f}, 95 % below {CHI2_95:.2f}): " + "; ".join(part) + ".")
+    return lines
+
+
+def scan_lines(scan: pd.DataFrame) -> list[str]:
+    """Per recorded drive: the profile's setting and its word, and the values of the grid that are consistent."""
+    lines = []
+    for ds, g in scan.groupby("dataset", sort=False):
+        longest = g[g["duration_s"] == g["duration_s"].max()]
+        own = longest[longest["profile"]]
+        ok = longest.loc[longest["verdict"] == "consistent", "gyro_bias_instability_dps"]
+        lines.append(f"{ds}: with the profile's gyro bias instability ({own['gyro_bias_instability_dps'].iloc[0]:g} "
+                     f"deg/s) the INS is {own['verdict'].iloc[0]} at {longest['duration_s'].iloc[0]:g} s (median NEES "
+                     f"{own['median_nees'].iloc[0]:.3g}); consistent with "
+                     + (", ".join(f"{v:g}" for v in ok) + " deg/s" if len(ok) else "no value of the grid") + ".")
+    return lines
+
+
+def twin_lines(table: pd.DataFrame | None, tolerance: float = 1.25) -> list[str]:
+    """What the check says: the two effective instabilities, the drift on one road, and whether the stand-in's
+    setting holds (the twin within a factor ``tolerance`` of the recorded drive); empty without a table (no pair of
+    drives to compare, :func:`~bgfn.studies.ins_fidelity.imu_twin.twin_section`)."""
+    if table is None:
+        return []
+    rec_e, twin_e, model = effective_levels(table)
+    rec = table[table["imu"] == "recorded"]
+    twin = table[table["imu"] != "recorded"]
+    drift = ", ".join(f"{du:g} s: {float(rec.loc[rec['duration_s'] == du, 'median_max_h_m'].iloc[0]):.1f} m recorded "
+                      f"against {float(twin.loc[twin['duration_s'] == du, 'median_max_h_m'].median()):.1f} m simulated"
+                      for du in sorted(rec["duration_s"].unique()))
+    if not (np.isfinite(rec_e) and np.isfinite(twin_e)):
+        return [f"The effective gyro bias instability lies outside the scan's grid for one IMU: no comparison ({drift})."]
+    ratio = rec_e / twin_e
+    holds = 1.0 / tolerance <= ratio <= tolerance
+    return [f"Effective gyro bias instability on the recorded drive's road: {rec_e:.3g} deg/s for its real IMU, "
+            f"{twin_e:.3g} deg/s for the stand-in's error model simulated with {model:.3g} deg/s (ratio {ratio:.2f}; "
+            f"median INS drift, each with its filter's own model: {drift}).",
+            ("The stand-in's setting holds: its simulated IMU is as rough as the recorded one within a factor "
+             f"{tolerance:g}." if holds else "The stand-in's setting does not hold: its simulated IMU is "
+             + ("smoother" if ratio > 1 else "rougher") + f" than the recorded one; the measurement implies "
+             f"{implied_setting(table):.3g} deg/s (evaluate.imu_twin.settle_setting).")]

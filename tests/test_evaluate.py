@@ -25,7 +25,7 @@ from bgfn.nav.filter import run_filter, run_outage
 from bgfn.nav.outages import OutageWindow, TablePseudoGps
 from synthetic_drive import demo_drive
 from bgfn.profile_schema import with_overrides
-from bgfn.report import evaluation_words
+from bgfn.report import evaluation_words, sweep_words
 
 WINDOWS = [(60.0, 20.0), (110.0, 20.0)]
 NAV = {"init": {"position_std_m": 1.0, "height_std_m": 2.0, "velocity_std_mps": 0.1, "level_std_deg": 0.2,
@@ -394,10 +394,10 @@ def test_sweep_summary_and_comparisons():
     assert set(c.loc[c["method"] == "BGFN", "baseline"]) == {"INS", "MLP", "INS+NHC", "BGFN+NHC"}
     pair = c[(c["method"] == "BGFN+NHC")].set_index("baseline")
     assert list(pair.index) == ["INS+NHC"] and pair.loc["INS+NHC", "wins"] == 36
-    (line,) = studies.outage_sweep.describe_sweep(s, c)
+    (line,) = sweep_words.describe_sweep(s, c)
     assert "BGFN vs INS: wins 36/36" in line and "BGFN+NHC vs INS+NHC: wins 36/36" in line
     # a pairs table of older runs (no method column) still reads
-    (old,) = studies.outage_sweep.describe_sweep(studies.outage_sweep.sweep_summary(df, n_boot=100), studies.outage_sweep.sweep_comparisons(df).drop(columns="method"))
+    (old,) = sweep_words.describe_sweep(studies.outage_sweep.sweep_summary(df, n_boot=100), studies.outage_sweep.sweep_comparisons(df).drop(columns="method"))
     assert "BGFN vs INS: wins 36/36" in old
 
 
@@ -650,11 +650,11 @@ def test_sweep_tables_and_lines():
     assert wide.loc[("d", "BGFN"), "30 s"] == "2.0 [1.5, 2.5]" and wide.loc[("d", "INS"), "10 s"] == "3.0 [2.0, 4.0]"
     sweep = pd.DataFrame({"start_s": [1.0, 1.0, 2.0, 2.0], "duration_s": 10.0, "method": ["INS", "BGFN"] * 2,
                           "seed": 0})
-    assert studies.outage_sweep.describe_sweep_size(sweep) == "4 rows, 2 starts x 1 durations x 2 methods x 1 seeds"
+    assert sweep_words.describe_sweep_size(sweep) == "4 rows, 2 starts x 1 durations x 2 methods x 1 seeds"
     # the fold networks are described with the sweep's train overrides over the train: section
     cfg = load_profile("smoke")
     ecfg = ev.evaluate_config({"methods": ["mlp"], "sweep": {"train": {"optimizer": {"epochs": 7}}}}, cfg["train"])
-    lines = studies.outage_sweep.describe_sweep_setup(cfg["train"], ecfg, ["d"])
+    lines = sweep_words.describe_sweep_setup(cfg["train"], ecfg, ["d"])
     assert lines[0].startswith("datasets ['d']: ") and lines[0].endswith("x methods ['MLP'] + INS + GPS")
     assert f"'epochs': 7, 'batch_size': {cfg['train']['optimizer']['batch_size']}" in lines[1]
     assert lines[2] == f"  {'MLP':>12}: {cfg['train']['sizes']['mlp'][cfg['train']['size']]}"

@@ -17,6 +17,7 @@ from bgfn.errors import DataError
 from bgfn.studies.outage_sweep import oracle as orc
 from bgfn.nav import sim
 from bgfn.profile_schema import ProfileError, validate
+from bgfn.report import sweep_words
 from synthetic_drive import LEVER, demo_drive
 
 NAV = {"init": {"position_std_m": 1.0, "height_std_m": 2.0, "velocity_std_mps": 0.1, "level_std_deg": 0.2,
@@ -170,7 +171,7 @@ def test_breakeven_table_against_ins_and_an_extra_baseline():
     assert np.isnan(ins.loc["MLP", "equivalent_sigma_m"]) and ins.loc["MLP", "equivalent_crossing"] == orc.BEYOND_GRID
     nhc = be[be["baseline"] == "INS+NHC"]
     assert nhc["breakeven_sigma_m"].iloc[0] == pytest.approx(0.05)
-    lines = orc.describe_oracle(be)
+    lines = sweep_words.describe_oracle(be)
     assert len(lines) == 2 and lines[0].startswith("d (field test), sweep, 30 s outages: ")
     assert "below 0.15 m per axis and 1 s increment (break-even)" in lines[0]
     assert "BGFN 0.35 m (2.3 times the break-even" in lines[0]
@@ -180,7 +181,7 @@ def test_breakeven_table_against_ins_and_an_extra_baseline():
     never = orc.breakeven_table(table, levels.assign(median_m=[3.0, 0.5, 7.0, 50.0, 0.5]))
     row = never[never["baseline"] == "INS+NHC"].iloc[0]
     assert row["crossing"] == orc.NEVER_BELOW and np.isnan(row["breakeven_sigma_m"])
-    assert "even the exact increments do not beat INS+NHC" in orc.describe_oracle(never)[1]
+    assert "even the exact increments do not beat INS+NHC" in sweep_words.describe_oracle(never)[1]
 
 
 def test_oracle_interval_table_layout():
@@ -240,14 +241,14 @@ def test_run_oracle_writes_its_tables_and_figure(drive, ctx, tmp_path):
     bgfn = o.breakeven[(o.breakeven["outage"] == "1") & (o.breakeven["method"] == "BGFN")].iloc[0]
     assert bgfn["increment_rmse_m"] > 0.1 and bgfn["baseline"] == "INS"
     assert set(o.breakeven.loc[o.breakeven["outage"] == orc.SWEEP_OUTAGE, "baseline"]) == {"INS", "INS+NHC"}
-    assert any("INS+NHC" in s for s in o.describe())
+    assert any("INS+NHC" in s for s in sweep_words.oracle_lines(o))
     labels = [t.get_text() for t in o.figures["synthetic"].axes[0].get_legend().get_texts()]
     assert "INS+NHC" in labels and "INS" in labels
     plt.close("all")
     # an empty grid: no oracle, nothing run
     ecfg0 = {**ecfg, "oracle": _oracle([])}
     empty = studies.outage_sweep.run_oracle(cfg, "t", ev.EvaluationSetup("t", "", ecfg0, ["synthetic"], [], [], [], windows))
-    assert empty.table.empty and empty.describe() == []
+    assert empty.table.empty and sweep_words.oracle_lines(empty) == []
 
 
 def test_profiles_define_the_oracle_and_its_durations_fit_the_sweep():

@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from bgfn.config import RESULTS_ROOT, SHARED_TABLES, profile_chain
-from bgfn.studies.outage_sweep.sweep import describe_sweep
+from bgfn.report.sweep_words import describe_sweep
 from bgfn.paper import TESTS, label
 from bgfn.report.provenance import short_source
 from bgfn.report.reading import missing_note, read_csv

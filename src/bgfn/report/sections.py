@@ -13,7 +13,7 @@ from bgfn import paper
 from bgfn.config import RUN_RECORDS, SHARED_TABLES
 from bgfn.data.names import dataset_id
 from bgfn.data.registry import recorded_first
-from bgfn.studies.outage_sweep.sweep import describe_sweep
+from bgfn.report.sweep_words import describe_sweep
 from bgfn.report.odometer_words import odometer_lines
 from bgfn.studies.odometer.section import odometer_table
 from bgfn.report.glance import run_header
@@ -156,7 +156,7 @@ def odometer_section(res: ProfileResults) -> list:
 
 def sweep_section(res: ProfileResults) -> list:
     """The outage sweep (notebook 06) as ``median [interval]`` per duration, its source, the paired
-    comparisons (:func:`bgfn.studies.outage_sweep.sweep.describe_sweep`) when their table is there."""
+    comparisons (:func:`bgfn.report.sweep_words.describe_sweep`) when their table is there."""
     file = res.table(SHARED_TABLES["sweep_summary"])
     st = sweep_table(res.sweep)
     if st is None:

@@ -10,20 +10,19 @@ beats INS+NHC; :mod:`~bgfn.studies.outage_sweep.variant_outages` trains and eval
 
 from bgfn.studies.outage_sweep.increments import AntennaTruth, increment_errors, increment_rmse
 from bgfn.studies.outage_sweep.oracle import (BREAKEVEN_COLUMNS, ORACLE_COLUMNS, OracleIncrements, OracleResult,
-                                              breakeven_table, crossing_sigma, curve_at, describe_oracle, method_levels,
+                                              breakeven_table, crossing_sigma, curve_at, method_levels,
                                               oracle_interval_table, oracle_runs, oracle_table, oracle_windows,
                                               plot_oracle, run_oracle)
-from bgfn.studies.outage_sweep.sweep import (describe_sweep, describe_sweep_setup, describe_sweep_size, pairs_style,
-                                             profile_sweep_plan, run_sweep, run_sweeps, sweep_comparisons,
+from bgfn.studies.outage_sweep.sweep import (pairs_style, profile_sweep_plan, run_sweep, run_sweeps, sweep_comparisons,
                                              sweep_interval_table, sweep_plan, sweep_summary, sweep_train_config)
 from bgfn.studies.outage_sweep.variant_outages import (NO_VARIANT, VARIANT_COLUMNS, VARIANT_METRICS,
                                                        load_variant_network, variant_pivot, variant_runs, variant_table)
 
 __all__ = [
     "AntennaTruth", "increment_errors", "increment_rmse", "BREAKEVEN_COLUMNS", "ORACLE_COLUMNS", "OracleIncrements",
-    "OracleResult", "breakeven_table", "crossing_sigma", "curve_at", "describe_oracle", "method_levels",
+    "OracleResult", "breakeven_table", "crossing_sigma", "curve_at", "method_levels",
     "oracle_interval_table", "oracle_runs", "oracle_table", "oracle_windows", "plot_oracle", "run_oracle",
-    "describe_sweep", "describe_sweep_setup", "describe_sweep_size", "pairs_style", "profile_sweep_plan",
+    "pairs_style", "profile_sweep_plan",
     "run_sweep", "run_sweeps", "sweep_comparisons", "sweep_interval_table", "sweep_plan", "sweep_summary",
     "sweep_train_config", "NO_VARIANT", "VARIANT_COLUMNS", "VARIANT_METRICS", "load_variant_network",
     "variant_pivot", "variant_runs", "variant_table",

@@ -373,52 +373,6 @@ def oracle_interval_table(table: pd.DataFrame) -> pd.DataFrame:
     return wide[[c for c in cols if c in wide.columns]]
 
 
-def _m(x: float) -> str:
-    """A length in the sentences: two significant digits below 1 m, one decimal above."""
-    return f"{x:.2g}" if abs(x) < 1 else f"{x:.1f}"
-
-
-def _windows_text(outage: str, duration: float) -> str:
-    return f"sweep, {duration:g} s outages" if outage == SWEEP_OUTAGE else f"outage {outage} ({duration:g} s)"
-
-
-def describe_oracle(breakeven: pd.DataFrame) -> list[str]:
-    """One plain sentence per dataset, windows, duration and baseline: the break-even sigma and how far each
-    network is from it, computed from :func:`breakeven_table`."""
-    lines = []
-    keys = ["dataset", "test", "outage", "duration_s", "baseline"]
-    for (ds, test, o, du, base), g in breakeven.groupby(keys, sort=False):
-        r0 = g.iloc[0]
-        head = f"{ds} ({test} test), {_windows_text(o, du)}: "
-        if r0["crossing"] == NEVER_BELOW:
-            lines.append(head + f"even the exact increments do not beat {base} ({r0['baseline_m']:.1f} m): no "
-                         "increment accuracy makes the pseudo-GPS worth fusing.")
-            continue
-        if r0["crossing"] == BEYOND_GRID:
-            s = head + (f"the oracle beats {base} ({r0['baseline_m']:.1f} m) at every sigma of the grid: the "
-                        "break-even lies beyond it")
-        else:
-            s = head + (f"the pseudo-GPS beats {base} ({r0['baseline_m']:.1f} m) while the increment error stays "
-                        f"below {_m(r0['breakeven_sigma_m'])} m per axis and {r0['increment_s']:.2g} s increment "
-                        "(break-even)")
-        nets = []
-        for r in g.dropna(subset=["method"]).itertuples(index=False):
-            if not np.isfinite(r.increment_rmse_m):
-                continue
-            far = [f"{r.rmse_to_breakeven:.1f} times the break-even"] if np.isfinite(r.rmse_to_breakeven) else []
-            if r.equivalent_crossing == CROSSED:
-                far.append(f"its aided error ({r.method_m:.1f} m) is the oracle's at sigma "
-                           f"{_m(r.equivalent_sigma_m)} m")
-            elif r.equivalent_crossing == BEYOND_GRID:
-                far.append(f"its aided error ({r.method_m:.1f} m) exceeds the oracle's at every sigma of the grid")
-            else:
-                far.append(f"its aided error ({r.method_m:.1f} m) is below the exact oracle's")
-            nets.append(f"{r.method} {_m(r.increment_rmse_m)} m ({'; '.join(far)})")
-        lines.append(s + ("; the networks' increment errors (RMS per axis): " + ", ".join(nets) if nets else "")
-                     + ".")
-    return lines
-
-
 # ----------------------------------------------------------------------------------------------- notebook 06
 @dataclass
 class OracleResult:
@@ -448,10 +402,6 @@ class OracleResult:
     figures: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
-
-    def describe(self) -> list[str]:
-        """The notes, then :func:`describe_oracle`."""
-        return list(self.notes) + describe_oracle(self.breakeven)
 
 
 def plot_oracle(table: pd.DataFrame, levels: pd.DataFrame, breakeven: pd.DataFrame, dataset: str):

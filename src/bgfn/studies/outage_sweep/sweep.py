@@ -21,7 +21,7 @@ from bgfn.studies.outage_sweep.increments import AntennaTruth, increment_rmse
 from bgfn.evaluate.networks import load_model
 from bgfn.learning import build_learning_data, learning_options
 from bgfn.nav.baseline import filter_start
-from bgfn.paper import METHOD_LABELS, NHC_SUFFIX, label, nhc_label
+from bgfn.paper import METHOD_LABELS, NHC_SUFFIX, nhc_label
 from bgfn.parallel import Runner
 from bgfn.stats import bootstrap_ci, paired_comparison, wilcoxon_p
 from bgfn.train.checkpoints import checkpoint_name, checkpoint_path
@@ -271,46 +271,6 @@ def sweep_comparisons(sweep: pd.DataFrame, method: str = "BGFN", metric: str = "
     return pd.DataFrame(rows)
 
 
-def describe_sweep(summary: pd.DataFrame, pairs: pd.DataFrame, method: str = "BGFN") -> list[str]:
-    """Plain-language lines on the sweep: medians with intervals and the paired comparisons."""
-    lines = []
-    for (ds, du), g in summary.groupby(["dataset", "duration_s"]):
-        g = g.set_index("method")
-        med = ", ".join(f"{m} {g.loc[m, 'median_m']:.1f} [{g.loc[m, 'ci_lo_m']:.1f}, {g.loc[m, 'ci_hi_m']:.1f}]"
-                        for m in TABLE_METHODS if m in g.index)
-        here = pairs[(pairs["dataset"] == ds) & (pairs["duration_s"] == du)]
-        text = []
-        for m in (method, nhc_label(method)):
-            # a pairs table written before the +NHC rows has no method column: all its rows are `method`'s
-            pp = (here[here["method"] == m] if "method" in here.columns else here if m == method
-                  else here.iloc[:0]).set_index("baseline")
-            if len(pp):
-                text.append(f"{m} " + "; ".join(
-                    f"vs {b}: wins {int(pp.loc[b, 'wins'])}/{int(pp.loc[b, 'n'])} "
-                    f"(p = {pp.loc[b, 'p_value']:.2g}, by start {pp.loc[b, 'p_value_by_start']:.2g})" for b in pp.index))
-        lines.append(f"{ds}, {du:g} s outages: median max horizontal error (m) [95 % interval]: {med}. "
-                     + ". ".join(text) + ("." if text else ""))
-    return lines
-
-
-def describe_sweep_setup(train_section: dict, ecfg: dict, datasets) -> list[str]:
-    """Lines saying what the sweep runs: its sizes, and the fold networks' window, size block, optimizer budget
-    and per-method sizes (the ``train:`` section with the ``sweep.train`` overrides, :func:`sweep_train_config`).
-    """
-    sw = ecfg["sweep"]
-    tc = sweep_train_config(train_section, sw)
-    budget = {k: tc["optimizer"][k] for k in ("epochs", "batch_size", "max_train_windows", "patience")
-              if k in tc["optimizer"]}
-    lines = [f"datasets {list(datasets)}: {sw['n_starts']} starts x durations {sw['durations_s']} s x "
-             f"{sw['folds']} folds x seeds {sw['seeds']} x methods {[label(m) for m in ecfg['methods']]} + INS + GPS",
-             f"fold networks: window {tc.get('window')} samples, size block {tc.get('size')!r}, optimizer {budget}"]
-    lines += [f"  {label(m):>12}: {tc['sizes'][m][tc['size']]}" for m in ecfg["methods"]]
-    if ecfg["nhc_rows"]:
-        lines.append("INS and every network also with the vehicle constraints (NHC, ZUPT when still): rows "
-                     + ", ".join(nhc_label(m) for m in ["INS"] + list(ecfg["methods"])))
-    return lines
-
-
 def run_sweeps(cfg: dict, profile: str, datasets, ecfg: dict, runner: Runner | None = None,
                report: Callable[[str], None] | None = None) -> tuple[pd.DataFrame, dict, dict]:
     """:func:`run_sweep` of every dataset, the networks of all of them spread over ``runner`` at once.
@@ -351,12 +311,6 @@ def run_sweeps(cfg: dict, profile: str, datasets, ecfg: dict, runner: Runner | N
         timings["sweep_wall_s"] = time.perf_counter() - t0
     rows = pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(columns=list(SWEEP_COLUMNS))
     return rows, info, timings
-
-
-def describe_sweep_size(sweep: pd.DataFrame) -> str:
-    """``<n> rows, <a> starts x <b> durations x <c> methods x <d> seeds`` of a sweep table."""
-    return (f"{len(sweep)} rows, {sweep['start_s'].nunique()} starts x {sweep['duration_s'].nunique()} durations x "
-            f"{sweep['method'].nunique()} methods x {sweep['seed'].nunique()} seeds")
 
 
 def pairs_style(pairs: pd.DataFrame):

@@ -13,6 +13,7 @@ import torch
 from bgfn import energy
 from bgfn.config import PROJECT_ROOT
 from bgfn.studies.odometer.energy import OdometerEnergy, odometer_dataset
+from bgfn.report import energy_words
 from bgfn.report.odometer_words import odometer_energy_lines
 from bgfn.energy.record import REPORTED_KEYS
 from bgfn.learning import WindowSet
@@ -61,7 +62,7 @@ def test_energy_totals_by_hand():
     frame = t.frame(66.3)
     assert frame.loc["energy reduction vs Transformer (%)"].tolist() == pytest.approx([t.reduction_pct, 66.3])
     assert frame["paper"].isna().sum() == 3                        # the paper gives only the reduction
-    lines = t.lines()
+    lines = energy_words.totals_lines(t)
     assert "110 MACs + 40 SOPs" in lines[0] and "84.6 %" in lines[0]
     assert "72.7 % of the twin's" in lines[1] and "7.7 % of BGFN's" in lines[1] and lines[1].endswith("20.0 %")
 
@@ -81,8 +82,8 @@ def test_stacked_tables_are_checked_and_show_the_input_trains():
 
 
 def test_break_even_note_says_which_side():
-    assert "stays cheaper at any firing rate" in energy.break_even_note(3.99)
-    assert "costs more than the twin above it" in energy.break_even_note(0.4)
+    assert "stays cheaper at any firing rate" in energy_words.break_even_note(3.99)
+    assert "costs more than the twin above it" in energy_words.break_even_note(0.4)
 
 
 # ----------------------------------------------------------------------------------------------- which windows
@@ -128,7 +129,7 @@ def test_load_measured_reads_dataset_seed_and_cards(tmp_path, monkeypatch):
     measured = energy.load_measured("smoke", cfg)
     assert (measured.dataset, measured.seed, measured.time_steps) == ("drive-b", 2, 3)
     assert measured.cards == {"bgfn": {"best_epoch": 7, "val_rmse_m": 1.25}, "transformer": {}}
-    assert "best epoch 7, val RMSE 1.250 m" in measured.lines()[0] and "val RMSE nan m" in measured.lines()[1]
+    assert "best epoch 7, val RMSE 1.250 m" in energy_words.measured_lines(measured)[0] and "val RMSE nan m" in energy_words.measured_lines(measured)[1]
     assert measured.relative_paths()["bgfn"] == str(folder / "bgfn_seed2.pt")   # outside the project: absolute
 
 
@@ -151,7 +152,7 @@ def test_comparison_with_spikingjelly_agrees_on_tiny_models():
     assert cross.strict_uj["transformer"] == pytest.approx(t.loc["transformer", "energy SJ (µJ)"])
     assert cross.strict_reduction_pct == pytest.approx(
         100 * (1 - cross.strict_uj["bgfn"] / cross.strict_uj["transformer"]))
-    assert cross.lines(5.0)[0] == f"agreement within {cross.worst_pct:.2f} % (tolerance 5.0 %)"
+    assert energy_words.crosscheck_lines(cross, 5.0)[0] == f"agreement within {cross.worst_pct:.2f} % (tolerance 5.0 %)"
 
 
 # ----------------------------------------------------------------------------------------------- speed table
@@ -163,11 +164,11 @@ def test_speed_table_falls_back_to_bench_speed_latency():
     assert t[["model", "size"]].values.tolist() == [["bgfn", "quick"], ["mlp", "paper"]]
     assert t["latency (ms, batch 1)"].tolist() == [1.5, 0.2]      # infer_ms first, bench_speed's latency else
     assert t.loc[0, "throughput (windows/s, batch 64)"] == 1000.0 and pd.isna(t.loc[1, "keeps up with 100 Hz IMU"])
-    notes = energy.speed_notes(bench)
+    notes = energy_words.speed_notes(bench)
     assert notes[0] == "recorded with: {'threads': 1}"
     assert notes[1].startswith("missing in results/bench.json: realtime_imu_100hz, realtime_gnss_1hz")
     assert energy.speed_table({}).empty
-    assert "`make bench` produces them" in energy.speed_notes({})[0]
+    assert "`make bench` produces them" in energy_words.speed_notes({})[0]
 
 
 # ----------------------------------------------------------------------------------------------- energy.json
@@ -194,7 +195,7 @@ def test_energy_summary_has_what_the_results_page_reads():
     assert s["macs"] == {"bgfn": 110.0, "transformer": 550.0} and s["sops"] == {"bgfn": 40.0, "transformer": 0.0}
     assert s["reduction_pct"] == totals.reduction_pct and s["reduction_pct_without_attention"] == pytest.approx(20.0)
     json.dumps(s)                                                  # writable as JSON
-    md = energy.result_markdown(s)
+    md = energy_words.result_markdown(s)
     assert "BGFN 0.00026 µJ vs Transformer twin 0.0011 µJ" in md and "**76.4 % less energy** (paper: 66.3 %)" in md
     assert "takes 73 % of its energy" in md and "the reduction is 20.0 %" in md and md.endswith("it is 50.0 %.")
 

@@ -36,25 +36,25 @@ Modules, one concept each (every public name is also importable from ``bgfn.ener
 
 from bgfn.energy.checkpoint import (MEASURED, EvaluationWindows, MeasuredModels, energy_checkpoint, evaluation_windows,
                                     load_measured, window_indices)
-from bgfn.energy.counts import (LayerCount, break_even_note, layer_counts, mean_rate, measure_firing_rates, rates_table,
+from bgfn.energy.counts import (LayerCount, layer_counts, mean_rate, measure_firing_rates, rates_table,
                                 reduction_vs_rate, reduction_vs_time_steps, same_size_builder, with_rates)
 from bgfn.energy.crosscheck import Crosscheck, compare_with_spikingjelly, spikingjelly_counts
 from bgfn.energy.passes import fold_batchnorm, is_spike_count
 from bgfn.energy.plots import plot_energy_per_layer, plot_firing_rates, plot_sweeps
-from bgfn.energy.record import energy_summary, result_markdown
+from bgfn.energy.record import energy_summary
 from bgfn.energy.rules import E_AC_PJ, E_MAC_PJ, energy_uj, softmax_attention_macs, ssa_dense_ops, ssa_sops
 from bgfn.energy.tables import (COLUMNS, EnergyTotals, attention_energy_uj, energy_table, energy_totals, model_name,
-                                reduction_pct, speed_notes, speed_table, stack_tables, table_from_counts,
+                                reduction_pct, speed_table, stack_tables, table_from_counts,
                                 total_energy_uj, with_input_trains)
 
 __all__ = [
     "E_AC_PJ", "E_MAC_PJ", "COLUMNS", "MEASURED",
     "Crosscheck", "EnergyTotals", "EvaluationWindows", "LayerCount", "MeasuredModels",
-    "attention_energy_uj", "break_even_note", "compare_with_spikingjelly", "energy_checkpoint", "energy_summary",
+    "attention_energy_uj", "compare_with_spikingjelly", "energy_checkpoint", "energy_summary",
     "energy_table", "energy_totals", "energy_uj", "evaluation_windows", "fold_batchnorm", "is_spike_count",
     "layer_counts", "load_measured", "mean_rate", "measure_firing_rates", "model_name", "plot_energy_per_layer",
     "plot_firing_rates", "plot_sweeps", "rates_table", "reduction_pct", "reduction_vs_rate",
-    "reduction_vs_time_steps", "result_markdown", "same_size_builder", "softmax_attention_macs", "speed_notes",
+    "reduction_vs_time_steps", "same_size_builder", "softmax_attention_macs",
     "speed_table", "spikingjelly_counts", "ssa_dense_ops", "ssa_sops", "stack_tables", "table_from_counts",
     "total_energy_uj", "window_indices", "with_input_trains", "with_rates",
 ]

@@ -150,12 +150,6 @@ class MeasuredModels:
         return {m: p.relative_to(PROJECT_ROOT).as_posix() if p.is_relative_to(PROJECT_ROOT) else str(p)
                 for m, p in self.paths.items()}
 
-    def lines(self) -> list[str]:
-        """One line per network: checkpoint, size, best epoch, validation RMSE."""
-        rel = self.relative_paths()
-        return [f"{m:>12}: {rel[m]} | size {self.trained[m].size_cfg} | best epoch {c.get('best_epoch')}, "
-                f"val RMSE {c.get('val_rmse_m', float('nan')):.3f} m" for m, c in self.cards.items()]
-
 
 def load_measured(profile: str, cfg: dict | None = None, methods=MEASURED) -> MeasuredModels:
     """Load the networks of the energy estimate (:func:`energy_checkpoint`) on the CPU.
@@ -211,13 +205,6 @@ class EvaluationWindows:
     windows: WindowSet
     x: dict[str, np.ndarray]
     n_validation: int
-
-    def line(self, dataset: str, time_steps: int) -> str:
-        """How many windows, of what shape, from when."""
-        ws = self.windows
-        return (f"{dataset}: {len(ws)} of {self.n_validation} validation windows, {ws.x.shape[1]} IMU samples x "
-                f"{ws.x.shape[2]} channels, t = {ws.t_end.min():.0f} .. {ws.t_end.max():.0f} s (GPS time of "
-                f"week); T_s = {time_steps}")
 
 
 def evaluation_windows(cfg: dict, measured: MeasuredModels) -> EvaluationWindows:

@@ -246,13 +246,6 @@ def reduction_vs_rate(snn_counts: list[LayerCount], ann_counts: list[LayerCount]
     return df
 
 
-def break_even_note(rate: float) -> str:
-    """One sentence on the break-even mean firing rate of :func:`reduction_vs_rate`."""
-    return (f"break-even mean firing rate: {rate:.3f} "
-            + ("(above 1: BGFN stays cheaper at any firing rate)" if rate > 1
-               else "(BGFN costs more than the twin above it)"))
-
-
 def same_size_builder(size_cfgs: dict[str, dict], in_channels: int, seed: int = 0,
                       methods: tuple[str, str] = ("bgfn", "transformer")
                       ) -> Callable[[int], tuple[nn.Module, nn.Module]]:

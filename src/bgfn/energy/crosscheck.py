@@ -140,12 +140,6 @@ class Crosscheck:
     strict_uj: dict
     strict_reduction_pct: float
 
-    def lines(self, tolerance_pct: float, snn: str = "bgfn", ann: str = "transformer") -> list[str]:
-        """The agreement against the tolerance, and the result under SpikingJelly's default rules."""
-        return [f"agreement within {self.worst_pct:.2f} % (tolerance {tolerance_pct} %)",
-                f"SpikingJelly default rules (non-binary inputs -> MACs): BGFN {self.strict_uj[snn]:.4g} µJ, "
-                f"twin {self.strict_uj[ann]:.4g} µJ, reduction {self.strict_reduction_pct:.1f} %"]
-
 
 def compare_with_spikingjelly(models: dict[str, nn.Module], windows: dict, n_windows: int,
                               e_mac: float = E_MAC_PJ, e_ac: float = E_AC_PJ, batch_size: int = 32,

@@ -1,4 +1,5 @@
-"""``results/<profile>/energy.json``: what notebook 05 hands to the results page, and its one-paragraph result."""
+"""``results/<profile>/energy.json``: what notebook 05 hands to the results page (its one-paragraph result:
+:func:`bgfn.report.energy_words.result_markdown`)."""
 
 from __future__ import annotations
 
@@ -65,18 +66,3 @@ def energy_summary(measured: MeasuredModels, windows: EvaluationWindows, tables:
                                     "default_rules_reduction_pct": cross.strict_reduction_pct},
         "metadata": metadata,
     }
-
-
-def result_markdown(summary: dict) -> str:
-    """The result of notebook 05 in one paragraph (Markdown), from :func:`energy_summary`'s dict."""
-    s = summary
-    e, attn = s["energy_uj_per_prediction"], s["attention_energy_uj"]
-    return (
-        f"**Result ({s['profile']} profile, {s['dataset']}, seed {s['seed']}):** BGFN {e['bgfn']:.4g} µJ vs "
-        f"Transformer twin {e['transformer']:.4g} µJ per prediction: **{s['reduction_pct']:.1f} % less energy** "
-        f"(paper: {s['paper_reduction_pct']} %), at a mean input firing rate of {s['mean_input_firing_rate']:.3f} "
-        f"(break-even {s['break_even_firing_rate']:.3f}). The twin's softmax attention (2N²D MACs per block) "
-        f"takes {100 * attn['transformer'] / e['transformer']:.0f} % of its energy; without the attention "
-        f"products in both models the reduction is {s['reduction_pct_without_attention']:.1f} %. Under "
-        f"SpikingJelly's stricter default rules (integer residual inputs counted as MACs) it is "
-        f"{s['crosscheck_spikingjelly']['default_rules_reduction_pct']:.1f} %.")

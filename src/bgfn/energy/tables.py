@@ -169,14 +169,6 @@ class EnergyTotals:
             index=["BGFN energy per prediction (µJ)", "Transformer twin energy per prediction (µJ)",
                    "energy reduction vs Transformer (%)", "BGFN mean input firing rate"])
 
-    def lines(self) -> list[str]:
-        """Where BGFN's energy goes, and how much of the gap the attention products make."""
-        return [f"BGFN: {self.macs:,.0f} MACs + {self.sops:,.0f} SOPs; "
-                f"the MAC layers (encoder, readout) take {100 * self.mac_share:.1f} % of its energy",
-                f"attention products: {100 * self.attention_uj['transformer'] / self.twin_uj:.1f} % of the twin's "
-                f"energy, {100 * self.attention_uj['bgfn'] / self.bgfn_uj:.1f} % of BGFN's; reduction without "
-                f"them in both models: {self.reduction_without_attention_pct:.1f} %"]
-
 
 def energy_totals(tables: dict[str, pd.DataFrame], bgfn_counts: list[LayerCount],
                   e_mac: float = E_MAC_PJ) -> EnergyTotals:
@@ -244,16 +236,3 @@ def speed_table(bench: dict, methods=("bgfn", "transformer", "at_lstm", "mlp"),
             if any(v is not None for k, v in rec.items() if k not in ("model", "size")):
                 recs.append(rec)
     return pd.DataFrame(recs)
-
-
-def speed_notes(bench: dict, path: str = "results/bench.json") -> list[str]:
-    """What the table cannot say: no figures yet, the settings they were recorded with, missing keys."""
-    if not any(k in bench for k in SPEED_KEYS):
-        return [f"{path} has no speed figures yet: `make bench` produces them."]
-    info = bench.get("speed_bench") or bench.get("models_bench") or {}
-    settings = {k: info.get(k) for k in ("threads", "threads_infer", "batch", "device", "torch") if k in info}
-    notes = [f"recorded with: {settings}"]
-    missing = [k for k in SPEED_KEYS if k not in bench]
-    if missing:
-        notes.append(f"missing in {path}: {', '.join(missing)} -- run `make bench`")
-    return notes

@@ -17,6 +17,7 @@ from bgfn.data import Drive
 from bgfn.data import imu_errors as ie
 from bgfn.errors import DataError
 from bgfn.nav import baseline, metrics, sim
+from bgfn.report import ins_fidelity_words
 from bgfn.studies.ins_fidelity import ins_setups
 from bgfn.nav import error_model as em
 from bgfn.nav import navego_setup as ns
@@ -262,18 +263,18 @@ def test_gap_explained_and_its_sentences():
     assert gap.loc["navego", "explained_pct"] == pytest.approx(40.0)
     assert gap.loc["navego-reset", "explained_pct"] == pytest.approx(-20.0)
     assert gap.loc["navego", ["shipped_m", "setup_m", "paper_m"]].tolist() == [3.0, 7.0, 13.0]
-    (line,) = ins_setups.sentences(table)
+    (line,) = ins_fidelity_words.ins_setup_sentences(table)
     assert "3.0 m with the shipped filter against the paper's 13.0 m" in line
     assert "7.0 m, so it explains 40 % of the gap" in line
     assert "moves away from the paper's row (-20 % of the gap)" in line
     over = _table([("shipped", 1, 2.0, 2.0), ("navego", 1, 30.0, 30.0), ("paper", 1, 12.0, 12.0)])
-    assert "overshoots the paper's row (280 % of the gap)" in ins_setups.sentences(over)[0]
+    assert "overshoots the paper's row (280 % of the gap)" in ins_fidelity_words.ins_setup_sentences(over)[0]
     # NaveGo's own run beside our setup of it: the ratio, and both GPS-aided solutions (NaveGo's far off here)
     own = _table([("shipped", 1, 2.0, 2.0), ("navego", 1, 30.0, 30.0), ("NaveGo (Octave)", 1, 60.0, 60.0),
                   ("paper", 1, 12.0, 12.0)])
     own.loc[own["setup"] == "NaveGo (Octave)", ["aided_rms_h_m", "max_gyro_bias_est_dps",
                                                 "max_accel_bias_est_mps2"]] = [190.0, 44.0, 3.1]
-    line = ins_setups.sentences(own)[0]
+    line = ins_fidelity_words.ins_setup_sentences(own)[0]
     assert ("the largest gyro-bias estimate over the drive is 44 deg/s in NaveGo, 0.1 deg/s in our setup of it, "
             "against the drive's largest true gyro bias of 1.7 deg/s") in line
     assert ("the largest accelerometer-bias estimate over the drive is 3.1 m/s^2 in NaveGo, 0.05 m/s^2 in our setup "
@@ -284,7 +285,7 @@ def test_gap_explained_and_its_sentences():
     # ... and NaveGo with its bias feedback made consistent (make navego-check's diagnostic run): 30 / 25 = 1.2
     fixed = pd.concat([own, _table([(ins_setups.NAVEGO_CONSISTENT, 1, 25.0, 25.0)])], ignore_index=True)
     fixed.loc[fixed["setup"] == ins_setups.NAVEGO_CONSISTENT, "aided_rms_h_m"] = 4.2
-    line = ins_setups.sentences(fixed)[0]
+    line = ins_fidelity_words.ins_setup_sentences(fixed)[0]
     assert "With NaveGo's bias feedback made consistent" in line
     assert "our setup gives 1.20 times its INS error (within 30 %); its GPS-aided RMS is 4.2 m" in line
     assert ins_setups.gap_explained(fixed).set_index("setup").loc[ins_setups.NAVEGO_CONSISTENT, "setup_m"] == 25.0

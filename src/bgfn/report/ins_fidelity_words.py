@@ -1,14 +1,20 @@
 """How good and how honest our INS is, in words (notebooks 06 and 08): its drift on the stand-in against the recorded
-drive, the filter's NEES during outages, the gyro bias scan and the IMU twin's check."""
+drive, the filter's NEES during outages, the gyro bias scan, the IMU twin's check and the INS under each filter setup
+beside the paper's and NaveGo's own."""
 
 from __future__ import annotations
 
 import numpy as np
 import pandas as pd
 
+from bgfn import paper
 from bgfn.studies.ins_fidelity.imu_twin import effective_levels, implied_setting
 from bgfn.studies.ins_fidelity.ins_drift import DRIFT_TOLERANCE
+from bgfn.studies.ins_fidelity.ins_setups import (NAVEGO_CONSISTENT, NAVEGO_RUN, NAVEGO_TOLERANCE, RESET, TRUE_COLUMNS,
+                                                  gap_explained)
 from bgfn.studies.ins_fidelity.nees import CHI2_95, CHI2_MEDIAN
+
+_NAN = float("nan")
 
 
 def drift_sentences(summary: pd.DataFrame, stand_in: str = "turin-sim-mpu6000",
@@ -96,3 +102,89 @@ def twin_lines(table: pd.DataFrame | None, tolerance: float = 1.25) -> list[str]
              f"{tolerance:g}." if holds else "The stand-in's setting does not hold: its simulated IMU is "
              + ("smoother" if ratio > 1 else "rougher") + f" than the recorded one; the measurement implies "
              f"{implied_setting(table):.3g} deg/s (evaluate.imu_twin.settle_setting).")]
+
+
+def _share(pct: float) -> str:
+    if not np.isfinite(pct):
+        return "there is no gap to explain"
+    if pct < 0:
+        return f"it moves away from the paper's row ({pct:.0f} % of the gap)"
+    if pct > 100:
+        return f"it overshoots the paper's row ({pct:.0f} % of the gap)"
+    return f"it explains {pct:.0f} % of the gap"
+
+
+def ins_setup_sentences(table: pd.DataFrame) -> list[str]:
+    """Plain sentences from :func:`~bgfn.studies.ins_fidelity.ins_setups.gap_explained`: per dataset, the mean INS max error under each setup, the
+    paper's, and the share of the gap each setup explains."""
+    gap = gap_explained(table)
+    names = {"navego": "NaveGo v1.4's setup", RESET: "that setup with the bias estimates cleared at the outage start",
+             NAVEGO_RUN: "NaveGo v1.4 itself, run under Octave on the same drive and outages",
+             NAVEGO_CONSISTENT: "the same with its bias feedback made consistent"}
+    out = []
+    for dataset, g in gap.groupby("dataset", sort=False):
+        first = g.iloc[0]
+        parts = [f"{names.get(r.setup, r.setup)}: {r.setup_m:.1f} m, so {_share(r.explained_pct)}"
+                 for r in g.itertuples(index=False)]
+        out.append(f"{dataset} ({paper.TESTS[first.test]['title']}): the INS max error (mean of east and north over "
+                   f"the outages) is {first.shipped_m:.1f} m with the shipped filter against the paper's "
+                   f"{first.paper_m:.1f} m; " + "; ".join(parts) + "." + _against_navego(g))
+    return out
+
+
+def _within(ratio: float, why: str = "") -> str:
+    """``(within 30 %)`` or ``(more than 30 % apart<why>)`` for a ratio of INS errors."""
+    return ("(within 30 %)" if abs(ratio - 1.0) <= NAVEGO_TOLERANCE else f"(more than 30 % apart{why})")
+
+
+def _bias_states(row, ours, true: dict) -> str:
+    """The largest gyro- and accelerometer-bias estimates of NaveGo's run ``row`` and of our setup ``ours``,
+    against the drive's largest true biases (``true``), in words; empty where they are not measured."""
+    parts = []
+    for col, true_col, unit, fmt in (("max_gyro_bias_est_dps", "true_gyro_bias_dps", "deg/s", ".3g"),
+                                     ("max_accel_bias_est_mps2", "true_accel_bias_mps2", "m/s^2", ".2g")):
+        theirs, mine = getattr(row, col, _NAN), getattr(ours, col, _NAN)
+        if not (np.isfinite(theirs) and np.isfinite(mine)):
+            continue
+        sensor = "gyro" if "gyro" in col else "accelerometer"
+        text = f"the largest {sensor}-bias estimate over the drive is {theirs:{fmt}} {unit} in NaveGo, {mine:{fmt}} {unit} in our setup of it"
+        t = true.get(true_col, _NAN)
+        parts.append(text + (f", against the drive's largest true {sensor} bias of {t:{fmt}} {unit}" if np.isfinite(t) else ""))
+    return "; ".join(parts)
+
+
+def _against_navego(gap: pd.DataFrame) -> str:
+    """Our ``navego`` setup against NaveGo's own runs (within 30 % of it?), when both are there: the INS
+    ratio, both GPS-aided solutions' horizontal RMS (outages that start from far different states cannot agree) and
+    the bias states step by step; then the same against NaveGo with its bias feedback made consistent."""
+    rows = {r.setup: r for r in gap.itertuples(index=False)}
+    ours = rows.get("navego")
+    if ours is None:
+        return ""
+    true = {c: float(gap[c].iloc[0]) if c in gap.columns else _NAN for c in TRUE_COLUMNS}
+    text = ""
+    released = rows.get(NAVEGO_RUN)
+    if released is not None and released.setup_m > 0:
+        ratio = ours.setup_m / released.setup_m
+        text += (f" Our setup of NaveGo gives {ratio:.2f} times NaveGo's own INS error "
+                 f"{_within(ratio, ': methods page, NaveGo run beside us, lists the differences')}.")
+        a_ours, a_theirs = getattr(ours, "aided_rms_h_m", _NAN), getattr(released, "aided_rms_h_m", _NAN)
+        if np.isfinite(a_ours) and np.isfinite(a_theirs):
+            text += (f" Their GPS-aided solutions, from which every outage starts: {a_theirs:.1f} m horizontal RMS for "
+                     f"NaveGo, {a_ours:.1f} m for our setup of it"
+                     + (" (NaveGo's own filter loses the drive with the GNSS still there)." if a_theirs > 3 * max(a_ours, 1.0)
+                        else "."))
+        states = _bias_states(released, ours, true)
+        text += f" Their bias states, step by step: {states}." if states else ""
+    fixed = rows.get(NAVEGO_CONSISTENT)
+    if fixed is not None and fixed.setup_m > 0:
+        ratio = ours.setup_m / fixed.setup_m
+        text += (" With NaveGo's bias feedback made consistent (every error state zeroed before an update and the "
+                 "bias estimates corrected by the states with the signs of its own F, where v1.4 carries the bias "
+                 f"states and takes their negative as the estimate), our setup gives {ratio:.2f} times its INS error "
+                 f"{_within(ratio)}")
+        a_fixed = getattr(fixed, "aided_rms_h_m", _NAN)
+        text += f"; its GPS-aided RMS is {a_fixed:.1f} m" if np.isfinite(a_fixed) else ""
+        states = _bias_states(fixed, ours, true)
+        text += (f"; {states}." if states else ".")
+    return text

@@ -212,7 +212,7 @@ def layout(table: pd.DataFrame, dataset: str) -> pd.DataFrame:
 
 #: Columns of a setup's GPS-aided run (one value per drive) and of the drive's truth, carried by :func:`gap_explained`.
 _RUN_COLUMNS = ("aided_rms_h_m", "max_gyro_bias_est_dps", "max_accel_bias_est_mps2")
-_TRUE_COLUMNS = ("true_gyro_bias_dps", "true_accel_bias_mps2")
+TRUE_COLUMNS = ("true_gyro_bias_dps", "true_accel_bias_mps2")
 
 
 def gap_explained(table: pd.DataFrame) -> pd.DataFrame:
@@ -241,7 +241,7 @@ def gap_explained(table: pd.DataFrame) -> pd.DataFrame:
         size = {s: float(g[["max_east_m", "max_north_m"]].to_numpy().mean()) for s, g in t.groupby("setup")}
         # per setup: its run's values (one per drive, repeated on every outage row); the truth: the drive's
         per_setup = {c: {s: float(g[c].iloc[0]) for s, g in t.groupby("setup")} for c in _RUN_COLUMNS if c in t.columns}
-        truth = {c: float(t[c].iloc[0]) if c in t.columns else _NAN for c in _TRUE_COLUMNS}
+        truth = {c: float(t[c].iloc[0]) if c in t.columns else _NAN for c in TRUE_COLUMNS}
         gap = size[PAPER] - size["shipped"]
         for s in SETUPS:
             if s in ("shipped", PAPER) or s not in size:
@@ -251,97 +251,11 @@ def gap_explained(table: pd.DataFrame) -> pd.DataFrame:
                          "setup_m": size[s], "paper_m": size[PAPER], "explained_pct": pct,
                          **{c: per_setup.get(c, {}).get(s, _NAN) for c in _RUN_COLUMNS}, **truth})
     return pd.DataFrame(rows, columns=["dataset", "test", "setup", "shipped_m", "setup_m", "paper_m",
-                                       "explained_pct", *_RUN_COLUMNS, *_TRUE_COLUMNS])
-
-
-def _share(pct: float) -> str:
-    if not np.isfinite(pct):
-        return "there is no gap to explain"
-    if pct < 0:
-        return f"it moves away from the paper's row ({pct:.0f} % of the gap)"
-    if pct > 100:
-        return f"it overshoots the paper's row ({pct:.0f} % of the gap)"
-    return f"it explains {pct:.0f} % of the gap"
-
-
-def sentences(table: pd.DataFrame) -> list[str]:
-    """Plain sentences from :func:`gap_explained`: per dataset, the mean INS max error under each setup, the
-    paper's, and the share of the gap each setup explains."""
-    gap = gap_explained(table)
-    names = {"navego": "NaveGo v1.4's setup", RESET: "that setup with the bias estimates cleared at the outage start",
-             NAVEGO_RUN: "NaveGo v1.4 itself, run under Octave on the same drive and outages",
-             NAVEGO_CONSISTENT: "the same with its bias feedback made consistent"}
-    out = []
-    for dataset, g in gap.groupby("dataset", sort=False):
-        first = g.iloc[0]
-        parts = [f"{names.get(r.setup, r.setup)}: {r.setup_m:.1f} m, so {_share(r.explained_pct)}"
-                 for r in g.itertuples(index=False)]
-        out.append(f"{dataset} ({paper.TESTS[first.test]['title']}): the INS max error (mean of east and north over "
-                   f"the outages) is {first.shipped_m:.1f} m with the shipped filter against the paper's "
-                   f"{first.paper_m:.1f} m; " + "; ".join(parts) + "." + _against_navego(g))
-    return out
+                                       "explained_pct", *_RUN_COLUMNS, *TRUE_COLUMNS])
 
 
 #: How far our ``navego`` setup's INS error may lie from NaveGo's own, as a ratio.
 NAVEGO_TOLERANCE = 0.3
-
-
-def _within(ratio: float, why: str = "") -> str:
-    """``(within 30 %)`` or ``(more than 30 % apart<why>)`` for a ratio of INS errors."""
-    return ("(within 30 %)" if abs(ratio - 1.0) <= NAVEGO_TOLERANCE else f"(more than 30 % apart{why})")
-
-
-def _bias_states(row, ours, true: dict) -> str:
-    """The largest gyro- and accelerometer-bias estimates of NaveGo's run ``row`` and of our setup ``ours``,
-    against the drive's largest true biases (``true``), in words; empty where they are not measured."""
-    parts = []
-    for col, true_col, unit, fmt in (("max_gyro_bias_est_dps", "true_gyro_bias_dps", "deg/s", ".3g"),
-                                     ("max_accel_bias_est_mps2", "true_accel_bias_mps2", "m/s^2", ".2g")):
-        theirs, mine = getattr(row, col, _NAN), getattr(ours, col, _NAN)
-        if not (np.isfinite(theirs) and np.isfinite(mine)):
-            continue
-        sensor = "gyro" if "gyro" in col else "accelerometer"
-        text = f"the largest {sensor}-bias estimate over the drive is {theirs:{fmt}} {unit} in NaveGo, {mine:{fmt}} {unit} in our setup of it"
-        t = true.get(true_col, _NAN)
-        parts.append(text + (f", against the drive's largest true {sensor} bias of {t:{fmt}} {unit}" if np.isfinite(t) else ""))
-    return "; ".join(parts)
-
-
-def _against_navego(gap: pd.DataFrame) -> str:
-    """Our ``navego`` setup against NaveGo's own runs (within 30 % of it?), when both are there: the INS
-    ratio, both GPS-aided solutions' horizontal RMS (outages that start from far different states cannot agree) and
-    the bias states step by step; then the same against NaveGo with its bias feedback made consistent."""
-    rows = {r.setup: r for r in gap.itertuples(index=False)}
-    ours = rows.get("navego")
-    if ours is None:
-        return ""
-    true = {c: float(gap[c].iloc[0]) if c in gap.columns else _NAN for c in _TRUE_COLUMNS}
-    text = ""
-    released = rows.get(NAVEGO_RUN)
-    if released is not None and released.setup_m > 0:
-        ratio = ours.setup_m / released.setup_m
-        text += (f" Our setup of NaveGo gives {ratio:.2f} times NaveGo's own INS error "
-                 f"{_within(ratio, ': methods page, NaveGo run beside us, lists the differences')}.")
-        a_ours, a_theirs = getattr(ours, "aided_rms_h_m", _NAN), getattr(released, "aided_rms_h_m", _NAN)
-        if np.isfinite(a_ours) and np.isfinite(a_theirs):
-            text += (f" Their GPS-aided solutions, from which every outage starts: {a_theirs:.1f} m horizontal RMS for "
-                     f"NaveGo, {a_ours:.1f} m for our setup of it"
-                     + (" (NaveGo's own filter loses the drive with the GNSS still there)." if a_theirs > 3 * max(a_ours, 1.0)
-                        else "."))
-        states = _bias_states(released, ours, true)
-        text += f" Their bias states, step by step: {states}." if states else ""
-    fixed = rows.get(NAVEGO_CONSISTENT)
-    if fixed is not None and fixed.setup_m > 0:
-        ratio = ours.setup_m / fixed.setup_m
-        text += (" With NaveGo's bias feedback made consistent (every error state zeroed before an update and the "
-                 "bias estimates corrected by the states with the signs of its own F, where v1.4 carries the bias "
-                 f"states and takes their negative as the estimate), our setup gives {ratio:.2f} times its INS error "
-                 f"{_within(ratio)}")
-        a_fixed = getattr(fixed, "aided_rms_h_m", _NAN)
-        text += f"; its GPS-aided RMS is {a_fixed:.1f} m" if np.isfinite(a_fixed) else ""
-        states = _bias_states(fixed, ours, true)
-        text += (f"; {states}." if states else ".")
-    return text
 
 
 def save_table(out, table: pd.DataFrame) -> Path:
@@ -357,4 +271,4 @@ def read_table(out) -> pd.DataFrame | None:
 
 __all__ = ["COLUMNS", "NAVEGO_CHECK_COLUMNS", "NAVEGO_CHECK_FILE", "NAVEGO_CONSISTENT", "NAVEGO_RUN", "NAVEGO_VARIANTS", "PAPER", "RESET", "SETUPS",
            "navego_measured", "gap_explained", "ins_tuning_table", "ins_tuning_tables", "layout",
-           "layouts", "read_table", "save_table", "sentences"]
+           "layouts", "read_table", "save_table", "TRUE_COLUMNS"]

@@ -170,7 +170,7 @@ def test_run_metadata_is_deterministic_and_complete():
     assert a["git_commit"] is None or len(a["git_commit"]) == 40
     flat = repr(a).lower()
     assert "time" not in flat and "date" not in flat  # no timestamps: identical tables on rerun
-    lines = config.metadata_lines("smoke")
+    lines = config.metadata_header("smoke")
     assert "# profile: smoke" in lines
 
 

@@ -442,7 +442,7 @@ def run_metadata(profile: str) -> dict[str, Any]:
     }
 
 
-def metadata_lines(profile: str) -> list[str]:
+def metadata_header(profile: str) -> list[str]:
     """:func:`run_metadata` as ``# key: value`` lines, for a comment header above a CSV table."""
     meta = run_metadata(profile)
     lines = [f"# {k}: {v}" for k, v in meta.items() if k != "packages"]

@@ -100,3 +100,58 @@ def test_imports_inside_functions_are_the_few_optional_ones():
                 assert lines[node.lineno - 2].strip().startswith("#"), f"{path}:{node.lineno}: say why it is here"
     assert found <= ALLOWED_FUNCTION_IMPORTS, sorted(found - ALLOWED_FUNCTION_IMPORTS)
     assert len(found) < 10
+
+
+#: Names that make sentences, labels or a page's prose: below ``report/`` a module returns numbers, tables and codes.
+WORD_FUNCTION = re.compile(r"^(lines?|sentences?|describe\w*|\w+_lines|\w+_sentences?|\w+_words|\w+_markdown)$")
+#: The edge may word its own messages (the command line, the profile check); ``report/`` words everything else.
+WORD_HOMES = ("report/", "__main__.py", "profile_schema.py")
+#: Word-making functions allowed below ``report/``, each with why.
+WORD_EXCEPTIONS = {
+    # a progress line for the terminal or the log of a long run, not a sentence of a page
+    "parallel.py:RunProgress.line",
+    # the clock offset estimated at load, quoted by the load errors of bgfn.data.csv_drive and kept in the drive's
+    # meta; its numbers and its words are to be parted (numbers in data, words in report)
+    "data/time_offset.py:OffsetEstimate.line",
+}
+
+
+def word_makers(package: Path) -> list[str]:
+    """``<module path>:<function>`` / ``<module path>:<class>.<method>`` named like a word-making function
+    (:data:`WORD_FUNCTION`), and ``<module path>:<NAME>`` of a module-level ``*_WORDS`` constant, in every module
+    under ``package`` outside :data:`WORD_HOMES`."""
+    found = []
+    for path in sorted(package.rglob("*.py")):
+        rel = path.relative_to(package).as_posix()
+        if rel.startswith(WORD_HOMES):
+            continue
+        for node in ast.parse(path.read_text(encoding="utf-8")).body:
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and WORD_FUNCTION.match(node.name):
+                found.append(f"{rel}:{node.name}")
+            elif isinstance(node, ast.ClassDef):
+                found += [f"{rel}:{node.name}.{m.name}" for m in node.body
+                          if isinstance(m, (ast.FunctionDef, ast.AsyncFunctionDef)) and WORD_FUNCTION.match(m.name)]
+            elif isinstance(node, (ast.Assign, ast.AnnAssign)):
+                targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+                found += [f"{rel}:{t.id}" for t in targets if isinstance(t, ast.Name) and t.id.endswith("_WORDS")]
+    return found
+
+
+def test_sentences_are_made_in_report_only():
+    """Below ``report/`` the layers return numbers, tables and codes; their words are made in ``report/``."""
+    assert set(word_makers(PACKAGE)) == WORD_EXCEPTIONS
+
+
+@pytest.mark.parametrize("where, body, name", [
+    ("nav/planted.py", "def describe_windows(windows):\n    return [str(w) for w in windows]\n",
+     "nav/planted.py:describe_windows"),
+    ("train/planted.py", "class Plan:\n    def lines(self):\n        return []\n", "train/planted.py:Plan.lines"),
+    ("studies/gallery/planted.py", "def decision_words(code):\n    return code\n",
+     "studies/gallery/planted.py:decision_words"),
+    ("energy/planted.py", "PLANTED_WORDS: dict = {'a': 'an a'}\n", "energy/planted.py:PLANTED_WORDS"),
+])
+def test_the_word_check_finds_a_planted_word_maker(tmp_path, where, body, name):
+    package = _copy(tmp_path) / "bgfn"
+    (package / where).write_text(body, encoding="utf-8")
+    (package / "report" / "planted_words.py").write_text("def planted_lines():\n    return []\n", encoding="utf-8")
+    assert set(word_makers(package)) == WORD_EXCEPTIONS | {name}          # the one below report, not report's own

@@ -23,7 +23,10 @@ Modules, in the order the page needs them:
 - :mod:`bgfn.report.glance` -- the run header, the *At a glance* lines and ``findings.md``;
 - :mod:`bgfn.report.figures` -- the page's figure lists and the four drawings made from the profile;
 - :mod:`bgfn.report.sections` -- each section of the page as the pieces to display;
-- :mod:`bgfn.report.verdict` -- the verdict on top: every aid per test and the answers to five questions.
+- :mod:`bgfn.report.verdict` -- the verdict on top: every aid per test and the answers to five questions;
+- ``bgfn.report.*_words`` -- the notebooks' sentences, a module per topic (:mod:`~bgfn.report.nav_words`,
+  :mod:`~bgfn.report.training_words`, :mod:`~bgfn.report.evaluation_words`, :mod:`~bgfn.report.energy_words`, ...):
+  the lower layers return numbers, tables and codes.
 
 Everything public is re-exported here: ``from bgfn import report; report.outage_section(res, "dataset")``.
 """

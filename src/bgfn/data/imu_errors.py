@@ -1,61 +1,15 @@
 """IMU error models: the Ekinox-D (tactical MEMS) and the InvenSense MPU-6000 (consumer MEMS).
 
-Measurement model, per IMU row ``k`` (mean rate over ``(t[k-1], t[k]]``, CONTRIBUTING.md), for the
-gyro (rad/s) and the accelerometer (m/s^2) alike::
+Per IMU row ``k`` (the mean rate over ``(t[k-1], t[k]]``, CONTRIBUTING.md), for the gyro and the accelerometer::
 
-    y_k = T @ x_k + b_fixed + b_turn_on + b_gm[k] + n_k + vib[k]
-    T   = I + diag(scale_factor) + misalignment          (misalignment: zero diagonal)
+    y_k = T @ x_k + b_fixed + b_turn_on + b_gm[k] + n_k + vib[k],    T = I + diag(scale_factor) + misalignment
 
-=====================  =====================================================================
-term                   model
-=====================  =====================================================================
-``n_k``                white noise, std ``noise_density / sqrt(dt)`` (noise density = ARW/VRW)
-``b_fixed``            deterministic constant bias (the Ekinox profile's ``gb_sta``/``ab_sta``)
-``b_turn_on``          run-to-run constant bias, drawn once ~ N(0, turn_on_bias_std^2)
-``b_boot``             (optional) boot-time calibration of that bias, as autopilots do at rest before
-                       driving: ``b_boot = b_turn_on + e``, ``e ~ N(0, boot_calibration_residual_std^2)``,
-                       subtracted from the output, so ``b_turn_on - b_boot = -e`` remains
-``b_gm[k]``            first-order Gauss-Markov bias (bias instability): stationary std
-                       ``bias_instability``, correlation time ``bias_corr_time``, started in its
-                       stationary distribution; ``b_gm[k] = a b_gm[k-1] + sqrt(1-a^2) sigma w_k``,
-                       ``a = exp(-dt / tau)``
-``scale_factor``       per axis, drawn ~ U(-scale_factor_tol, +scale_factor_tol)
-``misalignment``       each off-diagonal (cross-axis) term drawn ~ U(-misalignment_tol, +tol)
-``vib[k]``             vehicle vibration: Gaussian noise band-passed to
-                       ``vibration_freq_hz +- vibration_bandwidth_hz / 2`` (2nd-order Butterworth),
-                       std ``vibration_*_std`` times the speed envelope
-                       ``idle + (1 - idle) * min(1, speed / vibration_speed_ref_mps)``
-=====================  =====================================================================
-
-Parameter keys (``meta['imu_errors']``, every value a list of 3 per axis x, y, z unless noted):
-
-- ``gyro_noise_density`` rad/s/sqrt(Hz) = rad/sqrt(s) (angle random walk);
-  ``accel_noise_density`` m/s^2/sqrt(Hz) = m/s/sqrt(s) (velocity random walk).
-  Continuous white-noise PSD for a KF's Q: ``noise_density**2``.
-- ``gyro_bias_fixed`` rad/s, ``accel_bias_fixed`` m/s^2.
-- ``gyro_turn_on_bias_std`` rad/s, ``accel_turn_on_bias_std`` m/s^2.
-- ``gyro_boot_calibration_residual_std`` rad/s, ``accel_boot_calibration_residual_std`` m/s^2, or
-  ``None`` (no boot calibration): std of what a boot calibration leaves of the turn-on bias.
-- ``gyro_bias_instability`` rad/s, ``accel_bias_instability`` m/s^2 (GM stationary std);
-  ``gyro_bias_corr_time``, ``accel_bias_corr_time`` s (GM correlation time; driving-noise PSD for Q:
-  ``2 sigma^2 / tau``).
-- ``gyro_scale_factor_tol``, ``accel_scale_factor_tol``, ``gyro_misalignment_tol``,
-  ``accel_misalignment_tol`` (fractions; a draw's std is ``tol / sqrt(3)``).
-- ``vibration_gyro_std`` rad/s, ``vibration_accel_std`` m/s^2 (lists);
-  ``vibration_freq_hz``, ``vibration_bandwidth_hz`` Hz, ``vibration_speed_ref_mps`` m/s,
-  ``vibration_idle_fraction`` (scalars).
-- ``model`` (str), ``seed`` (int).
-- ``realized`` (dict, the draws of this run): ``gyro_turn_on_bias``, ``accel_turn_on_bias``,
-  ``gyro_boot_calibration``, ``accel_boot_calibration`` (the estimate subtracted at boot; zeros without
-  calibration), ``gyro_bias_constant`` (= fixed + turn-on - boot calibration), ``accel_bias_constant``, ``gyro_scale_factor``,
-  ``accel_scale_factor`` (lists of 3), ``gyro_misalignment``, ``accel_misalignment`` (3 x 3, zero
-  diagonal), ``gyro_sensor_matrix``, ``accel_sensor_matrix`` (``T``, 3 x 3).
-- ``p0_gyro_bias_std`` rad/s, ``p0_accel_bias_std`` m/s^2: prior std of the total constant-plus-GM
-  bias, ``sqrt(fixed^2 + turn_on_std^2 + instability^2)`` per axis (a KF's P0 for its bias states);
-  with a boot calibration, its residual std replaces ``turn_on_std``.
-
-The time series of the additive bias ``b_fixed + b_turn_on + b_gm[k]`` is returned as a table
-(``Drive.imu_bias``) for comparing estimated and true biases.
+with white noise ``n_k`` (std ``noise_density / sqrt(dt)``), a fixed and a run-to-run bias (less an optional boot
+calibration), a first-order Gauss-Markov bias (``bias_instability``, ``bias_corr_time``), drawn scale factors and
+misalignments, and a vibration band-passed around ``vibration_freq_hz`` that grows with the speed. The keys of
+``meta['imu_errors']`` (SI units, 3 values per axis) are those of the profiles here; ``realized`` holds one run's
+draws and ``p0_*_bias_std`` the prior std a filter's P0 takes for its bias states. The additive bias series is
+returned as ``Drive.imu_bias``, to compare the estimated biases with the true ones.
 """
 
 from __future__ import annotations
@@ -148,7 +102,7 @@ def error_params(profile: str | dict, overrides: dict | None = None) -> dict:
     profile : str or dict
         ``"ekinox-d"``, ``"mpu6000"`` or a full parameter dict.
     overrides : dict, optional
-        Keys of the module docstring; a scalar given for a 3-vector key is broadcast.
+        Keys of :data:`MPU6000` (the model: module docstring); a scalar given for a 3-vector key is broadcast.
 
     Returns
     -------

@@ -1,50 +1,13 @@
 """Read the files of a drive logged with RTKLIB (demo5): the IMU's CSV, its time-tag file and a ``.pos`` solution.
 
-The drive ``rtklib-drive0708`` (:mod:`bgfn.data.drives`) comes from the public repository
-``rtklibexplorer/GNSS_IMU`` (folder ``data/drive_0708``, BSD 3-Clause; ``data/NOTICE``): a TDK ICM-45686 MEMS IMU
-and a u-blox X20 receiver on a car roof, logged by RTKLIB's stream server. Every reader returns tables in the
-schemas of CONTRIBUTING.md (SI units, GPS time of week) and raises :class:`bgfn.errors.DataError` naming the
+The drive ``rtklib-drive0708`` (:mod:`bgfn.data.drives`) comes from ``rtklibexplorer/GNSS_IMU`` (``data/drive_0708``,
+BSD 3-Clause; ``data/NOTICE``): a TDK ICM-45686 MEMS IMU and a u-blox X20 receiver on a car roof. The file formats
+and the drive's configuration (the IMU time offset of -0.125 s, the mounting ``[180, 0, 180] + [0, -6.79, 5.35]``
+deg, the 5 cm lever arm :data:`LEVER_ARM_M`) are read from that repository's source at commit ``c35774d``; its
+stretch of the IMU counter to the tags is not applied (``stretch_to_tags=False``, deviations page): this drive's
+yaw rate against its course over ground contradicts it (``tests/test_data_rtklib.py``). Every reader returns tables
+in the schemas of CONTRIBUTING.md (SI units, GPS time of week) and raises :class:`bgfn.errors.DataError` naming the
 file and the field on any defect.
-
-File formats (from the files and the source repository's ``src/convert_imu_file.py``, ``src/imu_files.py``,
-``src/GNSS_IMU.py`` and ``src/drive_config.py`` at commit ``c35774d``, which holds the data's configuration):
-
-- ``<imu>.csv.tag`` (RTKLIB time tags): a 60-byte text header (``TIMETAG RTKLIB demo5``), a uint32 (the
-  logging computer's millisecond tick at the start of the file; the mirror's README and the source call it the
-  tick frequency, neither uses it), a uint32 and a float64: the file's start time as RTKLIB's ``gtime_t``
-  (whole seconds since 1970-01-01 in the GPS time scale, and the fraction), then pairs of uint32 (ms since the
-  start, file position) for each chunk received. All little-endian.
-- ``<imu>.csv``: ``ax, ay, az`` (g), ``gx, gy, gz`` (deg/s), the IMU's millisecond counter; the first and the
-  last line are not samples (the source skips them).
-- ``<name>.pos`` (RTKLIB solution, GPS time): ``date time lat(deg) lon(deg) h(m) Q ns sdn sde sdu sdne sdeu
-  sdun age ratio vn ve vu sdvn sdve sdvu ...``; header lines start with ``%``; ``Q = 1`` is an RTK fixed
-  solution, ``2`` float, ``5`` single.
-
-What was verified in the source and what is assumed:
-
-- *Time of a sample*: the tag's start time plus the counter's elapsed milliseconds, plus the IMU time offset
-  ``imu_t_off = -0.125`` s (``drive_config.py``; ``GNSS_IMU.py`` *adds* it to the IMU time: a logging delay;
-  verified). The source (``convert_imu_file.py``) also stretches the counter so that the last sample falls at
-  the tag's last tick (a factor 1 + 2.9e-4 here); this drive's data contradict that stretch, so it is not
-  applied (``stretch_to_tags=False``; deviations page): the IMU's yaw rate, matched against the rate of
-  the course over ground of the RTK positions (symmetric differences, speed above 3 m/s), lags by the same
-  0.02-0.03 s in each third of the drive without the stretch, but drifts by 0.085 s from the first third to the
-  last with it (``tests/test_data_rtklib.py``). That residual lag is under 3 IMU samples: the source's offset
-  is kept.
-- *Axes* (verified, ``GNSS_IMU.py``): ``f_b = C @ f_sensor`` with ``C = Euler_to_CTM(mounting + misalignment)``,
-  the Euler angles (roll, pitch, yaw) added as numbers, ``[180, 0, 180] + [0, -6.79, 5.35]`` deg, and Groves'
-  ``Euler_to_CTM``, which is the transpose of this project's ``C_bn`` (:func:`bgfn.nav.transform.dcm_from_euler`).
-  The mounting alone maps sensor (x, y, z) to body (-x, y, -z): the sensor's z axis points up, and a level IMU
-  at rest reads ``accel_z = -g`` in the body frame (CONTRIBUTING.md).
-- *Units*: g -> m/s^2 with standard gravity 9.80665 (assumed: the datasheet's g; the source's filter multiplies
-  by the local gravity magnitude instead, 0.1 % smaller there, below the sensor's scale-factor tolerance);
-  deg/s -> rad/s.
-- *Lever arm* (verified values, sign assumed): ``drive_config.py`` gives offsets from the system origin
-  (forward, right, down): IMU ``[0, 0, -0.65]``, antenna ``[0, -0.05, -0.65]`` m, so the antenna lies
-  ``[0, -0.05, 0]`` m from the IMU in the body frame (:data:`LEVER_ARM_M`). The source's filter uses
-  ``imu_offset - gnss_offset`` as its IMU-to-antenna arm, the opposite sign; either way 5 cm.
-- *A sample's meaning* (assumed): a MEMS IMU's output at 100 Hz is a low-passed point sample; it is taken as
-  the mean rate over the interval that ends at its time, the IMU schema of CONTRIBUTING.md.
 """
 
 from __future__ import annotations

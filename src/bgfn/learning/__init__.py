@@ -1,58 +1,14 @@
-"""The learning problem of BGFN: IMU/INS windows -> GPS position increment (paper's O_INS - Delta P_GPS model).
+"""The learning problem of BGFN: IMU/INS windows -> GPS position increment (the paper's O_INS - Delta P_GPS model).
 
-Inputs (Eq. eq21): per IMU sample the 9 channels ``[roll, pitch, yaw, fx, fy, fz, wx, wy, wz]`` -- the attitude
-of the INS/KF solution (interpolated to the IMU times) and the raw IMU specific force and angular rate; a
-window holds the ``N`` (paper: 200) most recent samples at 100 Hz, i.e. those with ``time <= t_end``.
-
-Target (Eq. eq8-1): ``delta_p_gps`` = (north, east) change of the GNSS position between two consecutive GNSS
-epochs, in metres, from the latitude/longitude differences and the WGS84 curvature radii at the mid-point::
-
-    dN = (lat_b - lat_a) (R_M + h),   dE = (lon_b - lon_a) (R_N + h) cos(lat)
-
-Alignment of window and target (``alignment``):
-
-- ``'ending'`` (default): the window ends at GNSS epoch ``t_b`` and the target is the increment
-  ``t_a -> t_b`` into that epoch. The IMU samples of the increment interval lie inside the window, as in
-  Eq. (eq8-1) where Delta P_GPS is the double integral of the IMU output over the interval; the paper's
-  "predicts Delta P^{k+1} from the preceding k IMU observations" with the IMU step k+1 being the GNSS epoch.
-  It is causal: at a pseudo-GNSS epoch ``t_b`` of an outage the IMU data up to ``t_b`` exist.
-- ``'next'``: the window ends at ``t_a`` and the target is ``t_a -> t_b`` (a forecast of the next interval).
-
-Yaw wrap-around (``yaw_encoding``; all keep 9 channels):
-
-- ``'unwrap'`` (default): yaw unwrapped along the window and anchored so that the window's last sample is the
-  wrapped value in (-pi, pi]. A window never holds a 2 pi jump; the absolute heading (which the north/east
-  target needs) is kept. Two windows at headings just either side of +-pi still differ by about 2 pi.
-- ``'relative'``: yaw minus the window's last yaw, wrapped to (-pi, pi]: no jump at all, but the absolute
-  heading is lost (only useful with a target in a heading-aligned frame; not the paper's).
-- ``'raw'``: the wrapped yaw as given.
-
-Target frame (``target_frame``):
-
-- ``'ned'`` (default, the paper's Eq. eq21 output): the network outputs (dN, dE) directly.
-- ``'heading'``: the network outputs the increment in the frame of the window's last INS yaw
-  (along-track, cross-track), rotated back to (dN, dE) with that yaw after prediction. Not the paper's; it
-  spares every model learning cos/sin of the heading. The reported errors are always in north/east metres.
-
-Training data come only from GPS-available time (:func:`split_windows`): a window whose input span or
-target interval touches an evaluation outage widened by ``margin_s`` is dropped; validation is one held-out
-block of time (``val_fraction`` of the windows at ``val_position``) and training windows overlapping that block
-are dropped too, so no training window shares an IMU sample or GNSS epoch with a validation window.
-Normalization statistics (:class:`Normalizer`) come from the training windows only.
-
-Modules, one concept each (every public name is re-exported here):
-
-- :mod:`bgfn.learning.inputs`: the nine channels of Eq. (eq21), their named slices, derived channels, yaw encoding;
-- :mod:`bgfn.learning.targets`: delta_p_gps of Eq. (eq8-1), INS increments, screening, target frame;
-- :mod:`bgfn.learning.windows`: :class:`WindowSet`, the windows of a drive and of an outage (Eq. pred-gps);
-- :mod:`bgfn.learning.split`: outage exclusion and the validation block;
-- :mod:`bgfn.learning.normalize`: :class:`Normalizer`;
-- :mod:`bgfn.learning.references`: the validation RMSE and the zero / last-increment / INS-increment references;
-- :mod:`bgfn.learning.coverage`: headings and speeds seen in training, validation and the outages;
-- :mod:`bgfn.learning.data`: :class:`LearningData`, the learning options, the tuning split;
-- :mod:`bgfn.learning.synthetic`: a toy drive for tests and examples;
-- :mod:`bgfn.learning.odometry`: beyond the paper, the odometer problem (IMU-only windows -> forward speed) and
-  its ridge baseline.
+Inputs (Eq. eq21): per IMU sample the INS attitude and the raw specific force and angular rate (9 channels), in
+windows of the ``N`` (paper: 200) latest samples. Target (Eq. eq8-1): ``delta_p_gps``, the (north, east) change of
+the GNSS position between consecutive epochs, m. By default a window ends at the epoch its increment ends at
+(``alignment: ending``, causal at a pseudo-GNSS epoch), its yaw unwrapped, its target in NED
+(:data:`LEARNING_DEFAULTS` names the options). Training windows come from GPS-available time only, outside the
+evaluation outages widened by ``margin_s`` and apart from one held-out validation block; the normalization from
+the training windows only. Modules (every public name re-exported here): ``inputs``, ``targets``, ``windows``,
+``split``, ``normalize``, ``references``, ``coverage``, ``data``, ``synthetic``; beyond the paper, ``odometry``
+(IMU windows -> forward speed, and its ridge baseline).
 """
 
 from bgfn.learning.coverage import (VAL_POSITIONS, motion_in_windows, motion_of_windows, motion_sets, unseen_fraction,

@@ -1,39 +1,16 @@
 """BGFN: the spiking Transformer of paper Sec. 3.2 (Eqs. eq:bgfn_net, eq:spike_input, eq:spiking_embedding).
 
-Data flow (shapes as comments; T = T_s SNN steps per IMU step, B = batch, N = window length in IMU samples,
-C = 9 input channels, D = embedding width)::
+Data flow (T = T_s SNN steps per IMU step, B batch, N window length, C = 9 channels, D embedding width)::
 
     x [B, N, C] --spike_encoder--> [T, B, N, C*K] spikes      Eq. (eq:spike_input)  S = SN(BN(Conv(S_k)))
       --embedding--> [T, B, N, D] spikes                       Eq. (eq:spiking_embedding)  S_emb = SN(Linear(S))
       --L x Block (SSA + spiking MLP, residuals)--> [T, B, N, D]
       --mean over T and N--> [B, D] --Linear--> [B, 2]         delta_p_gps (north, east), Eq. (eq:bgfn_net)
 
-How the T_s axis is made (paper: "each IMU step dT is divided into T_s segments ... the input is expanded to
-T_s x T x C"): the encoder is a 1-D convolution along the window with ``T_s`` kernels per sensor channel
-(``groups=C``), followed by BatchNorm; its ``C*T_s`` output maps are read as ``T_s`` SNN time steps of ``C``
-channels, so every SNN step of an IMU sample gets its own learned current and the LIF turns the sequence of
-``T_s`` currents into a spike pattern. This is the convolutional spike encoder of SeqSNN (Lv et al. 2024, the
-Spikformer-for-time-series code BGFN builds on), there ``Conv2d(1, T_s, (1, k))`` shared by all channels; we
-give each channel its own kernels because the nine channels have different units and dynamics.
-
-Encoder width ``K`` (``encoder_neurons``, default 1 = the paper's ``T_s x T x C``): with one neuron per channel a
-token carries only ``T_s`` binary values per sensor channel, so a slowly varying input such as a velocity is
-quantized to about ``T_s + 1`` levels whatever the window length. ``K > 1`` gives each channel ``K`` neurons with
-their own kernels and BatchNorm offsets (a population code, as in the wider first layer of Spikformer's image
-stem); the spike tensor is then ``[T_s, B, N, C*K]``. Not in the paper; a deviation when set.
-
-Spiking blocks follow Spikformer's ``model.py``: Q, K, V = SN(BN(Linear(x))); attention ``Q K^T V * scale``
-without softmax (all factors are non-negative spikes), then an LIF with threshold 0.5, then
-SN(BN(Linear(.))); spiking MLP = two SN(BN(Linear)) layers; residual additions around both. Since there is no
-softmax, ``(Q K^T) V == Q (K^T V)``; we evaluate the cheaper order (N*dh^2 instead of N^2*dh per head), the
-result is the same (exact for binary spikes up to float32 summation of small integers).
-
-Readout: the paper passes "the output sequence of the last block through a projection layer"; we average the
-last block's output over the T_s steps and the N tokens (as SeqSNN's Spikformer does) and apply one Linear
-layer (``readout='mean'``); ``readout='last'`` uses the last token only (averaged over T_s).
-
-The membrane potentials are reset (``functional.reset_net``) at the start of every forward pass, so a batch
-never sees the state left by the previous one.
+The encoder is SeqSNN's convolutional spike encoder (Lv et al. 2024), with each channel's own ``T_s`` kernels (the
+nine channels differ in units and dynamics); ``encoder_neurons`` K > 1 is a population code, not the paper's. The
+blocks follow Spikformer: attention without softmax, evaluated as ``Q (K^T V)`` (the same result, cheaper). The
+membranes are reset at the start of every forward pass.
 """
 
 from __future__ import annotations

@@ -1,37 +1,13 @@
 """LIF neurons of the paper (Eq. eq:LIF) on SpikingJelly, with the ATan surrogate (Eq. eq:surrogate_gradient).
 
-The paper writes the leaky integrate-and-fire neuron as (Eq. eq:LIF)::
-
-    U(t) = H(t - dt) + I(t)                         # charge
-    S(t) = 1 if U(t) >= U_thr else 0                # fire (Heaviside)
-    H(t) = V_reset S(t) + (1 - S(t)) beta U(t)      # hard reset or leak
-
-SpikingJelly's ``LIFNode(decay_input=False)`` charges ``H_sj[t] = V[t-1] - (V[t-1] - V_reset)/tau + X[t]``,
-fires ``S = Heaviside(H_sj - v_threshold)`` and hard-resets ``V[t] = (1 - S) H_sj + S V_reset``.
-With ``V_reset = 0`` the two are the same recursion:
-
-    paper U(t)        == SpikingJelly H_sj[t]   (the membrane potential that is compared with the threshold)
-    paper I(t)        == SpikingJelly X[t]      (``decay_input=False``: the input current is not scaled by 1/tau)
-    paper beta        == 1 - 1/tau              (tau = 2 -> beta = 0.5, Spikformer's setting)
-    paper H(t)        == beta * V[t]            (SpikingJelly stores the potential before the leak)
-
-(With ``V_reset != 0`` SpikingJelly leaks toward ``V_reset`` while the paper leaks toward 0, so every layer
-here uses ``V_reset = 0``, the default of SpikingJelly and Spikformer.) :func:`lif_reference` is the paper's
-equation written out literally; the tests check SpikingJelly's node against it.
-
-The backward pass replaces dS/dU by the derivative of the ATan surrogate (Eq. eq:surrogate_gradient)
-``g(x) = arctan(pi/2 alpha x)/pi + 1/2`` at ``x = U - U_thr``, i.e. ``g'(x) = alpha / (2 (1 + (pi/2 alpha x)^2))``
-(:func:`atan_surrogate_grad`). Training is BPTT through the ``T_s`` SNN steps (multi-step mode ``'m'``).
-
-Speed: on the CPU, SpikingJelly's multi-step LIF runs the recursion as many small autograd operations per
-step (charge, fire, reset, surrogate), and this overhead, not arithmetic, made BGFN train many times slower
-than its ANN twin. :class:`FusedLIFNode` is a ``LIFNode`` whose multi-step pass on the CPU is one autograd
-node (:class:`FusedLIF`) whose forward and backward passes are numba kernels (:mod:`bgfn.models.lif_kernels`):
-each neuron's ``T`` steps run in registers, one pass over memory each way, where torch operations took three
-passes per step forward and ten backward over tensors too large for the cache. Spikes are bit-identical and
-gradients equal within float32 rounding (tests compare it with :func:`lif_reference` and with SpikingJelly's
-``LIFNode``). On a CUDA device, for another dtype than float32, or for any setting it does not cover, it falls
-back to SpikingJelly's own implementation (whose CUDA kernels are fused already).
+SpikingJelly's ``LIFNode(decay_input=False, v_reset=0)`` is the paper's recursion: its ``H[t]`` is the paper's
+``U(t)``, its input ``X[t]`` the paper's ``I(t)``, and ``beta = 1 - 1/tau`` (tau = 2: beta = 0.5, Spikformer's
+setting); :func:`lif_reference` writes the paper's equation out literally and the tests check the node against it.
+The backward pass uses the ATan surrogate's derivative (:func:`atan_surrogate_grad`); training is BPTT through the
+``T_s`` SNN steps. :class:`FusedLIFNode` runs the multi-step pass on the CPU as one autograd node whose forward and
+backward passes are numba kernels (:mod:`bgfn.models.lif_kernels`): SpikingJelly's many small operations per step
+made BGFN train many times slower than its ANN twin. Spikes are bit-identical, gradients equal within float32
+rounding; on CUDA, or for a setting it does not cover, it falls back to SpikingJelly's own implementation.
 """
 
 from __future__ import annotations

@@ -1,40 +1,13 @@
 """Coarse self-alignment of a land vehicle's INS from its own IMU and GNSS (no reference attitude needed).
 
-The paper's filter (Sec. 2, Eqs. eq3-eq4) is linearized about a known attitude: it cannot start from an unknown
-heading. Real logs rarely carry a reference attitude, so the filter starts at an *alignment epoch* ``t_a`` chosen
-from the data, and waits until then:
-
-1. **Stillness** (from the IMU): consecutive blocks of ``still_window_s`` at the start of the drive whose
-   specific-force and angular-rate spreads (root sum of the per-axis variances) stay below
-   ``still_accel_std_mps2`` and ``still_gyro_std_dps`` (engine vibration passes, driving does not), and whose means
-   stay that close to the first block's (a smooth, vibration-free drive is caught by its acceleration and turns).
-   The last still block is dropped (it may hold the first metre of motion), and the span ends before the first
-   GNSS interval above ``speed_threshold_mps``. A span of at least ``still_min_s`` is *rest*.
-2. **Alignment epoch**: the first GNSS fix that ends ``heading_time_s`` of GNSS intervals (fixes at least
-   :data:`BASELINE_S` apart) whose horizontal speed all exceed ``speed_threshold_mps``; the state is taken at the
-   first IMU epoch at or after that fix (so the filter never fuses it twice).
-3. **Level** (roll, pitch) at ``t_a``:
-
-   - after *rest*: from the mean specific force at rest, ``f = C_bn^T (-g^n)``:
-     ``roll = atan2(-f_y, -f_z)``, ``pitch = atan2(f_x, hypot(f_y, f_z))``, carried to ``t_a`` by the gyros
-     (their mean at rest removed: bias plus Earth rate);
-   - else (the drive starts moving): velocity matching over the last ``level_time_s``: the specific force
-     averaged in the body frame of ``t_a`` (gyro-integrated) equals ``C_bn(t_a)^T (dv^n / T - g^n)``, ``dv^n``
-     from the GNSS; solved for roll and pitch with the heading of step 4 (Coriolis and transport terms,
-     ~1e-3 m/s^2, are left out).
-4. **Heading** at ``t_a``: the course of the GNSS intervals of step 2 (``atan2(d_e, d_n)``; the GNSS velocities
-   when the fixes carry them, else differenced positions), each displacement turned by the heading change the
-   gyros measured from its mid-time to ``t_a``, then summed: the heading of the sum. A land vehicle moves along
-   its body x axis (no sideslip, IMU aligned with the car); the sum's noise falls with the path length.
-5. **Position and velocity** from the GNSS fix (antenna moved to the IMU with the lever arm); without GNSS
-   velocities, the velocity of the last interval carried from its mid-time to the fix by the IMU.
-6. **P0**: position std from the fix's ``std_n/e/d``; velocity std from the fixes (per axis) or
-   ``velocity_std_mps`` when the GNSS gives velocities; level std ``level_std_deg`` combined with the
-   accelerometer-bias prior over g (and, moving, the GNSS velocity noise over ``g T``); azimuth std
-   ``azimuth_std_deg`` combined with the course noise over the path length (root sum of squares).
-
-All durations in s, speeds m/s, angles rad unless a key's name says deg. Options are the ``nav.alignment``
-profile section (:data:`ALIGNMENT_DEFAULTS`).
+The paper's filter (Sec. 2, Eqs. eq3-eq4) is linearized about a known attitude and cannot start from an unknown
+heading; real logs rarely carry a reference attitude. So the filter starts at an *alignment epoch* chosen from the
+data: the first fix that ends ``heading_time_s`` of GNSS intervals above ``speed_threshold_mps``. Level comes from
+the mean specific force at rest (a still span of at least ``still_min_s`` at the start) carried by the gyros, else
+from velocity matching over ``level_time_s``; heading from the course of those GNSS intervals, each turned by the
+gyros to the epoch; position and velocity from the fix; P0 from the fixes' stds and the options' level and azimuth
+stds. A land vehicle is taken to move along its body x axis. Durations in s, speeds m/s, angles rad unless a key's
+name says deg; the options are the ``nav.alignment`` section (:data:`ALIGNMENT_DEFAULTS`).
 """
 
 from __future__ import annotations
@@ -413,7 +386,7 @@ def _velocity_change(t, acc, R, tk, c_bn, g, t0: float, t1: float) -> np.ndarray
 
 def _moving_level(t, acc, R, tk, iv: _Intervals, last: int, level_time: float, yaw: float, g: float,
                   ba_h: float, floor: float) -> tuple[float, float, float]:
-    """Velocity matching over the last ``level_time`` before the alignment fix (module docstring, step 3)."""
+    """Velocity matching over the last ``level_time`` before the alignment fix (module docstring)."""
     mid = 0.5 * (iv.t0 + iv.t1)
     vel = iv.d / (iv.t1 - iv.t0)[:, None]
     j0 = int(np.argmin(np.abs(mid[: last + 1] - (mid[last] - level_time))))

@@ -1,45 +1,14 @@
 """Learning-free outage aids of a road vehicle: non-holonomic constraints (NHC) and zero-velocity updates (ZUPT).
 
-Beyond the paper (the classic aids a learned one must beat or add to). Both are velocity measurements of the
-15-state filter, one *aid* of the engine :mod:`bgfn.nav.engine` (:class:`Constraints` is an
-:class:`~bgfn.nav.engine.Aid`): at each aid epoch the engine asks which measurement to fuse, and fuses it with the
-same sequential Joseph update and closed-loop feedback as a position fix. The *aid epochs* are the first
-IMU row at or after every multiple of ``1 / nhc_rate_hz`` of the time of week (the same epochs in every run of a
-drive).
-
-- **NHC**: a car neither slides sideways nor leaves the road, so its velocity in the *vehicle* frame has
-  zero lateral and vertical components: ``z = [v^v_y, v^v_z] = 0 + w``, ``w ~ N(0, nhc_std^2)``. With
-  ``v^v = R_vb C_bn^T v^n`` and the error conventions of :mod:`bgfn.nav.error_model`
-  (``C_computed = (I - [phi]) C_true``, ``dV = v_computed - v_true``) the computed value is
-  ``v^v_computed = v^v_true + M dV - M [v x] phi`` with ``M = R_vb C_bn^T``, so the two rows of ``H`` are
-  ``M`` on ``dV`` and ``-M [v x]`` on ``phi`` (rows y, z of the vehicle frame).
-- **ZUPT**: when the stillness detector fires at an aid epoch the vehicle stands still, so its velocity is
-  zero: ``z = v^n = 0 + w`` (3 rows, ``H = I`` on ``dV``, std ``zupt_std``). It replaces the NHC update of
-  that epoch (zero velocity holds the NHC rows too). It is refused (NHC instead) while the filter's own speed
-  exceeds ``max_speed_mps``: an IMU without vibration reads the same on a smooth straight road at constant
-  acceleration as at rest, and a zero-velocity update at speed would wreck the solution.
-
-Stillness detector (:func:`stillness`): a moving-variance test on a *trailing* window (causal: the samples up to
-the epoch) of ``window_s`` seconds, ``T_f = sqrt(sum_a var(f_a) / sum_a sigma_f,a^2)`` and the same ``T_w`` for
-the angular rate, with ``sigma`` the at-rest std of one IMU sample from the drive's sensor description
-(``meta['imu_errors']``, the one that sets the filter's Q: white noise at the IMU rate plus the idle engine
-vibration, :func:`rest_noise`); still when ``T_f < accel_ratio`` and ``T_w < gyro_ratio``. The variance of the
-*vectors* is used, not that of their norms, because a gentle manoeuvre turns the specific force without
-changing its norm (``|f| ~ sqrt(g^2 + a^2)``): on the Turin drive the norms' variance does not separate smooth
-cruising from a stop with a vibration-free IMU, the vectors' does. Thresholds relative to the at-rest noise
-make one setting serve sensors whose noise differs by orders of magnitude (the GLRT of Skog et al. 2010
-normalizes by the sensor noise for the same reason). Without vibration keys (a real drive's datasheet) the
-idle vibration is taken as zero, so a vibrating stop stays undetected: ZUPT then never fires, it never fires
-falsely.
-
-Vehicle frame (:func:`mounting_track`): the IMU body frame need not be the vehicle's (the Turin reference's
-body frame is about a degree off the direction of travel in yaw and pitch). The vehicle x axis is estimated,
-causally, from the GPS-aided solution: the running mean of ``v^b_y / v^b_x`` and ``v^b_z / v^b_x`` over the
-epochs with forward speed above ``mounting_min_speed_mps`` up to the epoch (``mounting: none``: the body frame),
-each weighted by the inverse variance of the solution's heading (``mounting_weight: heading``; ``equal``: the same
-weight): a heading error turns the body-frame velocity with it, and a self-aligned filter's first minute would
-otherwise set the vehicle frame by its own unconverged heading.
-Inside an outage no fix updates it: it is held at its value at the outage start (:meth:`Constraints.frozen`).
+Beyond the paper: the classic aids a learned one must beat or add to. Both are velocity measurements of the
+15-state filter, one :class:`~bgfn.nav.engine.Aid` (:class:`Constraints`) fused at the *aid epochs* (the first IMU
+row at or after each multiple of ``1 / nhc_rate_hz``). NHC: the velocity in the vehicle frame has no lateral and no
+vertical part (``H``: ``M`` on ``dV`` and ``-M [v x]`` on ``phi``, ``M = R_vb C_bn^T``, the error conventions of
+:mod:`bgfn.nav.error_model`). ZUPT: at rest it is zero; it replaces that epoch's NHC update and is refused above
+``max_speed_mps``. Stillness (:func:`stillness`) is a causal moving-variance test of the specific-force and
+angular-rate vectors against the drive's at-rest sensor noise (:func:`rest_noise`). The vehicle frame
+(:func:`mounting_track`) is estimated causally from the GPS-aided velocity and held through an outage. Which
+platform takes which aid: :data:`PLATFORM_AIDS`.
 """
 
 from __future__ import annotations

@@ -1,68 +1,14 @@
 """The 15-state filter set up as NaveGo v1.4's ``ins_gnss.m`` sets it up (profile key ``nav.ins_tuning``).
 
-The paper's data come from NaveGo (R. Gonzalez, LGPL-3.0, ``rodralez/NaveGo``) and its INS row is larger than
-ours. How large a standalone INS drifts in an outage depends on how the filter modelled the IMU biases before
-it, and NaveGo models them differently from our shipped filter (:func:`bgfn.nav.state.noise_from_imu_errors`).
-This module reproduces NaveGo's *setup* in our filter; ``nav.ins_tuning: shipped`` (the default) leaves every
-result as it was, ``navego`` selects this one.
-
-What NaveGo v1.4 does, read from its source as mirrored in ``../shared/navego-v1.4/`` (``ins-gnss/ins_gnss.m``
-Version 011 of 2022-04, ``ins-gnss/F_update.m`` Version 010, ``ins-gnss/kf_prediction.m`` Version 001,
-``conversions/imu_si_errors.m`` Version 011; line numbers of those files):
-
-1. *Static biases removed, as known constants.* Every IMU sample is corrected before the strapdown with the
-   profile's static biases ``gb_sta``/``ab_sta`` (``ins-gnss/ins_gnss.m`` lines 251-252,
-   ``wb_corrected = imu.wb(i,:)' - gb_dyn - imu.gb_sta'``); they are never estimated.
-2. *Bias states = dynamic biases only.* The bias block of P0 is ``diag(gb_dyn, ab_dyn)^2`` (``ins_gnss.m``
-   line 193): the static part's uncertainty is not in the filter.
-3. *The bias estimate starts at the dynamic-bias value.* ``gb_dyn = imu.gb_dyn'`` (lines 186-187) is
-   subtracted from the first samples, and the prior error state is ``[0, gb_dyn, ab_dyn]`` (line 192): the
-   one-sigma values of the profile are used as an initial estimate.
-4. *Gauss-Markov bias model.* ``F`` has ``-1/gb_corr`` and ``-1/ab_corr`` on the bias block
-   (``ins-gnss/F_update.m`` Version 010, lines 164 and 171) and ``G`` an identity for the bias driving noise
-   (line 158).
-5. *Driving noise ``gb_dyn^2 / gb_corr``.* ``Q = diag(arw, vrw, gb_psd, ab_psd)^2`` (``ins_gnss.m`` line 195)
-   with the root PSD ``gb_psd = gb_dyn / sqrt(gb_corr)`` (``conversions/imu_si_errors.m`` Version 011,
-   lines 95 and 101). That is half the PSD ``2 sigma^2 / tau`` that keeps a first-order Gauss-Markov process
-   at its stationary std ``sigma`` (the shipped filter's choice): NaveGo's bias states settle at
-   ``sigma / sqrt(2)``.
-6. Discretization ``A = expm(F dt)``, ``Q_d = G Q G^T dt`` at the GNSS epochs (``ins-gnss/kf_prediction.m``
-   Version 001, lines 49 and 51).
-7. *Bias estimates held between updates.* Every IMU sample is corrected with the last update's ``gb_dyn`` and
-   ``ab_dyn`` (lines 251-252); nothing relaxes them between fixes or through an outage, although ``F`` models
-   the biases as Gauss-Markov. (Our shipped filter lets a Gauss-Markov estimate relax as ``exp(-dt/tau)``; with
-   the MPU-6000's ``tau`` of 100 s that took a quarter of the bias correction away within a 30 s outage and made
-   this setup's INS row many times NaveGo's: found by running the two side by side, ``make navego-check``.)
-
-How this module maps it onto our filter, per sensor (our keys of :mod:`bgfn.data.imu_errors`; for NaveGo's
-own files :mod:`bgfn.data.drives` maps ``gb_sta -> gyro_bias_fixed``, ``gb_dyn -> gyro_bias_instability``,
-``gb_corr -> gyro_bias_corr_time``, ``arw -> gyro_noise_density``, the same for the accelerometer):
-
-==========================  ==============================================  ======================
-NaveGo                      here                                            shipped filter
-==========================  ==============================================  ======================
-static bias removed (1)     ``*_bias_fixed`` subtracted from the IMU table  estimated (in P0)
-P0 of the bias states (2)   ``*_bias_instability``                          ``p0_*_bias_std``
-initial estimate (3)        ``*_bias_instability``                          0
-bias model (4)              Gauss-Markov, ``tau = *_bias_corr_time``        random walk
-driving PSD (5)             ``instability^2 / corr_time``                   ``2 instability^2 / tau``
-white noise                 ``*_noise_density`` (``arw``, ``vrw``) x        the same
-                            ``nav.noise_scale``
-estimates between updates   held (7; ``FilterNoise.hold_bias_estimates``)   relax with the model
-==========================  ==============================================  ======================
-
-Not reproduced (our filter stays the paper's, Eqs. eq3/eq4): NaveGo also fuses the GNSS velocity, propagates
-P only at the GNSS epochs, starts from the first fix and ``ini_align``, and corrects with a ZUPT heuristic
-(lines 280-315). Before each update it zeroes the error states 1-9 only (``kf.xp(1:9) = 0.0``, line 363): the
-bias states 10-15 are carried from update to update (``xi = A xp``, ``kf_prediction.m`` line 54), and
-``gb_dyn = -kf.xp(10:12)`` (lines 408-409) is the accumulated estimate. That feedback is not reproduced: its
-prediction ``xi = A xp`` counts the carried bias states once more, and with the negative sign its accelerometer-bias
-states integrate the true bias without bound (``tools/navego_check.py`` explains it and runs NaveGo a second time
-with the feedback made consistent, all 15 states zeroed and the estimates corrected by them: our closed-loop
-filter's scheme, and the run this setup is compared with on a rough IMU). (An earlier
-reading of a later ``ins_gnss.m``, Version 012, which zeroes the whole state and so does not accumulate them, is
-why :func:`bgfn.studies.ins_fidelity.ins_setups.ins_tuning_table` also shows a run whose bias estimates are cleared at the outage
-start; v1.4 as mirrored here is Version 011.)
+The paper's data come from NaveGo (R. Gonzalez, LGPL-3.0, ``rodralez/NaveGo``) and its INS row is larger than ours:
+how far a standalone INS drifts in an outage depends on how the filter modelled the IMU biases before it. This
+module reproduces NaveGo's setup in our filter, as read from v1.4's source (``ins-gnss/ins_gnss.m`` Version 011,
+``F_update.m``, ``kf_prediction.m``, ``conversions/imu_si_errors.m``): the static biases removed as known
+constants; bias states for the dynamic biases only, started at their one-sigma value; a Gauss-Markov bias model
+driven with ``instability^2 / corr_time`` (half the PSD that keeps it stationary); the estimates held between
+updates (``FilterNoise.hold_bias_estimates``). NaveGo's GNSS-velocity fusion, its ZUPT heuristic and its bias
+feedback (which integrates the accelerometer bias without bound, ``tools/navego_check.py``) are not reproduced:
+our filter stays the paper's (Eqs. eq3/eq4). ``nav.ins_tuning: shipped``, the default, leaves every result as is.
 """
 
 from __future__ import annotations
@@ -87,7 +33,7 @@ def check_tuning(value, source: str = "params nav") -> str:
 
 
 def navego_noise(imu_errors: dict, noise_scale: float = 1.0, source: str = "meta['imu_errors']") -> FilterNoise:
-    """Filter noise and bias priors as NaveGo v1.4 sets them up (items 2, 4, 5 of the module docstring).
+    """Filter noise and bias priors as NaveGo v1.4 sets them up (its bias states: module docstring).
 
     Parameters
     ----------

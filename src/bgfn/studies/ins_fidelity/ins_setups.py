@@ -1,34 +1,13 @@
 """Is the INS row comparable? The standalone INS in the outages under each filter setup, beside the paper's.
 
-Issue 17, question 5: the paper's INS row (its data come from NaveGo) is larger than ours. The INS of an outage
-starts from the GPS-aided filter's state, so its drift depends on how that filter modelled the IMU biases.
-:func:`ins_tuning_table` runs :func:`bgfn.nav.baseline.run_baseline` once per setup of ``nav.ins_tuning``
-(:data:`bgfn.nav.navego_setup.INS_TUNINGS`) and adds one bound:
-
-- ``shipped``: our filter as every other result uses it (random-walk biases, the full constant bias in P0);
-- ``navego``: the filter set up as NaveGo v1.4's ``ins_gnss.m`` (:mod:`bgfn.nav.navego_setup`);
-- ``navego-reset``: the same GPS-aided run, then each outage's INS started with its bias estimates cleared:
-  only the profile's static biases are removed: a bound for a filter that keeps no accumulated bias estimate
-  (a later ``ins_gnss.m``, Version 012; v1.4 as mirrored, Version 011, accumulates them as ours does:
-  :mod:`bgfn.nav.navego_setup`, "Not reproduced");
-- ``NaveGo (Octave)``: NaveGo v1.4 itself on the same drive and outages, as released (``make navego-check``,
-  ``data/measured/navego_check.csv``);
-- ``NaveGo, bias feedback consistent (Octave)``: the same with NaveGo's bias feedback made consistent, a diagnostic
-  of why the released one diverges on a rough IMU (``tools/navego_check.py``: v1.4 carries its bias states from
-  update to update and takes their negative as the estimate, so its accelerometer-bias states integrate the true
-  bias without bound);
-- ``paper``: the paper's INS row (:func:`bgfn.paper.published_values`: the field test's beside the real drive),
-  only for a dataset that stands for one of its tests.
-
-Table columns (:data:`COLUMNS`; ``tables/kf_ins_tuning.csv``, ``bgfn.config.SHARED_TABLES['kf_ins_tuning']``):
-``dataset``, ``test`` (the paper's test or empty), ``outage`` (1, 2, ...), ``setup``, ``max_east_m``,
-``max_north_m`` (max absolute error in the outage, m, :func:`bgfn.nav.metrics.outage_metrics`), ``aided_rms_h_m``
-(the horizontal RMS of the setup's GPS-aided run over the whole drive, m: the state every outage starts from;
-NaveGo's own from its check; NaN for the paper's row and the reset bound, which shares the ``navego`` run),
-``max_gyro_bias_est_dps`` (the largest gyro-bias estimate of that run over the drive, deg/s: the bias states step by
-step, NaveGo's from its check), ``true_gyro_bias_dps`` (the drive's largest true gyro bias, deg/s, a simulated IMU's
-``Drive.imu_bias``; NaN for a recorded one), ``max_accel_bias_est_mps2`` and ``true_accel_bias_mps2`` (the same for
-the accelerometers, m/s^2).
+The paper's INS row (its data come from NaveGo) is larger than ours. The INS of an outage starts from the
+GPS-aided filter's state, so its drift depends on how that filter modelled the IMU biases. :func:`ins_tuning_table`
+runs :func:`bgfn.nav.baseline.run_baseline` once per setup of ``nav.ins_tuning`` (``shipped``, ``navego``:
+:mod:`bgfn.nav.navego_setup`), adds ``navego-reset`` (each outage's bias estimates cleared: a bound), NaveGo v1.4
+itself run under Octave as released and with its bias feedback made consistent (``make navego-check``,
+``data/measured/navego_check.csv``), and the paper's row where a dataset stands for one of its tests. The table
+(:data:`COLUMNS`, ``tables/kf_ins_tuning.csv``) gives per outage and setup the max east/north error, the GPS-aided
+run's horizontal RMS and the largest bias estimates beside the true ones (a simulated IMU's).
 """
 
 from __future__ import annotations

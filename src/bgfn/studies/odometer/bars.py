@@ -1,55 +1,14 @@
 """The bars a learned odometer must clear (beyond the paper), in the outage sweep's windows.
 
-A learned odometer predicts the forward speed and its std from body-frame IMU windows, and the filter fuses it
-with the NHC rows (:mod:`bgfn.nav.odometer`). Before any network, this module measures what such an aid is worth
-on a drive, with the same starts, folds and durations as the sweep (:func:`bgfn.studies.outage_sweep.sweep.sweep_plan`):
-
-- ``INS+NHC``: the learning-free aid (:mod:`bgfn.nav.constraints`);
-- ``INS+NHC+HOLD``: the forward speed at the outage start held constant, std ``hold_std_mps`` (the dumb prior);
-- ``RIDGE-ODO``: ridge regression on the band energies of the IMU window of ``window_s`` seconds ending at the epoch (:class:`bgfn.learning.odometry.RidgeOdometer`),
-  trained per fold on the GPS-aided solution's forward speed outside that fold's outages (+- ``train.margin_s``),
-  its std the RMS of its residuals on a held-out block in the middle of the remaining windows;
-- ``BGFN-ODO``, ``Transformer-ODO``, ``AT-LSTM-ODO``, ``MLP-ODO`` (``methods``): the networks as learned odometers,
-  the forward speed and its log-variance from the same IMU-only windows through the networks' front end
-  (``inputs``, :func:`bgfn.learning.odometry.network_inputs`), trained per fold with beta-NLL
-  (:class:`bgfn.train.objectives.SpeedObjective`) with the sweep's budget and ``train`` laid over it
-  (:func:`odometer_train_config`) and the profile's ``train.lr`` (the same for every network: notebook 03's search
-  tuned its rates for the increments), their std calibrated on their validation windows (NIS = 1; ``val_blocks``
-  blocks spread over the drive; with ``calibration_blocks`` every other block calibrates and the others stop the
-  training, so that the std is fitted on windows early stopping has not chosen the network on: the ridge's std
-  and every odometer's ``kappa`` come from the same calibration windows) (:func:`network_odometers`);
-- ``BGFN-ODO-ENS`` ... (``ensemble`` and two or more ``network_seeds``): per fold the equal-weight ensemble of a
-  network's seeds (:func:`bgfn.learning.odometry.ensemble_speed`: the mean speed, the std of the Gaussian mixture,
-  the members' own uncertainty plus their disagreement; with ``ensemble_recalibrate`` scaled once more to NIS = 1
-  on the fold's validation windows, :func:`ensemble_tracks`); one row per start, at the members' summed cost per
-  prediction;
-- ``ORACLE-SPEED``: the reference's horizontal speed plus white noise of std ``sigma`` (the grid ``sigmas_mps``),
-  fused with std ``sigma``: how accurate a speed must be to help; ``ORACLE-SPEED+WALK`` (when
-  ``walk_mps_per_sqrt_s`` > 0): the same plus a random walk the fused std does not know of, the slowly drifting
-  error a learned odometer makes between the drive's situations.
-
-With ``paper_outages``, every row also runs in the drive's two evaluation outages (the profile's ``outage_windows``,
-the paper's tables) as one more fold, :data:`PAPER_FOLD`: its networks and its ridge learn outside those outages
-+- ``train.margin_s``; its rows (one per outage, at the outage's own duration) go to ``outage_odometer_paper.csv``
-(:func:`paper_outage_table`), never into the sweep's statistics.
-
-How far each network's predicted std ranks its speed errors in the outages, the premise of weighing each speed by
-it: :mod:`bgfn.studies.odometer.uncertainty` (``outage_odometer_uncertainty.csv``). How much of each odometer's
-speed error in the outages is an offset that lasts the outage, which the filter cannot average away:
-:mod:`bgfn.studies.odometer.errors` (``outage_odometer_errors.csv``).
-
-With ``curve_folds``, the ridge is also refitted with the sweep's starts split into each of those numbers of folds:
-its speed error against its training windows per fold (:mod:`bgfn.studies.odometer.ridge_curve`,
-``outage_odometer_curve.csv``).
-
-Every row is fused at the aid epochs (``nav.nhc.rate_hz``) through the chi-square gate (``gate_probability``).
-With ``correlation`` the learned odometers (the ridge, the networks, the ensembles) are fused with ``R = kappa
-std^2``, ``kappa`` the integrated autocorrelation of their errors on their validation windows
-(:func:`bgfn.learning.odometry.error_correlation`, lags up to ``correlation_max_lag_s``): their errors last
-several epochs, and fused as white they would count each epoch as new information. The learning-free bars keep
-``kappa = 1``: the oracle's noise is white by construction, and the held speed has no validation windows.
-Each row also carries the speed error the odometer made inside the outage against the reference's speed
-(``speed_rmse_mps``) and the share of epochs within its own 2 sigma (``coverage_2sigma``).
+A learned odometer predicts the forward speed and its std from body-frame IMU windows, fused with the NHC rows
+(:mod:`bgfn.nav.odometer`). With the sweep's starts, folds and durations this module runs ``INS+NHC``;
+``INS+NHC+HOLD`` (the speed at the outage start held); ``RIDGE-ODO`` (a ridge on band energies,
+:class:`bgfn.learning.odometry.RidgeOdometer`); the networks as odometers (``BGFN-ODO`` ...,
+trained per fold with beta-NLL, their std calibrated on validation windows) and their seed ensembles; and
+``ORACLE-SPEED`` (the reference's speed plus white noise ``sigma``; ``+WALK`` adds a random walk): how accurate a
+speed must be to help. Learned odometers are fused with ``R = kappa std^2``, ``kappa`` the integrated
+autocorrelation of their validation errors. With ``paper_outages`` every row also runs in the drive's two
+evaluation outages (:data:`PAPER_FOLD`, ``outage_odometer_paper.csv``), outside the sweep's statistics.
 """
 
 from __future__ import annotations

@@ -1,26 +1,11 @@
 """Independent runs side by side: one runner for every loop whose items do not depend on each other.
 
-The runs of a profile are independent: a training run is ``(dataset, method, seed)``, a sweep run
-``(dataset, fold, method, seed)``, an oracle run ``(dataset, window, sigma, seed)``. :class:`Runner` hands them to
-joblib and gives the results back **in the order of the tasks**, whatever order they finish in, so a table built
-from them does not depend on the number of jobs. Each run seeds itself and sets its own torch thread count (the
-profile's ``train.optimizer.num_threads``; a thread count changes the order of floating-point sums), so a run's
-result depends on its own inputs only: the tables are the same with 1 job, with 2 and on a cluster.
-
-Where the runs go (the profile's ``parallel:`` section; ``JOBS=`` and ``DASK_SCHEDULER=`` on the make command line
-win, as the environment variables ``BGFN_JOBS`` and ``DASK_SCHEDULER``):
-
-- ``jobs: 1``: one after the other in this process (no pool, no pickling);
-- ``backend: loky`` (default) with ``jobs`` > 1 or null (= the cores of this machine): joblib's process pool;
-- ``backend: dask`` with a ``scheduler`` address (``tcp://host:8786``): joblib's Dask backend on a
-  ``dask.distributed`` cluster, every worker a Python with this package installed, the checkout on a filesystem
-  the workers share at the same path (they write checkpoints under ``results/<profile>/``; README, "On a
-  cluster").
-
-Progress (:class:`RunProgress`): a tqdm bar over the runs (in a notebook: one bar per loop, no per-batch output)
-and one line per finished run with what it reports, its seconds, the runs left and an ETA. Under ``make
-reproduce`` the lines go to the file named by ``BGFN_PROGRESS_LOG`` (``results/<profile>/logs/<notebook>.log``),
-which make shows on the terminal as they come; without it they are printed.
+A training run ``(dataset, method, seed)``, a sweep run, an oracle run are independent. :class:`Runner` hands them to
+joblib and gives the results back in the order of the tasks, and each run seeds itself and sets its own torch
+thread count, so the tables are the same with 1 job, with 2 and on a cluster. Where they go is the profile's
+``parallel:`` section (``JOBS=`` and ``DASK_SCHEDULER=`` on the make command line win): one after the other, a
+loky process pool, or a ``dask.distributed`` cluster sharing the checkout's path. :class:`RunProgress` shows a bar
+and one line per finished run, to ``BGFN_PROGRESS_LOG`` under ``make reproduce``.
 """
 
 from __future__ import annotations

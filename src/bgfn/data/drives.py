@@ -1,28 +1,13 @@
 """Datasets of the Turin drive and of a recorded car drive: ``load_drive(name, **overrides)``, cached in
 ``data/processed/``.
 
-=====================  ==========================================================================
-name                   content
-=====================  ==========================================================================
-``turin-sim-ekinox``   the paper's *dataset test* (default): smooth 100 Hz truth from NaveGo ``ref``;
-                       IMU synthesized from it (:func:`bgfn.nav.sim.imu_from_trajectory`) with the
-                       Ekinox-D error profile; GNSS = real Ekinox fixes (5 Hz, or decimated)
-``turin-sim-mpu6000``  stand-in for the paper's private *field test*: same truth, MPU-6000 errors
-                       (turn-on biases, scale factor, misalignment, vibration), GNSS simulated like a
-                       1 Hz u-blox receiver with lever arm [-0.369, 0, -0.219] m
-``navego-ekinox``      real Ekinox-D IMU (``ekinox_imu.mat``, 200 Hz -> 100 Hz) + real GNSS + truth
-``navego-mpu6000``     real MPU-6000 IMU (``mpu6000_imu.mat``, ~250 Hz -> 100 Hz) + real GNSS + truth
-``rtklib-drive0708``   a real car drive (Colorado, 548 s): real 100 Hz MEMS IMU (TDK ICM-45686, jittery
-                       times -> 100 Hz grid); reference = the RTK fixed solution (position, velocity, no
-                       attitude); GNSS = a seeded degraded copy of it like the simulated u-blox receiver
-                       (:func:`_build_rtklib`)
-a folder path          a user's drive in the CSV schema (:mod:`bgfn.data.csv_drive`)
-=====================  ==========================================================================
-
-Every random draw is seeded by the ``seed`` parameter (independent sub-streams for IMU and GNSS).
-A built dataset is cached under ``<data>/processed/<name>/<key>.npz|json``; ``key`` hashes the dataset
-name, its parameters, the raw files' checksums and the source of the data modules, so a change of any
-of them rebuilds. ``t_start``/``t_end`` crop after the cache (they are not part of the key).
+``turin-sim-ekinox`` (the paper's dataset test: NaveGo's truth, an IMU synthesized from it with the Ekinox-D errors,
+the real Ekinox fixes), ``turin-sim-mpu6000`` (the stand-in for the paper's private field test: MPU-6000 errors and
+a simulated 1 Hz receiver), ``navego-ekinox`` and ``navego-mpu6000`` (the recorded IMUs), ``rtklib-drive0708`` (a
+real car drive, its RTK fixed solution as the reference, a seeded degraded copy as the GNSS), or a folder path (a
+user's CSV drive, :mod:`bgfn.data.csv_drive`). Every draw is seeded by ``seed``; a built dataset is cached under a
+key that hashes its name, parameters, raw files' checksums and the data modules' source, so a change rebuilds;
+``t_start``/``t_end`` crop after the cache.
 """
 
 from __future__ import annotations

@@ -1,28 +1,12 @@
 """The odometer learning problem (beyond the paper): body-frame IMU windows -> forward speed.
 
-Unlike ``delta_p_gps`` (:mod:`bgfn.learning.targets`), the forward speed does not accumulate, and an IMU window can
-observe it: centripetal acceleration over yaw rate in turns, the vibration spectrum while rolling, stillness at
-stops. The inputs are the six raw IMU channels only (``accel_x..z``, ``gyro_x..z``, body frame): no attitude,
-no GPS-derived or filter velocity, so nothing of the GPS-aided solution leaks into an outage.
-
-Target: the forward speed of the GPS-aided solution in the vehicle frame (:func:`forward_speed`), ``u . v^b`` with
-``v^b = C_bn^T v^n`` and ``u`` the vehicle's x axis in the body frame (the mounting tangents of
-:func:`bgfn.nav.constraints.mounting_track`; zero: the body x axis), at the epochs the windows end at.
-
-The simple learned odometer (``RIDGE-ODO``, the bar a network must clear to justify its cost): ridge regression
-on the log energies of each IMU axis in :data:`BANDS_HZ` (:func:`band_energies`), standardized on the training
-windows; its std is the RMS of its residuals on the validation windows (:class:`RidgeOdometer`).
-
-The networks read either the raw windows or, by default, the same kind of features over time
-(:func:`network_inputs`, ``evaluate.odometer.inputs: band_frames``): each 0.4 s frame's per-axis mean (gravity,
-centripetal acceleration, yaw rate) and log band powers (the vibration of rolling), 9 frames of a 2 s window. On
-a drive of a few hundred training windows a network that must first learn to square and log its raw inputs
-learned less than the ridge on those features (deviations page); the front end gives every network the ridge's
-features, ordered in time, so what a network adds over the ridge is its own.
-
-For the networks that predict a speed and its log-variance: the beta-NLL loss (:func:`beta_nll`, so the variance
-cannot swallow the error) and the one calibration factor on their std fitted on held-out windows so that the
-normalized residuals have unit mean square (:func:`calibration_factor`, NIS = 1).
+Unlike ``delta_p_gps``, the forward speed does not accumulate, and an IMU window can observe it (centripetal
+acceleration over yaw rate in turns, the vibration while rolling, stillness at stops). The inputs are the six raw
+IMU channels only, so nothing of the GPS-aided solution leaks into an outage; the target is the GPS-aided
+solution's speed along the vehicle's x axis (:func:`forward_speed`). ``RIDGE-ODO`` (:class:`RidgeOdometer`), the bar
+a network must clear, is a ridge on per-axis log band energies; the networks read, by default, the same features
+over time (:func:`network_inputs`). Networks that predict a speed and its log-variance fit the beta-NLL loss
+(:func:`beta_nll`) and one calibration factor on their std (:func:`calibration_factor`, NIS = 1).
 """
 
 from __future__ import annotations

@@ -1,26 +1,11 @@
 """Notebook 02 workflow: the KF baseline on a drive (full GPS/INS run, standalone INS in the outages).
 
-The ``nav:`` section of ``params/<profile>.yaml`` configures it (keys and defaults: :class:`bgfn.settings.Nav`); the
-outages are the profile's ``outage_windows`` (:func:`bgfn.nav.outages.outage_windows`).
-
-- ``datasets``: drive names for :func:`bgfn.data.load_drive` (the profile's ``data:`` section crops them);
-- ``init``: initial std ``position_std_m``, ``height_std_m``, ``velocity_std_mps``, ``level_std_deg``,
-  ``azimuth_std_deg`` (P0 when the filter starts from the reference's first row);
-- ``alignment``: where the filter starts (:mod:`bgfn.nav.alignment`): ``mode`` ``reference`` (the reference's first
-  row; the drive must carry an attitude), ``gnss`` (self-alignment from the IMU and GNSS; the filter waits for it)
-  or ``auto`` (reference when the drive has an attitude, else gnss), and the self-alignment's thresholds and stds;
-- ``bias_model`` (``random_walk`` | ``gauss_markov``): see :func:`bgfn.nav.state.noise_from_imu_errors`;
-- ``noise_scale``: factor on the IMU white-noise densities, a number or ``auto`` (the factor that makes the GNSS
-  innovations consistent, :mod:`bgfn.nav.tuning`, with the ``noise_search`` options), or a mapping of dataset
-  names to those with a ``default`` entry (:func:`noise_scale_of`);
-- ``ins_tuning``: ``shipped`` (the bias modelling above) or ``navego`` (NaveGo v1.4's: static biases removed
-  from the IMU, Gauss-Markov bias states of the dynamic biases; :mod:`bgfn.nav.navego_setup`, which then
-  ignores ``bias_model``);
-- ``innovation_gate``: null (every GNSS fix fused, the paper's filter) or a probability ``p``: a fix whose NIS
-  exceeds the ``p`` quantile of chi-square is not fused (:func:`bgfn.nav.filter.run_filter`);
-- ``nhc``, ``zupt``: the vehicle constraints of the ``INS+NHC`` rows (:mod:`bgfn.nav.constraints`; ZUPT whenever
-  the stillness detector fires, the label says NHC anyway); ``constraints_in_gps_run``: false (the paper's
-  GPS-aided filter) or true (the GPS-aided run applies them too, :func:`gps_aids`).
+The ``nav:`` section of the profile configures it (keys and defaults: :class:`bgfn.settings.Nav`): the datasets,
+the initial stds, where the filter starts (the reference's first row or a self-alignment, :mod:`bgfn.nav.alignment`),
+the bias model, the noise scale (a number, or ``auto``: :mod:`bgfn.nav.tuning`), NaveGo's setup
+(:mod:`bgfn.nav.navego_setup`), the innovation gate and the vehicle constraints of the ``INS+NHC`` rows
+(:mod:`bgfn.nav.constraints`). The outages are the profile's ``outage_windows``
+(:func:`bgfn.nav.outages.outage_windows`).
 """
 
 from __future__ import annotations

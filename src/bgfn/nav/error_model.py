@@ -1,31 +1,13 @@
 """The paper's 15-state INS error model (Sec. 2): state indices, system matrix F, discrete Phi and Q.
 
-State vector, Eq. (eq13), in exactly the paper's order::
+State vector, Eq. (eq13), in the paper's order::
 
     x = [phi_E, phi_N, phi_D, dV_E, dV_N, dV_D, dL, dlambda, dh, nabla_x, nabla_y, nabla_z, eps_x, eps_y, eps_z]
 
-- ``phi``: attitude (misalignment) errors, rad, defined by ``C_bn_computed = (I - [phi x]) C_bn_true``;
-- ``dV``: velocity errors (computed - true), m/s;
-- ``dL, dlambda``: latitude and longitude errors, rad; ``dh``: height error, m (all computed - true);
-- ``nabla``: accelerometer bias estimate errors (body), m/s^2; ``eps``: gyro bias errors (body), rad/s.
-
-The component order inside the attitude and velocity blocks (E, N, D) is the paper's; the arithmetic below
-works with NED 3-vectors and scatters them with the index arrays ``PHI_NED`` and ``DV_NED``.
-
-Continuous model (NED; ``w_in = w_ie + w_en``, ``f^n = C_bn f^b``, ``v`` the NED velocity):
-
-- Eq. (eq9):  ``phi_dot = -w_in x phi + d(w_in) - C_bn eps``
-- Eq. (IVE):  ``dV_dot = f^n x phi - (2 w_ie + w_en) x dV + v x (2 d(w_ie) + d(w_en)) + C_bn nabla + dg^n``
-  (``dg^n = [0, 0, dg/dL dL - 2 g dh / R]``: normal-gravity variation, an addition to the paper's
-  equation);
-- Eq. (IPE):  ``dL_dot = dV_N/(R_M+h) - dh V_N/(R_M+h)^2``,
-  ``dlambda_dot = dV_E sec L/(R_N+h) + dL V_E tan L sec L/(R_N+h) - dh V_E sec L/(R_N+h)^2``,
-  ``dh_dot = -dV_D`` (NED: down velocity);
-- biases: ``nabla_dot = -nabla/tau_a + w_a``, ``eps_dot = -eps/tau_g + w_g`` (``tau = inf``: random walk).
-
-Here ``d(w_ie) = dw_ie/dL dL`` and ``d(w_en)`` is the first-order variation of the transport rate in
-``dV``, ``dL`` and ``dh`` (curvature-radius derivatives neglected, as in Eq. IPE).
-Discretization per IMU step: ``Phi = I + F dt``, ``Q_d = G Q_c G^T dt`` (Eq. eq3).
+``phi`` the attitude errors (``C_bn_computed = (I - [phi x]) C_bn_true``), ``dV``, ``dL, dlambda, dh`` the velocity
+and position errors (computed - true), ``nabla``/``eps`` the accelerometer/gyro bias errors (body frame). F follows
+Eqs. (eq9, IVE, IPE) with the normal-gravity variation added to Eq. IVE; the biases are first-order Gauss-Markov
+(``tau = inf``: random walk). Discretization per IMU step: ``Phi = I + F dt``, ``Q_d = G Q_c G^T dt`` (Eq. eq3).
 """
 
 from __future__ import annotations

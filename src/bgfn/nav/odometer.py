@@ -1,27 +1,12 @@
 """An odometer as an aid of the filter engine: the forward speed in the vehicle frame, with its uncertainty.
 
-Beyond the paper (the design of OdoNet, TLIO and AI-IMU: the network predicts a quantity that does not
-accumulate, with its own uncertainty, and the filter owns the fusion). At every NHC epoch of the vehicle
-(:mod:`bgfn.nav.constraints`: its aid epochs, its vehicle frame) the odometer measures the forward row of the
-vehicle-frame velocity::
-
-    z = v^v_x = speed + w,   w ~ N(0, kappa std^2)
-
-(``kappa``: the track's error correlation from epoch to epoch, :class:`SpeedTrack`; 1 for white errors.)
-
-With ``M = R_vb C_bn^T`` (NED -> vehicle frame) the computed value is ``v^v_computed = v^v_true + M dV - M [v x] phi``
-(the same linearization as the NHC rows), so the forward row of ``H`` is ``M_x`` on ``dV`` and ``-(M [v x])_x`` on
-``phi``. The odometer is an aid of its own (:class:`Odometer`); put after the vehicle constraints in the aid list
-it is *joint*: its row joins their NHC rows at the epoch, measured from the same state and fused as one update
-(:class:`bgfn.nav.engine.AidSchedule`). At a ZUPT epoch the velocity is zero in every axis and no speed row is
-added.
-
-The speed and its std come from a :class:`SpeedTrack` (a learned odometer's predictions at the aid epochs, the
-speed held from the outage start, an oracle ...): at an epoch, the track's last value at or before it, no older
-than ``max_age_s``. A row whose normalized innovation squared exceeds the ``gate_probability`` quantile of
-chi-square with one degree of freedom is left out (:attr:`bgfn.nav.engine.Measurement.gate`), so one wild
-prediction cannot pull the solution away. :func:`speed_errors` scores a track against the true speed inside an
-outage (its RMSE and the share of epochs within its +-2 sigma).
+Beyond the paper (the design of OdoNet, TLIO and AI-IMU: the network predicts a quantity that does not accumulate,
+with its own uncertainty, and the filter owns the fusion). At every NHC epoch of the vehicle
+(:mod:`bgfn.nav.constraints`) it measures ``z = v^v_x = speed + w``, ``w ~ N(0, kappa std^2)`` (``kappa``: the
+track's error correlation, 1 for white errors), linearized as the NHC rows are. Put after the vehicle constraints
+in the aid list its row joins their NHC rows as one update; at a ZUPT epoch no speed row is added. The speed comes
+from a :class:`SpeedTrack` (a learned odometer, a held speed, an oracle); a row beyond the ``gate_probability``
+quantile of chi-square is left out. :func:`speed_errors` scores a track against the true speed in an outage.
 """
 
 from __future__ import annotations

@@ -1,34 +1,14 @@
-"""The results page (notebook 10): our tables beside the paper's, where each number came from, and plain
-sentences computed from the numbers.
+"""The results page (notebook 10) and every sentence of the notebooks: our tables beside the paper's, where each
+number came from, and plain sentences computed from the numbers.
 
-Inputs (all written by notebooks 01-05 under ``results/<profile>/``; a missing file is reported, never
-fatal):
-
-- ``tables/outage_dataset.csv``, ``tables/outage_field.csv`` (notebook 04): ``outage, method, max_east_m,
-  max_north_m, rmse_h_m, final_h_m`` -- paper Tables ``tab-out1-exin`` and ``tab-real``;
-- ``data/paper/outage_max_errors.csv`` and ``data/paper/claims.yaml`` (read by :mod:`bgfn.paper`): the
-  paper's published values (shown in a column group labelled *paper*; never used to choose anything);
-- ``kf_baseline.json`` (02), ``training.json`` and ``tables/training_summary.csv`` (03),
-  ``outage_evaluation.json`` and ``tables/outage_sweep_summary.csv`` (04), ``energy.json`` (05), the model
-  cards ``models/<dataset>/<method>_seed<k>.json`` (03/04): metadata lines under every table.
-
-Modules, in the order the page needs them:
-
-- :mod:`bgfn.report.reading` -- read ``results/<profile>/`` (:func:`read_results`), a missing file is ``None``;
-- :mod:`bgfn.report.tables` -- table styling, BGFN's reduction against INS, the energy, filter, training and
-  sweep tables;
-- :mod:`bgfn.report.provenance` -- the source and run-metadata line under every table;
-- :mod:`bgfn.report.sentences` -- plain sentences computed from the numbers;
-- :mod:`bgfn.report.profile_comparison` -- profiles side by side, and one profile against the untrained references;
-- :mod:`bgfn.report.glance` -- the run header, the *At a glance* lines and ``findings.md``;
-- :mod:`bgfn.report.figures` -- the page's figure lists and the four drawings made from the profile;
-- :mod:`bgfn.report.sections` -- each section of the page as the pieces to display;
-- :mod:`bgfn.report.verdict` -- the verdict on top: every aid per test and the answers to five questions;
-- ``bgfn.report.*_words`` -- the notebooks' sentences, a module per topic (:mod:`~bgfn.report.nav_words`,
-  :mod:`~bgfn.report.training_words`, :mod:`~bgfn.report.evaluation_words`, :mod:`~bgfn.report.energy_words`, ...):
-  the lower layers return numbers, tables and codes.
-
-Everything public is re-exported here: ``from bgfn import report; report.outage_section(res, "dataset")``.
+The page reads what notebooks 01-09 wrote under ``results/<profile>/`` (a missing file is reported, never fatal)
+and the paper's published values (:mod:`bgfn.paper`; shown beside ours, never used to choose anything). Modules:
+:mod:`~bgfn.report.reading`, :mod:`~bgfn.report.tables`, :mod:`~bgfn.report.provenance`,
+:mod:`~bgfn.report.sentences`, :mod:`~bgfn.report.profile_comparison`, :mod:`~bgfn.report.glance`,
+:mod:`~bgfn.report.figures`, :mod:`~bgfn.report.sections`, :mod:`~bgfn.report.verdict` and the page's first screen;
+``*_words`` modules word each notebook's results (:mod:`~bgfn.report.nav_words`, ...): the lower layers return
+numbers, tables and codes. Everything public of the page is re-exported here:
+``from bgfn import report; report.outage_section(res, "dataset")``.
 """
 
 from bgfn.report.figures import (EXTRA_FIGURES, PAPER_FIGURES, draw_diagrams, extra_figure_section, figure_list,

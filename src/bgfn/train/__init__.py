@@ -1,32 +1,13 @@
-"""Training of BGFN and the baselines (paper Sec. 4.1: BPTT, batch 8, 1000 epochs on a GPU), kept apart from
-the networks (:mod:`bgfn.models`) and the learning problem (:mod:`bgfn.learning`).
+"""Training of BGFN and the baselines (paper Sec. 4.1: BPTT, batch 8, 1000 epochs on a GPU), kept apart from the
+networks (:mod:`bgfn.models`) and the learning problem (:mod:`bgfn.learning`).
 
-Modules, one concept each (every public name is re-exported here):
-
-- :mod:`bgfn.train.options`: the ``train:`` optimizer settings, per-method learning rate, model size blocks;
-- :mod:`bgfn.train.loop`: :func:`train_model`, one ``(method, seed)`` with early stopping, checkpoint, card and
-  resume;
-- :mod:`bgfn.train.memory`: :func:`keep_freed_memory`, freed tensors kept in the heap for the next step;
-- :mod:`bgfn.train.objectives`: what a run fits, the paper's increments or a learned odometer's speed;
-- :mod:`bgfn.train.trained`: :class:`TrainedModel` and :func:`load_trained`, a checkpoint predicting
-  delta_p_gps (Eq. pred-gps);
-- :mod:`bgfn.train.tasks`: a network to train as one independent run (:class:`TrainingRun`), all of them spread
-  over a :class:`bgfn.parallel.Runner` (:func:`train_runs`);
-- :mod:`bgfn.train.lr_search`: the learning rate of every method from one grid on a tuning split;
-- :mod:`bgfn.train.profile`: a profile's runs (:class:`TrainingPlan`), its drives and windows, the INS attitude
-  input, the training over datasets x methods x seeds;
-- :mod:`bgfn.train.runs`: :func:`train_profile`, a whole profile (main networks, then variants) from one call;
-- :mod:`bgfn.train.variants`: the profile's input and protocol variants (:class:`VariantPlan`), trained beside the
-  main networks with their learning rates;
-- :mod:`bgfn.train.recheck`: the runs that never improved on their initial network, trained again on all their
-  training windows;
-- :mod:`bgfn.train.tables`: the run and summary tables, the windows table, ``training.json``;
-- :mod:`bgfn.train.plots`: the figures of notebook 03;
-- :mod:`bgfn.train.estimate`: how long the paper profile would train here, from ``make bench``;
-- :mod:`bgfn.train.speed`: CPU timing (latency, throughput, the profiled training step) for ``make bench``;
-- :mod:`bgfn.train.checkpoints`: where trained networks live (names of checkpoints and cards).
-
-The command line ``python -m bgfn train --profile ...`` is the package's edge (:mod:`bgfn.__main__`).
+Modules, one concept each (every public name is re-exported here): ``options`` (the ``train:`` settings),
+``loop`` (:func:`train_model`, one run with early stopping, checkpoint, card and resume), ``memory``,
+``objectives`` (the increments or a learned odometer's speed), ``trained`` (:func:`load_trained`), ``tasks``
+(independent runs over a :class:`bgfn.parallel.Runner`), ``lr_search``, ``profile`` (:class:`TrainingPlan`: a
+profile's runs), ``runs`` (:func:`train_profile`), ``variants``, ``recheck``, ``tables``, ``plots``, ``estimate``
+(the paper profile's training time here), ``speed`` (timing for ``make bench``), ``checkpoints``. The command line
+``python -m bgfn train --profile ...`` is the package's edge (:mod:`bgfn.__main__`).
 """
 
 from bgfn.learning import REFERENCES, VAL_POSITIONS

@@ -1,26 +1,16 @@
-"""``python -m bgfn train``: train the networks of a profile from the shell (what notebook 03 trains, with the
-learning rates its search selected once it has run). A command line is an edge of the package: it checks the
-profile and its options (:func:`bgfn.profile_schema.with_overrides`) before anything runs.
+"""The package's command line, an edge: each command checks the profile and its options
+(:func:`bgfn.profile_schema.with_overrides`) before anything runs.
 
-``python -m bgfn kernels``: compile the navigation's numba kernels into numba's cache (:mod:`bgfn.evaluate.kernels`;
-``make reproduce`` runs it in the background while notebook 01 prepares the data).
-
-``python -m bgfn odometers``: notebook 04's odometer bars alone (:func:`bgfn.studies.odometer.bars.run_odometer_section`) for a
-profile, its tables under ``results/<profile>/``; ``--record`` then keeps their summary in ``data/measured/``
-(:mod:`bgfn.studies.odometer.sizes`), where the book reads a run made on another machine (a GPU: the profile
-``paper-odometer``).
-
-``python -m bgfn walltimes``: the wall-time section of the book's "Reproduce it" page
-(:mod:`bgfn.report.walltimes`; ``make book`` writes it), or ``--record JOBS`` to add the notebooks of a finished
-run to the measured runs.
+- ``python -m bgfn train``: a profile's networks (what notebook 03 trains, with the learning rates its search chose);
+- ``python -m bgfn kernels``: the navigation's numba kernels compiled into numba's cache (:mod:`bgfn.evaluate.kernels`);
+- ``python -m bgfn odometers``: the odometer bars alone (:func:`bgfn.studies.odometer.section.run_odometer_section`);
+  ``--record`` keeps their summary in ``data/measured/`` (:mod:`bgfn.studies.odometer.sizes`: a run on a GPU);
+- ``python -m bgfn walltimes``: the wall times of the book's "Reproduce it" page (:mod:`bgfn.report.walltimes`).
 
 Example::
 
     python -m bgfn train --profile quick --dataset turin-sim-mpu6000 --method bgfn --seed 0
-    python -m bgfn train --profile quick --variants        # every network of notebook 03, variants included
     python -m bgfn train --profile paper --jobs 8           # 8 runs at a time (default: the profile's parallel:)
-    python -m bgfn walltimes --profile quick --record 2 --total-s 655   # after make reproduce JOBS=2
-    python -m bgfn odometers --profile paper-odometer --record          # on a GPU machine
 """
 
 from __future__ import annotations

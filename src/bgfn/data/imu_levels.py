@@ -1,26 +1,12 @@
 """IMU error levels measured on a drive: noise at rest, vibration while driving, spectra.
 
-The field-test stand-in (``turin-sim-mpu6000``) simulates a consumer MEMS IMU; how noisy such an IMU is in a
-car is not on its datasheet (engine and road vibration dominate). This module measures the levels on any
-drive's IMU table so that the stand-in's error model can be set from a real car's IMU (the recorded drive
-``rtklib-drive0708``) and checked against it (notebook 01; the book's deviations page).
-
-Motion states come from the reference speed (not from the IMU, so the measurement does not depend on a
-detector tuned on the same signal), averaged over ``SMOOTH_S``: *still* below ``STILL_MPS`` for at least
-``MIN_REST_S`` with ``TRIM_S`` cut from both ends of each stop (starting and stopping), *driving* above
-``DRIVING_MPS``. At rest the mean gyro reading of each stop is the gyro bias (the Earth rate, below
-7.3e-5 rad/s, is not removed: a real drive's attitude is unknown) and the mean |f| compares the
-accelerometers with gravity (:func:`rest_biases`).
-
-- *vibration* = standard deviation of the high-passed signal (2nd-order Butterworth above ``highpass_hz``,
-  zero phase): above a few hertz a car's own motion (turns, pitch and heave of the body) has little power, so
-  what is left is sensor noise plus vibration.
-- *white-noise density* ``N`` (the convention of :mod:`bgfn.data.imu_errors`: white noise of std
-  ``N / sqrt(dt)``, one-sided PSD ``2 N^2``): the high-passed level of white noise is ``N sqrt(B)`` with the
-  filter's noise bandwidth ``B = 2 * integral of |H(f)|^4 df`` over ``[0, f_nyq]`` (:func:`noise_band_hz`;
-  ``|H|^4``: the filter runs forward and backward), about ``f_s - 2 f_hp``.
-- The simulated vibration (:mod:`bgfn.data.imu_errors`) is band-limited noise times a speed envelope; its std
-  that reproduces a measured driving level is ``sqrt(level^2 - N^2 B)`` (:func:`vibration_overrides`).
+How noisy a consumer MEMS IMU is in a car is not on its datasheet (engine and road vibration dominate). This module
+measures the levels on any drive's IMU table, so that the stand-in's error model (``turin-sim-mpu6000``) can be set
+from a recorded car's IMU and checked against it (notebook 01; the deviations page). Motion states come from the
+reference speed (still, driving), not from the IMU; the vibration is the std of the high-passed signal (a car's own
+motion has little power above a few hertz); the white-noise density follows from the high-pass filter's noise
+bandwidth (:func:`noise_band_hz`), and the simulated vibration that reproduces a measured driving level from both
+(:func:`vibration_overrides`).
 """
 
 from __future__ import annotations

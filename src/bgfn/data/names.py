@@ -1,23 +1,10 @@
 """Dataset names and dataset ids: what a profile writes, and the safe id every result file is named by.
 
-A profile names a drive either by a registered dataset (``turin-sim-ekinox``, ... :data:`bgfn.data.DATASETS`)
-or by a folder in the CSV schema (:mod:`bgfn.data.csv_drive`), given as an absolute path or relative to the
-repository root (the folder ``make`` runs the notebooks in), else to the current directory. Result files
-(checkpoints, tables, figures, filter states) are named by :func:`dataset_id`, never by the path: outputs stay
-under ``results/<profile>/`` and no file name holds a folder path.
-
-=======================  ===============================================================================
-name in the profile      dataset id
-=======================  ===============================================================================
-a registered dataset     the name itself (the shipped datasets keep their file names)
-a CSV folder             ``name`` of its ``meta.yaml`` when given, else the folder's own name made safe
-                         (characters other than letters, digits, ``_``, ``-``, ``.`` become ``-``)
-anything else            the last path component, made safe (a missing folder fails later, in
-                         :func:`bgfn.data.load_drive`, with a message naming it)
-=======================  ===============================================================================
-
-Every function that builds a file name from a dataset calls :func:`dataset_id`; it is idempotent on ids, so a
-name read back from a result file (a model card, a table's ``dataset`` column) gives the same file.
+A profile names a drive by a registered dataset (:data:`bgfn.data.DATASETS`) or by a folder in the CSV schema
+(:mod:`bgfn.data.csv_drive`; absolute, or relative to the repository root, else to the current directory). Result
+files are named by :func:`dataset_id`, never by the path, so outputs stay under ``results/<profile>/`` and no file
+name holds a folder path: a registered dataset keeps its name, a CSV folder takes its ``meta.yaml`` ``name`` or its
+own name made safe. :func:`dataset_id` is idempotent, so a name read back from a result file gives the same file.
 """
 
 from __future__ import annotations

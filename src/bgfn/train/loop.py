@@ -1,25 +1,12 @@
 """One training loop for BGFN and the baselines (paper Sec. 4.1: BPTT, batch 8, 1000 epochs on a GPU).
 
-:func:`train_model` trains one ``(method, seed)`` on a :class:`bgfn.learning.LearningData` and writes
-
-- ``<out_dir>/<method>_seed<k>.pt``: the best checkpoint (lowest validation loss): weights, normalization,
-  learning options and model size, enough for :func:`bgfn.train.trained.load_trained`;
-- ``<out_dir>/<method>_seed<k>.json``: the card (parameters, epochs run, best validation loss, wall time,
-  device, per-epoch history, validation RMSE of delta_p_gps and of the zero / last-increment references);
-  epoch 0 of the history is the initial network, validated before training, so that ``best_epoch >= 1`` says
-  that training improved on it;
-- ``<out_dir>/<method>_seed<k>.last.pt`` while training: the state after the last finished epoch (optimizer,
-  scheduler, RNG), from which an interrupted run resumes; removed when the run completes.
-
-Every method gets the same budget (:mod:`bgfn.train.options`): AdamW, the same epochs, batch size, schedule and
-early stopping on the validation loss (MSE of the normalized increments; for a learned odometer's speed data the
-beta-NLL of its speed and variance, :mod:`bgfn.train.objectives`).
-
-A completed run is not redone: if its card exists with the same configuration hash, :func:`train_model`
-returns the card (delete the files to retrain). The hash covers the method, seed, sizes, optimizer, learning
-options, the training data and the code: the source of :mod:`bgfn.models` and of this loop and its objectives
-(:func:`training_fingerprint`), so a network trained under another definition of its layers or its loss is trained
-again rather than loaded.
+:func:`train_model` trains one ``(method, seed)`` on a :class:`bgfn.learning.LearningData` and writes the best
+checkpoint (``<method>_seed<k>.pt``, enough for :func:`bgfn.train.trained.load_trained`), its card (``.json``: the
+history from epoch 0, the initial network, so that ``best_epoch >= 1`` says training improved on it) and, while
+training, the state to resume from (``.last.pt``). Every method gets the same budget (:mod:`bgfn.train.options`).
+A completed run is not redone: a card with the same configuration hash is returned, and the hash covers the
+method, seed, sizes, optimizer, learning options, training data and the source of the models and this loop
+(:func:`training_fingerprint`), so a network trained under another definition is trained again.
 """
 
 from __future__ import annotations

@@ -1,28 +1,13 @@
 """How rough an IMU is beyond its vibration: Allan deviation at rest, the bias's wander between stops, and the
 yaw-rate residual while driving; measured alike on a recorded drive and on the simulated stand-in.
 
-The stand-in ``turin-sim-mpu6000`` must drift as a real MEMS IMU in a car does (notebook 08 compares the
-drift). Which error terms set the drift? A 9-minute recorded drive cannot give the classic hour-long static
-Allan curve, so three measurements that a drive does allow, each run on the stand-in too (where the truth is
-known, so the method's own bias shows):
-
-1. **Allan deviation at rest** (:func:`rest_allan`): the stops (:func:`bgfn.data.imu_levels.rest_spans`)
-   pooled, clusters never straddling two stops (:func:`bgfn.data.allan.allan_deviation`). Averaging times up
-   to a few seconds: the white-noise density ``N`` (``adev * sqrt(tau)``, :func:`noise_densities`).
-2. **Bias wander between stops** (:func:`stop_biases`, :func:`bias_instability`): the mean gyro reading of each
-   stop, less the Earth rate seen by a level IMU heading along the course before the stop, is that stop's
-   bias; between stops ``dt`` apart a Gauss-Markov bias of std ``sigma`` and correlation time ``T`` changes by
-   ``E[db^2] = 2 sigma^2 (1 - exp(-dt/T)) + a(d_i)^2 + a(d_j)^2`` (the second term: the noise of the two stop
-   means, read off the Allan deviation at rest ``a`` at each stop's duration ``d``: idle vibration is not
-   white). ``sigma^2`` by the moment estimator over all pairs of stops, ``T`` the stand-in's.
-   This reaches the averaging times (minutes) that set the INS drift in an outage.
-3. **Yaw-rate residual while driving** (:func:`yaw_residual_allan`): the gyro's z reading minus the course
-   rate of the reference velocity (zero at rest), in 1 s bins that are fully at rest or fully driving
-   (sideslip-free car, level IMU: the assumptions hold to a few hundredths of a degree per second; the
-   reference's own rate noise dominates below about 10 s).
-
-:func:`roughness_table` puts each measured value beside the stand-in's setting and what the same measurement
-finds on the stand-in; ``implied`` = setting x recorded / stand-in measured carries the method's bias over.
+The stand-in ``turin-sim-mpu6000`` must drift as a real MEMS IMU in a car does. A 9-minute drive cannot give the
+classic hour-long static Allan curve, so three measurements a drive does allow, each run on the stand-in too (where
+the truth is known, so the method's own bias shows): the Allan deviation over the pooled stops (:func:`rest_allan`,
+the white-noise density), the gyro bias of each stop and its change between stops against a Gauss-Markov model
+(:func:`stop_biases`, :func:`bias_instability`: the minutes that set an outage's drift), and the gyro's yaw rate
+against the reference's course rate while driving (:func:`yaw_residual_allan`). :func:`roughness_table` sets each
+beside the stand-in's setting; ``implied`` = setting x recorded / stand-in measured carries the method's bias over.
 """
 
 from __future__ import annotations

@@ -1,27 +1,13 @@
 """Is the stand-in's IMU as rough as a real one? The recorded drive against its trajectory twin (notebook 08).
 
-The stand-in ``turin-sim-mpu6000`` simulates a consumer MEMS IMU; its INS drift decides how hard the paper's field
-test is. Measured at rest (:mod:`bgfn.studies.ins_fidelity.imu_roughness`: Allan deviation, the bias between stops) the recorded
-car's IMU is no rougher than the stand-in's error model, yet in outages it drifts several times further. What acts
-only while driving (scale factor and misalignment under turns, vibration rectification, a bias that wanders with
-temperature and load) is not seen at rest; it is seen by the filter.
-
-The measurement: the **effective gyro bias instability** of a drive, the value of the filter's gyro bias
-instability at which its standalone INS is consistent in outages (median NEES = the chi-square median 1.39,
-:mod:`bgfn.studies.ins_fidelity.nees`; log-log interpolated on the scan's grid, :func:`effective_instability`). It lumps every
-unmodelled driving error into the one term that dominates a MEMS INS's drift. Measured on
-
-- the recorded drive (its real IMU), and
-- its **trajectory twin** (:func:`bgfn.studies.ins_fidelity.imu_roughness.trajectory_twin`): the same road, GNSS, starts and
-  filter, with the stand-in's error model simulated on it (several seeds), whose truth is known: even a perfect
-  error model needs some margin (the filter does not model scale factor, misalignment or vibration).
-
-The twin needs more than its simulated instability ``m`` (the terms the filter does not model add ``x``); taking
-the two in quadrature, ``e_twin^2 = m^2 + x^2``, the simulated instability that gives the twin the recorded
-drive's ``e_rec`` is ``sqrt(e_rec^2 - x^2)`` (:func:`implied_setting`). From the MPU-6000 profile's 0.01 deg/s,
-:func:`settle_setting` repeats that step until it moves the setting by less than 10 %; the profile carries the
-result, and notebook 08 checks it on every run (:func:`bgfn.report.ins_fidelity_words.twin_lines`: the twin's
-effective instability against the recorded drive's, with the profile's setting).
+At rest (:mod:`bgfn.studies.ins_fidelity.imu_roughness`) the recorded car's IMU is no rougher than the stand-in's
+error model, yet in outages it drifts several times further: what acts only while driving is seen by the filter.
+The measurement is a drive's *effective gyro bias instability*, the filter's setting at which its standalone INS is
+consistent in outages (median NEES 1.39, :mod:`bgfn.studies.ins_fidelity.nees`; :func:`effective_instability`), on
+the recorded drive and on its trajectory twin (the same road, GNSS, starts and filter, with the stand-in's error
+model simulated). Taking the terms the filter does not model in quadrature, :func:`implied_setting` gives the
+simulated instability that matches the recorded drive and :func:`settle_setting` iterates it; the profile carries
+the result and notebook 08 checks it on every run (:func:`twin_check`).
 """
 
 from __future__ import annotations

@@ -1,25 +1,12 @@
 """Is the filter's covariance honest during an outage? The NEES of the horizontal position at each window's end.
 
-Every aid is fused with the filter's covariance, so a filter that believes its position better than it is (its
-covariance too small: *overconfident*) under-weights every aid, and one that believes it worse (*underconfident*)
-over-weights them. The normalized estimation error squared of the horizontal position against the filter's own
-std at the end of each outage window (:func:`bgfn.evaluate.hybrid.window_metrics`)::
-
-    NEES = (e_N / sd_N)^2 + (e_E / sd_E)^2
-
-is chi-square with 2 degrees of freedom when the filter is consistent: median 2 ln 2 = 1.39, 95 % of the runs
-below 5.99. The north-east correlation of the covariance is left out (the filter keeps only the stds of its
-states per epoch); with it the NEES could only be larger or smaller by the correlation's effect on the ellipse, not
-by the orders of magnitude that separate a consistent from an inconsistent filter.
-
-Per dataset, method and duration (the sweep) or outage (the paper's two): the median NEES, the share of runs
-inside the 95 % bound, and a word: *consistent* when the median lies within a factor :data:`FACTOR` of 1.39,
-*overconfident* above, *underconfident* below.
-
-Which setting explains an inconsistent filter? :func:`consistency_scan` (notebook 08) runs the standalone INS from
-the sweep's starts of each recorded drive (a simulated IMU's error model is known exactly) with the gyro bias
-instability of the filter's error model set to each value of a grid: the INS drift of a MEMS IMU over tens of
-seconds is the heading error its gyro biases build, and a filter that under-states them is overconfident.
+Every aid is fused with the filter's covariance: an *overconfident* filter (covariance too small) under-weights
+every aid, an *underconfident* one over-weights them. The normalized estimation error squared of the horizontal
+position at the end of each outage window, ``NEES = (e_N / sd_N)^2 + (e_E / sd_E)^2``, is chi-square with 2 degrees
+of freedom when the filter is consistent: median 2 ln 2 = 1.39, 95 % below 5.99. Per dataset, method and duration
+(the sweep) or outage (the paper's two): the median, the share inside the 95 % bound and a word (within a factor
+:data:`FACTOR` of 1.39: consistent). :func:`consistency_scan` (notebook 08) finds which gyro bias instability of
+the filter's error model makes the standalone INS of a recorded drive consistent.
 """
 
 from __future__ import annotations

@@ -1,21 +1,11 @@
 """Profiles (``params/<profile>.yaml``) and the paths every notebook writes to.
 
-A *profile* fixes the size of a run: ``smoke`` (CI, a minute), ``quick`` (default, minutes on a laptop),
-``paper`` (the paper's settings). Every notebook starts with a ``parameters`` cell (``profile = "quick"``)
-that papermill overrides, then::
-
-    from bgfn.config import results_dir, run_metadata
-    from bgfn.profile_schema import load_profile
-    cfg = load_profile(profile)          # dict: profile, description, seed, data, nav, train, evaluate, energy
-    out = results_dir(profile)           # results/<profile>/ with tables/ figures/ notebooks/ models/
-
-Outputs go to ``out / "tables" / "<name>.csv"``, ``out / "figures" / "<name>.png"`` and
-``out / "<name>.json"`` (metrics), always through :mod:`bgfn.io` (atomic writes).
-
-This module finds and merges profiles (:func:`read_profile`, the ``base:`` chain, laid over the defaults and checked
-key by key by :mod:`bgfn.settings`) and knows paths: it is a core fact and imports nothing of the package above it.
-The facts that tie keys together are the edge's (:mod:`bgfn.profile_schema`, whose ``load_profile`` reads with
-:func:`read_profile`, then checks them).
+A *profile* fixes the size of a run: ``smoke`` (CI, a minute), ``quick`` (default, minutes on a laptop), ``paper``
+(the paper's settings). Every notebook starts with a ``parameters`` cell (``profile = "quick"``) that papermill
+overrides, then ``cfg = load_profile(profile)`` (:mod:`bgfn.profile_schema`) and ``out = results_dir(profile)``
+(``results/<profile>/``), and writes its tables, figures and records there through :mod:`bgfn.io`. This module finds
+and merges profiles (:func:`read_profile`: the ``base:`` chain over the defaults of :mod:`bgfn.settings`) and knows
+the paths: a core fact, it imports nothing of the package above it.
 """
 
 from __future__ import annotations

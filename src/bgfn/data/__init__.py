@@ -1,21 +1,12 @@
-"""The NaveGo Turin drive: acquisition, truth, simulated IMUs/GNSS, datasets (``load_drive``).
+"""The drives: the NaveGo Turin drive (acquisition, truth, simulated IMUs and GNSS), a recorded car drive and a
+user's CSV folders, as datasets (``load_drive``).
 
-Public API:
-
-- :func:`load_drive` ``(name="turin-sim-ekinox", **overrides) -> Drive`` and the registry
-  :data:`DATASETS` (name -> default parameters); a CSV folder path loads a user's drive.
-- :func:`dataset_id`: the safe id that names a dataset's result files (a folder path never becomes a file name).
-- :class:`Drive`: ``name``, ``reference``, ``imu``, ``gnss`` tables, ``meta``, ``imu_bias``.
-- :func:`fetch_all` / :func:`resolve`: the NaveGo files, ``data/raw`` -> mirror -> pinned URL
-  (``python -m bgfn.data fetch``).
-- :func:`smooth_reference`, :func:`apply_imu_errors`, :func:`error_params`, :func:`simulate_fixes`,
-  :func:`load_csv_drive`, :func:`write_csv_drive`: the building blocks.
-- :mod:`bgfn.data.rtklib`: readers of RTKLIB-logged files, behind the dataset ``rtklib-drive0708`` (a real car
-  drive: recorded MEMS IMU, RTK reference without attitude); :mod:`bgfn.data.imu_levels`: a drive's IMU
-  noise levels at rest and while driving; :mod:`bgfn.studies.ins_fidelity.imu_roughness` (on :mod:`bgfn.data.allan`): its Allan
-  deviation, the bias between stops, and the trajectory twin (the same road with a simulated IMU).
-- :mod:`bgfn.data.summary` (``summary_table``) and :mod:`bgfn.data.plots` (matplotlib; not imported here):
-  notebook 01's tables and figures.
+:func:`load_drive` ``(name, **overrides) -> Drive`` over the registry :data:`DATASETS` (a CSV folder path loads a
+user's drive); :func:`dataset_id` names a dataset's result files; :class:`Drive` holds the ``reference``, ``imu``
+and ``gnss`` tables, ``meta`` and ``imu_bias``; :func:`fetch_all` / :func:`resolve` get the raw files
+(``python -m bgfn.data fetch``). The building blocks (truth, IMU errors, fixes, the CSV schema, RTKLIB's files,
+regridding, IMU levels) are modules of their own; :mod:`bgfn.data.summary` and :mod:`bgfn.data.plots` make
+notebook 01's tables and figures.
 """
 
 from bgfn.data.acquire import NAVEGO_FILES, MissingFileError, fetch_all, resolve

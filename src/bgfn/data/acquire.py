@@ -1,21 +1,11 @@
-"""Resolve the four NaveGo v1.4 Turin-drive files: ``data/raw`` -> local mirror -> pinned URL.
+"""Resolve the raw files of the shipped drives: ``data/raw`` -> local mirror -> pinned URL.
 
-The same for the three files of the RTKLIB-logged car drive ``rtklib-drive0708`` (:data:`RTKLIB_FILES`,
-repository ``rtklibexplorer/GNSS_IMU``, pinned commit; read by :mod:`bgfn.data.rtklib`): every file names its
-source, its pinned URL and its mirror folder.
-
-Every file is verified before use (SHA-256 where published, else its git blob id), including a file that
-is already in ``data/raw``. A file from the mirror or from the network is copied into ``data/raw`` only
-after it verifies, atomically (temporary file, then rename), so ``data/raw`` never holds a bad or
-half-written file.
-
-Locations (all configurable, so that tests never touch the repository's ``data/``):
-
-- data folder: argument ``data_dir``, else env ``BGFN_DATA_DIR``, else ``<repo>/data``;
-  raw files in ``<data>/raw``, processed datasets in ``<data>/processed``.
-- mirror folder: argument ``mirror``, else env ``BGFN_DATA_MIRROR``, else ``<repo>/../shared/data/navego``
-  when that folder exists. For the RTKLIB drive: argument ``mirror``, else env ``BGFN_RTKLIB_MIRROR``, else
-  ``<repo>/../shared/data/rtklib-drive0708``.
+The four NaveGo v1.4 Turin-drive files and the three of the RTKLIB-logged car drive ``rtklib-drive0708``
+(:data:`RTKLIB_FILES`); every file names its source, its pinned URL and its mirror folder, and is verified before
+use (SHA-256 where published, else its git blob id), one already in ``data/raw`` included. A file from the mirror
+or the network is copied into ``data/raw`` only after it verifies, atomically, so ``data/raw`` never holds a bad or
+half-written file. The data folder (``BGFN_DATA_DIR``) and the mirrors (``BGFN_DATA_MIRROR``,
+``BGFN_RTKLIB_MIRROR``, else ``<repo>/../shared/data/...``) are configurable, so tests never touch ``data/``.
 """
 
 from __future__ import annotations

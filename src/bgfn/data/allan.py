@@ -1,21 +1,11 @@
 """Allan deviation of an inertial sensor's output, with gaps, and the two error models it separates.
 
-The Allan variance at averaging time ``tau`` is half the mean squared difference of adjacent ``tau``-averages
-of a rate signal (IEEE Std 952, Annex C)::
-
-    avar(tau) = 1/2 < (xbar_{k+1}(tau) - xbar_k(tau))^2 >
-
-Overlapping clusters (one per sample) are used. A real drive stands still only in short stops and is usable
-for a given comparison only in some spans, so a mask ``valid`` drops every pair of clusters that touches an
-invalid sample: stops joined with one invalid sample between them give the pooled estimate over the stops.
-
-Two error models of :mod:`bgfn.data.imu_errors`, in its conventions:
-
-- white noise of density ``N`` (std ``N / sqrt(dt)`` per sample): ``avar = N^2 / tau``;
-- first-order Gauss-Markov bias of stationary std ``sigma`` and correlation time ``T`` (driving-noise PSD
-  ``q = 2 sigma^2 / T``): ``avar = (q T^2 / tau) [1 - T/(2 tau) (3 - 4 exp(-tau/T) + exp(-2 tau/T))]``
-  (IEEE Std 952 Annex C, the exponentially correlated process). It peaks near ``tau = 1.9 T`` at
-  ``0.62 sigma``.
+The Allan variance at averaging time ``tau`` is half the mean squared difference of adjacent ``tau``-averages of a
+rate signal (IEEE Std 952, Annex C), here with overlapping clusters; a mask ``valid`` drops every pair of clusters
+that touches an invalid sample, so short stops joined give one pooled estimate. The two error models of
+:mod:`bgfn.data.imu_errors` in its conventions: white noise of density ``N`` (``avar = N^2 / tau``) and a
+first-order Gauss-Markov bias of std ``sigma`` and correlation time ``T`` (IEEE Std 952's exponentially correlated
+process, peaking near ``tau = 1.9 T`` at ``0.62 sigma``).
 """
 
 from __future__ import annotations

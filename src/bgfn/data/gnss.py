@@ -1,21 +1,11 @@
 """GNSS fixes: decimation of real fixes, and a u-blox-like receiver simulated from the truth.
 
-Simulated receiver (position only, as the paper's KF measurement, Eq. 13, uses position): the antenna
-position ``p_ant = p_imu + C_bn @ lever_arm`` (NED offset converted to lat/lon/h with the local radii) is
-sampled at ``rate_hz`` on the truth's epochs that are multiples of ``1 / rate_hz`` and corrupted per axis
-(north, east, down) by
-
-- a time-correlated error: first-order Gauss-Markov, stationary std ``correlated_std_m``, correlation
-  time ``correlated_tau_s`` (slowly varying multipath / atmosphere / ephemeris), and
-- a white error of std ``white_std_m``.
-
-The reported ``std_n/e/d`` are ``sqrt(correlated^2 + white^2)``; velocities are not simulated (NaN).
-:func:`degrade_fixes` applies the same errors to given antenna fixes (a centimetre-level RTK solution made
-into a consumer receiver's, ``rtklib-drive0708``).
-
-A reference without attitude (``roll, pitch, yaw`` all NaN, :attr:`bgfn.data.Drive.has_attitude`) places the
-antenna with a level body whose x axis follows the course over ground (:func:`body_to_nav`): for a car's
-lever arm of centimetres the error is millimetres (sideslip and roll of a few degrees).
+The simulated receiver gives positions only (the paper's KF measurement, Eq. 13): the antenna position
+``p_ant = p_imu + C_bn @ lever_arm`` sampled at ``rate_hz`` and corrupted per axis by a first-order Gauss-Markov
+error (``correlated_std_m``, ``correlated_tau_s``: multipath, atmosphere, ephemeris) and a white error
+(``white_std_m``); the reported stds are their root sum of squares. :func:`degrade_fixes` applies the same errors
+to given fixes (an RTK solution made into a consumer receiver's, ``rtklib-drive0708``). Without a reference
+attitude the antenna is placed with a level body along the course over ground (:func:`body_to_nav`).
 """
 
 from __future__ import annotations

@@ -1,21 +1,11 @@
 """A logged drive onto one regular time grid: the IMU resampled, the reference interpolated at the IMU epochs.
 
-Real loggers timestamp their IMU with jitter (e.g. 8-11 ms steps at 100 Hz) and record the reference at its own
-rate (1-10 Hz for a GNSS/RTK solution). Everything downstream works on the IMU's epochs: the filter's states at an
-outage start, the reference compared with a solution row by row (:func:`bgfn.nav.metrics.align`), the network's
-input windows of N samples. So:
-
-- **IMU**: a regular log is kept as it is; a jittery one (or one at another rate than asked) is resampled onto
-  the grid ``k / rate_hz`` by integrating its increments (:func:`bgfn.data.navego.resample_imu`: angle and
-  velocity increments are preserved), at the rate asked, else at the log's median rate.
-- **Gaps**: a step longer than :data:`GAP_SAMPLES` median intervals (a logger that stopped) is an error naming
-  the file and the time: interpolating across it would invent motion.
-- **Reference**: at the IMU epochs (the first epoch is the start of the first IMU row's interval). A reference
-  with a row at each of them is used as it is; otherwise it is interpolated: the position (lat, lon, h) by cubic
-  Hermite segments whose slopes are the reference's own velocities (``dlat/dt = v_n / (R_M + h)``,
-  ``dlon/dt = v_e / ((R_N + h) cos lat)``, ``dh/dt = -v_d``), so a 1 Hz reference keeps the curvature its
-  velocities describe; the velocities and roll and pitch linearly; the yaw linearly after unwrapping (then
-  wrapped to (-pi, pi]); attitude columns that are all NaN (no attitude) stay NaN.
+Real loggers timestamp their IMU with jitter and record the reference at its own rate, while everything downstream
+works on the IMU's epochs (the filter's states, the row-by-row comparison with the reference, the networks'
+windows). A jittery IMU log is resampled onto ``k / rate_hz`` by integrating its increments (angle and velocity
+increments preserved); a gap longer than :data:`GAP_SAMPLES` median intervals is an error naming the file and the
+time (interpolating across it would invent motion); the reference is interpolated at the IMU epochs, its position
+by cubic Hermite segments with its own velocities as slopes, velocities and attitude linearly (yaw unwrapped).
 """
 
 from __future__ import annotations

@@ -1,20 +1,12 @@
 """The paper's published values and its vocabulary, in one place.
 
-Everything this artifact knows about what the paper *reports* lives here: its outage tables
-(``data/paper/outage_max_errors.csv``), the numbers it states in its text (``data/paper/claims.yaml``), the
-labels of its methods, which of our datasets stands for which of its tests, and the one function that lays
-a table out as the paper does (rows ``Outage k``, columns method x East/North). The values are shown beside
-ours in a column labelled *paper*; no code reads them to choose a parameter, a seed or a stopping point.
-
-Vocabulary
-----------
-- *test*: ``dataset`` (the paper's Table ``tab-out1-exin``, NaveGo's Turin drive, Ekinox-D IMU), ``field``
-  (Table ``tab-real``, the paper's own car with an MPU-6000 IMU) or ``real`` (ours: a recorded car drive with a
-  MEMS IMU; the paper has no such table, so the paper's field test is shown beside it, :func:`published_test`);
-- *method label*: how a table names a method (``INS``, ``MLP``, ``AT-LSTM``, ``BGFN``, and ours beyond the
-  paper: ``Transformer``, ``GPS``, and each of them with the vehicle constraints of :mod:`bgfn.nav.constraints`,
-  ``INS+NHC``, ``BGFN+NHC``, ...: :func:`nhc_label`); a *method id* is the key of :mod:`bgfn.models`
-  (``bgfn``, ``mlp``, ...).
+Its outage tables (``data/paper/outage_max_errors.csv``), the numbers its text states (``data/paper/claims.yaml``),
+its method labels, which of our datasets stands for which of its tests, and the layout of its tables. The values
+are shown beside ours in a column labelled *paper*; no code reads them to choose a parameter, a seed or a stopping
+point. A *test* is ``dataset`` (Table ``tab-out1-exin``), ``field`` (Table ``tab-real``) or ``real`` (ours, a
+recorded car drive, beside the paper's field test: :func:`published_test`); a *method label* names a table's row
+(``INS``, ``BGFN``, ... and ``+NHC`` with the vehicle constraints, :func:`nhc_label`), a *method id* the key of
+:mod:`bgfn.models`.
 """
 
 from __future__ import annotations

@@ -2,16 +2,11 @@
 
 The 15-state filter runs over each drive with every GNSS fix and saves its state at each outage start; from there
 each method runs the outage without GNSS: INS predicts only, a network's increments are summed into a pseudo-GPS
-fix (Eq. pred-gps) and fused like a GNSS fix. The ``+NHC`` rows add the vehicle constraints. Metrics per outage:
+fix (Eq. pred-gps) and fused like a GNSS fix; the ``+NHC`` rows add the vehicle constraints. Metrics per outage:
 max |east|, max |north| (the paper's tables), horizontal RMSE and final error; the median over training seeds.
-
-Modules, in the order of the protocol: :mod:`~bgfn.evaluate.setup` (methods, columns, the ``evaluate:``
-settings), :mod:`~bgfn.evaluate.hybrid` (Eq. pred-gps, the GPS-aided run, the outage runs, their metrics),
-:mod:`~bgfn.evaluate.networks` (notebook 03's checkpoints), :mod:`~bgfn.evaluate.tables` (Tables 1-2),
-:mod:`~bgfn.evaluate.claims` (ours beside the paper's), :mod:`~bgfn.evaluate.pseudo_std` (the
-tables again with each network's own pseudo-fix std, which the paper does not state), :mod:`~bgfn.evaluate.plots` (the outage figures),
-:mod:`~bgfn.evaluate.record` (the record the results page reads). The studies beyond the paper (the outage
-sweep, the oracle, the learned odometer, the INS's fidelity) are in :mod:`bgfn.studies`.
+Modules, in the order of the protocol: ``setup``, ``hybrid``, ``networks``, ``tables`` (Tables 1-2), ``claims``
+(ours beside the paper's), ``pseudo_std``, ``plots``, ``record``. The studies beyond the paper are in
+:mod:`bgfn.studies`.
 """
 
 from bgfn.evaluate.claims import REDUCTION_COLUMNS, ours_above_paper, paper_table_title, reduction_table

@@ -1,21 +1,12 @@
 """Compile the navigation's numba kernels (and BGFN's LIF kernels) into numba's cache before the notebooks call them.
 
-Every kernel of the filter engine and its aids (:mod:`bgfn.nav.strapdown`, :mod:`bgfn.nav.engine`,
-:mod:`bgfn.nav.error_model`, :mod:`bgfn.nav.constraints`, ...) is ``numba.njit(cache=True)``: numba compiles it on
-its first call and writes the machine code beside the source (``__pycache__``), where every later process, the
-parallel runner's workers included, loads it in a fraction of a second. On a fresh clone that first call came in
-notebook 02 and compiled for about 40 s on one core of the 2-core machine while the other idled.
-
-:func:`compile_kernels` calls every path of the notebooks once on a short synthetic drive (the GPS-aided filter
-with the vehicle constraints, the standalone INS, INS+NHC and an odometer in one outage), so that numba compiles
-the same functions for the same argument types. ``make reproduce`` runs it in the background
-(``python -m bgfn kernels``) while notebook 01 prepares the data, which does not need them. Nothing here changes
-a result: a kernel missing from the cache is compiled where it is first called, as before, and one that two
-processes compile at the same time is written to the cache atomically by numba.
-
-BGFN's LIF layers (:mod:`bgfn.models.lif_kernels`) are numba kernels too: :func:`compile_lif_kernels` runs one
-forward and backward pass on one thread and on two, the two variants training uses (a parallel runner's worker
-trains on one thread), so that notebook 03's workers load them instead of each compiling them.
+Every kernel of the filter engine and its aids is ``numba.njit(cache=True)``: compiled on its first call, then
+loaded by every later process in a fraction of a second. :func:`compile_kernels` calls every path of the notebooks
+once on a short synthetic drive (the GPS-aided filter with the vehicle constraints, the standalone INS, INS+NHC and
+an odometer in one outage), and :func:`compile_lif_kernels` one forward and backward pass of the LIF layers on one
+thread and on two, so that the same functions are compiled for the same argument types. ``make reproduce`` runs it
+in the background (``python -m bgfn kernels``) while notebook 01 prepares the data. Nothing here changes a result:
+a kernel missing from the cache is compiled where it is first called.
 """
 
 from __future__ import annotations

@@ -1,19 +1,12 @@
 """Baselines of paper Sec. 4: MLP, attention LSTM (AT-LSTM), and an ANN Transformer twin of BGFN.
 
-All take the same normalized input window ``x [B, N, C]`` (Eq. eq21) and return ``[B, 2]``
-(north, east increment, normalized).
-
-- :class:`MLP` is a *static* network (the paper: "MLP ... static"): it sees only the ``n_recent`` most recent
-  IMU samples of the window, flattened (default 1: the current INS output).
-- :class:`ATLSTM` follows the attention-LSTM error-compensation model the paper cites (Chen et al. 2024):
-  an LSTM over the whole window, additive temporal attention over its hidden states
-  (``e_t = v^T tanh(W h_t + b)``, ``alpha = softmax(e)``, ``c = sum alpha_t h_t``), and a linear head on the
-  context concatenated with the last hidden state.
-- :class:`TransformerTwin` has BGFN's structure with real-valued activations: the same temporal convolution
-  (``K*T_s`` kernels per channel, here read as ``C*K*T_s`` features of one token instead of ``T_s`` SNN steps
-  of ``C*K`` neurons),
-  a Linear embedding, ``depth`` pre-LayerNorm blocks of softmax multi-head attention and a GELU feed-forward
-  of the same widths, mean over tokens, Linear head. It is the ANN reference of the energy comparison.
+All take the same normalized input window ``x [B, N, C]`` (Eq. eq21) and return ``[B, 2]`` (north, east increment,
+normalized). :class:`MLP` is static (the paper's "MLP ... static"): it sees the ``n_recent`` latest samples only.
+:class:`ATLSTM` follows the attention-LSTM error-compensation model the paper cites (Chen et al. 2024): an LSTM
+over the window, additive temporal attention over its hidden states and a linear head. :class:`TransformerTwin` has
+BGFN's structure with real-valued activations (the same temporal convolution, embedding, ``depth`` blocks of
+softmax attention and feed-forward of the same widths, mean over tokens, head): the ANN reference of the energy
+comparison.
 """
 
 from __future__ import annotations

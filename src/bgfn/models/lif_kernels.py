@@ -1,20 +1,11 @@
 """numba kernels of the fused LIF layer (:class:`bgfn.models.lif.FusedLIF`): Eq. (eq:LIF) over all ``T`` SNN steps
 and its BPTT backward pass with the ATan surrogate (Eq. eq:surrogate_gradient), one pass over memory each.
 
-Why numba: written as torch operations, one LIF step is three passes over a [B, N, D] tensor (charge, fire,
-reset) and its backward pass seven more (the surrogate, then the membrane's chain rule), each reading and writing
-the whole tensor; at the paper's size these tensors do not stay in the cache from one operation to the next, so
-memory traffic, not arithmetic, set the layer's cost. Here each neuron's ``T`` steps run in registers: the
-forward pass reads the currents once and writes the spikes once; the backward pass reads the currents and the
-upstream gradient once, recomputes the potentials U(t) of a chunk into a buffer that stays in the cache, and
-writes the gradient of the currents once. Recomputing U(t) is the same arithmetic, so the gradients are the same
-bits, and it was a little faster than writing the surrogate in the forward pass and reading it back (an interleaved
-A/B of the paper-size training step, in the README).
-
-Layout: every array is ``[T, M]`` float32 and C-contiguous (``M`` = all neurons of the batch). The neurons are
-cut into chunks of :data:`CHUNK`; each chunk runs its ``T`` steps over contiguous rows, which LLVM vectorizes.
-The chunks are independent, so the result does not depend on how many threads share them: the same bits with
-one thread or many.
+Written as torch operations, one LIF step is several passes over a [B, N, D] tensor too large for the cache, so
+memory traffic set the layer's cost. Here each neuron's ``T`` steps run in registers: the forward pass reads the
+currents and writes the spikes once; the backward pass recomputes the potentials of a chunk in a cache-sized buffer
+(the same arithmetic, so the same bits) and writes the currents' gradient once. Every array is ``[T, M]`` float32,
+C-contiguous, cut into independent chunks of :data:`CHUNK` neurons: the same bits with one thread or many.
 """
 
 from __future__ import annotations

@@ -1,15 +1,9 @@
 """IMU readings from a trajectory: the exact algebraic inverse of :func:`bgfn.nav.strapdown.propagate`.
 
-For each pair of reference rows ``(k-1, k)`` the step equations of :mod:`bgfn.nav.strapdown` are solved
-for the mean rates, with Earth rate, transport rate and gravity at row ``k-1``:
-
-- ``exp([theta]) = C_{k-1}^T exp([zeta]) C_k`` gives ``gyro = theta / dt``;
-- ``(I - [zeta]/2) C_{k-1} (I + [theta]/2) accel dt = v_k - v_{k-1} - (g^n - (2 omega_ie + omega_en) x v_{k-1}) dt``
-  gives ``accel`` (two 3x3 solves).
-
-Integrating the result from any reference row reproduces the reference attitude and velocity to
-rounding (plus the tiny effect of position drift on the rates and gravity), and the position to the
-trapezoid-rule error of the given trajectory (zero if its positions were made with
+For each pair of reference rows the step equations of :mod:`bgfn.nav.strapdown` are solved for the mean rates
+(Earth rate, transport rate and gravity at the first row): the gyro from the attitude change, the accelerometer
+from the velocity change (two 3x3 solves). Integrating the result reproduces the reference attitude and velocity to
+rounding and the position to the trapezoid-rule error of the trajectory (zero for positions made with
 :func:`positions_from_velocity`).
 """
 

@@ -1,19 +1,11 @@
 """NED strapdown mechanization (paper Sec. 2): attitude, velocity and position from IMU mean rates.
 
-One step goes from epoch ``k-1`` to ``k`` with the *mean* angular rate ``gyro`` (rad/s) and specific
-force ``accel`` (m/s^2) over the step (IMU row ``k``, see CONTRIBUTING.md):
-
-- attitude: ``C_k = exp(-[zeta]) C_{k-1} exp([theta])`` with ``theta = gyro dt`` (body rotation, exact for
-  a constant rate) and ``zeta = omega_in^n dt`` (rotation of the NED frame);
-- velocity: ``v_k = v_{k-1} + (I - [zeta]/2) C_{k-1} (I + [theta]/2) accel dt
-  + (g^n - (2 omega_ie^n + omega_en^n) x v_{k-1}) dt``; the ``(I + [theta]/2)`` factor is the
-  rotation/sculling correction, exact to second order for constant rates;
-- position: trapezoid rule on the velocity (height first, then latitude, then longitude at mid-step).
-
-Earth rate, transport rate and gravity are evaluated at the start-of-step state, which makes
-:func:`bgfn.nav.sim.imu_from_trajectory` an exact algebraic inverse of :func:`propagate`.
-
-The inner loop is a numba kernel (:func:`step_inplace`) that the Kalman filter reuses.
+One step goes from epoch ``k-1`` to ``k`` with the mean angular rate and specific force over the step (IMU row
+``k``, CONTRIBUTING.md): attitude ``C_k = exp(-[zeta]) C_{k-1} exp([theta])`` (exact for a constant rate), velocity
+with the rotation/sculling factor ``(I + [theta]/2)`` (exact to second order), position by the trapezoid rule.
+Earth rate, transport rate and gravity are taken at the start of the step, which makes
+:func:`bgfn.nav.sim.imu_from_trajectory` the exact inverse of :func:`propagate`. The inner loop is a numba kernel
+(:func:`step_inplace`) that the Kalman filter reuses.
 """
 
 from __future__ import annotations

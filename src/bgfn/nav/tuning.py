@@ -1,20 +1,12 @@
 """The filter's IMU noise from the drive itself: the factor on the noise densities that makes its GNSS innovations
 consistent.
 
-A datasheet's noise densities describe a sensor on a bench; in a car, vibration adds noise many times larger, and
-a filter with the datasheet's ``Q`` is overconfident: its GNSS innovations are larger than its covariance says. For
-a consistent filter the normalized innovation squared of a fix, ``NIS = dz^T S^-1 dz`` (``S = H P H^T + R``,
-Eq. eq4's innovation covariance), is chi-square with as many degrees of freedom as the fix has axes (3), so its mean
-over the drive is near 3 (:mod:`bgfn.nav.consistency`).
-
-``nav.noise_scale: auto`` scales the white-noise densities of ``Q`` (and, with ``nav.noise_search.bias_walk: true``,
-the bias driving noise, which then follows a numeric ``noise_scale`` too) by the factor ``s`` whose GPS-aided run over the whole drive has a mean NIS equal to its mean
-degrees of freedom. The mean NIS falls as ``s`` grows (a larger ``Q``, a larger ``S``), so the factor is a root
-found in ``log s`` over ``nav.noise_search.range`` with a few filter runs (``max_runs``): the run at ``s = 1``, steps
-of the local log-log slope until the root is bracketed, then false position with the Illinois rule (converges in a
-few runs where bisection needs about ten), stopping when ``|log(mean NIS / dof)| <= log(1 + tolerance)``. A root
-outside the range returns the bound and says so (GNSS stds that are too small, for example, cannot be mended by
-``Q``).
+In a car, vibration adds noise many times the datasheet's, and a filter with the datasheet's ``Q`` is
+overconfident. For a consistent filter the mean normalized innovation squared of the fixes equals their degrees of
+freedom (:mod:`bgfn.nav.consistency`). ``nav.noise_scale: auto`` scales the white-noise densities of ``Q`` (with
+``nav.noise_search.bias_walk``, the bias driving noise too) by the factor whose GPS-aided run has that mean NIS: a
+root in ``log s`` over ``nav.noise_search.range``, bracketed by the local log-log slope and found by false position
+(Illinois) in a few filter runs. A root outside the range returns the bound and says so.
 """
 
 from __future__ import annotations

@@ -1,17 +1,12 @@
 """The check of a whole profile before anything runs: its keys (:mod:`bgfn.settings`), the facts that tie keys
 together, and the facts that need the drives.
 
-This module is the package's edge, the top of its layers: it may import everything it checks, and nothing of the
-package imports it. :func:`load_profile` reads the merged profile with every default filled and every key checked
-(:func:`bgfn.config.read_profile`, a ``base:`` chain included, over :func:`bgfn.settings.complete`), then checks the
-cross-field facts of :func:`cross_check`; :func:`with_overrides` does the same for a notebook's parameters. So every
-notebook's first cell and ``make reproduce`` (its ``check-profile`` step, ``python -m bgfn.profile_schema
-<profile>``) refuse a bad profile at once, with one message naming the YAML file that set the key, the key path and
-the value; a misspelt key gets the closest valid one.
-
-The checks that need the data (outages inside the drive, a rule's outages found in it, a window shorter than
-the GPS-available data, a possible outage sweep) run in :func:`check_with_drives`, the ``make`` step, after the
-data are fetched.
+The package's edge: it may import everything it checks, and nothing of the package imports it.
+:func:`load_profile` reads the merged profile with every default filled and every key checked
+(:func:`bgfn.config.read_profile`), then the cross-field facts (:func:`cross_check`); :func:`with_overrides` does
+the same for a notebook's parameters. A bad profile is refused at once, with one message naming the YAML file, the
+key path and the value (a misspelt key gets the closest valid one). The checks that need the data (outages inside
+the drive, a possible outage sweep) run in :func:`check_with_drives`, the ``make`` step, after the data are fetched.
 """
 
 from __future__ import annotations

@@ -1,17 +1,11 @@
 """The executed notebooks as the book shows them: one parameters cell per page.
 
-papermill keeps a notebook's own ``parameters`` cell and inserts a copy below it, tagged
-``injected-parameters``, with the values of the run (``profile = "paper"``). The book would show both, the
-first with the notebook's defaults. :func:`one_parameters_cell` writes the run's values into the notebook's own
-cell (its comments kept) and drops papermill's copy, so a reader sees one cell with the values that produced the
-page. ``make book`` applies it to the copies under ``book/notebooks/``, never to ``results/<profile>/notebooks/``.
-
-The same step refuses a notebook that printed a warning (:func:`warnings_in`): a ``RuntimeWarning`` or a
-``UserWarning`` in an executed notebook is a defect of ours (an all-NaN column plotted, a legend without lines)
-that the reader would otherwise see in the book.
-
-``python -m bgfn.report.book_notebooks FILE.ipynb ...`` rewrites each file in place, then exits 1 naming every
-warning found.
+papermill keeps a notebook's own ``parameters`` cell and inserts a copy with the run's values below it; the book
+would show both. :func:`one_parameters_cell` writes the run's values into the notebook's own cell (its comments
+kept) and drops the copy; ``make book`` applies it to the copies under ``book/notebooks/``. The same step refuses a
+notebook that printed a warning (:func:`warnings_in`): a ``RuntimeWarning`` or ``UserWarning`` there is a defect of
+ours the reader would otherwise see. ``python -m bgfn.report.book_notebooks FILE.ipynb ...`` rewrites each file in
+place, then exits 1 naming every warning found.
 """
 
 from __future__ import annotations

@@ -1,20 +1,11 @@
 """Diagrams and illustrations of the paper drawn from code (matplotlib patches and arrows, no graphviz).
 
-Every function returns a :class:`matplotlib.figure.Figure`; notebook 10 saves them into
-``results/<profile>/figures/`` (``bgfn.io.save_figure``) and the book shows them. The diagrams read the real
-configuration, so they change when a profile changes a parameter:
-
-- :func:`plot_loosely_coupled` -- paper Fig. ``ins-gps-loose``: IMU -> INS mechanization -> KF <- GPS, with
-  the corrections fed back (rates and state count from the profile / :mod:`bgfn.nav.error_model`);
-- :func:`plot_lif` on :func:`simulate_lif` -- paper Fig. ``fig:LIF``: a real SpikingJelly ``LIFNode``
-  (:func:`bgfn.models.lif.make_lif`, the model's ``tau`` and threshold) driven by an input current: ``I(t)``,
-  the membrane potential ``U(t)`` of Eq. (eq:LIF) with the threshold, and the output spikes;
-- :func:`plot_bgfn_architecture` on :func:`architecture_spec` -- paper Fig. ``BGFN-arc``, read from a built
-  :class:`bgfn.models.BGFN` (widths, depth, heads, ``T_s``, kernel, readout, parameter count);
-- :func:`plot_hybrid_system` -- paper Fig. ``BGFN``: online-training mode with GPS (solid) and prediction
-  mode during an outage (dashed), the pseudo-GPS of Eq. (pred-gps) fed to the KF.
-
-Text of a diagram is in ``ax.texts`` (the tests read it back).
+Every function returns a :class:`matplotlib.figure.Figure` that notebook 10 saves and the book shows, drawn from the
+real configuration so that it changes with the profile: :func:`plot_loosely_coupled` (paper Fig.
+``ins-gps-loose``), :func:`plot_lif` on :func:`simulate_lif` (Fig. ``fig:LIF``, a real SpikingJelly ``LIFNode``),
+:func:`plot_bgfn_architecture` on :func:`architecture_spec` (Fig. ``BGFN-arc``, read from a built BGFN) and
+:func:`plot_hybrid_system` (Fig. ``BGFN``: online training with GPS and prediction during an outage). A diagram's
+text is in ``ax.texts`` (the tests read it back).
 """
 
 from __future__ import annotations

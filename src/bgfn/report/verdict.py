@@ -1,21 +1,11 @@
 """The verdict on top of the results page: per test one table of every aid in the paper's two outages and in the
-outage sweep, and sentences answering the five questions a navigation engineer asks of a learned outage aid:
+outage sweep, and sentences answering what a navigation engineer asks of a learned outage aid: how accurate the
+increments must be (the oracle), whether it beats the learning-free aids (INS+NHC), whether the networks can know
+the speed (the velocity-input variant), whether the paper's protocol was leaky, whether the INS row is comparable
+(NaveGo's setup) and whether a learned odometer helps (:mod:`bgfn.report.odometer_verdict`).
 
-1. *How accurate must the increments be?* The oracle's break-even noise against the network's own increment error
-   (:mod:`bgfn.studies.outage_sweep.oracle`).
-2. *Does it beat the learning-free aids?* INS+NHC, and BGFN fused together with NHC (:mod:`bgfn.nav.constraints`).
-3. *Can the networks know the speed?* The velocity-input variant against Eq. (eq21)'s inputs, in the outages and
-   on the validation block (which networks improved on their initial weights, and how far).
-4. *Was the paper's protocol leaky?* The networks trained on the whole drive, test outages included.
-5. *Is the INS row comparable?* The INS row under NaveGo v1.4's bias modelling (:mod:`bgfn.studies.ins_fidelity.ins_setups`).
-6. *Does a learned odometer help?* The networks trained as odometers (forward speed and its std fused with the NHC
-   rows; beyond the paper) against INS+NHC, the spiking one against its twin, at what energy
-   (:mod:`bgfn.report.odometer_verdict`).
-
-The recorded drives come first: a simulated IMU is kinder than a real one, so the decisive test is the real drive.
-
-Every number comes from ``results/<profile>/tables/``; a table that a notebook has not written leaves its cells
-empty and its sentence says so. Nothing here is typed by hand.
+The recorded drives come first: a simulated IMU is kinder than a real one. Every number comes from
+``results/<profile>/tables/``; a table a notebook has not written leaves its cells empty and its sentence says so.
 """
 
 from __future__ import annotations

@@ -1,18 +1,10 @@
 """How long reproducing takes: each notebook's wall time, and how it scales with the number of jobs.
 
-Two sources:
-
-- the executed notebooks of a profile (``results/<profile>/notebooks/*.ipynb``): papermill writes each one's
-  wall time into its metadata (``metadata.papermill.duration``, s): :func:`notebook_wall_times`;
-- measured runs of ``make reproduce`` from a fresh clone with ``JOBS=1`` and ``JOBS=2``, recorded in
-  ``data/measured/reproduce_wall_times.csv`` (:data:`MEASURED_FILE`; ``python -m bgfn walltimes --record``
-  adds the notebooks of a finished run): :func:`scaling_table` puts them side by side and projects more jobs.
-
-The projection is Amdahl's law per notebook: from the wall times with 1 and 2 jobs, the share ``s`` that did
-not get faster (``T2 = T1 (s + (1 - s) / 2)``) is taken as serial, and ``T(n) = T1 (s + (1 - s) / n)``. Its
-assumption, named on the page: the rest divides evenly over ``n`` jobs, i.e. a notebook has at least ``n`` runs
-of about equal length and nothing else (memory, disk, a GPU) is shared. It is an upper bound on the speed-up:
-with fewer runs than jobs, or runs of unequal length, the longest run sets the time.
+The executed notebooks' wall times (papermill's ``metadata.papermill.duration``, :func:`notebook_wall_times`) and the
+measured runs of ``make reproduce`` with ``JOBS=1`` and ``JOBS=2`` (:data:`MEASURED_FILE`; ``python -m bgfn
+walltimes --record`` adds a finished run) side by side (:func:`scaling_table`), with more jobs projected by Amdahl's
+law per notebook: the share that did not get faster with 2 jobs is taken as serial. The page names its assumption
+(the rest divides evenly over the jobs); it is an upper bound on the speed-up.
 """
 
 from __future__ import annotations

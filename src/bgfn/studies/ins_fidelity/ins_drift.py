@@ -1,16 +1,10 @@
 """Standalone-INS drift over the outage sweep's starts, drive against drive (notebook 08).
 
-How far does the INS alone drift in an outage of 10, 30, 60 s? Two outages per drive (the paper's tables) say
-little; the sweep's starts (:func:`bgfn.studies.outage_sweep.sweep.sweep_plan`: evenly spread over the drive, the same starts
-notebook 06 evaluates every network in) say it for the whole drive. Notebook 02 puts the drives side by side:
-the simulated field-test stand-in ``turin-sim-mpu6000``, whose MEMS error model was set from levels measured
-on the recorded drive (:mod:`bgfn.data.imu_levels`), against that recorded drive ``rtklib-drive0708`` --
-does the stand-in drift as a real MEMS IMU does? -- and the INS with the vehicle constraints (``INS+NHC``,
-:mod:`bgfn.nav.constraints`) beside the INS alone.
-
-Each run starts from the GPS-aided filter's state at its start (:func:`bgfn.evaluate.navigation_context`) and
-runs the longest duration once; the shorter ones are its prefixes (a prefix's maximum error never exceeds the
-whole run's).
+How far does the INS alone drift in an outage of 10, 30, 60 s? Two outages per drive say little; the sweep's starts
+(:func:`bgfn.studies.outage_sweep.sweep.sweep_plan`) say it for the whole drive. The simulated field-test stand-in
+``turin-sim-mpu6000`` stands beside the recorded drive its error model was set from (``rtklib-drive0708``), and
+``INS+NHC`` beside the INS alone. Each run starts from the GPS-aided filter's state and runs the longest duration
+once; the shorter ones are its prefixes.
 """
 
 from __future__ import annotations

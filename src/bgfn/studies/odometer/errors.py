@@ -1,21 +1,12 @@
 """Why a learned odometer loses where an oracle speed with as much white noise wins: its speed error in the outages
 split into an offset that lasts the outage and a fluctuation around it (beyond the paper).
 
-The filter averages a white error away: ``n`` speeds of white noise ``sigma`` leave ``sigma / sqrt(n)`` of it,
-which is why the oracle speed (:mod:`bgfn.studies.odometer.bars`, ``ORACLE-SPEED``) helps up to a noise of metres per
-second. An offset shared by every epoch of an outage it cannot average: an offset ``b`` alone moves the solution
-``b t`` along the track. This module measures both on notebook 07's honest speed series (``speed_series`` of
-:func:`bgfn.studies.odometer.bars.odometer_rows`: each sweep outage predicted by its own fold's odometer, the networks'
-first seed), per odometer and duration ``D`` (the first ``D`` seconds of each outage):
-
-- ``offset_rms_mps``: the RMS over the outages of each outage's mean speed error;
-- ``fluctuation_mps``: the RMS over the outages of the error's std around that mean;
-- ``outage_correlation``: the median over the outages of the integrated autocorrelation of the normalized error
-  (error / predicted std; :func:`bgfn.learning.odometry.error_correlation`): how many epochs carry one epoch's worth
-  of information in the outages, against the ``kappa`` the filter fused the odometer with (its validation windows',
-  ``tables/outage_odometer_networks.csv``);
-- :func:`offset_bar_mps`: the offset that alone would move the car as far along the track over ``D`` as INS+NHC's
-  median max error: an odometer whose outage offset is larger cannot beat INS+NHC however it is weighted.
+The filter averages a white error away, but not an offset shared by every epoch of an outage (an offset ``b`` moves
+the solution ``b t`` along the track). On notebook 07's honest speed series (each sweep outage predicted by its own
+fold's odometer) this module measures, per odometer and duration, the RMS of each outage's mean speed error
+(``offset_rms_mps``), the fluctuation around it (``fluctuation_mps``) and the integrated autocorrelation of the
+normalized error (``outage_correlation``, against the ``kappa`` the filter fused it with); :func:`offset_bar_mps`
+is the offset that alone would move the car as far as INS+NHC's median max error.
 """
 
 from __future__ import annotations

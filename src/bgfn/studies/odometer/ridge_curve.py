@@ -1,18 +1,11 @@
 """How the simple learned odometer's speed error falls with its training windows (beyond the paper).
 
-The learned odometers of :mod:`bgfn.studies.odometer.bars` train per fold of the sweep's outage starts, outside that
-fold's outages +- ``train.margin_s``. On a short drive a fold holds out much of it: with 2 folds each odometer
-learns from a few minutes of driving. Whether that is why its speed is too coarse to help the filter is a question
-the drive itself can answer: split the same starts into more folds (``evaluate.odometer.curve_folds``; as many
-folds as starts leaves one start out), so that each fold holds out less of the drive, and refit ``RIDGE-ODO`` (the
-ridge on band energies, closed form, so the whole curve costs seconds) on each fold's honest split
-(:func:`bgfn.learning.odometry.build_speed_data`, the same margin, validation blocks and window as the bars).
-
-Each start is predicted by the ridge of its own fold. The table (:data:`CURVE_COLUMNS`, ``tables/
-outage_odometer_curve.csv``) gives per number of folds the training windows per fold, the ridge's validation std
-and its speed RMSE and +-2 sigma coverage in the outages. If the speed RMSE barely falls while the training windows
-grow, the drive's length is not what limits the learned speed: the situations of the outages that the training
-windows do not cover, or what an IMU window can tell of the speed, are.
+On a short drive each fold of the sweep's starts holds out much of it, so a learned odometer learns from a few
+minutes of driving. Is that why its speed is too coarse to help? The same starts split into more folds
+(``evaluate.odometer.curve_folds``) hold out less each; ``RIDGE-ODO`` (closed form: seconds) is refitted on each
+fold's honest split and predicts the starts of its own fold. The table (:data:`CURVE_COLUMNS`,
+``tables/outage_odometer_curve.csv``) gives per number of folds the training windows, the validation std and the
+speed RMSE and coverage in the outages: a speed RMSE that barely falls says the drive's length is not the limit.
 """
 
 from __future__ import annotations

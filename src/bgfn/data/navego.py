@@ -1,17 +1,10 @@
 """Read and validate the NaveGo MATLAB structs (``ref``, ``ekinox_gnss``, ``ekinox_imu``, ``mpu6000_imu``).
 
-Every reader returns tables in the schemas of CONTRIBUTING.md and raises :class:`bgfn.errors.DataError`
-naming the file and the field on any defect: unreadable/truncated file, missing struct or field, wrong
-length, non-finite value, time not strictly increasing.
-
-Field meanings (NaveGo conventions, SI units):
-
-- ``ref``: ``t`` (s, GPS time of week), ``lat``, ``lon`` (rad), ``h`` (m), ``vel`` (n x 3 NED, m/s),
-  ``roll``, ``pitch``, ``yaw`` (rad).
-- ``*_gnss``: ``t``, ``lat``, ``lon``, ``h``, ``vel`` (n x 3), ``stdm`` (3, m: north, east, down
-  position std), ``larm`` (3, m: antenna in the body frame), ``freq`` (Hz).
-- ``*_imu``: ``t``, ``wb`` (n x 3, rad/s), ``fb`` (n x 3, m/s^2), optional error profile ``arw``,
-  ``vrw``, ``gb_sta``, ``ab_sta``, ``gb_dyn``, ``ab_dyn``, ``gb_corr``, ``ab_corr``, ...
+Every reader returns tables in the schemas of CONTRIBUTING.md (NaveGo's fields: ``t`` in s of GPS time of week,
+``lat``/``lon`` rad, ``vel`` NED m/s, ``wb`` rad/s, ``fb`` m/s^2, ``stdm`` and ``larm`` m; an IMU's optional error
+profile ``arw``, ``gb_sta``, ``gb_dyn``, ``gb_corr``, ...) and raises :class:`bgfn.errors.DataError` naming the file
+and the field on any defect: an unreadable or truncated file, a missing struct or field, a wrong length, a
+non-finite value, a time not strictly increasing.
 """
 
 from __future__ import annotations

@@ -1,17 +1,10 @@
 """The 1 Hz NaveGo reference -> a smooth, continuous, self-consistent 100 Hz truth trajectory.
 
-Position: smoothing splines of degree ``degree`` (default 5) of north, east and up in a *scaled
-geodetic* local frame, ``north = (lat - lat0) (R_M0 + h0)``, ``east = (lon - lon0) (R_N0 + h0) cos lat0``,
-``up = h - h0``. That map is linear, so ``lat``, ``lon``, ``h`` are smooth functions of time and the
-velocity is their exact time derivative in the form the strapdown integrates (paper Eq. IPE):
-``v_n = lat' (R_M + h)``, ``v_e = lon' (R_N + h) cos lat``, ``v_d = -h'``. Position and velocity are thus
-consistent to rounding, which the strapdown-consistency test relies on.
-
-Attitude: smoothing splines (same degree) of roll, pitch and unwrapped yaw; yaw wrapped to (-pi, pi].
-
-The smoothing factor of each spline is ``s = n sigma^2`` (scipy ``UnivariateSpline``), with ``sigma``
-the documented parameters ``position_sigma_m`` / ``attitude_sigma_rad``: the spline's RMS residual
-against the 1 Hz samples is about ``sigma``.
+Position: smoothing splines (default degree 5) of north, east and up in a scaled geodetic local frame, a linear map
+of ``lat``, ``lon``, ``h``, so the velocity is their exact time derivative in the form the strapdown integrates
+(paper Eq. IPE): position and velocity are consistent to rounding, which the strapdown-consistency test relies on.
+Attitude: smoothing splines of roll, pitch and unwrapped yaw. Each spline's smoothing factor is ``s = n sigma^2``
+(``position_sigma_m``, ``attitude_sigma_rad``): its RMS residual against the 1 Hz samples is about ``sigma``.
 """
 
 from __future__ import annotations

@@ -6,13 +6,10 @@ One network = one ``(dataset, method, seed)`` of a profile (a fold ``k`` for the
                                                  <method>_seed<seed>.json      its card (metrics, config hash)
                                                  <method>_seed<seed>.last.pt   while training: resumable state
 
-A variant of the profile's learning problem (:mod:`bgfn.train.variants`) keeps its networks apart, under
-``results/<profile>/models/variants/<variant>/<dataset id>/`` (:func:`variant_models_dir`), with the same names.
-
-Every module builds these names with :func:`checkpoint_path` (or :func:`checkpoint_name` under a folder it
-was given) and reads them back with :func:`parse_checkpoint`; nothing else spells the pattern. The folder is the
-dataset's id (:func:`bgfn.data.names.dataset_id`: a shipped dataset's name, a CSV drive's ``meta.yaml`` name or
-folder name), so a drive named by a folder path never writes outside ``results/<profile>/``.
+A variant's networks live under ``models/variants/<variant>/<dataset id>/`` (:func:`variant_models_dir`). Every
+module builds these names with :func:`checkpoint_path` or :func:`checkpoint_name` and reads them back with
+:func:`parse_checkpoint`; the folder is the dataset's id, so a drive named by a path never writes outside
+``results/<profile>/``.
 """
 
 from __future__ import annotations

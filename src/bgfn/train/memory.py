@@ -1,16 +1,11 @@
 """Freed memory kept in the process for the next training step (glibc ``malloc``), not handed back to the OS.
 
-Why: torch allocates every activation and gradient of a training step afresh. glibc serves a block above its
-``mmap`` threshold (128 KiB to start with) with fresh pages from the OS and returns them when the tensor is freed,
-so the next step touches new pages again: the kernel zeroes each 4 KiB page on its first touch. At the paper's
-size BGFN's [T, B, N, D] tensors are 6.5 MB each, and a step cost about 31,000 such page faults (``getrusage``);
-its ANN twin, with T = 1 and fewer layers, about 1,900. Raising the ``mmap`` and trim thresholds keeps freed blocks
-in the heap, where the next step finds them already mapped: under 2,000 faults per BGFN step, which took a few per
-cent less wall time (the README's ``make bench`` paragraph).
-
-This is the usual advice for CPU training with torch (a caching allocator such as jemalloc or tcmalloc does the same
-by default); it changes no number, only where a tensor's memory comes from. The price is that a training process
-keeps the memory of its largest step until it exits. Elsewhere than glibc (macOS, musl) nothing happens.
+torch allocates every activation and gradient of a training step afresh; glibc serves large blocks with fresh
+pages from the OS and returns them when freed, so every step pays the kernel's zeroing of each page on first touch
+(BGFN's [T, B, N, D] tensors are megabytes each). Raising glibc's ``mmap`` and trim thresholds keeps freed blocks in
+the heap, already mapped for the next step, as a caching allocator (jemalloc, tcmalloc) does by default. It changes
+no number, only where a tensor's memory comes from; a training process keeps the memory of its largest step until
+it exits. Elsewhere than glibc (macOS, musl) nothing happens.
 """
 
 from __future__ import annotations

@@ -1,19 +1,12 @@
 """Variants of a profile's learning problem, trained beside its main networks.
 
-A profile names them at its top level (:class:`bgfn.settings.Variant`)::
-
-    variants:                                  # name -> overrides of the train: section
-      velocity: {train: {extra_channels: [v_along, v_cross], ...}}     # params/quick-heading.yaml's inputs
-      leaky: {train: {protocol: leaky}}        # the test outages are training windows (bgfn.learning.split)
-    variant_runs: {datasets: null, methods: null, seeds: [0]}          # null: train.datasets / train.methods
-
-A variant's overrides are merged over the profile as a ``base:`` chain merges (:func:`bgfn.config.merge_sections`)
-and the result is checked as a whole profile when the profile loads (a misspelt key fails naming the file and
-``variants.<name>.train.<key>``). Its networks train on the same drives, with the same INS attitude input, the
-same budget and **the learning rates the main search selected** for each dataset and method
-(:mod:`bgfn.train.lr_search`; the variants are not searched again, so a variant is compared at the rate its
-main network uses). They are stored under ``results/<profile>/models/variants/<variant>/<dataset>/``
-(:func:`bgfn.train.checkpoints.variant_models_dir`); :mod:`bgfn.studies.outage_sweep.variant_outages` evaluates them in the outages.
+A profile names them at its top level (:class:`bgfn.settings.Variant`): ``variants:`` maps a name to overrides of
+the ``train:`` section (other input channels, a leaky protocol), ``variant_runs:`` which datasets, methods and
+seeds train them. A variant is merged over the profile as a ``base:`` chain merges and checked as a whole profile.
+Its networks train on the same drives and inputs with the same budget and the learning rates the main search
+selected (:mod:`bgfn.train.lr_search`: a variant is compared at its main network's rate), under
+``results/<profile>/models/variants/<variant>/`` (:func:`bgfn.train.checkpoints.variant_models_dir`);
+:mod:`bgfn.studies.outage_sweep.variant_outages` evaluates them in the outages.
 """
 
 from __future__ import annotations

@@ -1,18 +1,11 @@
 """The learned odometers at another model size, run on another machine and kept in ``data/measured/``.
 
-quick trains its odometer networks (:mod:`bgfn.studies.odometer.bars`) at the smoke size to fit 15 minutes on two
-cores. Whether their failure against INS+NHC is a matter of size is a question for the paper's size (dim 256,
-4 blocks, batch 8, up to 1000 epochs: the profile ``paper-odometer``), which takes minutes on a GPU and hours
-here. Such a run is made once, elsewhere, and kept:
-
-1. ``python -m bgfn odometers --profile paper-odometer`` runs notebook 07's odometer bars alone and writes the
-   tables under ``results/paper-odometer/`` and the run's facts (:func:`write_run_facts`: device, wall time,
-   jobs, torch) to ``odometer_run.json`` there;
-2. ``python -m bgfn odometers --profile paper-odometer --record`` keeps the summary (every row but the oracle's
-   grid) and the networks' facts, with the date, the commit and the device, in :data:`MEASURED_FILE` and
-   :data:`MEASURED_NETWORKS` (:func:`record`; a profile's earlier rows are replaced).
-
-The results page reads them (:func:`read_measured`) beside quick's own rows, which ``make reproduce`` computes.
+quick trains its odometer networks at the smoke size; whether their failure against INS+NHC is a matter of size is
+a question for the paper's size (the profile ``paper-odometer``), minutes on a GPU and hours here. Such a run is
+made once, elsewhere: ``python -m bgfn odometers --profile paper-odometer`` runs the odometer bars alone and writes
+the run's facts (:func:`write_run_facts`); ``--record`` keeps the summary and the networks' facts, with the date,
+the commit and the device, in :data:`MEASURED_FILE` and :data:`MEASURED_NETWORKS` (:func:`record`). The results page
+reads them (:func:`read_measured`) beside quick's own rows.
 """
 
 from __future__ import annotations

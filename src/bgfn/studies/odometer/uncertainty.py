@@ -1,17 +1,11 @@
 """Does a learned odometer know when it is wrong? Its predicted std against its speed error in the outages (beyond
 the paper).
 
-The design of the odometer rows (TLIO, OdoNet; :mod:`bgfn.studies.odometer.bars`) lets each network predict the std
-of its own speed, and the filter weighs every speed by it (R = std^2 times one calibration factor,
-:mod:`bgfn.nav.odometer`). That helps only if the std ranks the errors: small where the speed is good, large where
-it is not. The calibration factor cannot repair a std that does not; it only scales all of them.
-
-This module checks the premise on the honest series of notebook 07's speed figure (``speed_series`` of
-:func:`bgfn.studies.odometer.bars.odometer_rows`: each outage of the sweep predicted by its own fold's odometer, the
-networks' first seed): the epochs of each odometer inside the outages are ranked by their predicted std and split
-into :data:`DEFAULT_GROUPS` groups of equal size, and each group's speed RMSE and share within +-2 sigma are set side
-by side, with the correlation of the absolute error and the std over all epochs. An odometer whose std is the same
-at every epoch of a fold (``RIDGE-ODO``: the RMS of its validation residuals) has nothing to rank and is left out.
+The filter weighs every speed by the network's own std (:mod:`bgfn.nav.odometer`); that helps only if the std ranks
+the errors, which one calibration factor cannot repair. On notebook 07's honest speed series the epochs of each
+odometer inside the outages are ranked by their predicted std and split into :data:`DEFAULT_GROUPS` groups of equal
+size, each group's speed RMSE and share within +-2 sigma set side by side, with the correlation of the absolute
+error and the std. An odometer whose std is the same at every epoch of a fold (``RIDGE-ODO``) is left out.
 """
 
 from __future__ import annotations

@@ -1,40 +1,13 @@
 """``meta.yaml`` of a user's CSV drive: its keys, their defaults, one clear error for anything else.
 
-=================  ====================================================================================
-key                meaning (all optional; the file itself is optional)
-=================  ====================================================================================
-``name``           dataset id naming the result files (:func:`bgfn.data.names.dataset_id`): letters,
-                   digits, ``_``, ``-``, ``.``; default: the folder's name
-``lever_arm_m``    GNSS antenna in the body frame [x, y, z], m; default [0, 0, 0]
-``source``         free text (where the log comes from); default ``CSV drive <folder>``
-``imu_errors``     the IMU error parameters the Kalman filter uses (its Q and P0,
-                   :func:`bgfn.nav.state.noise_from_imu_errors`): a mapping of keys of
-                   :mod:`bgfn.data.imu_errors` laid over the profile ``base`` (``mpu6000`` or
-                   ``ekinox-d``; default :data:`DEFAULT_IMU_PROFILE`), plus ``model`` (a free label)
-``platform``       what moves the IMU: ``car`` (default: NHC and ZUPT, the vehicle frame estimated),
-                   ``walker`` (ZUPT only) or ``other`` (neither) (:data:`bgfn.nav.constraints.PLATFORM_AIDS`)
-``imu_mounting_deg``  [roll, pitch, yaw] of the IMU's axes in the body frame (x forward, y right, z down),
-                   deg; the IMU rows are rotated into the body frame at load; default [0, 0, 0]
-``imu_time_offset_s``  added to every IMU time (a logger's delay), s; default 0
-``gnss_latency_s``  subtracted from every GNSS time (a receiver stamps a fix when it arrives, later than the
-                   epoch it is valid at), s, >= 0, or ``auto``: the offset estimated from the data
-                   (:mod:`bgfn.data.time_offset`); default 0. Without it, an estimated offset beyond 0.5 s
-                   is an error naming both files
-``gnss_std_m``     [north, east, down] std of a fix, m, for a ``gnss.csv`` without ``std_n, std_e, std_d``
-                   (a receiver that reports no accuracy); no default: such a file needs it
-``reference_lever_arm_m``  the point whose position ``reference.csv`` gives, in the body frame [x, y, z], m
-                   (e.g. the RTK antenna); the reference is moved to the IMU at load; default [0, 0, 0]
-=================  ====================================================================================
-
-Without ``meta.yaml``, or without ``imu_errors``, the filter uses the consumer-MEMS profile
-:data:`bgfn.data.imu_errors.MPU6000` (InvenSense MPU-6000 datasheet noise densities, the paper's turn-on biases
-5 deg/s and 60 mg, bias instability 0.01 deg/s and 0.5 mg with 100 s correlation time): the grade of the
-paper's field-test IMU and of most phones and autopilots. ``meta["imu_errors_source"]`` says which was used.
-A recorded IMU is usually noisier while driving than its datasheet (vibration); the filter's mean NIS, printed
-by notebook 02, shows it.
-
-An unknown key, at the top level or inside ``imu_errors``, is a :class:`bgfn.errors.DataError` naming the file,
-the key and the closest valid key: a misspelt noise density never silently becomes a default.
+Every key is optional, and so is the file (``data/README.md`` lists them for a user): the dataset's ``name``, the
+antenna's ``lever_arm_m``, the ``source``, the ``imu_errors`` the filter uses (laid over the profile ``base``,
+default :data:`DEFAULT_IMU_PROFILE`: the consumer-MEMS :data:`bgfn.data.imu_errors.MPU6000`, the grade of the
+paper's field-test IMU), the ``platform`` (which aids run, :data:`bgfn.nav.constraints.PLATFORM_AIDS`), the IMU's
+``imu_mounting_deg`` and ``imu_time_offset_s``, the fixes' ``gnss_latency_s`` (a number, or ``auto``: estimated,
+:mod:`bgfn.data.time_offset`) and ``gnss_std_m``, and the reference's ``reference_lever_arm_m``. An unknown key, at
+the top level or inside ``imu_errors``, is a :class:`bgfn.errors.DataError` naming the file, the key and the closest
+valid key: a misspelt noise density never silently becomes a default.
 """
 
 from __future__ import annotations

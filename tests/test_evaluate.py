@@ -585,8 +585,8 @@ def test_reductions_beside_the_paper_and_its_quoted_claims():
     assert lay.loc[("Outage 1", "paper"), ("BGFN", "East")] == 4.7
     assert lay.loc[("Outage 2", "ours"), ("INS", "North")] == 8.0
     assert np.isnan(lay.loc[("Outage 1", "paper"), ("Transformer", "East")])
-    assert (ev.paper_table_title("dataset"), ev.paper_table_title("field")) == ("Table 1 (dataset test)",
-                                                                              "Table 2 (field test)")
+    title = evaluation_words.paper_table_title
+    assert (title("dataset"), title("field")) == ("Table 1 (dataset test)", "Table 2 (field test)")
 
 
 def test_pseudo_std_sensitivity_runs_the_first_seeds_networks_with_their_validation_std(drive5, tmp_path):

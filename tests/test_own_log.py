@@ -26,6 +26,7 @@ from bgfn.errors import DataError
 from bgfn.nav import earth, sim
 from bgfn.nav.transform import dcm_from_euler
 from bgfn.profile_schema import check_with_drives, load_profile
+from bgfn.report import evaluation_words
 
 pytestmark = pytest.mark.usefixtures("repo_untouched")
 _spec = importlib.util.spec_from_file_location("demo_log", config.PROJECT_ROOT / "tools" / "demo_log.py")
@@ -131,7 +132,7 @@ def test_a_csv_log_named_by_its_path_runs_notebooks_01_to_04(tmp_path, monkeypat
     red = ev.reduction_table(res[name])
     assert red["paper east_%"].isna().all() and red["paper east_%"].dtype == float
     assert set(red["method"]) == {"GPS", "BGFN", "MLP", "INS+NHC", "BGFN+NHC", "MLP+NHC"}   # each against INS
-    assert ev.paper_table_title(did) == f"no table of the paper ({did})"
+    assert evaluation_words.paper_table_title(did) == f"no table of the paper ({did})"
 
     written = [p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*") if p.is_file()]
     outside = [p for p in written if not p.startswith(("results/mine/", "logs/", "params/"))]

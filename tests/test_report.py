@@ -449,8 +449,8 @@ def test_the_real_drive_stands_beside_the_papers_field_test(tmp_path):
     assert paper.test_of("rtklib-drive0708") == "real" and not paper.has_own_values("real")
     pd.testing.assert_frame_equal(paper.published_values("real"), paper.outage_table("field"))
     assert (paper.paper_label("real"), paper.paper_label("field")) == ("paper (field test)", "paper")
-    assert ev.paper_table_title("field") == "Table 2 (field test)"
-    assert ev.paper_table_title("real") == "real drive (not in the paper; beside it Table 2 (field test))"
+    assert evaluation_words.paper_table_title("field") == "Table 2 (field test)"
+    assert evaluation_words.paper_table_title("real") == "real drive (not in the paper; beside it Table 2 (field test))"
     res = results(tmp_path, OURS)
     assert report.shown_tests(res) == ["dataset", "field"]          # no real-drive table, none evaluated: hidden
     glance = report.glance_lines("p", res.ours, res.published, None, res.claims, None)

@@ -9,7 +9,7 @@ Modules, in the order of the protocol: ``setup``, ``hybrid``, ``networks``, ``ta
 :mod:`bgfn.studies`.
 """
 
-from bgfn.evaluate.claims import REDUCTION_COLUMNS, ours_above_paper, paper_table_title, reduction_table
+from bgfn.evaluate.claims import REDUCTION_COLUMNS, ours_above_paper, reduction_table
 from bgfn.evaluate.setup import (COLORS, EVALUATE_DEFAULTS, FIGURE_METHODS, METRIC_COLUMNS, REAL_IMU_DATASETS,
                                   SWEEP_COLUMNS, TABLE_COLUMNS, TABLE_FILES, TABLE_METHODS, EvaluationSetup,
                                   choose_datasets, evaluate_config, evaluation_setup)
@@ -25,7 +25,7 @@ from bgfn.evaluate.tables import (TableResult, aggregate_seeds, error_reduction,
                                   representative_seeds, run_tables, save_table_result, table_file, table_paths)
 
 __all__ = [
-    "REDUCTION_COLUMNS", "ours_above_paper", "paper_table_title", "reduction_table", "COLORS",
+    "REDUCTION_COLUMNS", "ours_above_paper", "reduction_table", "COLORS",
     "EVALUATE_DEFAULTS", "FIGURE_METHODS", "METRIC_COLUMNS", "REAL_IMU_DATASETS", "SWEEP_COLUMNS", "TABLE_COLUMNS",
     "TABLE_FILES", "TABLE_METHODS", "EvaluationSetup", "choose_datasets", "evaluate_config", "evaluation_setup",
     "NavContext", "OutageRun", "gps_run", "navigation_context", "pseudo_gps_positions", "run_outages",

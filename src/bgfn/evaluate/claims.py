@@ -25,19 +25,6 @@ def _paper_values(test: str) -> pd.DataFrame | None:
     return paper.published_values(test) if test in paper.TESTS else None
 
 
-def paper_table_title(test: str) -> str:
-    """How notebook 04 names the paper's table beside a test: ``Table 1 (dataset test)``, ``Table 2 (field
-    test)`` (the order of the paper's tests in :data:`bgfn.paper.TESTS`); for a test the paper has no table of,
-    ``real drive (not in the paper; beside it Table 2 (field test))``; ``no table of the paper (<test>)`` for any
-    other drive (a user's)."""
-    if test not in paper.TESTS:
-        return f"no table of the paper ({test})"
-    own = [t for t in paper.TESTS if paper.has_own_values(t)]
-    shown = paper.published_test(test)
-    title = f"Table {own.index(shown) + 1} ({paper.TESTS[shown]['title']})"
-    return title if shown == test else f"{paper.TESTS[test]['title']} (not in the paper; beside it {title})"
-
-
 def ours_above_paper(result: TableResult) -> pd.DataFrame:
     """Max east/north errors (m) of one dataset in the paper's layout, ours above its Table 1 or 2.
 

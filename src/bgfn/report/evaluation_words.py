@@ -112,3 +112,16 @@ def claim_lines(reductions: Mapping[str, pd.DataFrame]) -> list[str]:
             lines.append(f"BGFN vs INS, {spec['title']}, outage {outage}: paper quotes {stated['east']} % east / "
                          f"{stated['north']} % north; {got}")
     return lines
+
+
+def paper_table_title(test: str) -> str:
+    """How notebook 04 names the paper's table beside a test: ``Table 1 (dataset test)``, ``Table 2 (field
+    test)`` (the order of the paper's tests in :data:`bgfn.paper.TESTS`); for a test the paper has no table of,
+    ``real drive (not in the paper; beside it Table 2 (field test))``; ``no table of the paper (<test>)`` for any
+    other drive (a user's)."""
+    if test not in paper.TESTS:
+        return f"no table of the paper ({test})"
+    own = [t for t in paper.TESTS if paper.has_own_values(t)]
+    shown = paper.published_test(test)
+    title = f"Table {own.index(shown) + 1} ({paper.TESTS[shown]['title']})"
+    return title if shown == test else f"{paper.TESTS[test]['title']} (not in the paper; beside it {title})"

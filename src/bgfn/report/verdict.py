@@ -47,9 +47,10 @@ SUBJECT = "BGFN"
 SWEEP_DURATIONS: tuple[float, ...] = (30.0, 60.0)
 #: Label of the oracle row: the true increments plus white noise of the subject's own increment error.
 ORACLE_ROW = "oracle at BGFN's increment error"
-#: Columns of :func:`verdict_table`.
+#: Columns of :func:`verdict_table`; ``Holm p``: a learned odometer's p against INS+NHC Holm-adjusted over the
+#: learned odometers (the page names their best; :meth:`bgfn.report.odometer_verdict.OdometerInputs.holm_p`).
 VERDICT_COLUMNS: tuple[str, ...] = ("row", "inputs", "protocol", "outage 1", "outage 2", "sweep 30 s", "sweep 60 s",
-                                    "p 30 s", "p 60 s", "runs", "covariance")
+                                    "p 30 s", "p 60 s", "Holm p 30 s", "Holm p 60 s", "runs", "covariance")
 #: Rows whose filter consistency in the outages the table states (``covariance``: :mod:`bgfn.studies.ins_fidelity.nees`).
 NEES_ROWS: tuple[str, ...] = ("INS", "INS+NHC")
 
@@ -488,7 +489,7 @@ def drift_clause(drift: pd.DataFrame | None, ins_m: float, aided_m: float, durat
 def format_table(table: pd.DataFrame):
     """The verdict table styled for the page (lengths with one decimal, p with two digits, n/a for empty)."""
     fmt = {c: "{:.1f}" for c in ("outage 1", "outage 2", "sweep 30 s", "sweep 60 s")}
-    fmt.update({c: "{:.2g}" for c in ("p 30 s", "p 60 s")})
+    fmt.update({c: "{:.2g}" for c in ("p 30 s", "p 60 s", "Holm p 30 s", "Holm p 60 s")})
     return table.style.format(fmt, na_rep="-").hide(axis="index")
 
 

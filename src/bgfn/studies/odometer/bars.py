@@ -484,8 +484,11 @@ def holm_vs_nhc(summary: pd.DataFrame) -> pd.Series:
     """``p_vs_nhc`` of the learned odometers (:data:`LEARNED_ODOMETERS`) Holm-adjusted over those of one dataset and
     duration with a p-value (:func:`bgfn.stats.holm_adjust`): a page that names the best of them names the smallest
     of several p-values, small by chance alone. NaN for the other rows (INS+NHC, the held speed, the oracles)."""
-    out = pd.Series(np.nan, index=summary.index, name="p_vs_nhc_holm")
-    learned = summary[summary["method"].isin(LEARNED_ODOMETERS)]
-    for _, g in learned.groupby(["dataset", "duration_s"], sort=False):
-        out.loc[g.index] = holm_adjust(g["p_vs_nhc"].to_numpy(dtype=float))
-    return out
+    out = np.full(len(summary), np.nan)
+    learned = summary["method"].isin(LEARNED_ODOMETERS).to_numpy()
+    keys = summary[["dataset", "duration_s"]].reset_index(drop=True)           # by position: any index will do
+    p = summary["p_vs_nhc"].to_numpy(dtype=float)
+    for rows in keys[learned].groupby(["dataset", "duration_s"], sort=False).indices.values():
+        at = np.flatnonzero(learned)[rows]
+        out[at] = holm_adjust(p[at])
+    return pd.Series(out, index=summary.index, name="p_vs_nhc_holm")

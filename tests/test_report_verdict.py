@@ -82,6 +82,38 @@ def test_answers_say_the_measured_numbers():
         "INS with zero-velocity updates (no NHC: a walker steps sideways) 5.0 m.")
 
 
+def test_a_comparison_of_one_seed_and_two_windows_says_so():
+    # the case: BGFN below INS from one seed in the profile's two outages, no sweep
+    one = _seeds()
+    one = one[one["seed"] == 0]
+    inp = _inputs(seeds=one, sweep_summary=None, sweep_pairs=None)
+    t = verdict_table(inp)
+    head = headline(inp, t)
+    assert "mean max error in the paper's two outages (BGFN: one seed, 2 windows: no statistics): BGFN 45.0 m" in head
+    assert "(one seed, 2 windows: no statistics)." in answer_free_aids(t)
+    assert "(INS 15.0 m; each from one seed, 2 windows: no statistics)." in answer_protocol(t)
+    # three seeds in two windows: still too few windows
+    three = _inputs(sweep_summary=None, sweep_pairs=None)
+    assert "(BGFN: 3 seeds, 2 windows: no statistics)" in headline(three, verdict_table(three))
+    # the sweep: 20 starts of one seed each (n / n_starts), then 20 starts of 3 seeds (nothing to say)
+    summary = _inputs().sweep_summary.assign(n=20, n_starts=20)
+    sweep = _inputs(sweep_summary=summary)
+    assert ("median max error over the 30 s sweep (BGFN: one seed, 20 windows: no spread between training seeds): "
+            in headline(sweep, verdict_table(sweep)))
+    sweep = _inputs(sweep_summary=summary.assign(n=60))
+    assert "over the 30 s sweep: BGFN" in headline(sweep, verdict_table(sweep))
+
+
+def test_the_sample_clause_by_hand():
+    from bgfn.report.sample_words import sample_clause
+
+    assert sample_clause(1, 2) == "one seed, 2 windows: no statistics"
+    assert sample_clause(3, 1) == "3 seeds, one window: no statistics"
+    assert sample_clause(5, 4) == "5 seeds, 4 windows: no statistics"              # 4 windows: p >= 0.125
+    assert sample_clause(1, 5) == "one seed, 5 windows: no spread between training seeds"
+    assert sample_clause(2, 5) == ""
+
+
 def test_the_platform_comes_from_notebook_02s_record(tmp_path):
     import json
 

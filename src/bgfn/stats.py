@@ -5,6 +5,8 @@
   together, since runs of the same start share the trajectory and are not independent).
 - :func:`paired_comparison`: how often method A beats method B on paired runs, the median paired difference
   and the Wilcoxon signed-rank test (two-sided) of ``A - B``.
+- :func:`too_few_for_statistics`: whether a comparison rests on one training seed or fewer than
+  :data:`MIN_WINDOWS` outage windows (a page then says so instead of implying a result).
 - :func:`holm_adjust`: Holm's step-down adjusted p-values of a family of tests, for a page that names the best of
   several candidates (the smallest of k raw p-values is small by chance alone).
 
@@ -19,6 +21,11 @@ import numpy as np
 from scipy.stats import wilcoxon
 
 from bgfn.errors import DataError
+
+#: Outage windows below which a comparison has no statistics: the exact two-sided signed-rank test's smallest p
+#: with n pairs is 2 / 2^n (0.125 with 4 windows, whatever the errors), so fewer windows cannot tell a difference
+#: from chance.
+MIN_WINDOWS = 5
 
 
 def bootstrap_ci(values, stat: Callable = np.median, n_boot: int = 2000, level: float = 0.95, seed: int = 0,
@@ -118,6 +125,12 @@ def paired_comparison(a, b) -> dict:
             "p_value": wilcoxon_p(d)}
 
 
+def too_few_for_statistics(n_seeds: int, n_windows: int) -> bool:
+    """Whether a comparison rests on one training seed (or none) or fewer than :data:`MIN_WINDOWS` outage windows:
+    its numbers are one draw, and the page says so beside them."""
+    return int(n_seeds) < 2 or int(n_windows) < MIN_WINDOWS
+
+
 def holm_adjust(p_values) -> np.ndarray:
     """Holm(-Bonferroni) adjusted p-values of one family of tests (Holm 1979).
 
@@ -150,4 +163,4 @@ def holm_adjust(p_values) -> np.ndarray:
     return out
 
 
-__all__ = ["bootstrap_ci", "holm_adjust", "paired_comparison", "wilcoxon_p"]
+__all__ = ["MIN_WINDOWS", "bootstrap_ci", "holm_adjust", "too_few_for_statistics", "paired_comparison", "wilcoxon_p"]

@@ -14,11 +14,14 @@ from typing import Mapping
 import pandas as pd
 
 from bgfn import paper
+from bgfn.stats import too_few_for_statistics
 from bgfn.evaluate.setup import TABLE_METHODS
 from bgfn.evaluate.tables import TableResult, error_reduction
 
-#: Columns of :func:`reduction_table`: ours, then the paper's (reduction against INS, %).
-REDUCTION_COLUMNS: tuple[str, ...] = ("outage", "method", "east_%", "north_%", "paper east_%", "paper north_%")
+#: Columns of :func:`reduction_table`: ours, then the paper's (reduction against INS, %), then what ours rests on
+#: (``n_seeds``: the method's runs in the outage, ``n_windows``: the outages of the table).
+REDUCTION_COLUMNS: tuple[str, ...] = ("outage", "method", "east_%", "north_%", "paper east_%", "paper north_%",
+                                      "n_seeds", "n_windows")
 
 
 def _paper_values(test: str) -> pd.DataFrame | None:
@@ -67,7 +70,8 @@ def reduction_table(result: TableResult, reference: str = "INS") -> pd.DataFrame
     -------
     DataFrame
         :data:`REDUCTION_COLUMNS`: one row per outage and method of ours; the paper's columns NaN where it
-        has no such row (Transformer, GPS) or no such test (a user's drive).
+        has no such row (Transformer, GPS) or no such test (a user's drive); ``n_seeds`` the method's seeds in
+        that outage (``result.per_seed``; 0 when it holds no runs), ``n_windows`` the outages of the table.
     """
     ours = error_reduction(result.table, reference).rename(columns={"east_pct": "east_%", "north_pct": "north_%"})
     values = _paper_values(result.test)
@@ -75,7 +79,16 @@ def reduction_table(result: TableResult, reference: str = "INS") -> pd.DataFrame
               else pd.DataFrame({"outage": pd.Series(dtype=ours["outage"].dtype), "method": pd.Series(dtype=object),
                                  "east_pct": pd.Series(dtype=float), "north_pct": pd.Series(dtype=float)})).rename(
         columns={"east_pct": "paper east_%", "north_pct": "paper north_%"})
-    return ours.merge(theirs, on=["outage", "method"], how="left")[list(REDUCTION_COLUMNS)]
+    per = result.per_seed
+    seeds = (per.groupby(["outage", "method"])["seed"].nunique().rename("n_seeds").reset_index()
+             if {"outage", "method", "seed"} <= set(per.columns)
+             else pd.DataFrame({"outage": pd.Series(dtype=int), "method": pd.Series(dtype=object),
+                                "n_seeds": pd.Series(dtype=int)}))
+    seeds["outage"] = seeds["outage"].astype(int)
+    out = ours.merge(theirs, on=["outage", "method"], how="left").merge(seeds, on=["outage", "method"], how="left")
+    out["n_seeds"] = out["n_seeds"].fillna(0).astype(int)          # 0: the runs were not kept (unknown)
+    out["n_windows"] = int(result.table["outage"].nunique())
+    return out[list(REDUCTION_COLUMNS)]
 
 
 def claim_lines(reductions: Mapping[str, pd.DataFrame]) -> list[str]:
@@ -91,8 +104,10 @@ def claim_lines(reductions: Mapping[str, pd.DataFrame]) -> list[str]:
     -------
     list of str
         ``BGFN vs INS, <test title>, outage <k>: paper quotes E % east / N % north; ours ...`` (``not
-        evaluated`` when no dataset of that test, or no BGFN row, was run); the quotes are of the paper's own
-        tests, so a test it has no table of (the real drive) gets no line.
+        evaluated`` when no dataset of that test, or no BGFN row, was run), ended by ``(n seed(s), m window(s):
+        no statistics)`` when ours rests on one seed or fewer than :data:`bgfn.stats.MIN_WINDOWS` windows (the
+        table's ``n_seeds``, ``n_windows``); the quotes are of the paper's own tests, so a test it has no table of
+        (the real drive) gets no line.
     """
     claims = paper.claims()
     by_test: dict[str, pd.DataFrame] = {}
@@ -110,6 +125,11 @@ def claim_lines(reductions: Mapping[str, pd.DataFrame]) -> list[str]:
             row = red[(red["outage"] == outage) & (red["method"] == "BGFN")] if red is not None else None
             got = (f"ours {row['east_%'].item():.1f} % east / {row['north_%'].item():.1f} % north"
                    if row is not None and len(row) else "not evaluated")
+            if row is not None and len(row) and {"n_seeds", "n_windows"} <= set(row.columns):
+                seeds, windows = int(row["n_seeds"].item()), int(row["n_windows"].item())
+                if seeds > 0 and too_few_for_statistics(seeds, windows):
+                    got += (f" ({'one seed' if seeds == 1 else f'{seeds} seeds'}, "
+                            f"{'one window' if windows == 1 else f'{windows} windows'}: no statistics)")
             lines.append(f"BGFN vs INS, {spec['title']}, outage {outage}: paper quotes {stated['east']} % east / "
                          f"{stated['north']} % north; {got}")
     return lines

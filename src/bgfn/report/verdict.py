@@ -36,6 +36,7 @@ from bgfn.report.aid_words import aided_ins_words
 from bgfn.report.odometer_verdict import (OdometerInputs, answer_odometer, odometer_headline, odometer_rows,
                                           read_odometer_inputs, same_dataset)
 from bgfn.report.reading import read_csv, read_json
+from bgfn.report.sample_words import sample_clause
 
 #: Rows of the verdict table, in order: (label, method label in the tables). The oracle row is built apart.
 METHOD_ROWS: tuple[tuple[str, str], ...] = (
@@ -224,6 +225,34 @@ def _row(table: pd.DataFrame, label: str) -> pd.Series | None:
     return sel.iloc[0] if len(sel) else None
 
 
+def _outage_sample(row: pd.Series | None) -> tuple[int, int]:
+    """(seeds, windows) a row's mean over the paper's outages rests on: its ``runs`` per cell and its outages with
+    a value; (0, 0) without the row."""
+    if row is None:
+        return 0, 0
+    cells = np.array([row["outage 1"], row["outage 2"]], dtype=float)
+    return int(row["runs"]) if np.isfinite(float(row["runs"])) else 0, int(np.isfinite(cells).sum())
+
+
+def _sweep_sample(summary: pd.DataFrame | None, method: str, duration: float) -> tuple[int, int]:
+    """(seeds, windows) ``method``'s sweep median at ``duration`` rests on: its runs per start and its starts
+    (``outage_sweep_summary.csv``'s ``n`` and ``n_starts``); (0, 0) without them."""
+    if summary is None or not {"n", "n_starts"} <= set(summary.columns):
+        return 0, 0
+    sel = summary[(summary["method"] == method) & np.isclose(summary["duration_s"].astype(float), duration)]
+    if not len(sel) or int(sel["n_starts"].iloc[0]) < 1:
+        return 0, 0
+    starts = int(sel["n_starts"].iloc[0])
+    return int(round(int(sel["n"].iloc[0]) / starts)), starts
+
+
+def _sample_note(seeds_windows: tuple[int, int], lead: str = " (") -> str:
+    """:func:`bgfn.report.sample_words.sample_clause` in parentheses (``lead`` opens it), empty when the sample
+    is large enough or unknown."""
+    clause = sample_clause(*seeds_windows) if seeds_windows[1] > 0 else ""
+    return f"{lead}{clause})" if clause else ""
+
+
 def _mean_outages(row: pd.Series | None) -> float:
     """Mean of a row's max errors over the outages it has (a user's drive may have one), NaN without any."""
     if row is None:
@@ -273,7 +302,8 @@ def answer_free_aids(table: pd.DataFrame, drift: pd.DataFrame | None = None) -> 
     else:
         text = (f"In the paper's two outages (mean of their max errors) INS reaches {_m(_mean_outages(ins))}, INS+NHC "
                 f"{_m(_mean_outages(nhc))}" + drift_clause(drift, _mean_outages(ins), _mean_outages(nhc))
-                + f"; BGFN {_m(_mean_outages(bgfn))} and BGFN+NHC {_m(_mean_outages(both))}.")
+                + f"; BGFN {_m(_mean_outages(bgfn))} and BGFN+NHC {_m(_mean_outages(both))}"
+                + _sample_note(_outage_sample(bgfn)) + ".")
     a, b = (both[col], nhc[col]) if col else (_mean_outages(both), _mean_outages(nhc))
     add = ("BGFN adds to the free aid" if np.isfinite(a) and np.isfinite(b) and a < b
            else "BGFN does not add to the free aid: fused with NHC it is worse than NHC alone")
@@ -372,8 +402,9 @@ def answer_protocol(table: pd.DataFrame, claims: dict | None = None) -> str:
     if not len(leaky):
         return "Was the paper's protocol leaky? Not measured: the variant trained on the whole drive has not run."
     ins = _mean_outages(_row(table, "INS"))
-    lines = []
+    lines, samples = [], []
     for _, r in pd.concat([_variant_rows(table, None, "honest"), leaky]).iterrows():
+        samples.append(_outage_sample(r))
         err = _mean_outages(r)
         red = 100.0 * (ins - err) / ins if np.isfinite(ins) and ins > 0 else float("nan")
         lines.append(f"{r['row']}, {r['protocol']}: {_m(err)}, "
@@ -385,7 +416,9 @@ def answer_protocol(table: pd.DataFrame, claims: dict | None = None) -> str:
             stated = f" The paper states reductions of {min(pct):g}-{max(pct):g} %."
     return ("Was the paper's protocol leaky? Mean max error in the paper's two outages, trained with the test outages "
             "and a margin left out (honest) and on the whole drive, the test outages included (leaky): "
-            + "; ".join(lines) + f" (INS {_m(ins)})." + stated)
+            + "; ".join(lines) + f" (INS {_m(ins)}"
+            + _sample_note((min(n for n, _ in samples), max(w for _, w in samples)), "; each from ")[:-1] + ")."
+            + stated)
 
 
 def _numbers(node) -> list[float]:
@@ -455,11 +488,12 @@ def headline(inp: VerdictInputs, table: pd.DataFrame) -> str:
         return f"{title} ({inp.dataset}): not evaluated."
     if col:
         vals = (b[col], i[col], n[col] if n is not None else np.nan)
-        where = "median max error over the 30 s sweep"
+        where = ("median max error over the 30 s sweep"
+                 + _sample_note(_sweep_sample(inp.sweep_summary, SUBJECT, 30.0), " (BGFN: "))
     else:
         vals = (_mean_outages(b), _mean_outages(i), _mean_outages(n))
         where = ("mean max error in the paper's two outages" if paper.has_own_values(inp.test)
-                 else "mean max error in the profile's outages")
+                 else "mean max error in the profile's outages") + _sample_note(_outage_sample(b), " (BGFN: ")
     word = "below" if vals[0] < vals[1] else "above"
     odo = odometer_headline(inp.odometer, SWEEP_DURATIONS) if inp.odometer is not None else ""
     return (f"{title} ({inp.dataset}): " + (f"{odo[0].upper()}{odo[1:]}. " if odo else "")

@@ -231,6 +231,17 @@ def test_odometer_rows_answer_and_headline_read_the_odometer_tables():
     assert "better than its ANN twin" in answer and "(overconfident" in answer
 
 
+def test_an_untrained_odometer_claims_no_energy_saving():
+    odo = _odometer()
+    odo.energy = odo.energy.assign(improved=[False, True])                # BGFN-ODO's best epoch 0
+    inp = _inputs(odometer=odo)
+    answer = verdict_sentences(inp, verdict_table(inp))[5]
+    assert "% less" not in answer and "the BGFN-ODO measured did not train (best epoch 0), so no saving" in answer
+    assert "% less" not in headline(inp, verdict_table(inp))
+    odo.energy = odo.energy.assign(improved=[True, True])
+    assert "(75 % less)" in verdict_sentences(inp, verdict_table(inp))[5]
+
+
 def test_the_odometer_answer_gives_the_ensembles_error_calibration_and_energy():
     odo = _odometer()
     assert "as one ensemble" not in verdict_sentences(_inputs(odometer=odo), verdict_table(_inputs(odometer=odo)))[5]

@@ -47,6 +47,7 @@ def energy_summary(measured: MeasuredModels, windows: EvaluationWindows, tables:
         "profile": measured.profile, "dataset": measured.dataset, "seed": measured.seed,
         "checkpoints": measured.relative_paths(),
         "checkpoint_epochs": {m: measured.cards[m].get("best_epoch") for m in measured.cards},
+        "improved": measured.improved,
         "windows": {"source": "validation windows of bgfn.learning (bgfn.train.prepare_learning_data)",
                     "n_windows": int(len(ws)), "n_validation_windows": int(windows.n_validation),
                     "window_samples": int(ws.x.shape[1])},
@@ -71,6 +72,11 @@ def result_markdown(summary: dict) -> str:
     """The result of notebook 05 in one paragraph (Markdown), from :func:`energy_summary`'s dict."""
     s = summary
     e, attn = s["energy_uj_per_prediction"], s["attention_energy_uj"]
+    if not (s.get("improved") or {}).get("bgfn", True):
+        return (f"**Result ({s['profile']} profile, {s['dataset']}, seed {s['seed']}):** BGFN did not train (its best "
+                f"epoch is 0: training never improved on its initial network), so its firing rates are an untrained "
+                f"network's and no energy saving against the Transformer twin is claimed (BGFN {e['bgfn']:.4g} µJ, "
+                f"twin {e['transformer']:.4g} µJ per prediction; paper: {s['paper_reduction_pct']} % less).")
     return (
         f"**Result ({s['profile']} profile, {s['dataset']}, seed {s['seed']}):** BGFN {e['bgfn']:.4g} µJ vs "
         f"Transformer twin {e['transformer']:.4g} µJ per prediction: **{s['reduction_pct']:.1f} % less energy** "

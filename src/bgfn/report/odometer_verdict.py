@@ -150,6 +150,14 @@ class OdometerInputs:
         # identical at every start: no difference at all (the signed-rank test has no nonzero pair to rank)
         return float(diff.median()), 1.0 if (diff == 0).all() else wilcoxon_p(diff)
 
+    def energy_improved(self, method: str) -> bool:
+        """Whether ``method``'s odometer measured for its energy trained (``energy_odometer.csv``'s ``improved``;
+        True for a table written before that column, or without the network)."""
+        if self.energy is None or "improved" not in self.energy.columns:
+            return True
+        sel = self.energy[self.energy["model"] == method]
+        return bool(sel["improved"].astype(str).isin(["True", "true", "1", "1.0"]).all()) if len(sel) else True
+
     def energy_uj(self, method: str) -> float:
         """Energy per prediction of ``method``'s odometer (µJ), NaN when notebook 07 did not measure it."""
         if self.energy is None or not len(self.energy):
@@ -363,6 +371,9 @@ def _energy(odo: OdometerInputs) -> str:
     e_snn, e_ann = odo.energy_uj("BGFN-ODO"), odo.energy_uj("Transformer-ODO")
     if not np.isfinite(e_snn):
         return "its energy was not measured for this drive (notebook 07 audits one drive's odometers)"
+    if not odo.energy_improved("BGFN-ODO"):
+        return ("its energy not compared with the twin's: the BGFN-ODO measured did not train (best epoch 0), so no "
+                "saving is claimed")
     if not np.isfinite(e_ann):
         return f"at {e_snn:.3g} µJ per prediction"
     return (f"at {e_snn:.3g} µJ per prediction against the twin's {e_ann:.3g} µJ "

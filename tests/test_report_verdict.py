@@ -114,6 +114,29 @@ def test_the_sample_clause_by_hand():
     assert sample_clause(2, 5) == ""
 
 
+def test_a_walkers_rows_are_labelled_with_the_zupt_that_ran():
+    from bgfn.report.aid_words import aid_label
+    from bgfn.report.verdict import format_table
+    from bgfn.report.verdict_page import short_answers, short_table
+
+    assert aid_label("INS+NHC", "walker") == "INS+ZUPT" and aid_label("BGFN+NHC", "walker") == "BGFN+ZUPT"
+    assert aid_label("INS+NHC", "car") == "INS+NHC" and aid_label("INS+NHC+HOLD", "walker") == "INS+ZUPT+HOLD"
+    assert aid_label("INS+NHC", "other") == "INS+no aid" and aid_label("INS", "walker") == "INS"
+    assert aid_label("the `+NHC` rows", "walker") == "the `+NHC` rows"        # a bare suffix is no row's label
+    walker = _inputs(platform="walker")
+    t = verdict_table(walker)
+    shown = list(format_table(t, walker.platform).data["row"])
+    assert "INS+ZUPT" in shown and "BGFN+ZUPT" in shown and not any("NHC" in r for r in shown)
+    assert list(short_table(t, "walker").data["row"]) == ["INS", "INS+ZUPT", "MLP", "AT-LSTM", "Transformer", "BGFN",
+                                                          "BGFN+ZUPT"]
+    text = " ".join([headline(walker, t), *verdict_sentences(walker, t), *short_answers(walker, t).values()])
+    assert "INS+ZUPT" in text and "BGFN+ZUPT" in text and "+NHC" not in text
+    # a car's page as it was: its labels byte for byte
+    car = _inputs()
+    assert list(format_table(verdict_table(car)).data["row"]) == list(verdict_table(car)["row"])
+    assert "BGFN+NHC against INS+NHC" in verdict_sentences(car, verdict_table(car))[1]
+
+
 def test_the_platform_comes_from_notebook_02s_record(tmp_path):
     import json
 

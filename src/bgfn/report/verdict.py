@@ -27,15 +27,15 @@ import numpy as np
 import pandas as pd
 
 from bgfn import paper
-from bgfn.config import MAIN_VARIANT, RUN_RECORDS, SHARED_TABLES
+from bgfn.config import MAIN_VARIANT, SHARED_TABLES
 from bgfn.data.names import dataset_id
 from bgfn.data.registry import recorded_first
 from bgfn.evaluate.tables import table_paths
 from bgfn.studies.ins_fidelity.ins_setups import NAVEGO_CONSISTENT, NAVEGO_RUN, gap_explained
-from bgfn.report.aid_words import aided_ins_words
+from bgfn.report.aid_words import aid_label, aided_ins_words, recorded_platform
 from bgfn.report.odometer_verdict import (OdometerInputs, answer_odometer, odometer_headline, odometer_rows,
                                           read_odometer_inputs, same_dataset)
-from bgfn.report.reading import read_csv, read_json
+from bgfn.report.reading import read_csv
 from bgfn.report.sample_words import sample_clause
 
 #: Rows of the verdict table, in order: (label, method label in the tables). The oracle row is built apart.
@@ -464,23 +464,25 @@ def consistency_sentence(inp: VerdictInputs) -> str:
 
 
 def verdict_sentences(inp: VerdictInputs, table: pd.DataFrame, claims: dict | None = None) -> list[str]:
-    """The six answers for one test, in the issues' order."""
-    return [answer_accuracy(inp), answer_free_aids(table, inp.ins_drift), answer_speed(table, inp),
-            answer_protocol(table, claims), answer_ins_tuning(inp),
-            answer_odometer(inp.odometer or OdometerInputs(None, None, None), SWEEP_DURATIONS)]
+    """The six answers for one test, in the issues' order, the rows named by the aids that ran
+    (:func:`bgfn.report.aid_words.aid_label`: ``INS+ZUPT`` on a walker)."""
+    answers = [answer_accuracy(inp), answer_free_aids(table, inp.ins_drift), answer_speed(table, inp),
+               answer_protocol(table, claims), answer_ins_tuning(inp),
+               answer_odometer(inp.odometer or OdometerInputs(None, None, None), SWEEP_DURATIONS)]
+    return [aid_label(a, inp.platform) for a in answers]
 
 
-def _platform(out: Path, dataset: str) -> str:
-    """The drive's platform as notebook 02 recorded it (``kf_baseline.json``; ``car`` when it says nothing)."""
-    record = read_json(Path(out) / RUN_RECORDS["kf_baseline"]) or {}
-    for name, facts in (record.get("datasets") or {}).items():
-        if dataset_id(name) == dataset_id(dataset):
-            return str(((facts or {}).get("constraints") or {}).get("platform", "car"))
-    return "car"
+#: The drive's platform as notebook 02 recorded it (:func:`bgfn.report.aid_words.recorded_platform`).
+_platform = recorded_platform
 
 
 def headline(inp: VerdictInputs, table: pd.DataFrame) -> str:
-    """One line per test for the book's first page: BGFN against INS and INS+NHC where both were measured."""
+    """One line per test for the book's first page: BGFN against INS and INS+NHC where both were measured (the
+    rows named by the aids that ran, :func:`bgfn.report.aid_words.aid_label`)."""
+    return aid_label(_headline(inp, table), inp.platform)
+
+
+def _headline(inp: VerdictInputs, table: pd.DataFrame) -> str:
     title = paper.TESTS[inp.test]["title"] if inp.test in paper.TESTS else inp.test
     b, i, n = (_row(table, k) for k in (SUBJECT, "INS", "INS+NHC"))
     col = "sweep 30 s" if b is not None and np.isfinite(b["sweep 30 s"]) else None
@@ -520,8 +522,11 @@ def drift_clause(drift: pd.DataFrame | None, ins_m: float, aided_m: float, durat
             f"starts it is {_m(aided)} against INS's {_m(ins)} (median max error, {duration_s:g} s)")
 
 
-def format_table(table: pd.DataFrame):
-    """The verdict table styled for the page (lengths with one decimal, p with two digits, n/a for empty)."""
+def format_table(table: pd.DataFrame, platform: str = "car"):
+    """The verdict table styled for the page (lengths with one decimal, p with two digits, n/a for empty), its rows
+    named by the aids that ran on ``platform`` (:func:`bgfn.report.aid_words.aid_label`: ``INS+ZUPT`` on a
+    walker)."""
+    table = table.assign(row=[aid_label(r, platform) for r in table["row"]])
     fmt = {c: "{:.1f}" for c in ("outage 1", "outage 2", "sweep 30 s", "sweep 60 s")}
     fmt.update({c: "{:.2g}" for c in ("p 30 s", "p 60 s", "Holm p 30 s", "Holm p 60 s")})
     return table.style.format(fmt, na_rep="-").hide(axis="index")
@@ -544,7 +549,8 @@ class Verdict:
         out = []
         for d, inp in self.inputs.items():
             title = paper.TESTS[inp.test]["title"] if inp.test in paper.TESTS else inp.test
-            out += [f"### {title}: `{d}`", f"**{headline(inp, self.tables[d])}**", format_table(self.tables[d]),
+            out += [f"### {title}: `{d}`", f"**{headline(inp, self.tables[d])}**",
+                    format_table(self.tables[d], inp.platform),
                     "\n".join(f"{k}. {a}" for k, a in enumerate(self.answers[d], 1))]
         return out
 

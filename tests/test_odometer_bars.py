@@ -90,6 +90,11 @@ def test_summary_holm_adjusts_the_learned_odometers_together():
     # the held speed is no learned odometer: no member of the family, no adjusted p
     assert np.isfinite(s.loc["INS+NHC+HOLD", "p_vs_nhc"]) and np.isnan(s.loc["INS+NHC+HOLD", "p_vs_nhc_holm"])
     assert list(O.odometer_summary(pd.DataFrame(rows)).columns) == list(O.SUMMARY_COLUMNS)
+    from bgfn.studies.odometer.section import odometer_lines
+    line = odometer_lines(O.odometer_summary(pd.DataFrame(rows)))[0]
+    assert "BGFN-ODO 10.0 m (0.74 of INS+NHC per start, Wilcoxon p = 0.031, Holm-corrected over the learned " \
+           "odometers 0.094" in line
+    assert "INS+NHC+HOLD 10.0 m (0.74 of INS+NHC per start, Wilcoxon p = 0.031)" in line     # no learned odometer
 
 
 def test_summary_coverage_is_the_share_of_all_the_outages_epochs():

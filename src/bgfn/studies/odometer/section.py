@@ -219,6 +219,8 @@ def odometer_lines(summary: pd.DataFrame) -> list[str]:
                 row = by[m].iloc[0]
                 part.append(f"{m} {row['max_h_m']:.1f} m ({row['ratio_to_nhc']:.2f} of INS+NHC per start"
                             + (f", Wilcoxon p = {row['p_vs_nhc']:.2g}" if "p_vs_nhc" in row else "")
+                            + (f", Holm-corrected over the learned odometers {row['p_vs_nhc_holm']:.2g}"
+                               if np.isfinite(row.get("p_vs_nhc_holm", np.nan)) else "")
                             + (f"; speed RMSE {row['speed_rmse_mps']:.2f} m/s, 2-sigma coverage "
                                f"{100 * row['coverage_2sigma']:.0f} %" if m != HOLD else "") + ")")
         for m, what in ((ORACLE, "an oracle speed"), (ORACLE_WALK, "with a random walk")):

@@ -92,6 +92,8 @@ def test_a_comparison_of_one_seed_and_two_windows_says_so():
     assert "mean max error in the paper's two outages (BGFN: one seed, 2 windows: no statistics): BGFN 45.0 m" in head
     assert "(one seed, 2 windows: no statistics)." in answer_free_aids(t)
     assert "(INS 15.0 m; each from one seed, 2 windows: no statistics)." in answer_protocol(t)
+    from bgfn.report.verdict_page import short_answers
+    assert "in the paper's two outages (one seed, 2 windows: no statistics) INS+NHC" in short_answers(inp, t)["free_aids"]
     # three seeds in two windows: still too few windows
     three = _inputs(sweep_summary=None, sweep_pairs=None)
     assert "(BGFN: 3 seeds, 2 windows: no statistics)" in headline(three, verdict_table(three))

@@ -133,6 +133,7 @@ def test_a_walkers_rows_are_labelled_with_the_zupt_that_ran():
                                                           "BGFN+ZUPT"]
     text = " ".join([headline(walker, t), *verdict_sentences(walker, t), *short_answers(walker, t).values()])
     assert "INS+ZUPT" in text and "BGFN+ZUPT" in text and "+NHC" not in text
+    assert "fused with ZUPT it is worse than ZUPT alone" in verdict_sentences(walker, t)[1]
     # a car's page as it was: its labels byte for byte
     car = _inputs()
     assert list(format_table(verdict_table(car)).data["row"]) == list(verdict_table(car)["row"])

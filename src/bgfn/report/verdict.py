@@ -32,7 +32,7 @@ from bgfn.data.names import dataset_id
 from bgfn.data.registry import recorded_first
 from bgfn.evaluate.tables import table_paths
 from bgfn.studies.ins_fidelity.ins_setups import NAVEGO_CONSISTENT, NAVEGO_RUN, gap_explained
-from bgfn.report.aid_words import aid_label, aided_ins_words, recorded_platform
+from bgfn.report.aid_words import aid_label, aid_suffix, aided_ins_words, recorded_platform
 from bgfn.report.odometer_verdict import (OdometerInputs, answer_odometer, odometer_headline, odometer_rows,
                                           read_odometer_inputs, same_dataset)
 from bgfn.report.reading import read_csv
@@ -286,10 +286,11 @@ def answer_accuracy(inp: VerdictInputs) -> str:
             f"outage).")
 
 
-def answer_free_aids(table: pd.DataFrame, drift: pd.DataFrame | None = None) -> str:
+def answer_free_aids(table: pd.DataFrame, drift: pd.DataFrame | None = None, platform: str = "car") -> str:
     """Question 2: INS+NHC against INS and BGFN, and whether BGFN adds to NHC; ``drift`` (notebook 08's
     ``kf_ins_drift.csv``) puts the paper's two outages beside the drive's starts where they rank INS+NHC otherwise
-    (:func:`drift_clause`)."""
+    (:func:`drift_clause`); ``platform`` names the free aid that ran (:func:`bgfn.report.aid_words.aid_suffix`)."""
+    aid = aid_suffix(platform)[1:]
     ins, nhc, bgfn, both = (_row(table, k) for k in ("INS", "INS+NHC", "BGFN", "BGFN+NHC"))
     if nhc is None or not np.isfinite(_mean_outages(nhc)):
         return "Does it beat the learning-free aids? Not measured: the INS+NHC row has not run."
@@ -306,7 +307,7 @@ def answer_free_aids(table: pd.DataFrame, drift: pd.DataFrame | None = None) -> 
                 + _sample_note(_outage_sample(bgfn)) + ".")
     a, b = (both[col], nhc[col]) if col else (_mean_outages(both), _mean_outages(nhc))
     add = ("BGFN adds to the free aid" if np.isfinite(a) and np.isfinite(b) and a < b
-           else "BGFN does not add to the free aid: fused with NHC it is worse than NHC alone")
+           else f"BGFN does not add to the free aid: fused with {aid} it is worse than {aid} alone")
     return f"Does it beat the learning-free aids? {text} {add}."
 
 
@@ -466,7 +467,7 @@ def consistency_sentence(inp: VerdictInputs) -> str:
 def verdict_sentences(inp: VerdictInputs, table: pd.DataFrame, claims: dict | None = None) -> list[str]:
     """The six answers for one test, in the issues' order, the rows named by the aids that ran
     (:func:`bgfn.report.aid_words.aid_label`: ``INS+ZUPT`` on a walker)."""
-    answers = [answer_accuracy(inp), answer_free_aids(table, inp.ins_drift), answer_speed(table, inp),
+    answers = [answer_accuracy(inp), answer_free_aids(table, inp.ins_drift, inp.platform), answer_speed(table, inp),
                answer_protocol(table, claims), answer_ins_tuning(inp),
                answer_odometer(inp.odometer or OdometerInputs(None, None, None), SWEEP_DURATIONS)]
     return [aid_label(a, inp.platform) for a in answers]

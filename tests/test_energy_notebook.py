@@ -198,6 +198,15 @@ def test_energy_summary_has_what_the_results_page_reads():
     md = energy_words.result_markdown(s)
     assert "BGFN 0.00026 µJ vs Transformer twin 0.0011 µJ" in md and "**76.4 % less energy** (paper: 66.3 %)" in md
     assert "takes 73 % of its energy" in md and "the reduction is 20.0 %" in md and md.endswith("it is 50.0 %.")
+    assert s["improved"] == {"bgfn": True, "transformer": True}                  # the twin's card says nothing
+    # a BGFN that never trained (best epoch 0, let through by energy.allow_untrained): no saving is claimed
+    measured.cards["bgfn"] = {"best_epoch": 0}
+    s = energy.energy_summary(measured, windows, tables, totals, 66.3, {"lif": 0.1}, sweep_t, 3.5, cross, 5.0,
+                              E_MAC, E_AC, {"profile": "smoke"})
+    assert s["improved"]["bgfn"] is False
+    md = energy_words.result_markdown(s)
+    assert "BGFN did not train" in md and "no energy saving against the Transformer twin is claimed" in md
+    assert "less energy**" not in md and "76.4" not in md
 
 
 def test_the_energy_network_is_the_median_seed_and_must_be_trained(tmp_path, monkeypatch):
@@ -274,3 +283,11 @@ def test_the_odometer_audit_measures_the_recorded_drive_and_sums_by_hand():
     assert list(odo.table.columns[:2]) == ["dataset", "model"] and set(odo.table["dataset"]) == {"d"}
     alone = OdometerEnergy("d", 0, {}, {"bgfn": odo.tables["bgfn"]}, 0.1, 8)
     assert np.isnan(alone.reduction_pct) and "no Transformer-ODO was trained" in odometer_energy_lines(alone)[1]
+    assert "improved" not in odo.table.columns                       # the audit said nothing of training
+    # a BGFN-ODO whose best epoch is 0: measured, but no saving against its twin
+    untrained = OdometerEnergy("d", 0, {}, odo.tables, 0.1, 8, {"bgfn": False, "transformer": True})
+    assert np.isnan(untrained.reduction_pct) and "less energy" not in " ".join(odometer_energy_lines(untrained))
+    assert "BGFN-ODO did not train (best epoch 0), so no energy saving" in odometer_energy_lines(untrained)[1]
+    t = untrained.table
+    assert t.columns[-1] == "improved" and t.groupby("model")["improved"].all().to_dict() == {
+        "BGFN-ODO": False, "Transformer-ODO": True}

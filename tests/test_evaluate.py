@@ -367,6 +367,22 @@ def test_paired_test_detects_a_shift_and_not_a_null():
     assert np.isnan(stats.paired_comparison([1.0, 2.0], [1.0, 2.0])["p_value"])
 
 
+def test_holm_adjusts_a_hand_computed_family():
+    # k = 4 finite p-values (the NaN is no test): sorted 0.005, 0.01, 0.03, 0.04 -> times 4, 3, 2, 1 =
+    # 0.02, 0.03, 0.06, 0.04; the running maximum lifts the last to 0.06 (the adjusted keep the raw order)
+    got = stats.holm_adjust([0.01, 0.04, 0.03, 0.005, np.nan])
+    np.testing.assert_allclose(got[:4], [0.03, 0.06, 0.06, 0.02])
+    assert np.isnan(got[4])
+    # capped at 1: 0.02 * 3 = 0.06, 0.5 * 2 = 1.0, 0.7 * 1 -> lifted to 1.0 by the running maximum
+    np.testing.assert_allclose(stats.holm_adjust([0.5, 0.02, 0.7]), [1.0, 0.06, 1.0])
+    # one test: unchanged; none: empty; never below the raw p
+    assert stats.holm_adjust([0.014]).tolist() == [0.014] and stats.holm_adjust([]).size == 0
+    raw = np.random.default_rng(0).random(9)
+    assert np.all(stats.holm_adjust(raw) >= raw)
+    with pytest.raises(DataError, match="p_values"):
+        stats.holm_adjust([0.5, 1.5])
+
+
 def test_sweep_summary_and_comparisons():
     rows = []
     rng = np.random.default_rng(1)
@@ -526,14 +542,16 @@ def test_plot_gps_row_shows_the_fixes_inside_the_window_beside_gps_and_ins():
 
 
 # ----------------------------------------------------------------------------------------------- notebook 04's calls
-def _table_result(dataset="turin-sim-ekinox", bgfn=(2.0, 4.0)):
-    """Seed aggregate of INS (10/8 m), BGFN and Transformer in two outages (max east/north errors, m)."""
-    rows = []
+def _table_result(dataset="turin-sim-ekinox", bgfn=(2.0, 4.0), seeds=(0,)):
+    """Seed aggregate of INS (10/8 m), BGFN and Transformer in two outages (max east/north errors, m); the runs
+    (``per_seed``) of the networks' ``seeds`` (INS: one)."""
+    rows, runs = [], []
     for o in (1, 2):
         for m, (e, n) in (("INS", (10.0, 8.0)), ("BGFN", bgfn), ("Transformer", (20.0, 4.0))):
             rows.append({"outage": o, "method": m, "max_east_m": e, "max_north_m": n, "rmse_h_m": 1.0,
                          "final_h_m": 1.0})
-    return ev.TableResult(dataset, paper.test_of(dataset), pd.DataFrame(), pd.DataFrame(rows), [], {})
+            runs += [{"outage": o, "method": m, "seed": s} for s in (seeds if m != "INS" else (0,))]
+    return ev.TableResult(dataset, paper.test_of(dataset), pd.DataFrame(runs), pd.DataFrame(rows), [], {})
 
 
 def test_evaluation_setup_applies_the_notebook_parameters_over_the_profile(monkeypatch):
@@ -573,14 +591,24 @@ def test_reductions_beside_the_paper_and_its_quoted_claims():
     assert red.loc[red["method"] == "Transformer", "paper east_%"].isna().all()             # not in the paper
     lines = evaluation_words.claim_lines({"turin-sim-ekinox": red})
     c = paper.claims()["bgfn_reduction_vs_ins_pct"]
+    # one seed in the two outages: the line says it rests on too little for statistics (n_seeds, n_windows)
+    assert row["n_seeds"] == 1 and row["n_windows"] == 2
     assert lines == [f"BGFN vs INS, dataset test, outage 1: paper quotes {c['dataset_outage1']['east']} % east / "
-                     f"{c['dataset_outage1']['north']} % north; ours 80.0 % east / 50.0 % north",
+                     f"{c['dataset_outage1']['north']} % north; ours 80.0 % east / 50.0 % north (one seed, 2 windows: "
+                     "no statistics)",
                      f"BGFN vs INS, field test, outage 2: paper quotes {c['field_outage2']['east']} % east / "
                      f"{c['field_outage2']['north']} % north; not evaluated"]
     # a test's first dataset answers for it
     other = ev.reduction_table(_table_result("navego-ekinox", bgfn=(5.0, 4.0)))
-    assert evaluation_words.claim_lines({"turin-sim-ekinox": red, "navego-ekinox": other})[0].endswith("ours 80.0 % east / 50.0 % north")
-    assert evaluation_words.claim_lines({"navego-ekinox": other})[0].endswith("ours 50.0 % east / 50.0 % north")
+    assert evaluation_words.claim_lines({"turin-sim-ekinox": red, "navego-ekinox": other})[0].endswith(
+        "ours 80.0 % east / 50.0 % north (one seed, 2 windows: no statistics)")
+    assert evaluation_words.claim_lines({"navego-ekinox": other})[0].endswith("ours 50.0 % east / 50.0 % north (one seed, 2 windows: "
+                                                                "no statistics)")
+    # three seeds, still in two windows: too few windows; runs not kept (no per_seed): nothing said of them
+    three = ev.reduction_table(_table_result(seeds=(0, 1, 2)))
+    assert evaluation_words.claim_lines({"turin-sim-ekinox": three})[0].endswith("(3 seeds, 2 windows: no statistics)")
+    bare = ev.TableResult("turin-sim-ekinox", "dataset", pd.DataFrame(), res.table, [], {})
+    assert evaluation_words.claim_lines({"turin-sim-ekinox": ev.reduction_table(bare)})[0].endswith("ours 80.0 % east / 50.0 % north")
     lay = ev.ours_above_paper(res)
     assert lay.loc[("Outage 1", "paper"), ("BGFN", "East")] == 4.7
     assert lay.loc[("Outage 2", "ours"), ("INS", "North")] == 8.0

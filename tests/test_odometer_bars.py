@@ -68,6 +68,35 @@ def test_summary_takes_the_median_ratio_to_ins_nhc_start_by_start():
     assert np.isnan(s.loc["INS+NHC", "p_vs_nhc"])                            # no non-zero difference
 
 
+def test_summary_holm_adjusts_the_learned_odometers_together():
+    # three learned odometers against INS+NHC over 6 starts: every difference negative gives the smallest exact
+    # two-sided Wilcoxon p, 2 / 2^6 = 0.03125; RIDGE-ODO's differences alternate in sign (W+ = 12 of 21: p large).
+    # Holm over the k = 3: 0.03125 x 3 = 0.09375, 0.03125 x 2 = 0.0625 lifted to 0.09375 by the running maximum.
+    rows = []
+    for i, s in enumerate(range(1, 7)):
+        nhc = 10.0 + s
+        for m, v in (("INS+NHC", nhc), ("INS+NHC+HOLD", nhc - s), ("BGFN-ODO", nhc - s), ("MLP-ODO", nhc - 2 * s),
+                     ("RIDGE-ODO", nhc + (s if i % 2 else -s))):
+            rows.append({"dataset": "d", "start_s": float(s), "duration_s": 30.0, "method": m, "sigma_mps": np.nan,
+                         "seed": 0, "fold": 0, "max_h_m": v, "rmse_h_m": 0.0, "final_h_m": 0.0,
+                         "speed_rmse_mps": np.nan, "coverage_2sigma": np.nan})
+    s = O.odometer_summary(pd.DataFrame(rows)).set_index("method")
+    assert s.loc["BGFN-ODO", "p_vs_nhc"] == pytest.approx(0.03125)
+    assert s.loc["MLP-ODO", "p_vs_nhc"] == pytest.approx(0.03125)
+    ridge = s.loc["RIDGE-ODO", "p_vs_nhc"]                    # differences -1, +2, -3, +4, -5, +6
+    assert ridge > 0.5
+    assert s.loc["BGFN-ODO", "p_vs_nhc_holm"] == pytest.approx(0.09375)
+    assert s.loc["MLP-ODO", "p_vs_nhc_holm"] == pytest.approx(0.09375)
+    assert s.loc["RIDGE-ODO", "p_vs_nhc_holm"] == pytest.approx(max(ridge, 0.09375))
+    # the held speed is no learned odometer: no member of the family, no adjusted p
+    assert np.isfinite(s.loc["INS+NHC+HOLD", "p_vs_nhc"]) and np.isnan(s.loc["INS+NHC+HOLD", "p_vs_nhc_holm"])
+    assert list(O.odometer_summary(pd.DataFrame(rows)).columns) == list(O.SUMMARY_COLUMNS)
+    line = odometer_words.odometer_lines(O.odometer_summary(pd.DataFrame(rows)))[0]
+    assert "BGFN-ODO 10.0 m (0.74 of INS+NHC per start, Wilcoxon p = 0.031, Holm-corrected over the learned " \
+           "odometers 0.094" in line
+    assert "INS+NHC+HOLD 10.0 m (0.74 of INS+NHC per start, Wilcoxon p = 0.031)" in line     # no learned odometer
+
+
 def test_summary_coverage_is_the_share_of_all_the_outages_epochs():
     # five outages of one duration (the same epochs each): four wholly inside 2 sigma, one with none inside. The
     # median of the shares would read 100 %; 4 of every 5 epochs were inside.

@@ -114,10 +114,13 @@ def test_the_size_sentence_pairs_only_the_same_windows_and_says_whether_a_networ
     assert ("in the same windows as here (fused as white errors, R = std^2: recorded before "
             "`evaluate.odometer.correlation`), INS+NHC 10.0/20.0 m, BGFN-ODO 15.0/40.0 m") in text
     assert "speed RMSE 2.60 m/s at 60 s against 2.50 m/s here" in text
-    assert text.endswith("its best network at 60 s, MLP-ODO (30.0 m), does not beat INS+NHC significantly.")
+    # the best of the 2 learned odometers recorded: Holm over BGFN-ODO's 0.01 and MLP-ODO's 0.2 (0.02, 0.2)
+    assert text.endswith("its best network at 60 s, MLP-ODO (30.0 m), does not beat INS+NHC significantly (best of 2, "
+                         "Holm-corrected p 0.2, raw 0.2).")
     # other windows (INS+NHC 5 % off), and a network that beats INS+NHC there
     here.sized = _sized({30.0: 10.5, 60.0: 21.0}, {30.0: 8.0, 60.0: 15.0}, {30.0: 12.0, 60.0: 30.0}, p_odo=0.001)
     here.sized = here.sized.assign(correlation=True)                          # fused with its correlation
     text = size_sentence(here, DURATIONS)
     assert "in its own windows, INS+NHC 10.5/21.0 m" in text
-    assert text.endswith("its best network at 60 s, BGFN-ODO (15.0 m), beats INS+NHC (p < 0.05).")
+    assert text.endswith("its best network at 60 s, BGFN-ODO (15.0 m), beats INS+NHC (best of 2, Holm-corrected p "
+                         "0.002, raw 0.001).")

@@ -133,6 +133,27 @@ def test_energy_table_and_sentences():
     assert "missing" in report.energy_sentences(None, claims)[0]
 
 
+def test_an_untrained_bgfn_claims_no_energy_saving():
+    # energy.json of a BGFN whose best epoch is 0 (energy.allow_untrained): its 99.7 % is an untrained network's
+    energy = {"energy_uj_per_prediction": {"bgfn": 0.003, "transformer": 1.0}, "reduction_pct": 99.7,
+              "macs": {"bgfn": 10.0, "transformer": 100.0}, "sops": {"bgfn": 5.0}, "e_mac_pj": 4.6,
+              "e_ac_pj": 0.9, "time_steps": 4, "checkpoint_epochs": {"bgfn": 0, "transformer": 7},
+              "improved": {"bgfn": False, "transformer": True}}
+    claims = {"energy_reduction_vs_transformer_pct": 66.3}
+    lines = report.energy_sentences(energy, claims)
+    assert len(lines) == 1 and lines[0].startswith("BGFN did not train: the checkpoint measured (best epoch 0)")
+    assert "no energy saving against the Transformer twin is claimed" in lines[0]
+    assert "99.7" not in lines[0] and "less energy" not in lines[0]
+    t = report.energy_table(energy, claims)
+    assert math.isnan(t.loc["energy reduction (%)", "ours"]) and t.loc["energy reduction (%)", "paper"] == 66.3
+    assert t.loc["BGFN energy per prediction (µJ)", "ours"] == 0.003                 # measured, not compared
+    # a file written before the flag: its checkpoint_epochs say the same
+    older = {k: v for k, v in energy.items() if k != "improved"}
+    assert report.energy_sentences(older, claims)[0].startswith("BGFN did not train")
+    trained = {**energy, "checkpoint_epochs": {"bgfn": 4}, "improved": {"bgfn": True}}
+    assert "99.7 % less energy" in report.energy_sentences(trained, claims)[0]
+
+
 def test_comparison_sentences_say_who_wins():
     lines = report.comparison_sentences("dataset", OURS, PAPER)
     by = {(ln.split(",")[0], ln.split(" vs ")[1].split(":")[0]): ln for ln in lines}

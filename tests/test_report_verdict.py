@@ -82,6 +82,64 @@ def test_answers_say_the_measured_numbers():
         "INS with zero-velocity updates (no NHC: a walker steps sideways) 5.0 m.")
 
 
+def test_a_comparison_of_one_seed_and_two_windows_says_so():
+    # the case: BGFN below INS from one seed in the profile's two outages, no sweep
+    one = _seeds()
+    one = one[one["seed"] == 0]
+    inp = _inputs(seeds=one, sweep_summary=None, sweep_pairs=None)
+    t = verdict_table(inp)
+    head = headline(inp, t)
+    assert "mean max error in the paper's two outages (BGFN: one seed, 2 windows: no statistics): BGFN 45.0 m" in head
+    assert "(one seed, 2 windows: no statistics)." in answer_free_aids(t)
+    assert "(INS 15.0 m; each from one seed, 2 windows: no statistics)." in answer_protocol(t)
+    from bgfn.report.verdict_page import short_answers
+    assert "in the paper's two outages (one seed, 2 windows: no statistics) INS+NHC" in short_answers(inp, t)["free_aids"]
+    # three seeds in two windows: still too few windows
+    three = _inputs(sweep_summary=None, sweep_pairs=None)
+    assert "(BGFN: 3 seeds, 2 windows: no statistics)" in headline(three, verdict_table(three))
+    # the sweep: 20 starts of one seed each (n / n_starts), then 20 starts of 3 seeds (nothing to say)
+    summary = _inputs().sweep_summary.assign(n=20, n_starts=20)
+    sweep = _inputs(sweep_summary=summary)
+    assert ("median max error over the 30 s sweep (BGFN: one seed, 20 windows: no spread between training seeds): "
+            in headline(sweep, verdict_table(sweep)))
+    sweep = _inputs(sweep_summary=summary.assign(n=60))
+    assert "over the 30 s sweep: BGFN" in headline(sweep, verdict_table(sweep))
+
+
+def test_the_sample_clause_by_hand():
+    from bgfn.report.sample_words import sample_clause
+
+    assert sample_clause(1, 2) == "one seed, 2 windows: no statistics"
+    assert sample_clause(3, 1) == "3 seeds, one window: no statistics"
+    assert sample_clause(5, 4) == "5 seeds, 4 windows: no statistics"              # 4 windows: p >= 0.125
+    assert sample_clause(1, 5) == "one seed, 5 windows: no spread between training seeds"
+    assert sample_clause(2, 5) == ""
+
+
+def test_a_walkers_rows_are_labelled_with_the_zupt_that_ran():
+    from bgfn.report.aid_words import aid_label
+    from bgfn.report.verdict import format_table
+    from bgfn.report.verdict_page import short_answers, short_table
+
+    assert aid_label("INS+NHC", "walker") == "INS+ZUPT" and aid_label("BGFN+NHC", "walker") == "BGFN+ZUPT"
+    assert aid_label("INS+NHC", "car") == "INS+NHC" and aid_label("INS+NHC+HOLD", "walker") == "INS+ZUPT+HOLD"
+    assert aid_label("INS+NHC", "other") == "INS+no aid" and aid_label("INS", "walker") == "INS"
+    assert aid_label("the `+NHC` rows", "walker") == "the `+NHC` rows"        # a bare suffix is no row's label
+    walker = _inputs(platform="walker")
+    t = verdict_table(walker)
+    shown = list(format_table(t, walker.platform).data["row"])
+    assert "INS+ZUPT" in shown and "BGFN+ZUPT" in shown and not any("NHC" in r for r in shown)
+    assert list(short_table(t, "walker").data["row"]) == ["INS", "INS+ZUPT", "MLP", "AT-LSTM", "Transformer", "BGFN",
+                                                          "BGFN+ZUPT"]
+    text = " ".join([headline(walker, t), *verdict_sentences(walker, t), *short_answers(walker, t).values()])
+    assert "INS+ZUPT" in text and "BGFN+ZUPT" in text and "+NHC" not in text
+    assert "fused with ZUPT it is worse than ZUPT alone" in verdict_sentences(walker, t)[1]
+    # a car's page as it was: its labels byte for byte
+    car = _inputs()
+    assert list(format_table(verdict_table(car)).data["row"]) == list(verdict_table(car)["row"])
+    assert "BGFN+NHC against INS+NHC" in verdict_sentences(car, verdict_table(car))[1]
+
+
 def test_the_platform_comes_from_notebook_02s_record(tmp_path):
     import json
 
@@ -177,11 +235,15 @@ def test_odometer_rows_answer_and_headline_read_the_odometer_tables():
         "INS+NHC+HOLD", "RIDGE-ODO", "BGFN-ODO", "Transformer-ODO", ORACLE_ODO_ROW]
     assert t.loc["RIDGE-ODO", "sweep 60 s"] == pytest.approx(16.045) and np.isnan(t.loc["RIDGE-ODO", "outage 1"])
     assert t.loc["BGFN-ODO", "p 30 s"] == 0.002 and t.loc["BGFN-ODO", "runs"] == 1
+    assert t.loc["BGFN-ODO", "Holm p 30 s"] == pytest.approx(0.006)                # 3 learned odometers
+    assert np.isnan(t.loc["INS+NHC+HOLD", "Holm p 30 s"]) and np.isnan(t.loc["BGFN", "Holm p 30 s"])
     # log-log between (0.1 m/s, 4 m) and (1 m/s, 40 m) at 0.5 m/s: 4 * 10^log10(5) = 20 m at 60 s
     assert t.loc[ORACLE_ODO_ROW, "sweep 60 s"] == pytest.approx(20.0)
     answer = verdict_sentences(inp, verdict_table(inp))[5]
     assert answer.startswith("Does a learned odometer help? In the sweep's windows (10 starts")
-    assert "else among all) is BGFN-ODO: it beats INS+NHC at 30 s and 60 s (p < 0.05)." in answer
+    # 3 learned odometers at p 0.002 each: Holm 0.002 x 3 = 0.006 for the smallest, the running maximum for all
+    assert ("else among all) is BGFN-ODO: it beats INS+NHC at 30 s and 60 s (best of 3, Holm-corrected p 0.006, "
+            "raw 0.002 at 60 s; significant below 0.05).") in answer
     assert "no different from its ANN twin" in answer                      # identical per start: no difference
     assert "0.5 µJ per prediction against the twin's 2 µJ (75 % less)" in answer
     assert "95 % of epochs within its +-2 sigma (calibrated" in answer
@@ -193,6 +255,17 @@ def test_odometer_rows_answer_and_headline_read_the_odometer_tables():
     worse = _inputs(odometer=_odometer(twin_offset=2.0, coverage=0.7))
     answer = verdict_sentences(worse, verdict_table(worse))[5]
     assert "better than its ANN twin" in answer and "(overconfident" in answer
+
+
+def test_an_untrained_odometer_claims_no_energy_saving():
+    odo = _odometer()
+    odo.energy = odo.energy.assign(improved=[False, True])                # BGFN-ODO's best epoch 0
+    inp = _inputs(odometer=odo)
+    answer = verdict_sentences(inp, verdict_table(inp))[5]
+    assert "% less" not in answer and "the BGFN-ODO measured did not train (best epoch 0), so no saving" in answer
+    assert "% less" not in headline(inp, verdict_table(inp))
+    odo.energy = odo.energy.assign(improved=[True, True])
+    assert "(75 % less)" in verdict_sentences(inp, verdict_table(inp))[5]
 
 
 def test_the_odometer_answer_gives_the_ensembles_error_calibration_and_energy():
@@ -255,8 +328,33 @@ def test_the_best_learned_odometer_is_one_that_beats_ins_nhc_when_one_does():
     s.loc[s["method"] == "BGFN-ODO", "p_vs_nhc"] = 0.3
     s.loc[s["method"] == "Transformer-ODO", "p_vs_nhc"] = 0.3
     inp = _inputs(odometer=odo)
-    assert "A learned odometer beats INS+NHC at 60 s: RIDGE-ODO 16.0 m against 20.0 m (p 0.002)" in headline(
-        inp, verdict_table(inp))
+    # Holm over the 3: 0.002 x 3 = 0.006, 0.3 x 2 = 0.6, 0.3 lifted to 0.6
+    assert ("A learned odometer beats INS+NHC at 60 s: RIDGE-ODO 16.0 m against 20.0 m (best of 3, Holm-corrected p "
+            "0.006, raw 0.002)") in headline(inp, verdict_table(inp))
+
+
+def test_the_best_of_nine_is_named_with_its_holm_corrected_p():
+    # the case: the best of 9 learned odometers at a raw p of 0.014 beats INS+NHC uncorrected; over 9
+    # candidates (the others at p 0.5) its Holm-adjusted p is 9 x 0.014 = 0.126: no learned odometer beats it
+    odo = _odometer()
+    s = odo.summary
+    extra = [s[s["method"] == "RIDGE-ODO"].assign(method=m) for m in
+             ("MLP-ODO", "AT-LSTM-ODO", "BGFN-ODO-ENS", "Transformer-ODO-ENS", "MLP-ODO-ENS", "AT-LSTM-ODO-ENS")]
+    s = pd.concat([s, *extra], ignore_index=True)
+    learned = s["method"].str.contains("-ODO")
+    s.loc[learned, "p_vs_nhc"] = 0.5
+    s.loc[s["method"] == "BGFN-ODO", "p_vs_nhc"] = 0.014
+    s.loc[learned, "max_h_m"] = s.loc[learned, "max_h_m"] + 5.0                   # all above BGFN-ODO's
+    s.loc[s["method"] == "BGFN-ODO", "max_h_m"] -= 5.0
+    odo.summary = s
+    assert odo.family_size(60.0) == 9 and odo.holm_p("BGFN-ODO", 60.0) == pytest.approx(0.126)
+    inp = _inputs(odometer=odo)
+    head = headline(inp, verdict_table(inp))
+    assert "No learned odometer beats INS+NHC significantly at 60 s" in head
+    assert "best of 9, Holm-corrected p 0.13, raw 0.014" in head
+    # the same table with its adjusted column written by notebook 07 reads the column
+    odo.summary = s.assign(p_vs_nhc_holm=np.where(s["method"] == "BGFN-ODO", 0.126, np.nan))
+    assert odo.holm_p("BGFN-ODO", 60.0) == pytest.approx(0.126)
 
 
 def test_the_ins_rows_carry_the_filters_consistency_and_question_five_says_it():

@@ -5,6 +5,10 @@
   together, since runs of the same start share the trajectory and are not independent).
 - :func:`paired_comparison`: how often method A beats method B on paired runs, the median paired difference
   and the Wilcoxon signed-rank test (two-sided) of ``A - B``.
+- :func:`too_few_for_statistics`: whether a comparison rests on one training seed or fewer than
+  :data:`MIN_WINDOWS` outage windows (a page then says so instead of implying a result).
+- :func:`holm_adjust`: Holm's step-down adjusted p-values of a family of tests, for a page that names the best of
+  several candidates (the smallest of k raw p-values is small by chance alone).
 
 Every random draw takes a seed (``numpy.random.default_rng(seed)``).
 """
@@ -17,6 +21,11 @@ import numpy as np
 from scipy.stats import wilcoxon
 
 from bgfn.errors import DataError
+
+#: Outage windows below which a comparison has no statistics: the exact two-sided signed-rank test's smallest p
+#: with n pairs is 2 / 2^n (0.125 with 4 windows, whatever the errors), so fewer windows cannot tell a difference
+#: from chance.
+MIN_WINDOWS = 5
 
 
 def bootstrap_ci(values, stat: Callable = np.median, n_boot: int = 2000, level: float = 0.95, seed: int = 0,
@@ -116,4 +125,42 @@ def paired_comparison(a, b) -> dict:
             "p_value": wilcoxon_p(d)}
 
 
-__all__ = ["bootstrap_ci", "paired_comparison", "wilcoxon_p"]
+def too_few_for_statistics(n_seeds: int, n_windows: int) -> bool:
+    """Whether a comparison rests on one training seed (or none) or fewer than :data:`MIN_WINDOWS` outage windows:
+    its numbers are one draw, and the page says so beside them."""
+    return int(n_seeds) < 2 or int(n_windows) < MIN_WINDOWS
+
+
+def holm_adjust(p_values) -> np.ndarray:
+    """Holm(-Bonferroni) adjusted p-values of one family of tests (Holm 1979).
+
+    With the ``k`` finite p-values sorted ascending, ``p_(1) <= ... <= p_(k)``, the adjusted value of the ``i``-th
+    (1-based) is ``max_{j <= i} min(1, (k - j + 1) p_(j))``: the running maximum keeps the adjusted values in the
+    raw values' order, and the cap keeps them probabilities. Rejecting where the adjusted p is below ``alpha``
+    controls the family-wise error rate at ``alpha`` under any dependence between the tests.
+
+    Parameters
+    ----------
+    p_values : array_like [n]
+        Raw p-values; NaN (a test not run) is no member of the family and stays NaN.
+
+    Returns
+    -------
+    ndarray [n]
+        The adjusted p-values in the input's order.
+    """
+    p = np.asarray(p_values, dtype=float).ravel()
+    if np.any((p < 0) | (p > 1)):
+        raise DataError("holm_adjust", "p_values", "p-values in [0, 1] (or NaN)", repr(p[(p < 0) | (p > 1)][:3]))
+    out = np.full(p.shape, np.nan)
+    ok = np.flatnonzero(np.isfinite(p))
+    k = len(ok)
+    if k == 0:
+        return out
+    order = ok[np.argsort(p[ok], kind="stable")]
+    scaled = np.minimum(1.0, (k - np.arange(k)) * p[order])                # (k - j + 1) p_(j), j = 1..k
+    out[order] = np.maximum.accumulate(scaled)
+    return out
+
+
+__all__ = ["MIN_WINDOWS", "bootstrap_ci", "holm_adjust", "too_few_for_statistics", "paired_comparison", "wilcoxon_p"]

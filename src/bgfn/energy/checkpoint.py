@@ -90,6 +90,13 @@ def _card(profile: str, dataset: str, method: str, seed) -> dict | None:
     return json.loads(card.read_text()) if card.is_file() else None
 
 
+def improved(card: dict) -> bool:
+    """Whether training improved on the initial network: the card's ``best_epoch`` is at least 1 (epoch 0 is the
+    initial network, validated before training; :mod:`bgfn.train.loop`). A card without the field (written
+    before it) counts as improved."""
+    return int(card.get("best_epoch", 1)) >= 1
+
+
 def check_trained(card: dict, card_file: str | Path, allow_untrained: bool = False) -> None:
     """Refuse a network whose best epoch is 0 (the initial network: training never improved on it): its firing
     rates would be those of an untrained network.
@@ -99,7 +106,7 @@ def check_trained(card: dict, card_file: str | Path, allow_untrained: bool = Fal
     bgfn.errors.DataError
         Naming the card, unless ``allow_untrained`` (``energy.allow_untrained`` of the profile).
     """
-    if not allow_untrained and int(card.get("best_epoch", 1)) < 1:
+    if not allow_untrained and not improved(card):
         raise DataError(card_file, "best_epoch", "a network that training improved on its initial weights (best epoch >= 1; "
                         "epoch 0 is the initial network) "
                         "-- its firing rates decide the energy; train longer (train.optimizer.epochs, patience), set energy.dataset to a dataset whose BGFN "
@@ -144,6 +151,12 @@ class MeasuredModels:
     def time_steps(self) -> int:
         """BGFN's ``T_s`` (SNN steps per IMU sample)."""
         return int(self.trained["bgfn"].size_cfg.get("time_steps", 4))
+
+    @property
+    def improved(self) -> dict[str, bool]:
+        """Method -> whether training improved on its initial network (:func:`improved`): an energy of BGFN that
+        did not is an untrained network's, and no saving is claimed from it."""
+        return {m: improved(c) for m, c in self.cards.items()}
 
     def relative_paths(self) -> dict[str, str]:
         """Method -> checkpoint path relative to the project root (as ``energy.json`` records it)."""

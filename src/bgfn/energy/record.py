@@ -48,6 +48,7 @@ def energy_summary(measured: MeasuredModels, windows: EvaluationWindows, tables:
         "profile": measured.profile, "dataset": measured.dataset, "seed": measured.seed,
         "checkpoints": measured.relative_paths(),
         "checkpoint_epochs": {m: measured.cards[m].get("best_epoch") for m in measured.cards},
+        "improved": measured.improved,
         "windows": {"source": "validation windows of bgfn.learning (bgfn.train.prepare_learning_data)",
                     "n_windows": int(len(ws)), "n_validation_windows": int(windows.n_validation),
                     "window_samples": int(ws.x.shape[1])},

@@ -15,8 +15,10 @@ from bgfn import paper
 from bgfn.evaluate.setup import TABLE_METHODS
 from bgfn.evaluate.tables import TableResult, error_reduction
 
-#: Columns of :func:`reduction_table`: ours, then the paper's (reduction against INS, %).
-REDUCTION_COLUMNS: tuple[str, ...] = ("outage", "method", "east_%", "north_%", "paper east_%", "paper north_%")
+#: Columns of :func:`reduction_table`: ours, then the paper's (reduction against INS, %), then what ours rests on
+#: (``n_seeds``: the method's runs in the outage, ``n_windows``: the outages of the table).
+REDUCTION_COLUMNS: tuple[str, ...] = ("outage", "method", "east_%", "north_%", "paper east_%", "paper north_%",
+                                      "n_seeds", "n_windows")
 
 
 def _paper_values(test: str) -> pd.DataFrame | None:
@@ -52,7 +54,8 @@ def reduction_table(result: TableResult, reference: str = "INS") -> pd.DataFrame
     -------
     DataFrame
         :data:`REDUCTION_COLUMNS`: one row per outage and method of ours; the paper's columns NaN where it
-        has no such row (Transformer, GPS) or no such test (a user's drive).
+        has no such row (Transformer, GPS) or no such test (a user's drive); ``n_seeds`` the method's seeds in
+        that outage (``result.per_seed``; 0 when it holds no runs), ``n_windows`` the outages of the table.
     """
     ours = error_reduction(result.table, reference).rename(columns={"east_pct": "east_%", "north_pct": "north_%"})
     values = _paper_values(result.test)
@@ -60,4 +63,14 @@ def reduction_table(result: TableResult, reference: str = "INS") -> pd.DataFrame
               else pd.DataFrame({"outage": pd.Series(dtype=ours["outage"].dtype), "method": pd.Series(dtype=object),
                                  "east_pct": pd.Series(dtype=float), "north_pct": pd.Series(dtype=float)})).rename(
         columns={"east_pct": "paper east_%", "north_pct": "paper north_%"})
-    return ours.merge(theirs, on=["outage", "method"], how="left")[list(REDUCTION_COLUMNS)]
+    per = result.per_seed
+    seeds = (per.groupby(["outage", "method"])["seed"].nunique().rename("n_seeds").reset_index()
+             if {"outage", "method", "seed"} <= set(per.columns)
+             else pd.DataFrame({"outage": pd.Series(dtype=int), "method": pd.Series(dtype=object),
+                                "n_seeds": pd.Series(dtype=int)}))
+    seeds["outage"] = seeds["outage"].astype(int)
+    out = ours.merge(theirs, on=["outage", "method"], how="left").merge(seeds, on=["outage", "method"], how="left")
+    out["n_seeds"] = out["n_seeds"].fillna(0).astype(int)          # 0: the runs were not kept (unknown)
+    out["n_windows"] = int(result.table["outage"].nunique())
+    return out[list(REDUCTION_COLUMNS)]
+

@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 
 from bgfn.evaluate.setup import COLORS
+from bgfn.report.aid_words import aid_label
 from bgfn.studies.odometer.bars import HOLD, RIDGE
 from bgfn.studies.outage_sweep.sweep import sweep_summary
 
@@ -57,15 +58,16 @@ def duration_curves(dataset: str, sweep: pd.DataFrame | None, odometer: pd.DataF
                            kind="stable").reset_index(drop=True)
 
 
-def plot_duration_curves(curves: pd.DataFrame, title: str):
-    """One panel: every aid's median (line, dots) and interval (band) against the outage duration, log scale."""
+def plot_duration_curves(curves: pd.DataFrame, title: str, platform: str = "car"):
+    """One panel: every aid's median (line, dots) and interval (band) against the outage duration, log scale; the
+    legend names the rows by the aids that ran on ``platform`` (:func:`bgfn.report.aid_words.aid_label`)."""
     fig, ax = plt.subplots(figsize=(7.6, 3.6))
     for method, g in curves.groupby("method", sort=False):
         g = g.sort_values("duration_s")
         colour = COLORS.get(method) or _ODOMETER_COLORS.get(method, "tab:brown")
         dashed = method.endswith("+NHC") or method in ODOMETER_AIDS
         ax.plot(g["duration_s"], g["median_m"], "o-" if not dashed else "o--", color=colour, lw=1.4, ms=3,
-                label=method)
+                label=aid_label(method, platform))
         ax.fill_between(g["duration_s"], g["ci_lo_m"], g["ci_hi_m"], color=colour, alpha=0.12, lw=0)
     ax.set_yscale("log")
     ax.set_xlabel("outage duration (s)")

@@ -68,6 +68,11 @@ def result_markdown(summary: dict) -> str:
     """The result of notebook 05 in one paragraph (Markdown), from :func:`energy_summary`'s dict."""
     s = summary
     e, attn = s["energy_uj_per_prediction"], s["attention_energy_uj"]
+    if not (s.get("improved") or {}).get("bgfn", True):
+        return (f"**Result ({s['profile']} profile, {s['dataset']}, seed {s['seed']}):** BGFN did not train (its best "
+                f"epoch is 0: training never improved on its initial network), so its firing rates are an untrained "
+                f"network's and no energy saving against the Transformer twin is claimed (BGFN {e['bgfn']:.4g} µJ, "
+                f"twin {e['transformer']:.4g} µJ per prediction; paper: {s['paper_reduction_pct']} % less).")
     return (
         f"**Result ({s['profile']} profile, {s['dataset']}, seed {s['seed']}):** BGFN {e['bgfn']:.4g} µJ vs "
         f"Transformer twin {e['transformer']:.4g} µJ per prediction: **{s['reduction_pct']:.1f} % less energy** "

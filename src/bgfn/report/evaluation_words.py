@@ -11,6 +11,7 @@ from bgfn import paper
 from bgfn.evaluate.setup import METRIC_COLUMNS, EvaluationSetup
 from bgfn.evaluate.tables import error_reduction
 from bgfn.paper import nhc_label
+from bgfn.stats import too_few_for_statistics
 from bgfn.report.run_words import runner_words
 
 
@@ -90,8 +91,10 @@ def claim_lines(reductions: Mapping[str, pd.DataFrame]) -> list[str]:
     -------
     list of str
         ``BGFN vs INS, <test title>, outage <k>: paper quotes E % east / N % north; ours ...`` (``not
-        evaluated`` when no dataset of that test, or no BGFN row, was run); the quotes are of the paper's own
-        tests, so a test it has no table of (the real drive) gets no line.
+        evaluated`` when no dataset of that test, or no BGFN row, was run), ended by ``(n seed(s), m window(s):
+        no statistics)`` when ours rests on one seed or fewer than :data:`bgfn.stats.MIN_WINDOWS` windows (the
+        table's ``n_seeds``, ``n_windows``); the quotes are of the paper's own tests, so a test it has no table of
+        (the real drive) gets no line.
     """
     claims = paper.claims()
     by_test: dict[str, pd.DataFrame] = {}
@@ -109,6 +112,11 @@ def claim_lines(reductions: Mapping[str, pd.DataFrame]) -> list[str]:
             row = red[(red["outage"] == outage) & (red["method"] == "BGFN")] if red is not None else None
             got = (f"ours {row['east_%'].item():.1f} % east / {row['north_%'].item():.1f} % north"
                    if row is not None and len(row) else "not evaluated")
+            if row is not None and len(row) and {"n_seeds", "n_windows"} <= set(row.columns):
+                seeds, windows = int(row["n_seeds"].item()), int(row["n_windows"].item())
+                if seeds > 0 and too_few_for_statistics(seeds, windows):
+                    got += (f" ({'one seed' if seeds == 1 else f'{seeds} seeds'}, "
+                            f"{'one window' if windows == 1 else f'{windows} windows'}: no statistics)")
             lines.append(f"BGFN vs INS, {spec['title']}, outage {outage}: paper quotes {stated['east']} % east / "
                          f"{stated['north']} % north; {got}")
     return lines

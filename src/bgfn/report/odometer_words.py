@@ -56,6 +56,8 @@ def odometer_lines(summary: pd.DataFrame) -> list[str]:
                 row = by[m].iloc[0]
                 part.append(f"{m} {row['max_h_m']:.1f} m ({row['ratio_to_nhc']:.2f} of INS+NHC per start"
                             + (f", Wilcoxon p = {row['p_vs_nhc']:.2g}" if "p_vs_nhc" in row else "")
+                            + (f", Holm-corrected over the learned odometers {row['p_vs_nhc_holm']:.2g}"
+                               if np.isfinite(row.get("p_vs_nhc_holm", np.nan)) else "")
                             + (f"; speed RMSE {row['speed_rmse_mps']:.2f} m/s, 2-sigma coverage "
                                f"{100 * row['coverage_2sigma']:.0f} %" if m != HOLD else "") + ")")
         for m, what in ((ORACLE, "an oracle speed"), (ORACLE_WALK, "with a random walk")):
@@ -141,7 +143,10 @@ def odometer_energy_lines(odo: OdometerEnergy) -> list[str]:
     e = {m: total_energy_uj(t) for m, t in odo.tables.items()}
     out = [f"{odo.dataset}, sweep fold {FOLD}, seed {odo.seed}: {odo.n_windows} IMU windows evenly spaced over "
            f"the drive; BGFN-ODO mean input firing rate {odo.mean_rate:.3f}"]
-    if np.isfinite(odo.reduction_pct):
+    if not odo.improved.get("bgfn", True):
+        out.append(f"BGFN-ODO {e['bgfn']:.4g} µJ per prediction; BGFN-ODO did not train (best epoch 0), so no "
+                   f"energy saving against its twin is claimed")
+    elif np.isfinite(odo.reduction_pct):
         out.append(f"BGFN-ODO {e['bgfn']:.4g} µJ, Transformer-ODO {e['transformer']:.4g} µJ per prediction: "
                    f"{odo.reduction_pct:.1f} % less energy for the spiking odometer")
     else:

@@ -16,6 +16,7 @@ from bgfn.data.registry import recorded_first
 from bgfn.report.sweep_words import describe_sweep
 from bgfn.report.odometer_words import odometer_lines
 from bgfn.studies.odometer.section import odometer_table
+from bgfn.report.aid_words import aid_label, recorded_platform
 from bgfn.report.glance import run_header
 from bgfn.report.provenance import cards_line, model_cards, outage_datasets, outage_provenance, provenance, short_source
 from bgfn.report.reading import ProfileResults, missing_note, read_csv
@@ -167,5 +168,11 @@ def sweep_section(res: ProfileResults) -> list:
                          datasets=[f"`{d}`" for d in sw.get("datasets", [])], seeds=sw.get("seeds"),
                          starts=sw.get("n_starts"), folds=sw.get("folds"))]
     if res.sweep_pairs is not None:
-        pieces.append(bullets(describe_sweep(res.sweep, res.sweep_pairs)))
+        datasets = [str(d) for d in res.sweep["dataset"].unique()] if "dataset" in res.sweep.columns else []
+
+        def platform_of(line: str) -> str:       # each line leads with its drive (describe_sweep)
+            drive = next((d for d in datasets if line.startswith(f"{d}, ")), None)
+            return recorded_platform(res.out, drive) if drive is not None else "car"
+        pieces.append(bullets([aid_label(line, platform_of(line))
+                               for line in describe_sweep(res.sweep, res.sweep_pairs)]))
     return pieces

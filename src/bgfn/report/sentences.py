@@ -143,12 +143,30 @@ def reduction_sentences(comp: pd.DataFrame, method: str = "BGFN", test: str | No
     return lines
 
 
+def network_improved(energy: dict, method: str = "bgfn") -> bool:
+    """Whether ``method``'s network in ``energy.json`` improved on its initial network in training (its
+    ``improved`` flag; from ``checkpoint_epochs`` for a file written before the flag: best epoch >= 1; True when
+    neither says)."""
+    flags = energy.get("improved") or {}
+    if method in flags:
+        return bool(flags[method])
+    epoch = (energy.get("checkpoint_epochs") or {}).get(method)
+    return epoch is None or int(epoch) >= 1
+
+
 def energy_sentences(energy: dict | None, claims: dict) -> list[str]:
-    """BGFN's theoretical energy against its Transformer twin, and the paper's claim."""
+    """BGFN's theoretical energy against its Transformer twin, and the paper's claim; for a BGFN that did not
+    train (:func:`network_improved`), a sentence saying so in place of any saving."""
     paper = claims.get("energy_reduction_vs_transformer_pct")
     if not energy:
         return ["`energy.json` is missing: notebook 05 has not run for this profile, so there is no energy "
                 "estimate to compare with the paper's claim."]
+    if not network_improved(energy):
+        epoch = (energy.get("checkpoint_epochs") or {}).get("bgfn", 0)
+        return [f"BGFN did not train: the checkpoint measured (best epoch {epoch}) is its initial network, which "
+                "training never improved on, so its firing rates, and the energy they "
+                "give, are an untrained network's: no energy saving against the Transformer twin is claimed"
+                + (f" (the paper states {float(paper):.1f} % less)." if paper is not None else ".")]
     e = energy.get("energy_uj_per_prediction", {})
     red = float(energy.get("reduction_pct", float("nan")))
     verb = "less" if red >= 0 else "more"

@@ -17,6 +17,7 @@ import pandas as pd
 
 from bgfn.evaluate import error_reduction
 from bgfn.paper import DECIMALS, PAPER_METHODS, claim_for, label, published_test
+from bgfn.report.sentences import network_improved
 
 
 # ----------------------------------------------------------------------------------------------- styling
@@ -121,7 +122,8 @@ def reduction_comparison(ours: pd.DataFrame | None, paper: pd.DataFrame, claims:
 
 # ----------------------------------------------------------------------------------------------- other tables
 def energy_table(energy: dict | None, claims: dict) -> pd.DataFrame:
-    """Energy per prediction and the reduction, ours (``energy.json``) beside the paper's claim."""
+    """Energy per prediction and the reduction, ours (``energy.json``) beside the paper's claim; our reduction
+    empty when BGFN did not train (:func:`bgfn.report.sentences.network_improved`: no saving is claimed)."""
     paper_red = claims.get("energy_reduction_vs_transformer_pct")
     rows = {"BGFN energy per prediction (µJ)": (np.nan, np.nan),
             "Transformer energy per prediction (µJ)": (np.nan, np.nan),
@@ -136,7 +138,8 @@ def energy_table(energy: dict | None, claims: dict) -> pd.DataFrame:
             "BGFN MACs per prediction": (macs.get("bgfn", np.nan), np.nan),
             "BGFN synaptic operations per prediction": (sops.get("bgfn", np.nan), np.nan),
             "Transformer MACs per prediction": (macs.get("transformer", np.nan), np.nan),
-            "energy reduction (%)": (energy.get("reduction_pct", np.nan), paper_red)})
+            "energy reduction (%)": (energy.get("reduction_pct", np.nan) if network_improved(energy) else np.nan,
+                                     paper_red)})
     return pd.DataFrame([[float(a), float(b) if b is not None else np.nan] for a, b in rows.values()],
                         index=list(rows), columns=["ours", "paper"])
 

@@ -17,15 +17,16 @@ import numpy as np
 import pandas as pd
 
 from bgfn import paper
-from bgfn.config import MAIN_VARIANT, RUN_RECORDS, SHARED_TABLES
+from bgfn.config import MAIN_VARIANT, SHARED_TABLES
 from bgfn.data.names import dataset_id
 from bgfn.data.registry import recorded_first
 from bgfn.evaluate.tables import table_paths
 from bgfn.studies.ins_fidelity.ins_setups import NAVEGO_CONSISTENT, NAVEGO_RUN, gap_explained
-from bgfn.report.aid_words import aided_ins_words
+from bgfn.report.aid_words import aid_label, aid_suffix, aided_ins_words, recorded_platform
 from bgfn.report.odometer_verdict import (OdometerInputs, answer_odometer, odometer_headline, odometer_rows,
                                           read_odometer_inputs, same_dataset)
-from bgfn.report.reading import read_csv, read_json
+from bgfn.report.reading import read_csv
+from bgfn.report.sample_words import sample_clause
 
 #: Rows of the verdict table, in order: (label, method label in the tables). The oracle row is built apart.
 METHOD_ROWS: tuple[tuple[str, str], ...] = (
@@ -37,9 +38,10 @@ SUBJECT = "BGFN"
 SWEEP_DURATIONS: tuple[float, ...] = (30.0, 60.0)
 #: Label of the oracle row: the true increments plus white noise of the subject's own increment error.
 ORACLE_ROW = "oracle at BGFN's increment error"
-#: Columns of :func:`verdict_table`.
+#: Columns of :func:`verdict_table`; ``Holm p``: a learned odometer's p against INS+NHC Holm-adjusted over the
+#: learned odometers (the page names their best; :meth:`bgfn.report.odometer_verdict.OdometerInputs.holm_p`).
 VERDICT_COLUMNS: tuple[str, ...] = ("row", "inputs", "protocol", "outage 1", "outage 2", "sweep 30 s", "sweep 60 s",
-                                    "p 30 s", "p 60 s", "runs", "covariance")
+                                    "p 30 s", "p 60 s", "Holm p 30 s", "Holm p 60 s", "runs", "covariance")
 #: Rows whose filter consistency in the outages the table states (``covariance``: :mod:`bgfn.studies.ins_fidelity.nees`).
 NEES_ROWS: tuple[str, ...] = ("INS", "INS+NHC")
 
@@ -213,6 +215,34 @@ def _row(table: pd.DataFrame, label: str) -> pd.Series | None:
     return sel.iloc[0] if len(sel) else None
 
 
+def _outage_sample(row: pd.Series | None) -> tuple[int, int]:
+    """(seeds, windows) a row's mean over the paper's outages rests on: its ``runs`` per cell and its outages with
+    a value; (0, 0) without the row."""
+    if row is None:
+        return 0, 0
+    cells = np.array([row["outage 1"], row["outage 2"]], dtype=float)
+    return int(row["runs"]) if np.isfinite(float(row["runs"])) else 0, int(np.isfinite(cells).sum())
+
+
+def _sweep_sample(summary: pd.DataFrame | None, method: str, duration: float) -> tuple[int, int]:
+    """(seeds, windows) ``method``'s sweep median at ``duration`` rests on: its runs per start and its starts
+    (``outage_sweep_summary.csv``'s ``n`` and ``n_starts``); (0, 0) without them."""
+    if summary is None or not {"n", "n_starts"} <= set(summary.columns):
+        return 0, 0
+    sel = summary[(summary["method"] == method) & np.isclose(summary["duration_s"].astype(float), duration)]
+    if not len(sel) or int(sel["n_starts"].iloc[0]) < 1:
+        return 0, 0
+    starts = int(sel["n_starts"].iloc[0])
+    return int(round(int(sel["n"].iloc[0]) / starts)), starts
+
+
+def _sample_note(seeds_windows: tuple[int, int], lead: str = " (") -> str:
+    """:func:`bgfn.report.sample_words.sample_clause` in parentheses (``lead`` opens it), empty when the sample
+    is large enough or unknown."""
+    clause = sample_clause(*seeds_windows) if seeds_windows[1] > 0 else ""
+    return f"{lead}{clause})" if clause else ""
+
+
 def _mean_outages(row: pd.Series | None) -> float:
     """Mean of a row's max errors over the outages it has (a user's drive may have one), NaN without any."""
     if row is None:
@@ -246,10 +276,11 @@ def answer_accuracy(inp: VerdictInputs) -> str:
             f"outage).")
 
 
-def answer_free_aids(table: pd.DataFrame, drift: pd.DataFrame | None = None) -> str:
+def answer_free_aids(table: pd.DataFrame, drift: pd.DataFrame | None = None, platform: str = "car") -> str:
     """Question 2: INS+NHC against INS and BGFN, and whether BGFN adds to NHC; ``drift`` (notebook 08's
     ``kf_ins_drift.csv``) puts the paper's two outages beside the drive's starts where they rank INS+NHC otherwise
-    (:func:`drift_clause`)."""
+    (:func:`drift_clause`); ``platform`` names the free aid that ran (:func:`bgfn.report.aid_words.aid_suffix`)."""
+    aid = aid_suffix(platform)[1:]
     ins, nhc, bgfn, both = (_row(table, k) for k in ("INS", "INS+NHC", "BGFN", "BGFN+NHC"))
     if nhc is None or not np.isfinite(_mean_outages(nhc)):
         return "Does it beat the learning-free aids? Not measured: the INS+NHC row has not run."
@@ -262,10 +293,11 @@ def answer_free_aids(table: pd.DataFrame, drift: pd.DataFrame | None = None) -> 
     else:
         text = (f"In the paper's two outages (mean of their max errors) INS reaches {_m(_mean_outages(ins))}, INS+NHC "
                 f"{_m(_mean_outages(nhc))}" + drift_clause(drift, _mean_outages(ins), _mean_outages(nhc))
-                + f"; BGFN {_m(_mean_outages(bgfn))} and BGFN+NHC {_m(_mean_outages(both))}.")
+                + f"; BGFN {_m(_mean_outages(bgfn))} and BGFN+NHC {_m(_mean_outages(both))}"
+                + _sample_note(_outage_sample(bgfn)) + ".")
     a, b = (both[col], nhc[col]) if col else (_mean_outages(both), _mean_outages(nhc))
     add = ("BGFN adds to the free aid" if np.isfinite(a) and np.isfinite(b) and a < b
-           else "BGFN does not add to the free aid: fused with NHC it is worse than NHC alone")
+           else f"BGFN does not add to the free aid: fused with {aid} it is worse than {aid} alone")
     return f"Does it beat the learning-free aids? {text} {add}."
 
 
@@ -361,8 +393,9 @@ def answer_protocol(table: pd.DataFrame, claims: dict | None = None) -> str:
     if not len(leaky):
         return "Was the paper's protocol leaky? Not measured: the variant trained on the whole drive has not run."
     ins = _mean_outages(_row(table, "INS"))
-    lines = []
+    lines, samples = [], []
     for _, r in pd.concat([_variant_rows(table, None, "honest"), leaky]).iterrows():
+        samples.append(_outage_sample(r))
         err = _mean_outages(r)
         red = 100.0 * (ins - err) / ins if np.isfinite(ins) and ins > 0 else float("nan")
         lines.append(f"{r['row']}, {r['protocol']}: {_m(err)}, "
@@ -374,7 +407,9 @@ def answer_protocol(table: pd.DataFrame, claims: dict | None = None) -> str:
             stated = f" The paper states reductions of {min(pct):g}-{max(pct):g} %."
     return ("Was the paper's protocol leaky? Mean max error in the paper's two outages, trained with the test outages "
             "and a margin left out (honest) and on the whole drive, the test outages included (leaky): "
-            + "; ".join(lines) + f" (INS {_m(ins)})." + stated)
+            + "; ".join(lines) + f" (INS {_m(ins)}"
+            + _sample_note((min(n for n, _ in samples), max(w for _, w in samples)), "; each from ")[:-1] + ")."
+            + stated)
 
 
 def _numbers(node) -> list[float]:
@@ -420,23 +455,25 @@ def consistency_sentence(inp: VerdictInputs) -> str:
 
 
 def verdict_sentences(inp: VerdictInputs, table: pd.DataFrame, claims: dict | None = None) -> list[str]:
-    """The six answers for one test, in the issues' order."""
-    return [answer_accuracy(inp), answer_free_aids(table, inp.ins_drift), answer_speed(table, inp),
-            answer_protocol(table, claims), answer_ins_tuning(inp),
-            answer_odometer(inp.odometer or OdometerInputs(None, None, None), SWEEP_DURATIONS)]
+    """The six answers for one test, in the issues' order, the rows named by the aids that ran
+    (:func:`bgfn.report.aid_words.aid_label`: ``INS+ZUPT`` on a walker)."""
+    answers = [answer_accuracy(inp), answer_free_aids(table, inp.ins_drift, inp.platform), answer_speed(table, inp),
+               answer_protocol(table, claims), answer_ins_tuning(inp),
+               answer_odometer(inp.odometer or OdometerInputs(None, None, None), SWEEP_DURATIONS)]
+    return [aid_label(a, inp.platform) for a in answers]
 
 
-def _platform(out: Path, dataset: str) -> str:
-    """The drive's platform as notebook 02 recorded it (``kf_baseline.json``; ``car`` when it says nothing)."""
-    record = read_json(Path(out) / RUN_RECORDS["kf_baseline"]) or {}
-    for name, facts in (record.get("datasets") or {}).items():
-        if dataset_id(name) == dataset_id(dataset):
-            return str(((facts or {}).get("constraints") or {}).get("platform", "car"))
-    return "car"
+#: The drive's platform as notebook 02 recorded it (:func:`bgfn.report.aid_words.recorded_platform`).
+_platform = recorded_platform
 
 
 def headline(inp: VerdictInputs, table: pd.DataFrame) -> str:
-    """One line per test for the book's first page: BGFN against INS and INS+NHC where both were measured."""
+    """One line per test for the book's first page: BGFN against INS and INS+NHC where both were measured (the
+    rows named by the aids that ran, :func:`bgfn.report.aid_words.aid_label`)."""
+    return aid_label(_headline(inp, table), inp.platform)
+
+
+def _headline(inp: VerdictInputs, table: pd.DataFrame) -> str:
     title = paper.TESTS[inp.test]["title"] if inp.test in paper.TESTS else inp.test
     b, i, n = (_row(table, k) for k in (SUBJECT, "INS", "INS+NHC"))
     col = "sweep 30 s" if b is not None and np.isfinite(b["sweep 30 s"]) else None
@@ -444,11 +481,12 @@ def headline(inp: VerdictInputs, table: pd.DataFrame) -> str:
         return f"{title} ({inp.dataset}): not evaluated."
     if col:
         vals = (b[col], i[col], n[col] if n is not None else np.nan)
-        where = "median max error over the 30 s sweep"
+        where = ("median max error over the 30 s sweep"
+                 + _sample_note(_sweep_sample(inp.sweep_summary, SUBJECT, 30.0), " (BGFN: "))
     else:
         vals = (_mean_outages(b), _mean_outages(i), _mean_outages(n))
         where = ("mean max error in the paper's two outages" if paper.has_own_values(inp.test)
-                 else "mean max error in the profile's outages")
+                 else "mean max error in the profile's outages") + _sample_note(_outage_sample(b), " (BGFN: ")
     word = "below" if vals[0] < vals[1] else "above"
     odo = odometer_headline(inp.odometer, SWEEP_DURATIONS) if inp.odometer is not None else ""
     return (f"{title} ({inp.dataset}): " + (f"{odo[0].upper()}{odo[1:]}. " if odo else "")
@@ -475,10 +513,13 @@ def drift_clause(drift: pd.DataFrame | None, ins_m: float, aided_m: float, durat
             f"starts it is {_m(aided)} against INS's {_m(ins)} (median max error, {duration_s:g} s)")
 
 
-def format_table(table: pd.DataFrame):
-    """The verdict table styled for the page (lengths with one decimal, p with two digits, n/a for empty)."""
+def format_table(table: pd.DataFrame, platform: str = "car"):
+    """The verdict table styled for the page (lengths with one decimal, p with two digits, n/a for empty), its rows
+    named by the aids that ran on ``platform`` (:func:`bgfn.report.aid_words.aid_label`: ``INS+ZUPT`` on a
+    walker)."""
+    table = table.assign(row=[aid_label(r, platform) for r in table["row"]])
     fmt = {c: "{:.1f}" for c in ("outage 1", "outage 2", "sweep 30 s", "sweep 60 s")}
-    fmt.update({c: "{:.2g}" for c in ("p 30 s", "p 60 s")})
+    fmt.update({c: "{:.2g}" for c in ("p 30 s", "p 60 s", "Holm p 30 s", "Holm p 60 s")})
     return table.style.format(fmt, na_rep="-").hide(axis="index")
 
 
@@ -499,7 +540,8 @@ class Verdict:
         out = []
         for d, inp in self.inputs.items():
             title = paper.TESTS[inp.test]["title"] if inp.test in paper.TESTS else inp.test
-            out += [f"### {title}: `{d}`", f"**{headline(inp, self.tables[d])}**", format_table(self.tables[d]),
+            out += [f"### {title}: `{d}`", f"**{headline(inp, self.tables[d])}**",
+                    format_table(self.tables[d], inp.platform),
                     "\n".join(f"{k}. {a}" for k, a in enumerate(self.answers[d], 1))]
         return out
 

@@ -15,12 +15,13 @@ from bgfn import paper
 from bgfn.config import SHARED_TABLES
 from bgfn.data.names import dataset_id
 from bgfn.io import save_figure
+from bgfn.report.aid_words import aid_label
 from bgfn.report.duration_curves import duration_curves, plot_duration_curves
 from bgfn.report.glance import run_header
 from bgfn.report.odometer_verdict import OdometerInputs, odometer_headline
 from bgfn.report.reading import read_csv
-from bgfn.report.verdict import (SUBJECT, SWEEP_DURATIONS, Verdict, VerdictInputs, _mean_outages, _row,
-                                 _variant_rows, format_table, headline)
+from bgfn.report.verdict import (SUBJECT, SWEEP_DURATIONS, Verdict, VerdictInputs, _mean_outages, _outage_sample,
+                                 _row, _sample_note, _variant_rows, format_table, headline)
 from bgfn.studies.ins_fidelity.ins_setups import gap_explained
 
 #: The rows and columns of the short table (the full one, with the variants and the NEES, is further down).
@@ -73,7 +74,7 @@ def short_free_aids(table: pd.DataFrame) -> str:
         return float("nan") if r is None else float(r["sweep 30 s"]) if sweep else _mean_outages(r)
     ins, nhc, bgfn, both = (value(k) for k in rows)
     p = rows[f"{SUBJECT}+NHC"]["p 30 s"] if sweep and rows[f"{SUBJECT}+NHC"] is not None else float("nan")
-    where = "30 s sweep" if sweep else "paper's two outages"
+    where = "30 s sweep" if sweep else "paper's two outages" + _sample_note(_outage_sample(rows[SUBJECT]))
     return (f"{'yes' if np.isfinite(both) and both < nhc else 'no'}: in the {where} INS+NHC (no learning) reaches "
             f"{_m(nhc)}, BGFN {_m(bgfn)}, BGFN+NHC {_m(both)}" + (f" (p {p:.2g})" if np.isfinite(p) else "")
             + f"; INS {_m(ins)}.")
@@ -128,10 +129,12 @@ QUESTIONS: tuple[tuple[str, str], ...] = (
 
 
 def short_answers(inp: VerdictInputs, table: pd.DataFrame) -> dict[str, str]:
-    """``{question key: one-line answer}`` for one drive."""
-    return {"accuracy": short_accuracy(inp), "free_aids": short_free_aids(table), "speed": short_speed(table),
-            "protocol": short_protocol(table), "ins": short_ins(inp),
-            "odometer": short_odometer(inp.odometer or OdometerInputs(None, None, None))}
+    """``{question key: one-line answer}`` for one drive, the rows named by the aids that ran
+    (:func:`bgfn.report.aid_words.aid_label`)."""
+    answers = {"accuracy": short_accuracy(inp), "free_aids": short_free_aids(table), "speed": short_speed(table),
+               "protocol": short_protocol(table), "ins": short_ins(inp),
+               "odometer": short_odometer(inp.odometer or OdometerInputs(None, None, None))}
+    return {k: aid_label(a, inp.platform) for k, a in answers.items()}
 
 
 def _inline(text: str) -> str:
@@ -151,10 +154,11 @@ def answer_bullets(answers: dict[str, str]) -> str:
     return "<ul>\n" + "\n".join(items) + "\n</ul>"
 
 
-def short_table(table: pd.DataFrame):
-    """The verdict table's main rows and length columns, styled (:func:`bgfn.report.verdict.format_table`)."""
+def short_table(table: pd.DataFrame, platform: str = "car"):
+    """The verdict table's main rows and length columns, styled (:func:`bgfn.report.verdict.format_table`, the rows
+    named by the aids that ran on ``platform``)."""
     t = table[table["row"].isin(SHORT_ROWS)][list(SHORT_COLUMNS)]
-    return format_table(t)
+    return format_table(t, platform)
 
 
 def provenance_details(header_lines: list[str]) -> HtmlPiece:
@@ -170,7 +174,7 @@ def header_details(res) -> HtmlPiece:
     return provenance_details(run_header(res.profile, res.cfg, res.out, res.current))
 
 
-def verdict_figure(res, dataset: str, figures_dir: str | Path) -> Path | None:
+def verdict_figure(res, dataset: str, figures_dir: str | Path, platform: str = "car") -> Path | None:
     """Draw and save one drive's duration figure (:mod:`bgfn.report.duration_curves`); None without a sweep."""
     sw = res.cfg["evaluate"]["sweep"]
     curves = duration_curves(dataset, res.sweep, read_csv(res.table(SHARED_TABLES["odometer"])),
@@ -178,7 +182,7 @@ def verdict_figure(res, dataset: str, figures_dir: str | Path) -> Path | None:
     if not len(curves):
         return None
     title = f"{dataset}: median max horizontal error over the sweep's starts, 95 % interval"
-    return save_figure(plot_duration_curves(curves, title),
+    return save_figure(plot_duration_curves(curves, title, platform),
                        Path(figures_dir) / FIGURE_FILE.format(dataset=dataset_id(dataset)))
 
 
@@ -190,8 +194,8 @@ def verdict_top(res, verdict: Verdict) -> list:
         title = paper.TESTS[inp.test]["title"] if inp.test in paper.TESTS else inp.test
         table = verdict.tables[d]
         out += [f"### {title}: `{d}`", f"**{headline(inp, table)}**"]
-        figure = verdict_figure(res, d, res.out / "figures")
+        figure = verdict_figure(res, d, res.out / "figures", inp.platform)
         if figure is not None:
             out.append(figure)
-        out += [short_table(table), HtmlPiece(answer_bullets(short_answers(inp, table)))]
+        out += [short_table(table, inp.platform), HtmlPiece(answer_bullets(short_answers(inp, table)))]
     return out

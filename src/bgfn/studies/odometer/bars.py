@@ -39,13 +39,16 @@ from bgfn.nav.constraints import DEFAULT_PLATFORM
 from bgfn import train
 from bgfn.paper import METHOD_LABELS, ensemble_label, nhc_label, odometer_label
 from bgfn.parallel import Runner
-from bgfn.stats import wilcoxon_p
+from bgfn.stats import holm_adjust, wilcoxon_p
 
 HOLD, RIDGE, ORACLE, ORACLE_WALK = "INS+NHC+HOLD", "RIDGE-ODO", "ORACLE-SPEED", "ORACLE-SPEED+WALK"
 #: A network odometer's row: ``BGFN-ODO``, ``Transformer-ODO``, ...
 NETWORK_ODOMETERS: tuple[str, ...] = tuple(odometer_label(m) for m in METHOD_LABELS)
 #: The equal-weight ensemble of a network's seeds per fold (``evaluate.odometer.ensemble``): ``BGFN-ODO-ENS`` ...
 ENSEMBLE_ODOMETERS: tuple[str, ...] = tuple(ensemble_label(m) for m in NETWORK_ODOMETERS)
+#: The learned odometers: the family a page names its best of (the ridge, each network, each ensemble), whose
+#: p-values against INS+NHC are Holm-adjusted together (:func:`holm_vs_nhc`).
+LEARNED_ODOMETERS: tuple[str, ...] = (RIDGE, *NETWORK_ODOMETERS, *ENSEMBLE_ODOMETERS)
 #: Rows of the odometer table, in order.
 ODOMETER_METHODS: tuple[str, ...] = (nhc_label("INS"), HOLD, RIDGE, *NETWORK_ODOMETERS, *ENSEMBLE_ODOMETERS, ORACLE,
                                      ORACLE_WALK)
@@ -64,7 +67,7 @@ NETWORK_COLUMNS: tuple[str, ...] = ("dataset", "method", "fold", "seed", "lr", "
                                     "correlation", "outage_speed_rmse_mps", "outage_coverage_2sigma")
 #: Columns of ``tables/outage_odometer_summary.csv`` (:func:`odometer_summary`).
 SUMMARY_COLUMNS: tuple[str, ...] = ("dataset", "duration_s", "method", "sigma_mps", "max_h_m", "ratio_to_nhc",
-                                    "speed_rmse_mps", "coverage_2sigma", "runs", "p_vs_nhc")
+                                    "speed_rmse_mps", "coverage_2sigma", "runs", "p_vs_nhc", "p_vs_nhc_holm")
 
 
 @dataclass(frozen=True)
@@ -411,7 +414,8 @@ def network_table(rows: pd.DataFrame, facts: dict) -> pd.DataFrame:
 def odometer_summary(rows: pd.DataFrame) -> pd.DataFrame:
     """Median max horizontal error (m) per dataset, duration and method (the oracle per sigma), with the median
     speed RMSE, the 2-sigma coverage, the median per-start ratio to ``INS+NHC`` and the two-sided Wilcoxon
-    signed-rank p-value of the per-start differences to it (``p_vs_nhc``; seeds' median per start).
+    signed-rank p-value of the per-start differences to it (``p_vs_nhc``; seeds' median per start), and for the
+    learned odometers that p Holm-adjusted over them (``p_vs_nhc_holm``, :func:`holm_vs_nhc`).
 
     ``coverage_2sigma`` is the share of *all* the outages' epochs within +-2 sigma: the mean of the outages' shares,
     each outage of one duration holding the same epochs. (A median of the shares says how a typical outage went:
@@ -431,6 +435,19 @@ def odometer_summary(rows: pd.DataFrame) -> pd.DataFrame:
     p = per_start.groupby(level=key, dropna=False, sort=False).apply(
         lambda g: wilcoxon_p(g["max_h_m"] - g["nhc_m"])).rename("p_vs_nhc").reset_index()
     out = out.merge(p, on=key, how="left")                  # pandas matches the NaN sigma of non-oracle rows
+    out["p_vs_nhc_holm"] = holm_vs_nhc(out)
     return out.sort_values(["dataset", "duration_s"], kind="stable").reset_index(drop=True)[list(SUMMARY_COLUMNS)]
 
 
+def holm_vs_nhc(summary: pd.DataFrame) -> pd.Series:
+    """``p_vs_nhc`` of the learned odometers (:data:`LEARNED_ODOMETERS`) Holm-adjusted over those of one dataset and
+    duration with a p-value (:func:`bgfn.stats.holm_adjust`): a page that names the best of them names the smallest
+    of several p-values, small by chance alone. NaN for the other rows (INS+NHC, the held speed, the oracles)."""
+    out = np.full(len(summary), np.nan)
+    learned = summary["method"].isin(LEARNED_ODOMETERS).to_numpy()
+    keys = summary[["dataset", "duration_s"]].reset_index(drop=True)           # by position: any index will do
+    p = summary["p_vs_nhc"].to_numpy(dtype=float)
+    for rows in keys[learned].groupby(["dataset", "duration_s"], sort=False).indices.values():
+        at = np.flatnonzero(learned)[rows]
+        out[at] = holm_adjust(p[at])
+    return pd.Series(out, index=summary.index, name="p_vs_nhc_holm")

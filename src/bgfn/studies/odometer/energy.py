@@ -14,7 +14,7 @@ is preprocessing, not counted.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -23,7 +23,7 @@ import pandas as pd
 from bgfn.config import odometer_datasets, odometer_network_seeds
 from bgfn.data import load_drive
 from bgfn.data.registry import recorded_first
-from bgfn.energy.checkpoint import MEASURED, SPIKING, check_trained
+from bgfn.energy.checkpoint import MEASURED, SPIKING, check_trained, improved
 from bgfn.energy.counts import layer_counts, mean_rate
 from bgfn.energy.tables import reduction_pct, stack_tables, table_from_counts, total_energy_uj
 from bgfn.learning import odometry as lo
@@ -66,6 +66,9 @@ class OdometerEnergy:
     mean_rate : float
         BGFN-ODO's mean input firing rate.
     n_windows : int
+    improved : dict
+        Method -> whether training improved on its initial network (:func:`bgfn.energy.checkpoint.improved`); a
+        BGFN-ODO that did not gives an untrained network's energy, and no saving is claimed from it.
     """
 
     dataset: str
@@ -74,19 +77,22 @@ class OdometerEnergy:
     tables: dict[str, pd.DataFrame]
     mean_rate: float
     n_windows: int
+    improved: dict[str, bool] = field(default_factory=dict)
 
     @property
     def table(self) -> pd.DataFrame:
         """Every measured network's layers (:func:`bgfn.energy.tables.stack_tables`; ``model``: ``BGFN-ODO`` ...),
-        the dataset in the first column."""
+        the dataset in the first column; with :attr:`improved`, whether each network trained (``improved``, last)."""
         table = stack_tables(self.tables)
         table.insert(0, "dataset", self.dataset)
+        if self.improved:
+            table["improved"] = [self.improved.get(m, True) for m, t in self.tables.items() for _ in range(len(t))]
         return table
 
     @property
     def reduction_pct(self) -> float:
-        """BGFN-ODO's energy saved against its twin, % (NaN without the twin)."""
-        if not set(MEASURED) <= set(self.tables):
+        """BGFN-ODO's energy saved against its twin, % (NaN without the twin, or when BGFN-ODO did not train)."""
+        if not set(MEASURED) <= set(self.tables) or not self.improved.get("bgfn", True):
             return float("nan")
         return reduction_pct(self.tables["bgfn"], self.tables["transformer"])
 
@@ -122,8 +128,11 @@ def odometer_energy(profile: str, cfg: dict, e_mac: float, e_ac: float, batch_si
                                 f"notebook 07_learned_odometer.ipynb trains it (evaluate.odometer.methods)")
     paths = {m: p for m, p in paths.items() if p.is_file()}
     allow = bool(cfg["energy"]["allow_untrained"])
+    # BGFN-ODO's card must be there (its firing rates decide its energy); the twin's says only whether it trained
+    cards = {m: json.loads(card_path(p).read_text()) if m in SPIKING or card_path(p).is_file() else {}
+             for m, p in paths.items()}
     for m in SPIKING:
-        check_trained(json.loads(card_path(paths[m]).read_text()), card_path(paths[m]), allow)
+        check_trained(cards[m], card_path(paths[m]), allow)
     trained = {m: load_trained(p, device="cpu") for m, p in paths.items()}
     drive = load_drive(dataset, profile=profile)
     window, rate = lo.window_samples(drive.imu, oc["window_s"])
@@ -133,4 +142,5 @@ def odometer_energy(profile: str, cfg: dict, e_mac: float, e_ac: float, batch_si
     counts = {m: layer_counts(tm.model.eval(), tm.norm.x(ws.x).astype(np.float32), batch_size)
               for m, tm in trained.items()}
     tables = {m: table_from_counts(c, odometer_label(m), e_mac, e_ac) for m, c in counts.items()}
-    return OdometerEnergy(dataset, seed, paths, tables, mean_rate(counts["bgfn"]), len(ws))
+    return OdometerEnergy(dataset, seed, paths, tables, mean_rate(counts["bgfn"]), len(ws),
+                          {m: improved(c) for m, c in cards.items()})

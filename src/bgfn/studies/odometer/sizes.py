@@ -16,6 +16,7 @@ import os
 import time
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import torch
 
@@ -79,7 +80,8 @@ def record(profile: str, note: str = "", measured: Path = MEASURED_FILE,
     networks = pd.read_csv(paths["networks"])
     written = []
     for table, cols, path in ((summary, SUMMARY_COLUMNS, measured), (networks, NETWORK_COLUMNS, measured_networks)):
-        new = pd.DataFrame({**run, **{c: table[c] for c in cols}, "note": note}, index=table.index)
+        new = pd.DataFrame({**run, **{c: table[c] if c in table else np.nan for c in cols}, "note": note},
+                           index=table.index)     # a summary written before a column existed leaves it empty
         old = read_measured(path)
         keep = [old[old["profile"] != profile]] if len(old) else []
         table = pd.concat([*keep, new], ignore_index=True)

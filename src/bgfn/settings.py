@@ -83,6 +83,21 @@ class DriveParams(Section):
     t_end: float | None = Field(None, description="crop end, s")
 
 
+class ReferenceCheck(Section):
+    """The fixes against the reference, the reference's attitude against the IMU and the course
+    (bgfn.data.reference_check), and the rule an estimated GNSS-IMU clock offset must pass (bgfn.data.time_offset)."""
+
+    offset_tolerance_m: Pos = _f(3.0, "median along- or cross-track offset of the fixes above which a warning names "
+                                      "the likely cause, m")
+    equal_tolerance_m: Pos = _f(0.005, "every moving fix this close to the reference: the reference is the GNSS, m")
+    attitude_tolerance_deg: Pos = _f(10.0, "reference yaw vs course (straight, fast) or roll/pitch vs the IMU's "
+                                           "levelling at rest beyond this: not the initial attitude, deg")
+    clock_sigmas: Pos = _f(3.0, "an estimated clock offset is applied only beyond this many of its std")
+    clock_floor_s: NonNeg = _f(0.02, "... and beyond this, s")
+    clock_agreement_s: Pos = _f(0.1, "the turn-rate and the reference estimates agree within this (or within "
+                                     "clock_sigmas of their combined std), s")
+
+
 class Data(Section):
     """Notebook 01: the drives built, tabulated and plotted; other keys name a drive and hold its parameters."""
 
@@ -97,6 +112,7 @@ class Data(Section):
     t_end: float | None = _f(None, "end of that crop, s")
     imu_plot_start_tow: float | None = _f(138840.0, "notebook 01's IMU plot starts here, s GPS time of week")
     imu_plot_duration_s: Pos = _f(20.0, "and lasts this long, s")
+    reference_check: ReferenceCheck = _f({}, "the fixes against the reference, its attitude, the clock rule")
 
 
 class Init(Section):

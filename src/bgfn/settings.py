@@ -90,8 +90,6 @@ class ReferenceCheck(Section):
     offset_tolerance_m: Pos = _f(3.0, "median along- or cross-track offset of the fixes above which a warning names "
                                       "the likely cause, m")
     equal_tolerance_m: Pos = _f(0.005, "every moving fix this close to the reference: the reference is the GNSS, m")
-    attitude_tolerance_deg: Pos = _f(10.0, "reference yaw vs course (straight, fast) or roll/pitch vs the IMU's "
-                                           "levelling at rest beyond this: not the initial attitude, deg")
     clock_sigmas: Pos = _f(3.0, "an estimated clock offset is applied only beyond this many of its std")
     clock_floor_s: NonNeg = _f(0.02, "... and beyond this, s")
     clock_agreement_s: Pos = _f(0.1, "the turn-rate and the reference estimates agree within this (or within "
@@ -126,7 +124,8 @@ class Init(Section):
 class Alignment(Section):
     """Where the filter starts (bgfn.nav.alignment): reference | gnss (self-alignment) | auto."""
 
-    mode: Literal["reference", "gnss", "auto"] = _f("auto", "auto: the reference when the drive has an attitude")
+    mode: Literal["reference", "gnss", "auto"] = _f("auto", "auto: the reference when the drive has an attitude that "
+                                                            "passes reference_tolerance_deg")
     speed_threshold_mps: Pos = _f(3.0, "the heading needs the GNSS course above this horizontal speed, m/s")
     heading_time_s: Pos = _f(10.0, "... for this long, s")
     level_time_s: Pos = _f(5.0, "a drive that starts moving: level from f - dv/dt over this span, s")
@@ -137,6 +136,9 @@ class Alignment(Section):
     level_std_deg: Pos = _f(1.0, "P0 floor of the aligned roll and pitch, deg")
     azimuth_std_deg: Pos = _f(2.0, "P0 floor of the aligned heading, deg")
     velocity_std_mps: Pos = _f(0.2, "P0 floor of the aligned velocity, m/s")
+    reference_tolerance_deg: Pos = _f(10.0, "auto: a reference yaw off the course (straight, fast) or roll/pitch "
+                                            "off the IMU's levelling at rest by more is not the start, deg "
+                                            "(bgfn.nav.reference_attitude)")
 
 
 class NoiseSearch(Section):

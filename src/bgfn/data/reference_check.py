@@ -13,10 +13,7 @@
   the reference to millimetres (the reference *is* the GNSS: a GPS-aided error against it is no accuracy), and a
   cause code when a median offset exceeds the tolerance: ``latency`` (the lag explains it) or
   ``lever_arm_or_datum`` (a constant).
-- **Attitude** (:func:`check_attitude`): the reference yaw against the course while driving straight and fast, and
-  roll/pitch against the levelling of the IMU's own mean specific force at rest; beyond the tolerance the reference
-  attitude is not the filter's initial attitude (``meta["reference_attitude"]["usable"]``, read by
-  :func:`bgfn.nav.baseline.prepare_filter`).
+- **Attitude**: :func:`bgfn.nav.reference_attitude.check_attitude` (the filter's start decides with it).
 """
 
 from __future__ import annotations
@@ -28,13 +25,13 @@ import pandas as pd
 
 from bgfn import settings
 from bgfn.data.gnss import antenna_position
-from bgfn.nav.alignment import level_from_specific_force, rest_end
 from bgfn.nav.earth import lla_to_ned
+from bgfn.nav.reference_attitude import check_attitude
 
 #: Defaults of the ``data.reference_check`` profile section (their home: :class:`bgfn.settings.ReferenceCheck`).
 CHECK_DEFAULTS: dict = settings.defaults("data.reference_check")
-#: Fixes count only above this speed (their along-track direction is the course), m/s.
-MIN_SPEED_MPS = 2.0
+#: Fixes count only above this speed (their along-track direction is the course; a walker's 1.4 m/s passes), m/s.
+MIN_SPEED_MPS = 1.0
 #: Fewer moving fixes: nothing is estimated.
 MIN_FIXES = 20
 #: Coarse search of a gross offset: +- this, s, in steps of ``COARSE_STEP_S``; then +- ``FINE_HALF_S`` around it in
@@ -44,10 +41,6 @@ MAX_LAG_S, COARSE_STEP_S, FINE_HALF_S, FINE_STEP_S = 30.0, 0.25, 1.0, 0.01
 BLOCK_S, BOOTSTRAP_DRAWS, BOOTSTRAP_SEED, MIN_BLOCKS = 20.0, 200, 0, 4
 #: Fixes beyond this many scaled MADs from the median along-track offset are left out of the lag (outliers).
 OUTLIER_MADS = 5.0
-#: Straight and fast for the yaw check: reference yaw rate below (deg/s) and speed above (m/s); fewer epochs: no check.
-STRAIGHT_MAX_DPS, STRAIGHT_MIN_SPEED_MPS, MIN_STRAIGHT_EPOCHS = 2.0, 5.0, 100
-#: Rest for the levelling check (bgfn.nav.alignment.rest_end): blocks, spreads (settings' alignment defaults).
-_ALIGN = settings.defaults("nav.alignment")
 
 
 def _mad(x: np.ndarray) -> float:
@@ -185,8 +178,18 @@ def reference_lag(reference: pd.DataFrame, gnss: pd.DataFrame, lever_arm_m) -> L
         n = draws @ count
         mean = (s1 @ draws.T) / n
         var = (s2 @ draws.T) / n - mean ** 2                              # [shifts, D]
-        std = float(np.std(fine[np.argmin(var, axis=0)]))
+        std = float(max(np.std(fine[np.argmin(var, axis=0)]), FINE_STEP_S / 2))       # at least half a step
     return Lag(float(fine[k]), std, int(cols.size), rms0, float(np.sqrt(spread[k])))
+
+
+def reference_equals_gnss(reference: pd.DataFrame, gnss: pd.DataFrame, lever_arm_m,
+                          options: dict | None = None) -> bool:
+    """Whether every fix inside the reference's span sits within ``equal_tolerance_m`` of the reference's antenna
+    (3D): the reference is the GNSS itself (at least :data:`MIN_FIXES` fixes)."""
+    tol = {**CHECK_DEFAULTS, **(options or {})}["equal_tolerance_m"]
+    off = fix_offsets(reference, gnss, lever_arm_m)
+    dist = np.sqrt(off["along_m"] ** 2 + off["cross_m"] ** 2 + off["up_m"] ** 2).to_numpy()
+    return bool(dist.size >= MIN_FIXES and np.all(dist <= tol))
 
 
 @dataclass(frozen=True)
@@ -228,16 +231,16 @@ def check_reference(reference: pd.DataFrame, gnss: pd.DataFrame, lever_arm_m, op
     """The verdict of the module docstring. ``options``: the ``data.reference_check`` section (defaults:
     :data:`CHECK_DEFAULTS`); ``lag``: :func:`reference_lag` when already computed."""
     o = {**CHECK_DEFAULTS, **(options or {})}
+    equals = reference_equals_gnss(reference, gnss, lever_arm_m, o)
     off = fix_offsets(reference, gnss, lever_arm_m)
     off = off[off["speed_mps"] > MIN_SPEED_MPS]
     a, c = off["along_m"].to_numpy(), off["cross_m"].to_numpy()
     nan = float("nan")
     if a.size < MIN_FIXES:
-        return ReferenceCheck(int(a.size), *[nan] * 9, nan, nan, "too_few_moving_fixes", False, False, None,
-                              float(o["offset_tolerance_m"]))
+        return ReferenceCheck(int(a.size), *[nan] * 9, nan, nan, "too_few_moving_fixes", equals, False,
+                              "equals_gnss" if equals else None, float(o["offset_tolerance_m"]))
     lag = lag if lag is not None else reference_lag(reference, gnss, lever_arm_m)
     horizontal = np.hypot(a, c)
-    equals = bool(np.all(np.hypot(horizontal, off["up_m"].to_numpy()) <= o["equal_tolerance_m"]))
     tol = float(o["offset_tolerance_m"])
     exceeds = bool(abs(np.median(a)) > tol or abs(np.median(c)) > tol)
     cause = None
@@ -254,48 +257,14 @@ def check_reference(reference: pd.DataFrame, gnss: pd.DataFrame, lever_arm_m, op
                           exceeds, cause, tol)
 
 
-def _wrap_deg(x):
-    return (np.asarray(x, float) + 180.0) % 360.0 - 180.0
-
-
-def check_attitude(reference: pd.DataFrame, imu: pd.DataFrame, options: dict | None = None) -> dict | None:
-    """The reference attitude against the course and the IMU's levelling (module docstring); None without one.
-
-    Returns
-    -------
-    dict or None
-        ``usable`` (bool), ``reason`` (``None``, ``yaw_vs_course`` or ``level_vs_imu``), ``tolerance_deg``,
-        ``yaw_minus_course_deg`` (median, p05, p95 over straight fast epochs; None: too few), ``straight_epochs``,
-        ``level_minus_imu_deg`` (roll, pitch differences at rest; None: no rest at the start).
-    """
-    att = reference[["roll", "pitch", "yaw"]].to_numpy(float) if {"roll", "pitch", "yaw"} <= set(reference) else None
-    if att is None or not np.isfinite(att).all():
-        return None
-    o = {**CHECK_DEFAULTS, **(options or {})}
-    tol = float(o["attitude_tolerance_deg"])
-    t = reference["time"].to_numpy(float)
-    v_n, v_e = reference["v_n"].to_numpy(float), reference["v_e"].to_numpy(float)
-    yaw = np.unwrap(att[:, 2])
-    rate = np.degrees(np.abs(np.gradient(yaw, t)))
-    straight = (np.hypot(v_n, v_e) > STRAIGHT_MIN_SPEED_MPS) & (rate < STRAIGHT_MAX_DPS)
-    out = {"usable": True, "reason": None, "tolerance_deg": tol, "straight_epochs": int(straight.sum()),
-           "yaw_minus_course_deg": None, "level_minus_imu_deg": None}
-    if straight.sum() >= MIN_STRAIGHT_EPOCHS:
-        diff = _wrap_deg(np.degrees(att[straight, 2] - np.arctan2(v_e[straight], v_n[straight])))
-        p05, med, p95 = (float(np.percentile(diff, p)) for p in (5, 50, 95))
-        out["yaw_minus_course_deg"] = [med, p05, p95]
-        if abs(med) > tol or max(abs(p05), abs(p95)) > 2 * tol:
-            out.update(usable=False, reason="yaw_vs_course")
-    t_rest = rest_end(imu, _ALIGN["still_window_s"], _ALIGN["still_accel_std_mps2"],
-                      np.radians(_ALIGN["still_gyro_std_dps"]))
-    if t_rest is not None and t_rest - float(imu["time"].iloc[0]) >= _ALIGN["still_min_s"]:
-        ti = imu["time"].to_numpy(float)
-        roll, pitch = level_from_specific_force(imu.loc[ti <= t_rest, ["accel_x", "accel_y", "accel_z"]]
-                                                .to_numpy(float).mean(axis=0))
-        at = t <= t_rest
-        if at.any():
-            d = _wrap_deg(np.degrees([roll - np.mean(att[at, 0]), pitch - np.mean(att[at, 1])]))
-            out["level_minus_imu_deg"] = [float(x) for x in -d]
-            if out["usable"] and np.max(np.abs(d)) > tol:
-                out.update(usable=False, reason="level_vs_imu")
-    return out
+def drive_checks(drive, data_options: dict | None = None, alignment_options: dict | None = None) -> dict:
+    """Notebook 01's checks of one drive: ``reference`` (:func:`check_reference` under ``data.reference_check``:
+    the loader's own for a CSV drive), ``attitude`` (:func:`bgfn.nav.reference_attitude.check_attitude` under
+    ``nav.alignment``; None without a reference attitude) and ``clock`` (a CSV drive's ``meta["gnss_offset"]``,
+    :func:`bgfn.data.time_offset.decide_clock`; None for a built-in drive)."""
+    lever = drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0])
+    reference = drive.meta.get("reference_check") if data_options is None else None
+    if reference is None:
+        reference = check_reference(drive.reference, drive.gnss, lever, data_options).record()
+    return {"reference": reference, "attitude": check_attitude(drive.reference, drive.imu, alignment_options),
+            "clock": drive.meta.get("gnss_offset")}

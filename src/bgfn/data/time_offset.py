@@ -18,10 +18,13 @@ stamped after the motion the IMU saw at that time).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 import pandas as pd
 
+from bgfn import settings
+from bgfn.data.csv_meta import MAX_TIME_SHIFT_S
 from bgfn.nav.earth import lla_to_ned
 from bgfn.schema import ACCEL_COLUMNS, GYRO_COLUMNS
 
@@ -33,6 +36,9 @@ MIN_SPEED_MPS = 2.0
 MIN_CORRELATION, MIN_FIXES = 0.5, 30
 #: Offsets beyond this are an error at load (unless meta.yaml states the delay), s.
 TOLERANCE_S = 0.5
+#: Block bootstrap of the estimate's std: blocks of this many seconds of fixes, the lags within this of the best,
+#: this many draws, this seed; fewer blocks: no std.
+BLOCK_S, BOOTSTRAP_HALF_S, BOOTSTRAP_DRAWS, BOOTSTRAP_SEED, MIN_BLOCKS = 10.0, 1.0, 200, 0, 4
 
 
 @dataclass(frozen=True)
@@ -47,11 +53,14 @@ class OffsetEstimate:
         Correlation of the two turn-rate magnitudes at that lag.
     fixes : int
         Moving fixes the estimate used.
+    std_s : float
+        Its std from a block bootstrap over the fixes (NaN: not estimable, or too few blocks), s.
     """
 
     offset_s: float
     correlation: float
     fixes: int
+    std_s: float = float("nan")
 
     @property
     def estimable(self) -> bool:
@@ -107,4 +116,123 @@ def estimate_gnss_offset(imu: pd.DataFrame, gnss: pd.DataFrame, max_lag_s: float
             best = (float(lag), float(r))
     if best[1] < MIN_CORRELATION:
         return OffsetEstimate(float("nan"), float(best[1]) if np.isfinite(best[1]) else float("nan"), int(tg.size))
-    return OffsetEstimate(best[0], best[1], int(tg.size))
+    std = _bootstrap_std(tg, rg, t_mean, w_mean, best[0])
+    return OffsetEstimate(best[0], best[1], int(tg.size), std)
+
+
+def _bootstrap_std(tg: np.ndarray, rg: np.ndarray, t_mean: np.ndarray, w_mean: np.ndarray, lag0: float) -> float:
+    """Std of the best lag over block-bootstrap draws of the fixes (blocks of ``BLOCK_S``), the lags within
+    ``BOOTSTRAP_HALF_S`` of ``lag0`` (NaN with fewer than ``MIN_BLOCKS`` blocks); at least half a lag step."""
+    lags = lag0 + np.arange(-BOOTSTRAP_HALF_S, BOOTSTRAP_HALF_S + LAG_STEP_S / 2, LAG_STEP_S)
+    inside = np.ones(tg.size, bool)
+    for lag in lags[[0, -1]]:
+        inside &= (tg - lag >= t_mean[0]) & (tg - lag <= t_mean[-1])
+    x, t = rg[inside], tg[inside]
+    y = np.stack([np.interp(t - lag, t_mean, w_mean) for lag in lags])        # [L, n]
+    block = np.floor((t - t[0]) / BLOCK_S).astype(int)
+    blocks = np.unique(block)
+    if blocks.size < MIN_BLOCKS:
+        return float("nan")
+    member = (block[None, :] == blocks[:, None]).astype(float)                # [B, n]
+    sx, sxx, n_b = member @ x, member @ (x * x), member.sum(axis=1)
+    sy, syy, sxy = y @ member.T, (y * y) @ member.T, (y * x) @ member.T       # [L, B]
+    rng = np.random.default_rng(BOOTSTRAP_SEED)
+    draws = np.stack([np.bincount(rng.integers(0, blocks.size, blocks.size), minlength=blocks.size)
+                      for _ in range(BOOTSTRAP_DRAWS)]).astype(float).T       # [B, D]
+    n = n_b @ draws
+    mx, my = (sx @ draws) / n, (sy @ draws) / n
+    cov = (sxy @ draws) / n - mx * my
+    var_x, var_y = (sxx @ draws) / n - mx ** 2, (syy @ draws) / n - my ** 2
+    r = cov / np.sqrt(np.maximum(var_x * var_y, 1e-30))                        # [L, D]
+    return float(max(np.std(lags[np.argmax(r, axis=0)]), LAG_STEP_S / 2))
+
+
+#: What became of an estimated offset (:func:`decide_clock`): ``applied``; ``not_asked`` (a stated latency: nothing
+#: estimated is applied); ``not_estimable`` (the turn rates show none); ``not_significant`` (within ``clock_sigmas``
+#: of its std or the floor); ``unconfirmed`` (no lag from the reference to check it against); ``disagrees`` (with the
+#: reference's lag); ``refused_by_key`` (a latency ``gnss_latency_s`` refuses when typed: negative, or beyond
+#: :data:`bgfn.data.csv_meta.MAX_TIME_SHIFT_S`); ``worse`` (the fixes' along-track spread against the reference
+#: grows with it).
+CLOCK_STATUSES = ("applied", "not_asked", "not_estimable", "not_significant", "unconfirmed", "disagrees",
+                  "refused_by_key", "worse")
+#: Defaults of the rule (``data.reference_check``; their home: :class:`bgfn.settings.ReferenceCheck`).
+RULE_DEFAULTS: dict = settings.defaults("data.reference_check")
+
+
+@dataclass(frozen=True)
+class ClockDecision:
+    """The GNSS-IMU clock of a log (:func:`decide_clock`), numbers and codes.
+
+    ``status`` (:data:`CLOCK_STATUSES`); ``applied_s`` (taken off the fixes' stamps, s); the turn-rate estimate
+    ``turn_rate_s`` +- ``turn_rate_std_s`` (correlation ``correlation``, ``fixes``); the reference's lag
+    ``reference_lag_s`` +- ``reference_std_s`` (``reference_reason``: why none); the fixes' along-track RMS about
+    its mean against the reference without and with the candidate (``rms_without_m``, ``rms_with_m``; NaN: not
+    compared); ``gross_s``: an offset beyond :data:`TOLERANCE_S` left after ``applied_s`` that the evidence supports
+    (NaN: none), ``gross_method`` (``reference`` or ``turn_rate``).
+    """
+
+    status: str
+    applied_s: float
+    turn_rate_s: float
+    turn_rate_std_s: float
+    correlation: float
+    fixes: int
+    reference_lag_s: float
+    reference_std_s: float
+    reference_reason: str | None
+    rms_without_m: float = float("nan")
+    rms_with_m: float = float("nan")
+    gross_s: float = float("nan")
+    gross_method: str | None = None
+
+    def record(self) -> dict:
+        """JSON-ready (``meta["gnss_offset"]``; NaN as None)."""
+        return {k: (None if isinstance(v, float) and not np.isfinite(v) else v) for k, v in self.__dict__.items()}
+
+
+def _significant(x: float, std: float, o: dict) -> bool:
+    return bool(np.isfinite(x) and np.isfinite(std) and abs(x) > max(o["clock_floor_s"], o["clock_sigmas"] * std))
+
+
+def decide_clock(est: OffsetEstimate, lag, auto: bool, rms_at: Callable[[float], float] | None = None,
+                 options: dict | None = None) -> ClockDecision:
+    """Whether the turn-rate estimate ``est`` is applied (``auto``: ``gnss_latency_s: auto``), checked against the
+    reference's lag ``lag`` (:class:`bgfn.data.reference_check.Lag`, or None without a usable reference).
+
+    Applied only when it is significant (beyond ``clock_sigmas`` std and ``clock_floor_s``), agrees with the lag
+    (within ``clock_agreement_s`` or ``clock_sigmas`` of their combined std), is a latency the key takes when typed
+    (0 to :data:`~bgfn.data.csv_meta.MAX_TIME_SHIFT_S`) and does not widen the fixes' along-track spread against
+    the reference (``rms_at(shift)``, m). Then the offset left (the lag's, else the turn rates' where no lag
+    contradicts them) beyond :data:`TOLERANCE_S` is ``gross_s``: the loader's error.
+    """
+    o = {**RULE_DEFAULTS, **(options or {})}
+    c, sc = est.offset_s, est.std_s
+    has_lag = lag is not None and lag.estimable and np.isfinite(lag.std_s)
+    r, sr = (lag.lag_s, lag.std_s) if has_lag else (float("nan"), float("nan"))
+    agree = has_lag and np.isfinite(c) and abs(c - r) <= max(o["clock_agreement_s"],
+                                                            o["clock_sigmas"] * float(np.hypot(sc, sr)))
+    rms0 = rms1 = float("nan")
+    if not auto:
+        status = "not_asked"
+    elif not est.estimable or not np.isfinite(sc):
+        status = "not_estimable"
+    elif not _significant(c, sc, o):
+        status = "not_significant"
+    elif not has_lag:
+        status = "unconfirmed"
+    elif not agree:
+        status = "disagrees"
+    elif c < 0 or c > MAX_TIME_SHIFT_S:
+        status = "refused_by_key"
+    else:
+        rms0, rms1 = (float(rms_at(x)) for x in (0.0, c)) if rms_at is not None else (float("nan"),) * 2
+        status = "worse" if rms1 > rms0 else "applied"
+    applied = c if status == "applied" else 0.0
+    gross, method = float("nan"), None
+    if has_lag and abs(r - applied) > TOLERANCE_S and _significant(r, sr, o):
+        gross, method = r - applied, "reference"
+    elif (np.isfinite(c) and abs(c - applied) > TOLERANCE_S and _significant(c, sc, o) and (agree or not has_lag)):
+        gross, method = c - applied, "turn_rate"
+    return ClockDecision(status, float(applied), c, sc, est.correlation, est.fixes,
+                         r if lag is None else lag.lag_s, sr if lag is None else lag.std_s,
+                         None if lag is None else lag.reason, rms0, rms1, gross, method)

@@ -346,6 +346,9 @@ class Baseline:
     noise : FilterNoise
     constraints : dict
         :meth:`bgfn.nav.constraints.Constraints.summary` of the ``INS+NHC`` runs' constraints.
+    reference_equals_gnss : bool
+        The drive's reference is its GNSS (``meta["reference_equals_gnss"]``, :mod:`bgfn.data.reference_check`):
+        the errors against it are no accuracy.
     """
 
     drive_name: str
@@ -358,6 +361,7 @@ class Baseline:
     noise: FilterNoise
     setup: FilterSetup | None = None
     constraints: dict | None = None
+    reference_equals_gnss: bool = False
 
     def lines(self) -> list[str]:
         """Notebook 02's sentences of this run: the self-alignment and the noise search (when they ran) and the
@@ -419,7 +423,7 @@ def run_baseline(drive, cfg: dict, windows) -> Baseline:
         outage_errors[n] = pd.concat(parts, ignore_index=True)
     table = pd.DataFrame(rows).sort_values("method", key=lambda m: m != "INS", kind="stable").reset_index(drop=True)
     return Baseline(drive.name, full, errors, metrics.rms_table(errors), full.states, outage_errors, table, noise,
-                    setup, aids.summary())
+                    setup, aids.summary(), bool(drive.meta.get("reference_equals_gnss", False)))
 
 
 def ins_layout(outage_table: pd.DataFrame, dataset: str | None = None) -> pd.DataFrame:
@@ -499,6 +503,7 @@ def save_baseline(b: Baseline, out, file_id: str, lat=None) -> dict:
             "mean_nis": float(upd["nis"].mean()) if len(upd) else None,
             "mean_nis_dof": float(upd["dof"].mean()) if len(upd) else None,
             "nis_verdict": nis_summary(upd)["verdict"], "constraints": b.constraints,
+            "reference_equals_gnss": b.reference_equals_gnss,
             "states_file": f"nav_states_{d}.npz", **(b.setup.record() if b.setup is not None else {})}
 
 

@@ -268,3 +268,24 @@ def drive_checks(drive, data_options: dict | None = None, alignment_options: dic
         reference = check_reference(drive.reference, drive.gnss, lever, data_options).record()
     return {"reference": reference, "attitude": check_attitude(drive.reference, drive.imu, alignment_options),
             "clock": drive.meta.get("gnss_offset")}
+
+
+def checks_table(checks: dict) -> pd.DataFrame:
+    """One row per drive of :func:`drive_checks` outputs (``{name: checks}``; ``tables/reference_check.csv``): the
+    offsets, the lag, the flags and cause codes, the attitude check and the clock decision (empty where none)."""
+    rows = []
+    for name, c in checks.items():
+        ref, att, clock = c["reference"], c["attitude"] or {}, c["clock"] or {}
+        yaw = att.get("yaw_minus_course_deg") or [None] * 3
+        level = att.get("level_minus_imu_deg") or [None] * 2
+        rows.append({"dataset": name, **{k: ref[k] for k in ("fixes", "along_median_m", "along_mad_m", "along_p05_m",
+                                                             "along_p95_m", "cross_median_m", "cross_mad_m",
+                                                             "cross_p05_m", "cross_p95_m", "horizontal_median_m",
+                                                             "lag_s", "lag_std_s", "equals_gnss", "exceeds", "cause")},
+                     "attitude_usable": att.get("usable"), "attitude_reason": att.get("reason"),
+                     "yaw_minus_course_median_deg": yaw[0], "yaw_minus_course_p05_deg": yaw[1],
+                     "yaw_minus_course_p95_deg": yaw[2], "roll_minus_imu_deg": level[0],
+                     "pitch_minus_imu_deg": level[1], "clock_status": clock.get("status"),
+                     "clock_applied_s": clock.get("applied_s"), "turn_rate_offset_s": clock.get("turn_rate_s"),
+                     "turn_rate_std_s": clock.get("turn_rate_std_s")})
+    return pd.DataFrame(rows)

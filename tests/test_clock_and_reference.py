@@ -60,12 +60,15 @@ def test_a_known_latency_is_recovered_within_its_std_and_applied_only_when_it_ho
     # both methods recover the latency within 3 of their own std (the turn rates on a 0.05 s grid)
     assert o["turn_rate_s"] is not None and abs(o["turn_rate_s"] - latency) <= 3 * o["turn_rate_std_s"]
     assert abs(o["reference_lag_s"] - latency) <= 3 * o["reference_std_s"] + 0.01
+    assert abs(o["combined_s"] - latency) <= 3 * o["combined_std_s"] + 0.01       # they agree: their mean
     assert o["applied_s"] >= 0.0                                 # never a latency the key refuses
     if latency == 0.25:                                          # significant, confirmed, better: applied
-        assert o["status"] == "applied" and o["applied_s"] == pytest.approx(0.25, abs=3 * o["turn_rate_std_s"])
+        assert o["status"] == "applied" and o["applied_s"] == o["combined_s"]
         assert o["rms_with_m"] <= o["rms_without_m"]
-    else:                                                        # within its std: nothing applied
+    elif latency == 0.0:                                         # within its std: nothing applied
         assert o["status"] == "not_significant" and o["applied_s"] == 0.0
+    else:                                                        # found, and refused as the key refuses it typed
+        assert o["status"] == "refused_by_key" and o["applied_s"] == 0.0
     # what is left against the reference after the shift: no lag worth a warning, offsets of centimetres
     chk = d.meta["reference_check"]
     assert not chk["exceeds"] and chk["cause"] is None and not chk["equals_gnss"]
@@ -99,7 +102,10 @@ def test_the_rule_needs_significance_agreement_and_no_worse_along_track_error():
     assert decide_clock(est, lag, True, lambda s: 1.0 + s).status == "worse"               # checked, not assumed
     assert decide_clock(est, None, True).status == "unconfirmed"                            # no second method
     assert decide_clock(est, rc.Lag(0.0, 0.01, 200, 1.0, 1.0), True).status == "disagrees"  # the car of the issue
-    assert decide_clock(OffsetEstimate(0.10, 0.9, 200, 0.05), lag, True).status == "not_significant"
+    assert decide_clock(OffsetEstimate(0.01, 0.9, 200, 0.05), rc.Lag(0.01, 0.01, 200, 1.0, 1.0),
+                        True).status == "not_significant"
+    weak = decide_clock(OffsetEstimate(0.5, 0.8, 200, 0.3), lag, True, lambda s: 1.0 - s)   # a broad peak that agrees
+    assert weak.status == "applied" and weak.applied_s == pytest.approx(0.30, abs=0.001)
     assert decide_clock(OffsetEstimate(float("nan"), 0.2, 10), None, True).status == "not_estimable"
     typed = decide_clock(est, lag, False)
     assert typed.status == "not_asked" and typed.applied_s == 0.0 and np.isnan(typed.gross_s)

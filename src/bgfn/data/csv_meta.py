@@ -17,9 +17,10 @@ key                meaning (all optional; the file itself is optional)
                    deg; the IMU rows are rotated into the body frame at load; default [0, 0, 0]
 ``imu_time_offset_s``  added to every IMU time (a logger's delay), s; default 0
 ``gnss_latency_s``  subtracted from every GNSS time (a receiver stamps a fix when it arrives, later than the
-                   epoch it is valid at), s, >= 0, or ``auto``: the offset estimated from the data
-                   (:mod:`bgfn.data.time_offset`); default 0. Without it, an estimated offset beyond 0.5 s
-                   is an error naming both files
+                   epoch it is valid at), s, >= 0, or ``auto``: the offset estimated from the data, applied
+                   only when the rule of :func:`bgfn.data.time_offset.decide_clock` holds (significant,
+                   confirmed by the reference, a latency this key takes); default 0. An offset beyond 0.5 s
+                   that the data support is an error naming both files
 ``gnss_std_m``     [north, east, down] std of a fix, m, for a ``gnss.csv`` without ``std_n, std_e, std_d``
                    (a receiver that reports no accuracy); no default: such a file needs it
 ``reference_lever_arm_m``  the point whose position ``reference.csv`` gives, in the body frame [x, y, z], m

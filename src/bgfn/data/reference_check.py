@@ -37,8 +37,9 @@ MIN_FIXES = 20
 #: Coarse search of a gross offset: +- this, s, in steps of ``COARSE_STEP_S``; then +- ``FINE_HALF_S`` around it in
 #: steps of ``FINE_STEP_S``.
 MAX_LAG_S, COARSE_STEP_S, FINE_HALF_S, FINE_STEP_S = 30.0, 0.25, 1.0, 0.01
-#: Block bootstrap of the lag: blocks of this many seconds of fixes, this many draws, this seed; fewer blocks: no std.
-BLOCK_S, BOOTSTRAP_DRAWS, BOOTSTRAP_SEED, MIN_BLOCKS = 20.0, 200, 0, 4
+#: Block bootstrap of the lag: blocks of at least this many seconds of fixes (longer: the residuals' correlation
+#: time), this many draws, this seed; fewer blocks: no std.
+BLOCK_S, BOOTSTRAP_DRAWS, BOOTSTRAP_SEED, MIN_BLOCKS = 60.0, 200, 0, 4
 #: Fixes beyond this many scaled MADs from the median along-track offset are left out of the lag (outliers).
 OUTLIER_MADS = 5.0
 
@@ -127,6 +128,18 @@ def _along_matrix(track, gnss_t, fix_lla, taus) -> np.ndarray:
     return out
 
 
+def correlation_time_s(t: np.ndarray, x: np.ndarray) -> float:
+    """Integral correlation time of the series ``x`` at times ``t`` (s): ``dt (1 + 2 sum rho_k)`` over the lags up
+    to the first negative autocorrelation (``dt`` the median step)."""
+    x = np.asarray(x, float) - np.mean(x)
+    if x.size < 3 or not np.any(x):
+        return 0.0
+    acf = np.correlate(x, x, "full")[x.size - 1:] / np.dot(x, x)
+    neg = np.flatnonzero(acf[1:] < 0)
+    k = int(neg[0]) + 1 if neg.size else x.size
+    return float(np.median(np.diff(t)) * (1.0 + 2.0 * acf[1:k].sum()))
+
+
 def reference_lag(reference: pd.DataFrame, gnss: pd.DataFrame, lever_arm_m) -> Lag:
     """The lag of the fixes' stamps against the reference (module docstring): coarse search on the median
     horizontal distance, then the along-track spread about its mean, its std from a block bootstrap."""
@@ -165,8 +178,10 @@ def reference_lag(reference: pd.DataFrame, gnss: pd.DataFrame, lever_arm_m) -> L
     rms0 = float(np.nanstd(a0[cols])) if np.isfinite(a0[cols]).all() else float("nan")
     if k in (0, len(fine) - 1):
         return Lag(float("nan"), float("nan"), int(cols.size), rms0, float(np.sqrt(spread[k])), "at_search_edge")
-    # block bootstrap: whole blocks of BLOCK_S drawn with replacement, the lag of each draw
-    block = np.floor((t[cols] - t[cols][0]) / BLOCK_S).astype(int)
+    # block bootstrap: whole blocks drawn with replacement, the lag of each draw; a block spans the residuals'
+    # correlation time at least (a receiver's errors last tens of seconds: shorter blocks would understate the std)
+    block_s = max(BLOCK_S, 2.0 * correlation_time_s(t[cols], a[k] - a[k].mean()))
+    block = np.floor((t[cols] - t[cols][0]) / block_s).astype(int)
     blocks = np.unique(block)
     std = float("nan")
     if blocks.size >= MIN_BLOCKS:

@@ -12,7 +12,14 @@ the magnitude of the course rate from the fixes with the magnitude of the IMU's 
 matter; the roll and pitch rates, which lead or lag the turn in a car's body, would shift the match) over lags of
 +- ``max_lag_s`` and returns the
 lag of the best match: the time by which the GNSS stamps are late against the IMU's (positive: the fixes are
-stamped after the motion the IMU saw at that time).
+stamped after the motion the IMU saw at that time), with its std from a block bootstrap over the fixes.
+
+A correlation can peak at a wrong lag on a real log (vibration, a phone's own rotation), so an estimate is a
+candidate, not a fact: :func:`decide_clock` applies an offset (``gnss_latency_s: auto``) only when it agrees with
+the lag the reference shows (:func:`bgfn.data.reference_check.reference_lag`, a second, independent method), and
+then the two's inverse-variance mean only when it is significant, a latency ``gnss_latency_s`` takes when typed,
+and does not widen the fixes' along-track error against the reference; and it names an offset beyond
+:data:`TOLERANCE_S` that the evidence supports (the loader's error).
 """
 
 from __future__ import annotations
@@ -155,6 +162,8 @@ def _bootstrap_std(tg: np.ndarray, rg: np.ndarray, t_mean: np.ndarray, w_mean: n
 #: grows with it).
 CLOCK_STATUSES = ("applied", "not_asked", "not_estimable", "not_significant", "unconfirmed", "disagrees",
                   "refused_by_key", "worse")
+#: A lag without a std (too few blocks) still names a gross offset when it shrinks the along-track spread by this.
+GROSS_SPREAD_RATIO = 0.5
 #: Defaults of the rule (``data.reference_check``; their home: :class:`bgfn.settings.ReferenceCheck`).
 RULE_DEFAULTS: dict = settings.defaults("data.reference_check")
 
@@ -165,7 +174,8 @@ class ClockDecision:
 
     ``status`` (:data:`CLOCK_STATUSES`); ``applied_s`` (taken off the fixes' stamps, s); the turn-rate estimate
     ``turn_rate_s`` +- ``turn_rate_std_s`` (correlation ``correlation``, ``fixes``); the reference's lag
-    ``reference_lag_s`` +- ``reference_std_s`` (``reference_reason``: why none); the fixes' along-track RMS about
+    ``reference_lag_s`` +- ``reference_std_s`` (``reference_reason``: why none); where they agree their
+    inverse-variance mean ``combined_s`` +- ``combined_std_s`` (the candidate); the fixes' along-track RMS about
     its mean against the reference without and with the candidate (``rms_without_m``, ``rms_with_m``; NaN: not
     compared); ``gross_s``: an offset beyond :data:`TOLERANCE_S` left after ``applied_s`` that the evidence supports
     (NaN: none), ``gross_method`` (``reference`` or ``turn_rate``).
@@ -180,6 +190,8 @@ class ClockDecision:
     reference_lag_s: float
     reference_std_s: float
     reference_reason: str | None
+    combined_s: float = float("nan")
+    combined_std_s: float = float("nan")
     rms_without_m: float = float("nan")
     rms_with_m: float = float("nan")
     gross_s: float = float("nan")
@@ -196,13 +208,15 @@ def _significant(x: float, std: float, o: dict) -> bool:
 
 def decide_clock(est: OffsetEstimate, lag, auto: bool, rms_at: Callable[[float], float] | None = None,
                  options: dict | None = None) -> ClockDecision:
-    """Whether the turn-rate estimate ``est`` is applied (``auto``: ``gnss_latency_s: auto``), checked against the
-    reference's lag ``lag`` (:class:`bgfn.data.reference_check.Lag`, or None without a usable reference).
+    """Whether the GNSS-IMU offset is taken off the fixes (``auto``: ``gnss_latency_s: auto``): the turn-rate
+    estimate ``est`` checked against the reference's lag ``lag`` (:class:`bgfn.data.reference_check.Lag`, or None
+    without a usable reference).
 
-    Applied only when it is significant (beyond ``clock_sigmas`` std and ``clock_floor_s``), agrees with the lag
-    (within ``clock_agreement_s`` or ``clock_sigmas`` of their combined std), is a latency the key takes when typed
-    (0 to :data:`~bgfn.data.csv_meta.MAX_TIME_SHIFT_S`) and does not widen the fixes' along-track spread against
-    the reference (``rms_at(shift)``, m). Then the offset left (the lag's, else the turn rates' where no lag
+    The two must agree (within ``clock_agreement_s`` or ``clock_sigmas`` of their combined std: the turn rates say
+    that the reference shares the IMU's clock); their inverse-variance mean is then applied when it is significant
+    (beyond ``clock_sigmas`` of its std and ``clock_floor_s``), a latency the key takes when typed (0 to
+    :data:`~bgfn.data.csv_meta.MAX_TIME_SHIFT_S`) and does not widen the fixes' along-track spread against the
+    reference (``rms_at(shift)``, m). Then the offset left (the lag's, else the turn rates' where no lag
     contradicts them) beyond :data:`TOLERANCE_S` is ``gross_s``: the loader's error.
     """
     o = {**RULE_DEFAULTS, **(options or {})}
@@ -211,28 +225,36 @@ def decide_clock(est: OffsetEstimate, lag, auto: bool, rms_at: Callable[[float],
     r, sr = (lag.lag_s, lag.std_s) if has_lag else (float("nan"), float("nan"))
     agree = has_lag and np.isfinite(c) and abs(c - r) <= max(o["clock_agreement_s"],
                                                             o["clock_sigmas"] * float(np.hypot(sc, sr)))
+    both, both_std = float("nan"), float("nan")
+    if agree and np.isfinite(sc):              # the two methods' inverse-variance mean
+        w_c, w_r = 1.0 / sc ** 2, 1.0 / sr ** 2
+        both, both_std = (w_c * c + w_r * r) / (w_c + w_r), float(np.sqrt(1.0 / (w_c + w_r)))
     rms0 = rms1 = float("nan")
     if not auto:
         status = "not_asked"
     elif not est.estimable or not np.isfinite(sc):
         status = "not_estimable"
-    elif not _significant(c, sc, o):
-        status = "not_significant"
     elif not has_lag:
         status = "unconfirmed"
     elif not agree:
         status = "disagrees"
-    elif c < 0 or c > MAX_TIME_SHIFT_S:
+    elif not _significant(both, both_std, o):
+        status = "not_significant"
+    elif both < 0 or both > MAX_TIME_SHIFT_S:
         status = "refused_by_key"
     else:
-        rms0, rms1 = (float(rms_at(x)) for x in (0.0, c)) if rms_at is not None else (float("nan"),) * 2
+        rms0, rms1 = (float(rms_at(x)) for x in (0.0, both)) if rms_at is not None else (float("nan"),) * 2
         status = "worse" if rms1 > rms0 else "applied"
-    applied = c if status == "applied" else 0.0
+    applied = both if status == "applied" else 0.0
     gross, method = float("nan"), None
-    if has_lag and abs(r - applied) > TOLERANCE_S and _significant(r, sr, o):
-        gross, method = r - applied, "reference"
+    # a lag beyond the tolerance counts when significant, or (too few blocks for a std) when it removes most of
+    # the fixes' along-track spread: an 18 s offset on a minute of driving
+    clear = lag is not None and lag.estimable and (_significant(lag.lag_s, lag.std_s, o) or
+                                                   lag.rms_at_lag_m < GROSS_SPREAD_RATIO * lag.rms_m)
+    if clear and abs(lag.lag_s - applied) > TOLERANCE_S:
+        gross, method = lag.lag_s - applied, "reference"
     elif (np.isfinite(c) and abs(c - applied) > TOLERANCE_S and _significant(c, sc, o) and (agree or not has_lag)):
         gross, method = c - applied, "turn_rate"
     return ClockDecision(status, float(applied), c, sc, est.correlation, est.fixes,
                          r if lag is None else lag.lag_s, sr if lag is None else lag.std_s,
-                         None if lag is None else lag.reason, rms0, rms1, gross, method)
+                         None if lag is None else lag.reason, both, both_std, rms0, rms1, gross, method)

@@ -21,7 +21,7 @@ ATTITUDE_WORDS = {
 }
 #: What became of an estimated clock offset (``status`` codes of the clock decision).
 CLOCK_WORDS = {
-    "applied": "taken off the fixes' stamps",
+    "applied": "the two agree: their weighted mean taken off the fixes' stamps",
     "not_asked": "not applied (meta.yaml states the latency)",
     "not_estimable": "not estimable from the turn rates (too few turns while moving faster than 2 m/s): nothing "
                      "applied",
@@ -74,7 +74,7 @@ def reference_lines(name: str, checks: dict) -> list[str]:
                if clock["reference_lag_s"] is not None else "no lag from the reference")
         text = f"{name}: GNSS-IMU clock offset ({est}; {lag}): {CLOCK_WORDS[clock['status']]}"
         if clock["status"] == "applied":
-            text += f" ({clock['applied_s']:.2f} s)"
+            text += f" ({_pm(clock['combined_s'], clock['combined_std_s'])})"
         if clock.get("rms_without_m") is not None:
             text += (f"; along-track RMS against the reference {clock['rms_without_m']:.2f} m without it, "
                      f"{clock['rms_with_m']:.2f} m with it")

@@ -83,19 +83,6 @@ class DriveParams(Section):
     t_end: float | None = Field(None, description="crop end, s")
 
 
-class ReferenceCheck(Section):
-    """The fixes against the reference, the reference's attitude against the IMU and the course
-    (bgfn.data.reference_check), and the rule an estimated GNSS-IMU clock offset must pass (bgfn.data.time_offset)."""
-
-    offset_tolerance_m: Pos = _f(3.0, "median along- or cross-track offset of the fixes above which a warning names "
-                                      "the likely cause, m")
-    equal_tolerance_m: Pos = _f(0.005, "every moving fix this close to the reference: the reference is the GNSS, m")
-    clock_sigmas: Pos = _f(3.0, "an estimated clock offset is applied only beyond this many of its std")
-    clock_floor_s: NonNeg = _f(0.02, "... and beyond this, s")
-    clock_agreement_s: Pos = _f(0.1, "the turn-rate and the reference estimates agree within this (or within "
-                                     "clock_sigmas of their combined std), s")
-
-
 class Data(Section):
     """Notebook 01: the drives built, tabulated and plotted; other keys name a drive and hold its parameters."""
 
@@ -110,7 +97,7 @@ class Data(Section):
     t_end: float | None = _f(None, "end of that crop, s")
     imu_plot_start_tow: float | None = _f(138840.0, "notebook 01's IMU plot starts here, s GPS time of week")
     imu_plot_duration_s: Pos = _f(20.0, "and lasts this long, s")
-    reference_check: ReferenceCheck = _f({}, "the fixes against the reference, its attitude, the clock rule")
+    reference_tolerance_m: Pos = _f(3.0, "fixes off the reference by a median beyond this: a warning, m")
 
 
 class Init(Section):
@@ -124,8 +111,7 @@ class Init(Section):
 class Alignment(Section):
     """Where the filter starts (bgfn.nav.alignment): reference | gnss (self-alignment) | auto."""
 
-    mode: Literal["reference", "gnss", "auto"] = _f("auto", "auto: the reference when the drive has an attitude that "
-                                                            "passes reference_tolerance_deg")
+    mode: Literal["reference", "gnss", "auto"] = _f("auto", "auto: the reference's attitude when it passes its check")
     speed_threshold_mps: Pos = _f(3.0, "the heading needs the GNSS course above this horizontal speed, m/s")
     heading_time_s: Pos = _f(10.0, "... for this long, s")
     level_time_s: Pos = _f(5.0, "a drive that starts moving: level from f - dv/dt over this span, s")
@@ -136,9 +122,7 @@ class Alignment(Section):
     level_std_deg: Pos = _f(1.0, "P0 floor of the aligned roll and pitch, deg")
     azimuth_std_deg: Pos = _f(2.0, "P0 floor of the aligned heading, deg")
     velocity_std_mps: Pos = _f(0.2, "P0 floor of the aligned velocity, m/s")
-    reference_tolerance_deg: Pos = _f(10.0, "auto: a reference yaw off the course (straight, fast) or roll/pitch "
-                                            "off the IMU's levelling at rest by more is not the start, deg "
-                                            "(bgfn.nav.reference_attitude)")
+    reference_tolerance_deg: Pos = _f(10.0, "auto: reference yaw vs course, level vs the IMU's at rest within, deg")
 
 
 class NoiseSearch(Section):

@@ -144,7 +144,7 @@ def _gnss_std(gnss: pd.DataFrame, path: Path, header: list[str], default, meta_p
 
 
 def _on_imu_clock(imu: pd.DataFrame, gnss: pd.DataFrame, reference: pd.DataFrame, lever_arm_m, auto: bool,
-                  files: dict, meta_path: Path, options: dict | None) -> tuple:
+                  files: dict, meta_path: Path) -> tuple:
     """The fixes (already shifted by a stated latency) on the IMU's clock: the offset the turn rates show
     (:func:`bgfn.data.time_offset.estimate_gnss_offset`) checked against the reference's lag
     (:func:`bgfn.data.reference_check.reference_lag`) and taken off only when ``auto`` and the rule of
@@ -152,9 +152,9 @@ def _on_imu_clock(imu: pd.DataFrame, gnss: pd.DataFrame, reference: pd.DataFrame
     :data:`~bgfn.data.time_offset.TOLERANCE_S` is left. A reference that is the GNSS itself says nothing of the clock.
     Returns the fixes and the facts (``meta["gnss_offset"]``)."""
     est = estimate_gnss_offset(imu, gnss)
-    lag = None if reference_equals_gnss(reference, gnss, lever_arm_m, options) else \
+    lag = None if reference_equals_gnss(reference, gnss, lever_arm_m) else \
         reference_lag(reference, gnss, lever_arm_m)
-    decision = decide_clock(est, lag, auto, lambda shift: along_rms(reference, gnss, lever_arm_m, shift), options)
+    decision = decide_clock(est, lag, auto, lambda shift: along_rms(reference, gnss, lever_arm_m, shift))
     if np.isfinite(decision.gross_s):
         leap = " -- GNSS in UTC against an IMU in GPS time (18 s apart)?" if abs(abs(decision.gross_s) - 18.0) < 1.5 \
             else ""
@@ -187,7 +187,7 @@ def _header(path: Path) -> list[str]:
 
 
 def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_start: float | None = None,
-                   t_end: float | None = None, reference_check: dict | None = None) -> Drive:
+                   t_end: float | None = None, reference_tolerance_m: float | None = None) -> Drive:
     """Load a drive from a folder in the CSV schema of the module docstring.
 
     Parameters
@@ -199,9 +199,8 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_st
         :func:`bgfn.data.navego.resample_imu`); default: the log's median rate (a regular log is kept as is).
     t_start, t_end : float, optional
         Keep only this span, s (on the files' time base).
-    reference_check : dict, optional
-        The profile's ``data.reference_check`` section (tolerances of :mod:`bgfn.data.reference_check` and the
-        clock rule of :func:`bgfn.data.time_offset.decide_clock`; default: their settings).
+    reference_tolerance_m : float, optional
+        The profile's ``data.reference_tolerance_m`` (:func:`bgfn.data.reference_check.check_reference`).
 
     Returns
     -------
@@ -252,12 +251,12 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_st
         reference = reference.assign(lat=lat, lon=lon, h=h)
     # then the clocks, on plausible data (a unit mistake is not blamed on a clock offset), against the reference
     gnss, offset = _on_imu_clock(raw["imu"], gnss, reference, user["lever_arm_m"], latency == "auto", files,
-                                 meta_path, reference_check)
+                                 meta_path)
     fix_times, fix_shift = regular_fix_times(gnss["time"].to_numpy(float), files["gnss"])   # arrival jitter
     gnss = gnss.assign(time=fix_times)
     tg = gnss["time"].to_numpy(float)
     gnss = gnss.loc[(tg >= epochs[0]) & (tg <= epochs[-1])].reset_index(drop=True)
-    checked = check_reference(reference, gnss, user["lever_arm_m"], reference_check)
+    checked = check_reference(reference, gnss, user["lever_arm_m"], reference_tolerance_m)
     meta = {
         "imu_rate_hz": rate,
         "native_imu_rate_hz": native,

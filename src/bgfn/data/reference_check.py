@@ -28,8 +28,13 @@ from bgfn.data.gnss import antenna_position
 from bgfn.nav.earth import lla_to_ned
 from bgfn.nav.reference_attitude import check_attitude
 
-#: Defaults of the ``data.reference_check`` profile section (their home: :class:`bgfn.settings.ReferenceCheck`).
-CHECK_DEFAULTS: dict = settings.defaults("data.reference_check")
+#: Every fix within this of the reference (3D): the reference is the GNSS itself, m.
+EQUAL_TOLERANCE_M = 0.005
+#: A median along- or cross-track offset beyond this draws a warning (the profile's ``data.reference_tolerance_m``;
+#: its home: :class:`bgfn.settings.Data`), m.
+DEFAULT_TOLERANCE_M: float = settings.defaults("data")["reference_tolerance_m"]
+#: A lag explains an offset when it is beyond this many of its std.
+LAG_SIGMAS = 3.0
 #: Fixes count only above this speed (their along-track direction is the course; a walker's 1.4 m/s passes), m/s.
 MIN_SPEED_MPS = 1.0
 #: Fewer moving fixes: nothing is estimated.
@@ -197,11 +202,10 @@ def reference_lag(reference: pd.DataFrame, gnss: pd.DataFrame, lever_arm_m) -> L
     return Lag(float(fine[k]), std, int(cols.size), rms0, float(np.sqrt(spread[k])))
 
 
-def reference_equals_gnss(reference: pd.DataFrame, gnss: pd.DataFrame, lever_arm_m,
-                          options: dict | None = None) -> bool:
-    """Whether every fix inside the reference's span sits within ``equal_tolerance_m`` of the reference's antenna
+def reference_equals_gnss(reference: pd.DataFrame, gnss: pd.DataFrame, lever_arm_m) -> bool:
+    """Whether every fix inside the reference's span sits within :data:`EQUAL_TOLERANCE_M` of the reference's antenna
     (3D): the reference is the GNSS itself (at least :data:`MIN_FIXES` fixes)."""
-    tol = {**CHECK_DEFAULTS, **(options or {})}["equal_tolerance_m"]
+    tol = EQUAL_TOLERANCE_M
     off = fix_offsets(reference, gnss, lever_arm_m)
     dist = np.sqrt(off["along_m"] ** 2 + off["cross_m"] ** 2 + off["up_m"] ** 2).to_numpy()
     return bool(dist.size >= MIN_FIXES and np.all(dist <= tol))
@@ -213,8 +217,8 @@ class ReferenceCheck:
 
     ``fixes``: moving fixes compared; ``along_median_m``, ``along_mad_m``, ``along_p05_m``, ``along_p95_m`` and the
     same for ``cross``; ``horizontal_median_m``; ``lag_s``, ``lag_std_s``, ``lag_reason`` (:class:`Lag`);
-    ``equals_gnss`` (every moving fix within ``equal_tolerance_m``); ``exceeds`` (a median offset beyond
-    ``offset_tolerance_m``); ``cause`` (``None``, ``latency``, ``lever_arm_or_datum`` or ``equals_gnss``);
+    ``equals_gnss`` (every moving fix within ``EQUAL_TOLERANCE_M``); ``exceeds`` (a median offset beyond
+    the tolerance); ``cause`` (``None``, ``latency``, ``lever_arm_or_datum`` or ``equals_gnss``);
     ``tolerance_m``.
     """
 
@@ -241,22 +245,21 @@ class ReferenceCheck:
         return {k: (None if isinstance(v, float) and not np.isfinite(v) else v) for k, v in asdict(self).items()}
 
 
-def check_reference(reference: pd.DataFrame, gnss: pd.DataFrame, lever_arm_m, options: dict | None = None,
+def check_reference(reference: pd.DataFrame, gnss: pd.DataFrame, lever_arm_m, tolerance_m: float | None = None,
                     lag: Lag | None = None) -> ReferenceCheck:
-    """The verdict of the module docstring. ``options``: the ``data.reference_check`` section (defaults:
-    :data:`CHECK_DEFAULTS`); ``lag``: :func:`reference_lag` when already computed."""
-    o = {**CHECK_DEFAULTS, **(options or {})}
-    equals = reference_equals_gnss(reference, gnss, lever_arm_m, o)
+    """The verdict of the module docstring. ``tolerance_m``: the profile's ``data.reference_tolerance_m`` (default
+    :data:`DEFAULT_TOLERANCE_M`); ``lag``: :func:`reference_lag` when already computed."""
+    tol = float(DEFAULT_TOLERANCE_M if tolerance_m is None else tolerance_m)
+    equals = reference_equals_gnss(reference, gnss, lever_arm_m)
     off = fix_offsets(reference, gnss, lever_arm_m)
     off = off[off["speed_mps"] > MIN_SPEED_MPS]
     a, c = off["along_m"].to_numpy(), off["cross_m"].to_numpy()
     nan = float("nan")
     if a.size < MIN_FIXES:
         return ReferenceCheck(int(a.size), *[nan] * 9, nan, nan, "too_few_moving_fixes", equals, False,
-                              "equals_gnss" if equals else None, float(o["offset_tolerance_m"]))
+                              "equals_gnss" if equals else None, tol)
     lag = lag if lag is not None else reference_lag(reference, gnss, lever_arm_m)
     horizontal = np.hypot(a, c)
-    tol = float(o["offset_tolerance_m"])
     exceeds = bool(abs(np.median(a)) > tol or abs(np.median(c)) > tol)
     cause = None
     if equals:
@@ -264,7 +267,7 @@ def check_reference(reference: pd.DataFrame, gnss: pd.DataFrame, lever_arm_m, op
     elif exceeds:
         # a lag that moves the fixes by more than the tolerance at the median speed explains the along-track offset
         explained = lag.estimable and abs(lag.lag_s) * float(np.median(off["speed_mps"])) > tol / 2 and \
-            (not np.isfinite(lag.std_s) or abs(lag.lag_s) > o["clock_sigmas"] * lag.std_s)
+            (not np.isfinite(lag.std_s) or abs(lag.lag_s) > LAG_SIGMAS * lag.std_s)
         cause = "latency" if explained else "lever_arm_or_datum"
     q = lambda x, p: float(np.percentile(x, p))      # noqa: E731
     return ReferenceCheck(int(a.size), float(np.median(a)), _mad(a), q(a, 5), q(a, 95), float(np.median(c)), _mad(c),
@@ -272,15 +275,13 @@ def check_reference(reference: pd.DataFrame, gnss: pd.DataFrame, lever_arm_m, op
                           exceeds, cause, tol)
 
 
-def drive_checks(drive, data_options: dict | None = None, alignment_options: dict | None = None) -> dict:
-    """Notebook 01's checks of one drive: ``reference`` (:func:`check_reference` under ``data.reference_check``:
-    the loader's own for a CSV drive), ``attitude`` (:func:`bgfn.nav.reference_attitude.check_attitude` under
+def drive_checks(drive, tolerance_m: float | None = None, alignment_options: dict | None = None) -> dict:
+    """Notebook 01's checks of one drive: ``reference`` (:func:`check_reference` with the profile's
+    ``data.reference_tolerance_m``), ``attitude`` (:func:`bgfn.nav.reference_attitude.check_attitude` under
     ``nav.alignment``; None without a reference attitude) and ``clock`` (a CSV drive's ``meta["gnss_offset"]``,
     :func:`bgfn.data.time_offset.decide_clock`; None for a built-in drive)."""
     lever = drive.meta.get("lever_arm_m", [0.0, 0.0, 0.0])
-    reference = drive.meta.get("reference_check") if data_options is None else None
-    if reference is None:
-        reference = check_reference(drive.reference, drive.gnss, lever, data_options).record()
+    reference = check_reference(drive.reference, drive.gnss, lever, tolerance_m).record()
     return {"reference": reference, "attitude": check_attitude(drive.reference, drive.imu, alignment_options),
             "clock": drive.meta.get("gnss_offset")}
 

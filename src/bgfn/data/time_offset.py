@@ -30,7 +30,6 @@ from typing import Callable
 import numpy as np
 import pandas as pd
 
-from bgfn import settings
 from bgfn.data.csv_meta import MAX_TIME_SHIFT_S
 from bgfn.nav.earth import lla_to_ned
 from bgfn.schema import ACCEL_COLUMNS, GYRO_COLUMNS
@@ -155,7 +154,7 @@ def _bootstrap_std(tg: np.ndarray, rg: np.ndarray, t_mean: np.ndarray, w_mean: n
 
 
 #: What became of an estimated offset (:func:`decide_clock`): ``applied``; ``not_asked`` (a stated latency: nothing
-#: estimated is applied); ``not_estimable`` (the turn rates show none); ``not_significant`` (within ``clock_sigmas``
+#: estimated is applied); ``not_estimable`` (the turn rates show none); ``not_significant`` (within :data:`CLOCK_SIGMAS`
 #: of its std or the floor); ``unconfirmed`` (no lag from the reference to check it against); ``disagrees`` (with the
 #: reference's lag); ``refused_by_key`` (a latency ``gnss_latency_s`` refuses when typed: negative, or beyond
 #: :data:`bgfn.data.csv_meta.MAX_TIME_SHIFT_S`); ``worse`` (the fixes' along-track spread against the reference
@@ -164,8 +163,9 @@ CLOCK_STATUSES = ("applied", "not_asked", "not_estimable", "not_significant", "u
                   "refused_by_key", "worse")
 #: A lag without a std (too few blocks) still names a gross offset when it shrinks the along-track spread by this.
 GROSS_SPREAD_RATIO = 0.5
-#: Defaults of the rule (``data.reference_check``; their home: :class:`bgfn.settings.ReferenceCheck`).
-RULE_DEFAULTS: dict = settings.defaults("data.reference_check")
+#: The rule's thresholds: an offset counts beyond this many of its std and beyond a floor (s); the two methods agree
+#: within this (s) or within that many of their combined std.
+CLOCK_SIGMAS, CLOCK_FLOOR_S, CLOCK_AGREEMENT_S = 3.0, 0.02, 0.1
 
 
 @dataclass(frozen=True)
@@ -202,29 +202,26 @@ class ClockDecision:
         return {k: (None if isinstance(v, float) and not np.isfinite(v) else v) for k, v in self.__dict__.items()}
 
 
-def _significant(x: float, std: float, o: dict) -> bool:
-    return bool(np.isfinite(x) and np.isfinite(std) and abs(x) > max(o["clock_floor_s"], o["clock_sigmas"] * std))
+def _significant(x: float, std: float) -> bool:
+    return bool(np.isfinite(x) and np.isfinite(std) and abs(x) > max(CLOCK_FLOOR_S, CLOCK_SIGMAS * std))
 
 
-def decide_clock(est: OffsetEstimate, lag, auto: bool, rms_at: Callable[[float], float] | None = None,
-                 options: dict | None = None) -> ClockDecision:
+def decide_clock(est: OffsetEstimate, lag, auto: bool, rms_at: Callable[[float], float] | None = None) -> ClockDecision:
     """Whether the GNSS-IMU offset is taken off the fixes (``auto``: ``gnss_latency_s: auto``): the turn-rate
     estimate ``est`` checked against the reference's lag ``lag`` (:class:`bgfn.data.reference_check.Lag`, or None
     without a usable reference).
 
-    The two must agree (within ``clock_agreement_s`` or ``clock_sigmas`` of their combined std: the turn rates say
-    that the reference shares the IMU's clock); their inverse-variance mean is then applied when it is significant
-    (beyond ``clock_sigmas`` of its std and ``clock_floor_s``), a latency the key takes when typed (0 to
+    The two must agree (within :data:`CLOCK_AGREEMENT_S` or :data:`CLOCK_SIGMAS` of their combined std: the turn
+    rates say that the reference shares the IMU's clock); their inverse-variance mean is then applied when it is significant
+    (beyond :data:`CLOCK_SIGMAS` of its std and :data:`CLOCK_FLOOR_S`), a latency the key takes when typed (0 to
     :data:`~bgfn.data.csv_meta.MAX_TIME_SHIFT_S`) and does not widen the fixes' along-track spread against the
     reference (``rms_at(shift)``, m). Then the offset left (the lag's, else the turn rates' where no lag
     contradicts them) beyond :data:`TOLERANCE_S` is ``gross_s``: the loader's error.
     """
-    o = {**RULE_DEFAULTS, **(options or {})}
     c, sc = est.offset_s, est.std_s
     has_lag = lag is not None and lag.estimable and np.isfinite(lag.std_s)
     r, sr = (lag.lag_s, lag.std_s) if has_lag else (float("nan"), float("nan"))
-    agree = has_lag and np.isfinite(c) and abs(c - r) <= max(o["clock_agreement_s"],
-                                                            o["clock_sigmas"] * float(np.hypot(sc, sr)))
+    agree = has_lag and np.isfinite(c) and abs(c - r) <= max(CLOCK_AGREEMENT_S, CLOCK_SIGMAS * float(np.hypot(sc, sr)))
     both, both_std = float("nan"), float("nan")
     if agree and np.isfinite(sc):              # the two methods' inverse-variance mean
         w_c, w_r = 1.0 / sc ** 2, 1.0 / sr ** 2
@@ -238,7 +235,7 @@ def decide_clock(est: OffsetEstimate, lag, auto: bool, rms_at: Callable[[float],
         status = "unconfirmed"
     elif not agree:
         status = "disagrees"
-    elif not _significant(both, both_std, o):
+    elif not _significant(both, both_std):
         status = "not_significant"
     elif both < 0 or both > MAX_TIME_SHIFT_S:
         status = "refused_by_key"
@@ -249,11 +246,11 @@ def decide_clock(est: OffsetEstimate, lag, auto: bool, rms_at: Callable[[float],
     gross, method = float("nan"), None
     # a lag beyond the tolerance counts when significant, or (too few blocks for a std) when it removes most of
     # the fixes' along-track spread: an 18 s offset on a minute of driving
-    clear = lag is not None and lag.estimable and (_significant(lag.lag_s, lag.std_s, o) or
+    clear = lag is not None and lag.estimable and (_significant(lag.lag_s, lag.std_s) or
                                                    lag.rms_at_lag_m < GROSS_SPREAD_RATIO * lag.rms_m)
     if clear and abs(lag.lag_s - applied) > TOLERANCE_S:
         gross, method = lag.lag_s - applied, "reference"
-    elif (np.isfinite(c) and abs(c - applied) > TOLERANCE_S and _significant(c, sc, o) and (agree or not has_lag)):
+    elif (np.isfinite(c) and abs(c - applied) > TOLERANCE_S and _significant(c, sc) and (agree or not has_lag)):
         gross, method = c - applied, "turn_rate"
     return ClockDecision(status, float(applied), c, sc, est.correlation, est.fixes,
                          r if lag is None else lag.lag_s, sr if lag is None else lag.std_s,

@@ -45,7 +45,7 @@ def reference_lines(name: str, checks: dict) -> list[str]:
     out = []
     if ref["equals_gnss"]:
         out.append(f"{name}: the reference equals the GNSS fixes (every fix within millimetres, "
-                   "data.reference_check.equal_tolerance_m): an error against it measures how closely a solution "
+                   "bgfn.data.reference_check.EQUAL_TOLERANCE_M): an error against it measures how closely a solution "
                    "follows the fixes, not its accuracy")
     elif ref["along_median_m"] is None:
         out.append(f"{name}: fixes against the reference: too few moving fixes ({ref['fixes']}) to compare")
@@ -91,5 +91,5 @@ def reference_warning(name: str, checks: dict) -> str | None:
     lag = f" (a lag of {_pm(ref['lag_s'], ref['lag_std_s'])} explains it)" if ref["cause"] == "latency" else ""
     return (f"{name}: the GNSS fixes sit {ref['along_median_m']:+.1f} m along and {ref['cross_median_m']:+.1f} m "
             f"across the track from the reference (median; tolerance {ref['tolerance_m']:g} m, "
-            f"data.reference_check.offset_tolerance_m): likely {CAUSE_WORDS[ref['cause']]}{lag}. Errors against "
+            f"data.reference_tolerance_m): likely {CAUSE_WORDS[ref['cause']]}{lag}. Errors against "
             "this reference include that offset.")

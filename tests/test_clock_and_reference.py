@@ -216,3 +216,27 @@ def test_the_shipped_real_drive_matches_its_reference_and_its_clock_is_left_alon
     o = load_drive(folder).meta["gnss_offset"]
     assert o["status"] != "applied" or abs(o["applied_s"]) < 0.05
     assert abs(o["reference_lag_s"]) < 0.05
+
+
+def test_fixes_off_the_reference_draw_one_warning_naming_the_likely_cause(tmp_path):
+    """0.45 s late (a typed latency of 0; within the load's 0.5 s) puts the fixes about 3.6 m behind: a latency; a
+    lever arm 5 m off puts them 5 m ahead whatever the speed: a lever arm or a datum. The words come from report."""
+    from bgfn.report.data_checks import reference_lines, reference_warning
+
+    late = load_drive(_clock_log(tmp_path / "late", 0.45, auto=False))
+    checks = rc.drive_checks(late)
+    assert checks["reference"]["cause"] == "latency" and checks["reference"]["along_median_m"] < -3.0
+    assert abs(checks["reference"]["lag_s"] - 0.45) <= 3 * checks["reference"]["lag_std_s"] + 0.01
+    text = reference_warning("late", checks)
+    assert "clock offset" in text and "gnss_latency_s" in text
+    assert rc.drive_checks(late, tolerance_m=5.0)["reference"]["cause"] is None        # the profile's tolerance
+    folder = _clock_log(tmp_path / "lever", 0.0, auto=False)
+    _set_meta(folder, lever_arm_m=[LEVER[0] - 5.0, LEVER[1], LEVER[2]])
+    lever = load_drive(folder)
+    checks = rc.drive_checks(lever)
+    assert checks["reference"]["cause"] == "lever_arm_or_datum"
+    assert checks["reference"]["along_median_m"] == pytest.approx(5.0, abs=0.2)
+    assert "lever_arm_m" in reference_warning("lever", checks)
+    lines = reference_lines("lever", checks)          # the offsets, then the attitude (checked, still usable)
+    assert f"along track median {checks['reference']['along_median_m']:+.2f} m" in lines[0]
+    assert "used as the filter's initial attitude" in lines[1]

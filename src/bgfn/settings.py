@@ -97,6 +97,7 @@ class Data(Section):
     t_end: float | None = _f(None, "end of that crop, s")
     imu_plot_start_tow: float | None = _f(138840.0, "notebook 01's IMU plot starts here, s GPS time of week")
     imu_plot_duration_s: Pos = _f(20.0, "and lasts this long, s")
+    reference_tolerance_m: Pos = _f(3.0, "fixes off the reference by a median beyond this: a warning, m")
 
 
 class Init(Section):
@@ -110,7 +111,7 @@ class Init(Section):
 class Alignment(Section):
     """Where the filter starts (bgfn.nav.alignment): reference | gnss (self-alignment) | auto."""
 
-    mode: Literal["reference", "gnss", "auto"] = _f("auto", "auto: the reference when the drive has an attitude")
+    mode: Literal["reference", "gnss", "auto"] = _f("auto", "auto: the reference's attitude when it passes its check")
     speed_threshold_mps: Pos = _f(3.0, "the heading needs the GNSS course above this horizontal speed, m/s")
     heading_time_s: Pos = _f(10.0, "... for this long, s")
     level_time_s: Pos = _f(5.0, "a drive that starts moving: level from f - dv/dt over this span, s")
@@ -121,6 +122,7 @@ class Alignment(Section):
     level_std_deg: Pos = _f(1.0, "P0 floor of the aligned roll and pitch, deg")
     azimuth_std_deg: Pos = _f(2.0, "P0 floor of the aligned heading, deg")
     velocity_std_mps: Pos = _f(0.2, "P0 floor of the aligned velocity, m/s")
+    reference_tolerance_deg: Pos = _f(10.0, "auto: reference yaw vs course, level vs the IMU's at rest within, deg")
 
 
 class NoiseSearch(Section):

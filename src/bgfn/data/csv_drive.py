@@ -39,7 +39,8 @@ from bgfn.data.names import safe_id
 from bgfn.data.navego import check_time
 from bgfn.data.physics import check_drive
 from bgfn.data.regrid import check_gaps, imu_on_grid, interpolate_reference, median_rate_hz, regular_fix_times
-from bgfn.data.time_offset import TOLERANCE_S, estimate_gnss_offset
+from bgfn.data.reference_check import along_rms, check_reference, reference_equals_gnss, reference_lag
+from bgfn.data.time_offset import TOLERANCE_S, decide_clock, estimate_gnss_offset
 from bgfn.errors import DataError
 from bgfn.io import atomic_write_csv, atomic_write_text
 from bgfn.nav.transform import dcm_from_euler
@@ -142,30 +143,30 @@ def _gnss_std(gnss: pd.DataFrame, path: Path, header: list[str], default, meta_p
     return gnss
 
 
-def _on_imu_clock(imu: pd.DataFrame, gnss: pd.DataFrame, auto: bool, files: dict, meta_path: Path) -> tuple:
-    """The fixes (already shifted by a stated latency) shifted by the estimated offset when ``auto``, then the offset
-    left between them and the IMU estimated (:func:`bgfn.data.time_offset.estimate_gnss_offset`); one error naming
-    both files when it exceeds :data:`~bgfn.data.time_offset.TOLERANCE_S`. Returns the fixes and the facts
-    (``meta["gnss_offset"]``)."""
-    applied = 0.0
-    if auto:
-        est = estimate_gnss_offset(imu, gnss)
-        if not est.estimable:
-            raise DataError(meta_path, "gnss_latency_s", "auto: an offset the data can show (turns while moving, "
-                            "seen by the gyros and the GNSS course); give the latency in seconds instead", est.line())
-        applied = est.offset_s
-    gnss = gnss.assign(time=gnss["time"] - applied)
+def _on_imu_clock(imu: pd.DataFrame, gnss: pd.DataFrame, reference: pd.DataFrame, lever_arm_m, auto: bool,
+                  files: dict, meta_path: Path) -> tuple:
+    """The fixes (already shifted by a stated latency) on the IMU's clock: the offset the turn rates show
+    (:func:`bgfn.data.time_offset.estimate_gnss_offset`) checked against the reference's lag
+    (:func:`bgfn.data.reference_check.reference_lag`) and taken off only when ``auto`` and the rule of
+    :func:`bgfn.data.time_offset.decide_clock` holds; one error naming both files when an offset beyond
+    :data:`~bgfn.data.time_offset.TOLERANCE_S` is left. A reference that is the GNSS itself says nothing of the clock.
+    Returns the fixes and the facts (``meta["gnss_offset"]``)."""
     est = estimate_gnss_offset(imu, gnss)
-    if est.estimable and abs(est.offset_s) > TOLERANCE_S:
-        leap = " -- GNSS in UTC against an IMU in GPS time (18 s apart)?" if abs(abs(est.offset_s) - 18.0) < 1.5 else ""
+    lag = None if reference_equals_gnss(reference, gnss, lever_arm_m) else \
+        reference_lag(reference, gnss, lever_arm_m)
+    decision = decide_clock(est, lag, auto, lambda shift: along_rms(reference, gnss, lever_arm_m, shift))
+    if np.isfinite(decision.gross_s):
+        leap = " -- GNSS in UTC against an IMU in GPS time (18 s apart)?" if abs(abs(decision.gross_s) - 18.0) < 1.5 \
+            else ""
+        how = ("the fixes' along-track offsets against reference.csv follow the speed" if decision.gross_method ==
+               "reference" else f"the turn rates of both correlate {est.correlation:.2f} at that lag")
         raise DataError(files["gnss"], "time", f"fixes on the clock of {files['imu']} within {TOLERANCE_S:g} s "
                         f"(a known delay: gnss_latency_s or imu_time_offset_s in {meta_path})",
-                        f"stamps {est.offset_s:+.2f} s late against the IMU's (the turn rates of both correlate "
-                        f"{est.correlation:.2f} at that lag){leap}")
-    line = (f"GNSS latency {applied:.2f} s estimated and taken off (gnss_latency_s: auto); left after it: "
-            f"{est.line()}" if auto else est.line())
-    return gnss, {"applied_latency_s": float(applied), "residual_s": est.offset_s, "correlation": est.correlation,
-                  "fixes": est.fixes, "line": line}
+                        f"stamps {decision.gross_s:+.2f} s late ({how}){leap}")
+    gnss = gnss.assign(time=gnss["time"] - decision.applied_s)
+    line = (f"GNSS latency {decision.applied_s:.2f} s taken off (gnss_latency_s: auto, {decision.status}); "
+            f"estimated: {est.line()}" if auto else est.line())
+    return gnss, {**decision.record(), "applied_latency_s": decision.applied_s, "line": line}
 
 
 def rotate_imu(imu: pd.DataFrame, mounting_deg) -> pd.DataFrame:
@@ -186,7 +187,7 @@ def _header(path: Path) -> list[str]:
 
 
 def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_start: float | None = None,
-                   t_end: float | None = None) -> Drive:
+                   t_end: float | None = None, reference_tolerance_m: float | None = None) -> Drive:
     """Load a drive from a folder in the CSV schema of the module docstring.
 
     Parameters
@@ -198,6 +199,8 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_st
         :func:`bgfn.data.navego.resample_imu`); default: the log's median rate (a regular log is kept as is).
     t_start, t_end : float, optional
         Keep only this span, s (on the files' time base).
+    reference_tolerance_m : float, optional
+        The profile's ``data.reference_tolerance_m`` (:func:`bgfn.data.reference_check.check_reference`).
 
     Returns
     -------
@@ -228,10 +231,6 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_st
     gnss = gnss.assign(time=gnss["time"] - (0.0 if latency == "auto" else latency))
     # units and axes on the files' own rows, so that each message names the CSV file, column and data row
     check_drive(Drive(str(folder), raw["reference"], raw["imu"], gnss), {t: str(p) for t, p in files.items()})
-    # then the clocks, on plausible data: a unit mistake is not blamed on a clock offset
-    gnss, offset = _on_imu_clock(raw["imu"], gnss, latency == "auto", files, meta_path)
-    fix_times, fix_shift = regular_fix_times(gnss["time"].to_numpy(float), files["gnss"])   # arrival jitter
-    gnss = gnss.assign(time=fix_times)
     for table in ("imu", "reference"):
         check_gaps(raw[table]["time"].to_numpy(float), files[table])
     t_imu, t_ref = raw["imu"]["time"].to_numpy(float), raw["reference"]["time"].to_numpy(float)
@@ -250,8 +249,14 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_st
     if np.any(user["reference_lever_arm_m"]):       # a reference given at another point (an RTK antenna): to the IMU
         lat, lon, h = imu_position(reference, user["reference_lever_arm_m"])
         reference = reference.assign(lat=lat, lon=lon, h=h)
+    # then the clocks, on plausible data (a unit mistake is not blamed on a clock offset), against the reference
+    gnss, offset = _on_imu_clock(raw["imu"], gnss, reference, user["lever_arm_m"], latency == "auto", files,
+                                 meta_path)
+    fix_times, fix_shift = regular_fix_times(gnss["time"].to_numpy(float), files["gnss"])   # arrival jitter
+    gnss = gnss.assign(time=fix_times)
     tg = gnss["time"].to_numpy(float)
     gnss = gnss.loc[(tg >= epochs[0]) & (tg <= epochs[-1])].reset_index(drop=True)
+    checked = check_reference(reference, gnss, user["lever_arm_m"], reference_tolerance_m)
     meta = {
         "imu_rate_hz": rate,
         "native_imu_rate_hz": native,
@@ -266,6 +271,8 @@ def load_csv_drive(folder: str | Path, *, imu_rate_hz: float | None = None, t_st
         "platform": user["platform"],
         "time_shifts_s": {"imu_time_offset_s": user["imu_time_offset_s"], "gnss_latency_s": user["gnss_latency_s"]},
         "gnss_offset": offset,
+        "reference_check": checked.record(),
+        "reference_equals_gnss": checked.equals_gnss,
         "gnss_regridded_max_s": fix_shift,
         "imu_mounting_deg": user["imu_mounting_deg"],
         "reference_lever_arm_m": user["reference_lever_arm_m"],

@@ -5,7 +5,7 @@ antenna's ``lever_arm_m``, the ``source``, the ``imu_errors`` the filter uses (l
 default :data:`DEFAULT_IMU_PROFILE`: the consumer-MEMS :data:`bgfn.data.imu_errors.MPU6000`, the grade of the
 paper's field-test IMU), the ``platform`` (which aids run, :data:`bgfn.nav.constraints.PLATFORM_AIDS`), the IMU's
 ``imu_mounting_deg`` and ``imu_time_offset_s``, the fixes' ``gnss_latency_s`` (a number, or ``auto``: estimated,
-:mod:`bgfn.data.time_offset`) and ``gnss_std_m``, and the reference's ``reference_lever_arm_m``. An unknown key, at
+applied only when :func:`bgfn.data.time_offset.decide_clock` holds) and ``gnss_std_m``, and the reference's ``reference_lever_arm_m``. An unknown key, at
 the top level or inside ``imu_errors``, is a :class:`bgfn.errors.DataError` naming the file, the key and the closest
 valid key: a misspelt noise density never silently becomes a default.
 """

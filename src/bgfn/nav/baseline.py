@@ -28,6 +28,7 @@ from .error_model import PHI_D, STATE_NAMES
 from .filter import FilterResult, run_filter, run_outage
 from .gnss_aid import gate_thresholds
 from .outages import check_windows, epochs_before
+from .reference_attitude import check_attitude
 from .state import FilterNoise, FilterState, initial_covariance, initial_state, noise_from_imu_errors, save_states
 from .tuning import NOISE_SEARCH_DEFAULTS, NoiseTuning, search_noise_scale
 
@@ -143,6 +144,9 @@ class FilterSetup:
         The self-alignment (:mod:`bgfn.nav.alignment`); None when the filter starts from the reference.
     tuning : NoiseTuning or None
         The noise search (:mod:`bgfn.nav.tuning`); None when ``noise_scale`` is a number.
+    reference_attitude : dict or None
+        The check of the reference's attitude (:func:`bgfn.nav.reference_attitude.check_attitude`; not ``usable``:
+        ``auto`` aligned itself instead); None without a reference attitude.
     """
 
     initial: FilterState
@@ -150,11 +154,13 @@ class FilterSetup:
     noise_scale: float
     alignment: Alignment | None = None
     tuning: NoiseTuning | None = None
+    reference_attitude: dict | None = None
 
     def record(self) -> dict:
         """JSON-ready record (``kf_baseline.json``)."""
         a = self.alignment
         return {"start_time": float(self.initial.time), "noise_scale": float(self.noise_scale),
+                "reference_attitude": self.reference_attitude,
                 "noise_tuning": self.tuning.record() if self.tuning is not None else None,
                 "alignment": None if a is None else {
                     "time": float(a.state.time), "gnss_time": a.gnss_time, "roll_deg": float(np.degrees(a.roll)),
@@ -185,13 +191,21 @@ def _noise(drive, cfg: dict, scale: float) -> FilterNoise:
     return noise_from_imu_errors(errors, cfg["bias_model"], scale, source=source, bias_walk_scale=walk)
 
 
-def _initial(drive, cfg: dict, noise: FilterNoise) -> tuple[FilterState, Alignment | None]:
-    """The state the filter starts from (``nav.alignment.mode``) and the self-alignment when it ran."""
+def reference_attitude(drive, cfg: dict) -> dict | None:
+    """:func:`bgfn.nav.reference_attitude.check_attitude` of the drive's reference under ``nav.alignment`` (None:
+    the reference has no attitude)."""
+    return check_attitude(drive.reference, drive.imu, cfg["alignment"]) if _has_attitude(drive) else None
+
+
+def _initial(drive, cfg: dict, noise: FilterNoise, attitude: dict | None) -> tuple[FilterState, Alignment | None]:
+    """The state the filter starts from (``nav.alignment.mode``) and the self-alignment when it ran; ``auto`` aligns
+    itself when the reference's attitude fails its check (:mod:`bgfn.nav.reference_attitude`)."""
     mode = cfg["alignment"]["mode"]
     if mode == "reference" and not _has_attitude(drive):
         raise DataError(drive.name, "nav.alignment.mode", "'gnss' or 'auto' for a drive without a reference "
                         "attitude (roll, pitch, yaw all finite)", "'reference'")
-    if mode == "gnss" or (mode == "auto" and not _has_attitude(drive)):
+    refused = mode == "auto" and attitude is not None and not attitude["usable"]
+    if mode == "gnss" or (mode == "auto" and not _has_attitude(drive)) or refused:
         options = {k: v for k, v in cfg["alignment"].items() if k != "mode"}
         a = align(filter_imu(drive, cfg), drive.gnss, _lever(drive), noise, options, source=drive.name)
         initial, alignment = a.state, a
@@ -229,9 +243,10 @@ def prepare_filter(drive, cfg: dict) -> FilterSetup:
     scale = noise_scale_of(cfg, drive.name)
     auto = scale == AUTO
     noise = _noise(drive, cfg, 1.0 if auto else scale)
-    initial, alignment = _initial(drive, cfg, noise)
+    attitude = reference_attitude(drive, cfg)
+    initial, alignment = _initial(drive, cfg, noise, attitude)
     if not auto:
-        return FilterSetup(initial, noise, float(scale), alignment)
+        return FilterSetup(initial, noise, float(scale), alignment, reference_attitude=attitude)
 
     def mean_nis(scale: float) -> tuple[float, float]:
         run = run_filter(filter_imu(drive, cfg), initial, _noise(drive, cfg, scale), drive.gnss, _lever(drive),
@@ -242,7 +257,7 @@ def prepare_filter(drive, cfg: dict) -> FilterSetup:
         return s["mean_nis"], s["dof"]
 
     tuning = search_noise_scale(mean_nis, cfg["noise_search"])
-    return FilterSetup(initial, _noise(drive, cfg, tuning.scale), tuning.scale, alignment, tuning)
+    return FilterSetup(initial, _noise(drive, cfg, tuning.scale), tuning.scale, alignment, tuning, attitude)
 
 
 def initial_and_noise(drive, cfg: dict) -> tuple[FilterState, FilterNoise]:
@@ -280,10 +295,10 @@ def filter_start(drive, section: dict | None) -> float:
     """Time the filter of ``drive`` starts at with a profile's ``nav:`` section, s: the reference's first row, or
     the self-alignment's epoch. Cheap (no filter run): for the checks of outage windows and sweep starts."""
     cfg = nav_config(section)
-    mode = cfg["alignment"]["mode"]
-    if mode == "reference" or (mode == "auto" and _has_attitude(drive)):
+    mode, attitude = cfg["alignment"]["mode"], reference_attitude(drive, cfg)
+    if mode == "reference" or (mode == "auto" and attitude is not None and attitude["usable"]):
         return float(drive.reference["time"].iloc[0])
-    initial, _ = _initial(drive, cfg, _noise(drive, {**cfg, "noise_scale": 1.0}, 1.0))
+    initial, _ = _initial(drive, cfg, _noise(drive, {**cfg, "noise_scale": 1.0}, 1.0), attitude)
     return float(initial.time)
 
 
@@ -311,6 +326,9 @@ class Baseline:
     noise : FilterNoise
     constraints : dict
         :meth:`bgfn.nav.constraints.Constraints.summary` of the ``INS+NHC`` runs' constraints.
+    reference_equals_gnss : bool
+        The drive's reference is its GNSS (``meta["reference_equals_gnss"]``, :mod:`bgfn.data.reference_check`):
+        the errors against it are no accuracy.
     """
 
     drive_name: str
@@ -323,6 +341,7 @@ class Baseline:
     noise: FilterNoise
     setup: FilterSetup | None = None
     constraints: dict | None = None
+    reference_equals_gnss: bool = False
 
 
 def run_baseline(drive, cfg: dict, windows) -> Baseline:
@@ -369,7 +388,7 @@ def run_baseline(drive, cfg: dict, windows) -> Baseline:
         outage_errors[n] = pd.concat(parts, ignore_index=True)
     table = pd.DataFrame(rows).sort_values("method", key=lambda m: m != "INS", kind="stable").reset_index(drop=True)
     return Baseline(drive.name, full, errors, metrics.rms_table(errors), full.states, outage_errors, table, noise,
-                    setup, aids.summary())
+                    setup, aids.summary(), bool(drive.meta.get("reference_equals_gnss", False)))
 
 
 def ins_layout(outage_table: pd.DataFrame, dataset: str | None = None) -> pd.DataFrame:
@@ -449,6 +468,7 @@ def save_baseline(b: Baseline, out, file_id: str, lat=None) -> dict:
             "mean_nis": float(upd["nis"].mean()) if len(upd) else None,
             "mean_nis_dof": float(upd["dof"].mean()) if len(upd) else None,
             "nis_verdict": nis_summary(upd)["verdict"], "constraints": b.constraints,
+            "reference_equals_gnss": b.reference_equals_gnss,
             "states_file": f"nav_states_{d}.npz", **(b.setup.record() if b.setup is not None else {})}
 
 

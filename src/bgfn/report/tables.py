@@ -144,18 +144,28 @@ def energy_table(energy: dict | None, claims: dict) -> pd.DataFrame:
                         index=list(rows), columns=["ours", "paper"])
 
 
+#: What a GPS-aided error is measured against (``kf_table``'s ``reference`` column): a reference independent of the
+#: fixes, or the fixes themselves (its RMS then measures how closely the filter follows them, no accuracy).
+REFERENCE_KINDS = {False: "independent", True: "the GNSS itself"}
+
+
 def kf_table(kf: dict | None) -> pd.DataFrame | None:
-    """Full-drive GPS/INS filter errors per dataset (``kf_baseline.json``): updates, NIS, RMS position/attitude."""
+    """Full-drive GPS/INS filter errors per dataset (``kf_baseline.json``): updates, NIS, RMS position/attitude, and
+    what the reference is (:data:`REFERENCE_KINDS`); against a reference that is the GNSS the position RMS is left
+    empty."""
     if not kf:
         return None
     rows = []
     for name, d in kf.get("datasets", {}).items():
-        rms = d.get("rms", {})
+        same = bool(d.get("reference_equals_gnss", False))
+        rms = {k: v for k, v in d.get("rms", {}).items() if not same or k not in ("north", "east", "down",
+                                                                                   "horizontal")}
         rows.append({"dataset": name, "GNSS updates": d.get("gnss_updates"),
                      "mean NIS": d.get("mean_nis"), "NIS dof": d.get("mean_nis_dof"),
-                     "RMS north (m)": rms.get("north"), "RMS east (m)": rms.get("east"),
-                     "RMS down (m)": rms.get("down"), "RMS horizontal (m)": rms.get("horizontal"),
-                     "RMS yaw (deg)": math.degrees(rms["yaw"]) if rms.get("yaw") is not None else np.nan})
+                     "RMS north (m)": rms.get("north", np.nan), "RMS east (m)": rms.get("east", np.nan),
+                     "RMS down (m)": rms.get("down", np.nan), "RMS horizontal (m)": rms.get("horizontal", np.nan),
+                     "RMS yaw (deg)": math.degrees(rms["yaw"]) if rms.get("yaw") is not None else np.nan,
+                     "reference": REFERENCE_KINDS[same]})
     return pd.DataFrame(rows).set_index("dataset")
 
 

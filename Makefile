@@ -23,6 +23,22 @@ ifneq ($(words $(CURDIR) $(MAKEFILE_LIST)),2)
 $(error the path "$(CURDIR)" or "$(MAKEFILE_LIST)" contains a space; make cannot handle it -- move or clone the repository to a path without spaces)
 endif
 
+# A profile is a plain name (params/<name>.yaml): letters, digits, '.', '_' or '-', not starting with '.' or '-'.
+# It is checked here, by make's own functions, before any shell, recipe or sub-make sees it: its raw text
+# ($(value ...): a command-line variable is make code, and expanding it could run a $(shell ...)) with every
+# allowed character removed must leave nothing. Anything else (a path, a quote, `;`, `|`, `$`) is refused.
+PROFILE ?= quick
+NAME_CHARS := a b c d e f g h i j k l m n o p q r s t u v w x y z A B C D E F G H I J K L M N O P Q R S T U V W X Y Z \
+              0 1 2 3 4 5 6 7 8 9 _ . -
+drop_chars = $(if $(2),$(call drop_chars,$(subst $(firstword $(2)),,$(1)),$(wordlist 2,99,$(2))),$(1))
+is_name = $(if $(and $(filter 1,$(words $(1))),$(filter-out -% .%,$(1))),$(if $(call drop_chars,$(1),$(NAME_CHARS)),,ok))
+ifeq ($(call is_name,$(value PROFILE)),)
+$(error PROFILE "$(value PROFILE)" is not a profile name: expected letters, digits, '.', '_' or '-' (not first: '.' or '-') naming params/<name>.yaml)
+endif
+# JOBS and DASK_SCHEDULER reach Python (which checks them) as environment values, never as make code.
+override JOBS := $(value JOBS)
+override DASK_SCHEDULER := $(value DASK_SCHEDULER)
+
 # Every path below is relative to the repository root. `make -f <root>/Makefile` from elsewhere re-runs make
 # there (`make -C <root>` needs nothing: make changes directory first).
 ROOT := $(patsubst %/,%,$(dir $(abspath $(lastword $(MAKEFILE_LIST)))))
@@ -33,7 +49,6 @@ $(or $(MAKECMDGOALS),help):
 else
 
 
-PROFILE ?= quick
 VENV ?= .venv
 # Interpreter that creates the venv (the project pins Python 3.11).
 PYTHON ?= $(shell command -v python3.11 2>/dev/null || command -v python3)
@@ -64,11 +79,12 @@ STAMP := $(VENV)/.installed-$(LOCK_HASH)
 # The paper's five steps, the studies beyond it, own logs, the results page last.
 NOTEBOOKS := 01_data_prep 02_kf_baseline 03_bgfn_training 04_outage_evaluation 05_energy_estimate \
              06_outage_sweep 07_learned_odometer 08_ins_fidelity 09_own_logs 10_results
-# A profile's notebooks also depend on the profile(s) it builds on (`base:` in its YAML; two levels followed).
-base_of = $(shell sed -n 's/^base:[[:space:]]*\([A-Za-z0-9_.-]*\).*/\1/p' params/$(1).yaml 2>/dev/null)
-BASE1 := $(call base_of,$(PROFILE))
-BASE2 := $(if $(BASE1),$(call base_of,$(BASE1)))
-PARAMS := params/$(PROFILE).yaml $(BASE1:%=params/%.yaml) $(BASE2:%=params/%.yaml)
+# A profile's notebooks also depend on the profiles it builds on (`base:` in its YAML), followed to any depth until a
+# profile has no base or one already seen; each base name is checked as PROFILE is before it names a file to read.
+base_of = $(shell sed -n 's/^base:[[:space:]]*\([^[:space:]#]*\).*/\1/p' 'params/$(1).yaml' 2>/dev/null | tr -d "\"'")
+chain_of = $(if $(filter $(1),$(2)),,$(1) $(call bases_of,$(call base_of,$(1)),$(2) $(1)))
+bases_of = $(if $(1),$(if $(call is_name,$(1)),$(call chain_of,$(1),$(2)),$(error profile '$(PROFILE)': `base: $(1)` in params/$(lastword $(2)).yaml is not a profile name: expected letters, digits, '.', '_' or '-')))
+PARAMS := $(patsubst %,params/%.yaml,$(call chain_of,$(PROFILE)))
 RES := results/$(PROFILE)
 EXEC := $(NOTEBOOKS:%=$(RES)/notebooks/%.ipynb)
 SRC := $(shell find src/bgfn -name '*.py' -not -path '*/__pycache__/*' | sort)
@@ -96,11 +112,6 @@ export DASK_SCHEDULER
 KERNEL_CONFIG := $(VENV)/etc/ipython/ipython_kernel_config.py
 
 .PHONY: FORCE help reproduce notebooks _reproduce _notebooks navego-check book test bench clean clean-debris distclean venv data lock strip
-
-# A profile is a plain name (params/<name>.yaml); anything with a path in it would write outside results/.
-ifneq ($(shell printf '%s' '$(PROFILE)' | grep -Ex '[A-Za-z0-9][A-Za-z0-9_-]*'),$(PROFILE))
-$(error PROFILE '$(PROFILE)' is not a profile name: expected letters, digits, '_' or '-' naming params/<name>.yaml)
-endif
 
 ifneq ($(filter reproduce notebooks book,$(MAKECMDGOALS)),)
 ifeq ($(wildcard params/$(PROFILE).yaml),)

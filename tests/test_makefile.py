@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import fcntl
+import os
 import shutil
 import subprocess
 
@@ -92,3 +93,43 @@ def test_a_second_run_of_the_same_profile_refuses_at_once_naming_the_first(tmp_p
     assert res.returncode != 0 and "already running (PID 4242" in res.stderr
     assert live.exists()                                        # its live files are not cleaned as debris
     assert not (repo / ".venv").exists()                        # refused before anything was made
+
+
+#: PROFILE values that would run a command if a shell (or make's own $(shell ...)) ever expanded them.
+PAYLOADS = ["a||touch pwned", "`touch pwned`", "x'; touch pwned2; echo '", "$(touch pwned)", "$(shell touch pwned)",
+            "a;touch pwned", "a b", "-rf", "a\ntouch pwned", '"; touch pwned; "']
+
+
+@pytest.mark.parametrize("goal", [["-n", "reproduce"], ["help"], ["book"]])
+@pytest.mark.parametrize("payload", PAYLOADS)
+def test_a_profile_with_shell_metacharacters_runs_nothing_and_is_one_error(tmp_path, payload, goal):
+    repo = _checkout(tmp_path)
+    before = sorted(p.relative_to(repo) for p in repo.rglob("*"))
+    for how in ("command line", "environment"):
+        env = {**os.environ, "PROFILE": payload} if how == "environment" else None
+        res = subprocess.run(["make", "--no-print-directory", *goal, *([] if env else [f"PROFILE={payload}"])],
+                             cwd=repo, capture_output=True, text=True, timeout=60, env=env)
+        assert res.returncode != 0, (how, res.stdout)
+        assert res.stderr.count("is not a profile name") == 1 and res.stdout == "", (how, res.stderr)
+        assert sorted(p.relative_to(repo) for p in repo.rglob("*")) == before, how     # nothing created
+        assert not (PROJECT_ROOT / "pwned").exists() and not (tmp_path / "pwned").exists()
+
+
+def test_a_base_chain_is_followed_to_any_depth_and_a_bad_base_name_runs_nothing(tmp_path):
+    repo = _checkout(tmp_path)
+    (repo / "params" / "c.yaml").write_text("base: smoke   # three levels down to quick\n")
+    (repo / "params" / "d.yaml").write_text("base: 'c'\n")
+    res = _make("-p", "-n", "help", "PROFILE=d", cwd=repo)
+    assert "PARAMS := params/d.yaml params/c.yaml params/smoke.yaml params/quick.yaml" in res.stdout, res.stderr
+    (repo / "params" / "e.yaml").write_text("base: x';touch${IFS}pwned;'\n")
+    res = _make("-n", "reproduce", "PROFILE=e", cwd=repo)
+    assert res.returncode != 0 and "in params/e.yaml is not a profile name" in res.stderr
+    assert not (repo / "pwned").exists()
+    (repo / "params" / "f.yaml").write_text("base: f\n")         # a loop ends (the profile check names it)
+    assert _make("-n", "help", "PROFILE=f", cwd=repo).returncode == 0
+
+
+def test_jobs_and_the_scheduler_reach_python_as_text_never_as_make_code(tmp_path):
+    repo = _checkout(tmp_path)
+    res = _make("-n", "help", "JOBS=$(shell touch pwned)", "DASK_SCHEDULER=$(shell touch pwned)", cwd=repo)
+    assert res.returncode == 0 and not (repo / "pwned").exists()

@@ -156,7 +156,7 @@ VARIANT_RUN_KEYS = ("datasets", "methods", "seeds")
 #: Subfolders of ``results/<profile>/``.
 RESULT_SUBDIRS: tuple[str, ...] = ("tables", "figures", "notebooks", "models")
 
-_NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]*$")
+_NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")   # as the Makefile checks PROFILE
 
 #: Distributions whose versions are recorded in :func:`run_metadata`.
 _PACKAGES: tuple[str, ...] = (
@@ -165,8 +165,8 @@ _PACKAGES: tuple[str, ...] = (
 
 
 def _check_name(profile: str) -> str:
-    if not isinstance(profile, str) or not _NAME_RE.match(profile):
-        raise DataError(PARAMS_DIR, "profile", "a profile name of letters, digits, '_' or '-' "
+    if not isinstance(profile, str) or not _NAME_RE.fullmatch(profile):   # fullmatch: no "name\n"
+        raise DataError(PARAMS_DIR, "profile", "a profile name of letters, digits, '.', '_' or '-' "
                         f"(one of {', '.join(PROFILES)} or params/<name>.yaml)", repr(profile))
     return profile
 

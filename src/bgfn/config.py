@@ -193,9 +193,20 @@ def merge_sections(base: dict, override: dict) -> dict:
     return out
 
 
+#: A profile file is a page of settings: one larger than this is refused before it is parsed (a YAML parser may take
+#: minutes over a huge file).
+MAX_PROFILE_BYTES = 1_000_000
+
+
 def _read_profile_file(path: Path) -> dict:
+    size = path.stat().st_size
+    if size > MAX_PROFILE_BYTES:
+        raise DataError(path, "<file>", f"a profile of at most {MAX_PROFILE_BYTES:,} bytes", f"{size:,} bytes")
     try:
-        cfg = yaml.safe_load(path.read_text(encoding="utf-8"))
+        cfg = yaml.safe_load(path.read_bytes().decode("utf-8"))
+    except UnicodeDecodeError as exc:
+        raise DataError(path, "<file>", "a YAML text file in UTF-8", f"a byte {exc.object[exc.start]:#04x} that is "
+                        f"not UTF-8 at offset {exc.start} (a binary file?)") from None
     except yaml.YAMLError as exc:
         raise DataError(path, "<yaml>", "valid YAML", str(exc).replace("\n", " ")) from exc
     if not isinstance(cfg, dict):

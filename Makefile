@@ -207,12 +207,14 @@ $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(PARAMS) $(SRC) $(STAMP) | data $(K
 # about 40 s on one core. Its output goes to $(RES)/logs/kernels.log; it changes no result, and what it has not
 # cached yet when a notebook needs it is compiled there as before. (A changed src/bgfn file reruns this rule, and
 # numba recompiles the kernels of a changed file.)
+# The kernels start once the check has passed (a refused profile leaves no log behind); they run in the run's
+# process group, without its lock, and end with it (reproduce's recipe).
 $(RES)/.profile-checked: $(PARAMS) $(SRC) $(STAMP) | data
 	@mkdir -p $(@D) $(RES)/logs
-	@echo "==> [$(PROFILE)] numba kernels into the cache, in the background ($(RES)/logs/kernels.log)"
-	@$(PY) -m bgfn kernels --profile $(PROFILE) > $(RES)/logs/kernels.log 2>&1 < /dev/null &
-	@echo "==> [$(PROFILE)] check params/$(PROFILE).yaml"
+	@echo "==> [$(PROFILE)] check params/$(PROFILE).yaml with its drives"
 	@$(PY) -m bgfn.profile_schema $(PROFILE)
+	@echo "==> [$(PROFILE)] numba kernels into the cache, in the background ($(RES)/logs/kernels.log)"
+	@$(PY) -m bgfn kernels --profile $(PROFILE) > $(RES)/logs/kernels.log 2>&1 < /dev/null 9>&- &
 	@touch $@
 $(RES)/notebooks/01_data_prep.ipynb: $(RES)/.profile-checked $(RES)/.data-fingerprint
 
@@ -278,15 +280,33 @@ book: $(STAMP)
 
 # One run per profile at a time: `reproduce` and `notebooks` hold an flock on $(RES)/.lock (which names the
 # holder's PID) for the whole run, so a second run of the same profile refuses at once instead of overwriting
-# the first one's results or cleaning its live files as debris; other profiles run beside it.
+# the first one's results or cleaning its live files as debris; other profiles run beside it. The profile's keys
+# (and JOBS, DASK_SCHEDULER) are checked first, before the lock, the install's updates and the data (with no
+# venv yet: right after making it). The lock is an open file descriptor, held by the run's processes only: a run
+# that ends for any reason releases it, and no dead PID ever blocks (a PID left in the file by a killed run is
+# taken over, said once). The run is a process group of its own (setsid): SIGINT, SIGTERM or SIGHUP of this make,
+# or its end, sends SIGTERM to every process of it (a background job ignores SIGINT), background jobs included (a
+# notebook's kernel ends with papermill, and its pool workers with the kernel: bgfn.parallel.watch_owner).
 LOCK := $(RES)/.lock
+CHECK_KEYS = echo "==> [$(PROFILE)] check params/$(PROFILE).yaml (every key; JOBS, DASK_SCHEDULER)" && \
+  $(if $(DRY),echo )$(PY) -m bgfn.profile_schema --keys $(PROFILE)
+DRY = $(findstring n,$(filter-out --% %=%,$(firstword $(MAKEFLAGS))))
 reproduce notebooks:
+	@if [ -x "$(PY)" ]; then $(CHECK_KEYS); fi
 	@mkdir -p $(RES); exec 9>>"$(LOCK)"; \
-	if ! flock -n 9; then \
-	  echo "error: make $@ PROFILE=$(PROFILE) is already running (PID $$(cat "$(LOCK)" 2>/dev/null || echo unknown)," \
-	       "lock $(LOCK)); wait for it to end or stop it -- two runs of one profile would overwrite each other's results" >&2; \
+	if ! flock -n 9; then pid=$$(cat "$(LOCK)" 2>/dev/null); \
+	  echo "error: make $@ PROFILE=$(PROFILE) is already running (PID $${pid:-unknown}$$(kill -0 "$${pid:-0}" \
+	       2>/dev/null || echo ", ended; a process it started still holds the lock"), lock $(LOCK)); wait for it" \
+	       "to end or stop it -- two runs of one profile would overwrite each other's results" >&2; \
 	  exit 1; fi; \
-	echo $$$$ > "$(LOCK)"; $(MAKE) _$@
+	old=$$(cat "$(LOCK)"); if [ -n "$$old" ]; then echo "    $(LOCK) named PID $$old, a run that was killed" \
+	  "before it could clear it; the lock was free: taken over"; fi; \
+	echo $$$$ > "$(LOCK)"; export BGFN_RUN_LOCK=$$$$; run=0; \
+	trap '[ $$run = 0 ] || kill -TERM -- -$$run 2>/dev/null || true' INT TERM HUP; \
+	trap '[ $$run = 0 ] || kill -TERM -- -$$run 2>/dev/null || true; : > "$(LOCK)"' EXIT; \
+	if [ ! -x "$(PY)" ]; then $(MAKE) venv; $(CHECK_KEYS); fi; \
+	setsid $(MAKE) _$@ & run=$$!; \
+	rc=0; wait $$run || rc=$$?; while kill -0 $$run 2>/dev/null; do wait $$run || rc=$$?; done; exit $$rc
 
 _reproduce: $(BOOK_STAMP)
 	@echo "==> done (PROFILE=$(PROFILE)): results in $(RES)/, book at $(BOOK_HTML)"
@@ -325,10 +345,16 @@ navego-check: $(STAMP)
 
 # ---------------------------------------------------------------- cleaning
 # Debris of an interrupted run of $(PROFILE): papermill's temporary notebooks and half-written outputs
-# (bgfn.io.atomic_path names them .<name>.<random>.tmp<suffix>). It runs inside the profile's lock (reproduce,
-# notebooks) and notebooks run one at a time, so none of them is live.
+# (bgfn.io.atomic_path names them .<name>.<random>.tmp<suffix>). Inside the run that holds the profile's lock
+# (reproduce, notebooks: BGFN_RUN_LOCK names it) notebooks run one at a time, so none of them is live; from
+# anywhere else it takes the lock first, and removes nothing while a run holds it.
 clean-debris:
-	@if [ -d "$(RES)" ]; then find "$(RES)" -type f \( -name '.*.running-*.ipynb' -o -name '.*.tmp*' \) \
+	@if [ -d "$(RES)" ]; then \
+	  if [ -z "$${BGFN_RUN_LOCK:-}" ] || [ "$$BGFN_RUN_LOCK" != "$$(cat "$(LOCK)" 2>/dev/null)" ]; then \
+	    exec 8>>"$(LOCK)"; if ! flock -n 8; then \
+	    echo "clean-debris: a run of $(PROFILE) is live (PID $$(cat "$(LOCK)"), lock $(LOCK)): nothing removed" >&2; \
+	    exit 1; fi; fi; \
+	  find "$(RES)" -type f \( -name '.*.running-*.ipynb' -o -name '.*.tmp*' \) \
 	  -print -delete | sed 's/^/    removed debris of an interrupted run: /'; fi
 
 clean:

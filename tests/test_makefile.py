@@ -133,3 +133,117 @@ def test_jobs_and_the_scheduler_reach_python_as_text_never_as_make_code(tmp_path
     repo = _checkout(tmp_path)
     res = _make("-n", "help", "JOBS=$(shell touch pwned)", "DASK_SCHEDULER=$(shell touch pwned)", cwd=repo)
     assert res.returncode == 0 and not (repo / "pwned").exists()
+
+
+def _alive(pid: int) -> bool:
+    """The process runs (a zombie waiting for its parent to reap it has ended)."""
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            return not any(line.startswith("State:") and "Z" in line.split()[1] for line in f)
+    except OSError:
+        return False
+
+
+def _fake_run(tmp_path, papermill="exec sleep 300", keys="exit 0"):
+    """A checkout whose venv is a stand-in: its python passes every step (``keys``: the profile's key check), starts
+    the kernels job as a long sleep and papermill runs ``papermill``; each writes its PID under ``marks/``."""
+    import hashlib
+
+    repo = _checkout(tmp_path)
+    for folder in ("notebooks", "tools", "data/paper"):
+        shutil.copytree(PROJECT_ROOT / folder, repo / folder, ignore=shutil.ignore_patterns("*.ipynb_checkpoints"))
+    marks = tmp_path / "marks"
+    marks.mkdir()
+    bin_ = repo / ".venv" / "bin"
+    bin_.mkdir(parents=True)
+    (bin_ / "python").write_text(f"""#!/bin/bash
+case "$*" in
+  *"profile_schema --keys"*) {keys};;
+  *"bgfn kernels"*) echo $$ > {marks}/kernels.pid; exec sleep 300;;
+  *fingerprint*) : > "${{@: -1}}";;
+esac
+exit 0
+""")
+    (bin_ / "papermill").write_text(f"#!/bin/bash\necho $$ > {marks}/papermill.pid\n{papermill}\n")
+    for exe in bin_.iterdir():
+        exe.chmod(0o755)
+    lock_hash = hashlib.sha256((repo / "requirements.lock").read_bytes()).hexdigest()[:16]
+    (repo / ".venv" / f".installed-{lock_hash}").touch()
+    config = repo / ".venv" / "etc" / "ipython" / "ipython_kernel_config.py"
+    config.parent.mkdir(parents=True)
+    shutil.copy(repo / "tools" / "ipython_kernel_config.py", config)
+    return repo, marks
+
+
+def _wait_for(path, timeout=60.0):
+    import time
+
+    deadline = time.monotonic() + timeout
+    while not (path.is_file() and path.read_text().strip()):
+        assert time.monotonic() < deadline, f"{path.name} never appeared"
+        time.sleep(0.1)
+    return int(path.read_text())
+
+
+@pytest.mark.parametrize("sig", ["SIGTERM", "SIGINT"])
+def test_a_stopped_run_ends_every_process_it_started_and_releases_its_lock(tmp_path, sig):
+    import signal
+    import time
+
+    repo, marks = _fake_run(tmp_path)
+    make = subprocess.Popen(["make", "--no-print-directory", "reproduce", "PROFILE=smoke"], cwd=repo,
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True)
+    try:
+        pids = [_wait_for(marks / "papermill.pid"), _wait_for(marks / "kernels.pid")]
+        lock = repo / "results" / "smoke" / ".lock"
+        assert lock.read_text().strip() and all(_alive(p) for p in pids)
+        # Ctrl-C reaches the terminal's foreground group (make and its recipe shells); `kill` reaches make alone
+        os.killpg(make.pid, signal.SIGINT) if sig == "SIGINT" else make.send_signal(signal.SIGTERM)
+        make.wait(timeout=30)
+        deadline = time.monotonic() + 10
+        while any(_alive(p) for p in pids) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not any(_alive(p) for p in pids), make.stdout.read()
+        with open(lock, "a") as f:                     # the lock is free at once, and names no PID
+            fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        assert lock.read_text() == ""
+    finally:
+        if make.poll() is None:
+            os.killpg(make.pid, signal.SIGKILL)
+
+
+def test_a_lock_left_by_a_killed_run_is_taken_over_with_one_line(tmp_path):
+    repo, marks = _fake_run(tmp_path, papermill="exit 1")
+    lock = repo / "results" / "smoke" / ".lock"
+    lock.parent.mkdir(parents=True)
+    lock.write_text("999999\n")                       # a run killed with SIGKILL: its PID stays, its lock does not
+    res = _make("reproduce", "PROFILE=smoke", cwd=repo)
+    assert res.returncode != 0 and "already running" not in res.stderr        # papermill's stand-in failed
+    assert res.stdout.count("named PID 999999") == 1 and "taken over" in res.stdout
+    assert lock.read_text() == "" and not (marks / "kernels.pid").exists() or not _alive(
+        int((marks / "kernels.pid").read_text()))
+
+
+def test_a_bad_profile_fails_before_anything_and_leaves_nothing(tmp_path):
+    repo, marks = _fake_run(tmp_path, keys="echo 'error: profile smoke: a bad key' >&2; exit 2")
+    res = _make("reproduce", "PROFILE=smoke", cwd=repo)
+    assert res.returncode != 0 and res.stderr.count("a bad key") == 1
+    assert not (repo / "results").exists() and list(marks.iterdir()) == []   # no lock, no log, no job, no data step
+
+
+def test_clean_debris_never_touches_a_live_run(tmp_path):
+    repo = _checkout(tmp_path)
+    res_dir = repo / "results" / "smoke"
+    live = res_dir / "notebooks" / ".03_bgfn_training.running-4242.ipynb"
+    live.parent.mkdir(parents=True)
+    live.write_text("the live run's notebook")
+    with open(res_dir / ".lock", "w") as held:
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        held.write("4242\n")
+        held.flush()
+        res = _make("clean-debris", "PROFILE=smoke", cwd=repo)
+        assert res.returncode != 0 and "is live (PID 4242" in res.stderr and live.exists()
+        env = {**os.environ, "BGFN_RUN_LOCK": "4242"}                 # the run itself cleans its own debris
+        res = subprocess.run(["make", "clean-debris", "PROFILE=smoke"], cwd=repo, capture_output=True, text=True,
+                             env=env, timeout=60)
+        assert res.returncode == 0 and not live.exists()

@@ -247,3 +247,36 @@ def test_clean_debris_never_touches_a_live_run(tmp_path):
         res = subprocess.run(["make", "clean-debris", "PROFILE=smoke"], cwd=repo, capture_output=True, text=True,
                              env=env, timeout=60)
         assert res.returncode == 0 and not live.exists()
+
+
+def test_the_advice_for_a_corrupt_checkpoint_reruns_the_notebook_that_trains_it_and_what_follows(tmp_path,
+                                                                                                 monkeypatch):
+    import time
+
+    from bgfn import config
+    from bgfn.errors import DataError
+    from bgfn.train import checkpoints as ck
+
+    repo, _ = _fake_run(tmp_path)
+    monkeypatch.setattr(config, "PROJECT_ROOT", repo)
+    monkeypatch.setattr(config, "RESULTS_ROOT", repo / "results")
+    res_dir = repo / "results" / "smoke"
+    (res_dir / "notebooks").mkdir(parents=True)
+    time.sleep(0.05)
+    for stamp in (".profile-checked", ".data-fingerprint"):       # a finished run: checked, then every notebook
+        (res_dir / stamp).touch()
+    for nb in sorted((repo / "notebooks").glob("*.ipynb")):
+        time.sleep(0.02)
+        (res_dir / "notebooks" / nb.name).write_text("{}")
+    args = ["-n", "_notebooks", "PROFILE=smoke", f"-o{res_dir.relative_to(repo)}/.data-fingerprint"]
+    assert "papermill" not in _make(*args, cwd=repo).stdout              # nothing to redo
+    path = ck.checkpoint_path("smoke", "rtklib-drive0708", "bgfn", 0)
+    path.write_bytes(b"truncated")
+    with pytest.raises(DataError) as err:
+        ck.read_checkpoint(path)
+    advice = str(err.value).split("`")[1]
+    assert advice.startswith("rm -f results/smoke/models/") and advice.endswith("make reproduce PROFILE=smoke")
+    subprocess.run(advice.split(" && ")[0], shell=True, cwd=repo, check=True)
+    out = _make(*args, cwd=repo).stdout
+    reruns = [nb for nb in sorted(p.stem for p in (repo / "notebooks").glob("*.ipynb")) if f"notebooks/{nb}.ipynb\"" in out]
+    assert reruns[0] == "03_bgfn_training" and "04_outage_evaluation" in reruns and not path.exists()

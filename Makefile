@@ -111,7 +111,7 @@ export DASK_SCHEDULER
 # the venv's IPython kernel configuration (tools/ipython_kernel_config.py, installed by `make venv`)
 KERNEL_CONFIG := $(VENV)/etc/ipython/ipython_kernel_config.py
 
-.PHONY: FORCE help reproduce notebooks _reproduce _notebooks navego-check book test bench clean clean-debris distclean venv data lock strip
+.PHONY: FORCE help reproduce notebooks _reproduce _notebooks navego-check book _book-build test bench clean clean-debris distclean venv data lock strip
 
 ifneq ($(filter reproduce notebooks book,$(MAKECMDGOALS)),)
 ifeq ($(wildcard params/$(PROFILE).yaml),)
@@ -270,12 +270,21 @@ define build_book
 	@echo "book: $(BOOK_HTML)"
 endef
 
+# book/ is one folder for every profile: one build at a time, under an flock (a second one waits, saying so).
+BOOK_LOCK := results/.book.lock
+locked_book = @mkdir -p results; exec 7>>$(BOOK_LOCK); if ! flock -n 7; then \
+  echo "==> [$(PROFILE)] book/ is being built by another make (another profile's?): waiting for it"; flock 7; fi; \
+  $(MAKE) _book-build
+
 $(BOOK_STAMP): $(EXEC) $(BOOK_SRC) $(STAMP)
-	$(build_book)
+	$(locked_book)
 
 book: $(STAMP)
 	@missing=""; for f in $(EXEC); do [ -f "$$f" ] || missing="$$missing $$f"; done; \
 	if [ -n "$$missing" ]; then echo "error: not executed yet:$$missing -- run: make reproduce PROFILE=$(PROFILE)" >&2; exit 1; fi
+	$(locked_book)
+
+_book-build:
 	$(build_book)
 
 # One run per profile at a time: `reproduce` and `notebooks` hold an flock on $(RES)/.lock (which names the

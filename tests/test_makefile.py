@@ -280,3 +280,24 @@ def test_the_advice_for_a_corrupt_checkpoint_reruns_the_notebook_that_trains_it_
     out = _make(*args, cwd=repo).stdout
     reruns = [nb for nb in sorted(p.stem for p in (repo / "notebooks").glob("*.ipynb")) if f"notebooks/{nb}.ipynb\"" in out]
     assert reruns[0] == "03_bgfn_training" and "04_outage_evaluation" in reruns and not path.exists()
+
+
+def test_two_book_builds_at_once_take_turns(tmp_path):
+    import time
+
+    repo, marks = _fake_run(tmp_path)
+    (repo / ".venv" / "bin" / "jupyter-book").write_text(
+        f"#!/bin/bash\nmkdir -p book/_build && echo $$ > {marks}/book.pid\n")
+    (repo / ".venv" / "bin" / "jupyter-book").chmod(0o755)
+    (repo / "results" / "smoke" / "notebooks").mkdir(parents=True)
+    for nb in (repo / "notebooks").glob("*.ipynb"):
+        (repo / "results" / "smoke" / "notebooks" / nb.name).write_text("{}")
+    with open(repo / "results" / ".book.lock", "a") as held:        # another profile's book build is running
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        make = subprocess.Popen(["make", "--no-print-directory", "book", "PROFILE=smoke"], cwd=repo,
+                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        time.sleep(3)
+        assert make.poll() is None and not (marks / "book.pid").exists()    # it waits, touching nothing of book/
+    out, _ = make.communicate(timeout=60)
+    assert make.returncode == 0, out
+    assert out.count("waiting for it") == 1 and (marks / "book.pid").exists()

@@ -312,7 +312,8 @@ reproduce notebooks:
 	  "before it could clear it; the lock was free: taken over"; fi; \
 	echo $$$$ > "$(LOCK)"; export BGFN_RUN_LOCK=$$$$; run=0; \
 	trap '[ $$run = 0 ] || kill -TERM -- -$$run 2>/dev/null || true' INT TERM HUP; \
-	trap '[ $$run = 0 ] || kill -TERM -- -$$run 2>/dev/null || true; : > "$(LOCK)"' EXIT; \
+	trap '[ $$run = 0 ] || kill -TERM -- -$$run 2>/dev/null || true; : > "$(LOCK)"; exec 9>&- 8>>"$(LOCK)"; \
+	  flock -w 10 8 || true' EXIT; \
 	if [ ! -x "$(PY)" ]; then $(MAKE) venv; $(CHECK_KEYS); fi; \
 	setsid $(MAKE) _$@ & run=$$!; \
 	rc=0; wait $$run || rc=$$?; while kill -0 $$run 2>/dev/null; do wait $$run || rc=$$?; done; exit $$rc

@@ -47,6 +47,8 @@ BAD = {
                        "did you mean data.turin-sim-mpu6000.gnss_rate_hz?"),
     "drive key another drive takes": ("data: {turin-sim-ekinox: {lever_arm_m: [0.0, 0.0, 0.0]}}",
                                       "data.turin-sim-ekinox.lever_arm_m", "unknown key"),
+    "IMU error key typo": ("data: {turin-sim-mpu6000: {imu_errors: {gyro_bias_instabilty: 0.1}}}",
+                           "data.turin-sim-mpu6000.imu_errors.gyro_bias_instabilty", "unknown key"),
     "drive name typo": ("data: {turin-sim-mpu600: {seed: 1}}", "data.turin-sim-mpu600",
                         "did you mean data.turin-sim-mpu6000?"),
     "size key typo": ("train: {sizes: {bgfn: {smoke: {dimm: 16}}}}", "train.sizes.bgfn.smoke.dimm",

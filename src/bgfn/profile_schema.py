@@ -28,6 +28,7 @@ from bgfn.config import (DEFAULT_DATASET_KEY, MAIN_VARIANT, VARIANT_NAME, VARIAN
                          odometer_datasets, profile_chain, read_profile, set_keys, variant_config)
 from bgfn.data import load_drive
 from bgfn.data.names import profile_datasets, unique_ids
+from bgfn.data.imu_errors import EKINOX_D, MPU6000, error_params
 from bgfn.data.registry import DATASETS
 from bgfn.errors import DataError
 from bgfn.evaluate import evaluate_config
@@ -110,6 +111,10 @@ def _check_drive_keys(data: dict) -> None:
         for key in section or {}:
             if key not in DATASETS[name]:
                 raise _unknown(f"data.{name}.{key}", key, DATASETS[name])
+        try:                                    # the IMU error keys, as the data step will read them
+            error_params(EKINOX_D if "ekinox" in name else MPU6000, (section or {}).get("imu_errors") or {})
+        except DataError as exc:
+            raise ProfileError(f"data.{name}.imu_errors.{exc.field}", exc.expected, exc.found) from None
 
 
 def _check_sizes(key: str, sizes: dict) -> None:

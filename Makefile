@@ -23,6 +23,22 @@ ifneq ($(words $(CURDIR) $(MAKEFILE_LIST)),2)
 $(error the path "$(CURDIR)" or "$(MAKEFILE_LIST)" contains a space; make cannot handle it -- move or clone the repository to a path without spaces)
 endif
 
+# A profile is a plain name (params/<name>.yaml): letters, digits, '.', '_' or '-', not starting with '.' or '-'.
+# It is checked here, by make's own functions, before any shell, recipe or sub-make sees it: its raw text
+# ($(value ...): a command-line variable is make code, and expanding it could run a $(shell ...)) with every
+# allowed character removed must leave nothing. Anything else (a path, a quote, `;`, `|`, `$`) is refused.
+PROFILE ?= quick
+NAME_CHARS := a b c d e f g h i j k l m n o p q r s t u v w x y z A B C D E F G H I J K L M N O P Q R S T U V W X Y Z \
+              0 1 2 3 4 5 6 7 8 9 _ . -
+drop_chars = $(if $(2),$(call drop_chars,$(subst $(firstword $(2)),,$(1)),$(wordlist 2,99,$(2))),$(1))
+is_name = $(if $(and $(filter 1,$(words $(1))),$(filter-out -% .%,$(1))),$(if $(call drop_chars,$(1),$(NAME_CHARS)),,ok))
+ifeq ($(call is_name,$(value PROFILE)),)
+$(error PROFILE "$(value PROFILE)" is not a profile name: expected letters, digits, '.', '_' or '-' (not first: '.' or '-') naming params/<name>.yaml)
+endif
+# JOBS and DASK_SCHEDULER reach Python (which checks them) as environment values, never as make code.
+override JOBS := $(value JOBS)
+override DASK_SCHEDULER := $(value DASK_SCHEDULER)
+
 # Every path below is relative to the repository root. `make -f <root>/Makefile` from elsewhere re-runs make
 # there (`make -C <root>` needs nothing: make changes directory first).
 ROOT := $(patsubst %/,%,$(dir $(abspath $(lastword $(MAKEFILE_LIST)))))
@@ -33,7 +49,6 @@ $(or $(MAKECMDGOALS),help):
 else
 
 
-PROFILE ?= quick
 VENV ?= .venv
 # Interpreter that creates the venv (the project pins Python 3.11).
 PYTHON ?= $(shell command -v python3.11 2>/dev/null || command -v python3)
@@ -64,11 +79,12 @@ STAMP := $(VENV)/.installed-$(LOCK_HASH)
 # The paper's five steps, the studies beyond it, own logs, the results page last.
 NOTEBOOKS := 01_data_prep 02_kf_baseline 03_bgfn_training 04_outage_evaluation 05_energy_estimate \
              06_outage_sweep 07_learned_odometer 08_ins_fidelity 09_own_logs 10_results
-# A profile's notebooks also depend on the profile(s) it builds on (`base:` in its YAML; two levels followed).
-base_of = $(shell sed -n 's/^base:[[:space:]]*\([A-Za-z0-9_.-]*\).*/\1/p' params/$(1).yaml 2>/dev/null)
-BASE1 := $(call base_of,$(PROFILE))
-BASE2 := $(if $(BASE1),$(call base_of,$(BASE1)))
-PARAMS := params/$(PROFILE).yaml $(BASE1:%=params/%.yaml) $(BASE2:%=params/%.yaml)
+# A profile's notebooks also depend on the profiles it builds on (`base:` in its YAML), followed to any depth until a
+# profile has no base or one already seen; each base name is checked as PROFILE is before it names a file to read.
+base_of = $(shell sed -n 's/^base:[[:space:]]*\([^[:space:]#]*\).*/\1/p' 'params/$(1).yaml' 2>/dev/null | tr -d "\"'")
+chain_of = $(if $(filter $(1),$(2)),,$(1) $(call bases_of,$(call base_of,$(1)),$(2) $(1)))
+bases_of = $(if $(1),$(if $(call is_name,$(1)),$(call chain_of,$(1),$(2)),$(error profile '$(PROFILE)': `base: $(1)` in params/$(lastword $(2)).yaml is not a profile name: expected letters, digits, '.', '_' or '-')))
+PARAMS := $(patsubst %,params/%.yaml,$(call chain_of,$(PROFILE)))
 RES := results/$(PROFILE)
 EXEC := $(NOTEBOOKS:%=$(RES)/notebooks/%.ipynb)
 SRC := $(shell find src/bgfn -name '*.py' -not -path '*/__pycache__/*' | sort)
@@ -95,12 +111,7 @@ export DASK_SCHEDULER
 # the venv's IPython kernel configuration (tools/ipython_kernel_config.py, installed by `make venv`)
 KERNEL_CONFIG := $(VENV)/etc/ipython/ipython_kernel_config.py
 
-.PHONY: FORCE help reproduce notebooks _reproduce _notebooks navego-check book test bench clean clean-debris distclean venv data lock strip
-
-# A profile is a plain name (params/<name>.yaml); anything with a path in it would write outside results/.
-ifneq ($(shell printf '%s' '$(PROFILE)' | grep -Ex '[A-Za-z0-9][A-Za-z0-9_-]*'),$(PROFILE))
-$(error PROFILE '$(PROFILE)' is not a profile name: expected letters, digits, '_' or '-' naming params/<name>.yaml)
-endif
+.PHONY: FORCE help reproduce notebooks _reproduce _notebooks navego-check book _book-build test bench clean clean-debris distclean venv data lock strip
 
 ifneq ($(filter reproduce notebooks book,$(MAKECMDGOALS)),)
 ifeq ($(wildcard params/$(PROFILE).yaml),)
@@ -196,12 +207,14 @@ $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(PARAMS) $(SRC) $(STAMP) | data $(K
 # about 40 s on one core. Its output goes to $(RES)/logs/kernels.log; it changes no result, and what it has not
 # cached yet when a notebook needs it is compiled there as before. (A changed src/bgfn file reruns this rule, and
 # numba recompiles the kernels of a changed file.)
+# The kernels start once the check has passed (a refused profile leaves no log behind); they run in the run's
+# process group, without its lock, and end with it (reproduce's recipe).
 $(RES)/.profile-checked: $(PARAMS) $(SRC) $(STAMP) | data
 	@mkdir -p $(@D) $(RES)/logs
-	@echo "==> [$(PROFILE)] numba kernels into the cache, in the background ($(RES)/logs/kernels.log)"
-	@$(PY) -m bgfn kernels --profile $(PROFILE) > $(RES)/logs/kernels.log 2>&1 < /dev/null &
-	@echo "==> [$(PROFILE)] check params/$(PROFILE).yaml"
+	@echo "==> [$(PROFILE)] check params/$(PROFILE).yaml with its drives"
 	@$(PY) -m bgfn.profile_schema $(PROFILE)
+	@echo "==> [$(PROFILE)] numba kernels into the cache, in the background ($(RES)/logs/kernels.log)"
+	@$(PY) -m bgfn kernels --profile $(PROFILE) > $(RES)/logs/kernels.log 2>&1 < /dev/null 9>&- &
 	@touch $@
 $(RES)/notebooks/01_data_prep.ipynb: $(RES)/.profile-checked $(RES)/.data-fingerprint
 
@@ -257,25 +270,53 @@ define build_book
 	@echo "book: $(BOOK_HTML)"
 endef
 
+# book/ is one folder for every profile: one build at a time, under an flock (a second one waits, saying so).
+BOOK_LOCK := results/.book.lock
+locked_book = @mkdir -p results; exec 7>>$(BOOK_LOCK); if ! flock -n 7; then \
+  echo "==> [$(PROFILE)] book/ is being built by another make (another profile's?): waiting for it"; flock 7; fi; \
+  $(MAKE) _book-build
+
 $(BOOK_STAMP): $(EXEC) $(BOOK_SRC) $(STAMP)
-	$(build_book)
+	$(locked_book)
 
 book: $(STAMP)
 	@missing=""; for f in $(EXEC); do [ -f "$$f" ] || missing="$$missing $$f"; done; \
 	if [ -n "$$missing" ]; then echo "error: not executed yet:$$missing -- run: make reproduce PROFILE=$(PROFILE)" >&2; exit 1; fi
+	$(locked_book)
+
+_book-build:
 	$(build_book)
 
 # One run per profile at a time: `reproduce` and `notebooks` hold an flock on $(RES)/.lock (which names the
 # holder's PID) for the whole run, so a second run of the same profile refuses at once instead of overwriting
-# the first one's results or cleaning its live files as debris; other profiles run beside it.
+# the first one's results or cleaning its live files as debris; other profiles run beside it. The profile's keys
+# (and JOBS, DASK_SCHEDULER) are checked first, before the lock, the install's updates and the data (with no
+# venv yet: right after making it). The lock is an open file descriptor, held by the run's processes only: a run
+# that ends for any reason releases it, and no dead PID ever blocks (a PID left in the file by a killed run is
+# taken over, said once). The run is a process group of its own (setsid): SIGINT, SIGTERM or SIGHUP of this make,
+# or its end, sends SIGTERM to every process of it (a background job ignores SIGINT), background jobs included (a
+# notebook's kernel ends with papermill, and its pool workers with the kernel: bgfn.parallel.watch_owner).
 LOCK := $(RES)/.lock
+CHECK_KEYS = echo "==> [$(PROFILE)] check params/$(PROFILE).yaml (every key; JOBS, DASK_SCHEDULER)" && \
+  $(if $(DRY),echo )$(PY) -m bgfn.profile_schema --keys $(PROFILE)
+DRY = $(findstring n,$(filter-out --% %=%,$(firstword $(MAKEFLAGS))))
 reproduce notebooks:
+	@if [ -x "$(PY)" ]; then $(CHECK_KEYS); fi
 	@mkdir -p $(RES); exec 9>>"$(LOCK)"; \
-	if ! flock -n 9; then \
-	  echo "error: make $@ PROFILE=$(PROFILE) is already running (PID $$(cat "$(LOCK)" 2>/dev/null || echo unknown)," \
-	       "lock $(LOCK)); wait for it to end or stop it -- two runs of one profile would overwrite each other's results" >&2; \
+	if ! flock -n 9; then pid=$$(cat "$(LOCK)" 2>/dev/null); \
+	  echo "error: make $@ PROFILE=$(PROFILE) is already running (PID $${pid:-unknown}$$(kill -0 "$${pid:-0}" \
+	       2>/dev/null || echo ", ended; a process it started still holds the lock"), lock $(LOCK)); wait for it" \
+	       "to end or stop it -- two runs of one profile would overwrite each other's results" >&2; \
 	  exit 1; fi; \
-	echo $$$$ > "$(LOCK)"; $(MAKE) _$@
+	old=$$(cat "$(LOCK)"); if [ -n "$$old" ]; then echo "    $(LOCK) named PID $$old, a run that was killed" \
+	  "before it could clear it; the lock was free: taken over"; fi; \
+	echo $$$$ > "$(LOCK)"; export BGFN_RUN_LOCK=$$$$; run=0; \
+	trap '[ $$run = 0 ] || kill -TERM -- -$$run 2>/dev/null || true' INT TERM HUP; \
+	trap '[ $$run = 0 ] || kill -TERM -- -$$run 2>/dev/null || true; : > "$(LOCK)"; exec 9>&- 8>>"$(LOCK)"; \
+	  flock -w 10 8 || true' EXIT; \
+	if [ ! -x "$(PY)" ]; then $(MAKE) venv; $(CHECK_KEYS); fi; \
+	setsid $(MAKE) _$@ & run=$$!; \
+	rc=0; wait $$run || rc=$$?; while kill -0 $$run 2>/dev/null; do wait $$run || rc=$$?; done; exit $$rc
 
 _reproduce: $(BOOK_STAMP)
 	@echo "==> done (PROFILE=$(PROFILE)): results in $(RES)/, book at $(BOOK_HTML)"
@@ -314,10 +355,16 @@ navego-check: $(STAMP)
 
 # ---------------------------------------------------------------- cleaning
 # Debris of an interrupted run of $(PROFILE): papermill's temporary notebooks and half-written outputs
-# (bgfn.io.atomic_path names them .<name>.<random>.tmp<suffix>). It runs inside the profile's lock (reproduce,
-# notebooks) and notebooks run one at a time, so none of them is live.
+# (bgfn.io.atomic_path names them .<name>.<random>.tmp<suffix>). Inside the run that holds the profile's lock
+# (reproduce, notebooks: BGFN_RUN_LOCK names it) notebooks run one at a time, so none of them is live; from
+# anywhere else it takes the lock first, and removes nothing while a run holds it.
 clean-debris:
-	@if [ -d "$(RES)" ]; then find "$(RES)" -type f \( -name '.*.running-*.ipynb' -o -name '.*.tmp*' \) \
+	@if [ -d "$(RES)" ]; then \
+	  if [ -z "$${BGFN_RUN_LOCK:-}" ] || [ "$$BGFN_RUN_LOCK" != "$$(cat "$(LOCK)" 2>/dev/null)" ]; then \
+	    exec 8>>"$(LOCK)"; if ! flock -n 8; then \
+	    echo "clean-debris: a run of $(PROFILE) is live (PID $$(cat "$(LOCK)"), lock $(LOCK)): nothing removed" >&2; \
+	    exit 1; fi; fi; \
+	  find "$(RES)" -type f \( -name '.*.running-*.ipynb' -o -name '.*.tmp*' \) \
 	  -print -delete | sed 's/^/    removed debris of an interrupted run: /'; fi
 
 clean:

@@ -64,3 +64,38 @@ def test_a_corrupt_or_foreign_checkpoint_is_one_error_naming_its_file(tmp_path, 
         ck.read_checkpoint(path)
     torch.save({"state_dict": {"w": torch.ones(2)}, "norm": {"x_mean": [0.0]}}, path)
     assert ck.read_checkpoint(path)["state_dict"]["w"].sum() == 2.0
+
+
+def test_the_advice_for_a_corrupt_checkpoint_deletes_the_notebook_that_trains_it(tmp_path, monkeypatch):
+    monkeypatch.setattr(config, "PROJECT_ROOT", tmp_path)
+    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path / "results")
+    cases = {ck.checkpoint_path("p", "d", "bgfn", 0): "03_bgfn_training",
+             ck.variant_models_dir("p", "velocity", "d") / "mlp_seed1.pt": "03_bgfn_training",
+             ck.checkpoint_path("p", "d", "bgfn", 2, fold=1): "06_outage_sweep",
+             ck.odometer_models_dir("p", "d", 0) / "mlp_seed0.pt": "07_learned_odometer"}
+    for path, notebook in cases.items():
+        assert ck.writer_notebook(path) == notebook
+        path.write_bytes(b"truncated")
+        with pytest.raises(DataError) as err:
+            ck.read_checkpoint(path)
+        rel = path.relative_to(tmp_path).as_posix()
+        assert f"`rm -f {rel} results/p/notebooks/{notebook}.ipynb && make reproduce PROFILE=p`" in str(err.value)
+
+
+def test_the_train_command_the_energy_step_suggests_passes_the_profile_check(tmp_path, monkeypatch):
+    import re
+    import shlex
+
+    from bgfn.__main__ import train_config
+    from bgfn.energy.checkpoint import energy_checkpoint
+    from bgfn.profile_schema import load_profile
+
+    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)
+    for profile in ("smoke", "quick"):
+        with pytest.raises(FileNotFoundError) as err:
+            energy_checkpoint(profile, "bgfn", load_profile(profile))
+        words = shlex.split(re.search(r"`python -m bgfn train ([^`]*)`", str(err.value)).group(1))
+        opts = dict(zip(words[::2], words[1::2]))
+        cfg = train_config(opts["--profile"], [opts["--dataset"]], [opts["--method"]], [int(opts["--seed"])])
+        assert cfg["train"]["datasets"] == [opts["--dataset"]] and cfg["variants"] == {}
+        assert load_profile(profile)["variants"] or profile == "smoke"       # the profile's own are untouched

@@ -68,7 +68,7 @@ def test_unknown_profile_names_the_file():
     assert isinstance(err.value, ValueError)
 
 
-@pytest.mark.parametrize("bad", ["../quick", "", "a/b", ".hidden", "quick.yaml"])
+@pytest.mark.parametrize("bad", ["../quick", "", "a/b", ".hidden", "-rf", "quick\n", "a;b"])
 def test_profile_names_cannot_escape_params(bad):
     with pytest.raises(DataError):
         load_profile(bad)
@@ -223,3 +223,26 @@ def test_quick_heading_differs_from_quick_only_where_it_says():
         for size, kw in sizes.items():
             extra = {k: v for k, v in kw.items() if quick["train"]["sizes"][method][size].get(k) != v}
             assert extra == ({"encoder_neurons": 8} if method in ("bgfn", "transformer") else {})
+
+
+def test_a_full_disk_names_the_file_that_could_not_be_written_relative_to_the_repository(tmp_path, monkeypatch):
+    import errno
+
+    from bgfn import io
+
+    monkeypatch.chdir(tmp_path)
+    target = tmp_path / "results" / "p" / "tables" / "t.csv"
+    target.parent.mkdir(parents=True)
+    target.write_text("old\n")
+
+    def full(*_, **__):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    with pytest.raises(OSError) as err, io.atomic_path(target) as tmp:
+        tmp.write_text("half")
+        full()
+    assert err.value.errno == errno.ENOSPC and "results/p/tables/t.csv could not be written" in str(err.value)
+    assert str(tmp_path) not in str(err.value)                   # no machine path
+    assert target.read_text() == "old\n" and sorted(p.name for p in target.parent.iterdir()) == ["t.csv"]
+    with pytest.raises(RuntimeError), io.atomic_path(target):    # anything else, on a disk with room: as it was
+        raise RuntimeError("a bug")

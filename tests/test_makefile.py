@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import fcntl
+import os
 import shutil
 import subprocess
 
@@ -92,3 +93,221 @@ def test_a_second_run_of_the_same_profile_refuses_at_once_naming_the_first(tmp_p
     assert res.returncode != 0 and "already running (PID 4242" in res.stderr
     assert live.exists()                                        # its live files are not cleaned as debris
     assert not (repo / ".venv").exists()                        # refused before anything was made
+
+
+#: PROFILE values that would run a command if a shell (or make's own $(shell ...)) ever expanded them.
+PAYLOADS = ["a||touch pwned", "`touch pwned`", "x'; touch pwned2; echo '", "$(touch pwned)", "$(shell touch pwned)",
+            "a;touch pwned", "a b", "-rf", "a\ntouch pwned", '"; touch pwned; "']
+
+
+@pytest.mark.parametrize("goal", [["-n", "reproduce"], ["help"], ["book"]])
+@pytest.mark.parametrize("payload", PAYLOADS)
+def test_a_profile_with_shell_metacharacters_runs_nothing_and_is_one_error(tmp_path, payload, goal):
+    repo = _checkout(tmp_path)
+    before = sorted(p.relative_to(repo) for p in repo.rglob("*"))
+    for how in ("command line", "environment"):
+        env = {**os.environ, "PROFILE": payload} if how == "environment" else None
+        res = subprocess.run(["make", "--no-print-directory", *goal, *([] if env else [f"PROFILE={payload}"])],
+                             cwd=repo, capture_output=True, text=True, timeout=60, env=env)
+        assert res.returncode != 0, (how, res.stdout)
+        assert res.stderr.count("is not a profile name") == 1 and res.stdout == "", (how, res.stderr)
+        assert sorted(p.relative_to(repo) for p in repo.rglob("*")) == before, how     # nothing created
+        assert not (PROJECT_ROOT / "pwned").exists() and not (tmp_path / "pwned").exists()
+
+
+def test_a_base_chain_is_followed_to_any_depth_and_a_bad_base_name_runs_nothing(tmp_path):
+    repo = _checkout(tmp_path)
+    (repo / "params" / "c.yaml").write_text("base: smoke   # three levels down to quick\n")
+    (repo / "params" / "d.yaml").write_text("base: 'c'\n")
+    res = _make("-p", "-n", "help", "PROFILE=d", cwd=repo)
+    assert "PARAMS := params/d.yaml params/c.yaml params/smoke.yaml params/quick.yaml" in res.stdout, res.stderr
+    (repo / "params" / "e.yaml").write_text("base: x';touch${IFS}pwned;'\n")
+    res = _make("-n", "reproduce", "PROFILE=e", cwd=repo)
+    assert res.returncode != 0 and "in params/e.yaml is not a profile name" in res.stderr
+    assert not (repo / "pwned").exists()
+    (repo / "params" / "f.yaml").write_text("base: f\n")         # a loop ends (the profile check names it)
+    assert _make("-n", "help", "PROFILE=f", cwd=repo).returncode == 0
+
+
+def test_jobs_and_the_scheduler_reach_python_as_text_never_as_make_code(tmp_path):
+    repo = _checkout(tmp_path)
+    res = _make("-n", "help", "JOBS=$(shell touch pwned)", "DASK_SCHEDULER=$(shell touch pwned)", cwd=repo)
+    assert res.returncode == 0 and not (repo / "pwned").exists()
+
+
+def _alive(pid: int) -> bool:
+    """The process runs (a zombie waiting for its parent to reap it has ended)."""
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            return not any(line.startswith("State:") and "Z" in line.split()[1] for line in f)
+    except OSError:
+        return False
+
+
+def _fake_run(tmp_path, papermill="exec sleep 300", keys="exit 0"):
+    """A checkout whose venv is a stand-in: its python passes every step (``keys``: the profile's key check), starts
+    the kernels job as a long sleep and papermill runs ``papermill``; each writes its PID under ``marks/``."""
+    import hashlib
+
+    repo = _checkout(tmp_path)
+    for folder in ("notebooks", "tools", "data/paper"):
+        shutil.copytree(PROJECT_ROOT / folder, repo / folder, ignore=shutil.ignore_patterns("*.ipynb_checkpoints"))
+    marks = tmp_path / "marks"
+    marks.mkdir()
+    bin_ = repo / ".venv" / "bin"
+    bin_.mkdir(parents=True)
+    (bin_ / "python").write_text(f"""#!/bin/bash
+case "$*" in
+  *"profile_schema --keys"*) {keys};;
+  *"bgfn kernels"*) echo $$ > {marks}/kernels.pid; exec sleep 300;;
+  *fingerprint*) : > "${{@: -1}}";;
+esac
+exit 0
+""")
+    (bin_ / "papermill").write_text(f"#!/bin/bash\necho $$ > {marks}/papermill.pid\n{papermill}\n")
+    for exe in bin_.iterdir():
+        exe.chmod(0o755)
+    lock_hash = hashlib.sha256((repo / "requirements.lock").read_bytes()).hexdigest()[:16]
+    (repo / ".venv" / f".installed-{lock_hash}").touch()
+    config = repo / ".venv" / "etc" / "ipython" / "ipython_kernel_config.py"
+    config.parent.mkdir(parents=True)
+    shutil.copy(repo / "tools" / "ipython_kernel_config.py", config)
+    return repo, marks
+
+
+def _gone(pid: int, timeout: float = 10.0) -> None:
+    import time
+
+    deadline = time.monotonic() + timeout
+    while _alive(pid) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not _alive(pid), f"process {pid} outlived its run"
+
+
+def _wait_for(path, timeout=60.0):
+    import time
+
+    deadline = time.monotonic() + timeout
+    while not (path.is_file() and path.read_text().strip()):
+        assert time.monotonic() < deadline, f"{path.name} never appeared"
+        time.sleep(0.1)
+    return int(path.read_text())
+
+
+@pytest.mark.parametrize("sig", ["SIGTERM", "SIGINT"])
+def test_a_stopped_run_ends_every_process_it_started_and_releases_its_lock(tmp_path, sig):
+    import signal
+    import time
+
+    repo, marks = _fake_run(tmp_path)
+    make = subprocess.Popen(["make", "--no-print-directory", "reproduce", "PROFILE=smoke"], cwd=repo,
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True)
+    try:
+        pids = [_wait_for(marks / "papermill.pid"), _wait_for(marks / "kernels.pid")]
+        lock = repo / "results" / "smoke" / ".lock"
+        assert lock.read_text().strip() and all(_alive(p) for p in pids)
+        # Ctrl-C reaches the terminal's foreground group (make and its recipe shells); `kill` reaches make alone
+        os.killpg(make.pid, signal.SIGINT) if sig == "SIGINT" else make.send_signal(signal.SIGTERM)
+        make.wait(timeout=30)
+        deadline = time.monotonic() + 10
+        while any(_alive(p) for p in pids) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not any(_alive(p) for p in pids), make.stdout.read()
+        with open(lock, "a") as f:                     # the lock is free at once, and names no PID
+            fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        assert lock.read_text() == ""
+    finally:
+        if make.poll() is None:
+            os.killpg(make.pid, signal.SIGKILL)
+
+
+def test_a_lock_left_by_a_killed_run_is_taken_over_with_one_line(tmp_path):
+    repo, marks = _fake_run(tmp_path, papermill="exit 1")
+    lock = repo / "results" / "smoke" / ".lock"
+    lock.parent.mkdir(parents=True)
+    lock.write_text("999999\n")                       # a run killed with SIGKILL: its PID stays, its lock does not
+    res = _make("reproduce", "PROFILE=smoke", cwd=repo)
+    assert res.returncode != 0 and "already running" not in res.stderr        # papermill's stand-in failed
+    assert res.stdout.count("named PID 999999") == 1 and "taken over" in res.stdout
+    assert lock.read_text() == ""
+    if (marks / "kernels.pid").exists():                # the run's background job ended with it
+        _gone(_wait_for(marks / "kernels.pid"))
+
+
+def test_a_bad_profile_fails_before_anything_and_leaves_nothing(tmp_path):
+    repo, marks = _fake_run(tmp_path, keys="echo 'error: profile smoke: a bad key' >&2; exit 2")
+    res = _make("reproduce", "PROFILE=smoke", cwd=repo)
+    assert res.returncode != 0 and res.stderr.count("a bad key") == 1
+    assert not (repo / "results").exists() and list(marks.iterdir()) == []   # no lock, no log, no job, no data step
+
+
+def test_clean_debris_never_touches_a_live_run(tmp_path):
+    repo = _checkout(tmp_path)
+    res_dir = repo / "results" / "smoke"
+    live = res_dir / "notebooks" / ".03_bgfn_training.running-4242.ipynb"
+    live.parent.mkdir(parents=True)
+    live.write_text("the live run's notebook")
+    with open(res_dir / ".lock", "w") as held:
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        held.write("4242\n")
+        held.flush()
+        res = _make("clean-debris", "PROFILE=smoke", cwd=repo)
+        assert res.returncode != 0 and "is live (PID 4242" in res.stderr and live.exists()
+        env = {**os.environ, "BGFN_RUN_LOCK": "4242"}                 # the run itself cleans its own debris
+        res = subprocess.run(["make", "clean-debris", "PROFILE=smoke"], cwd=repo, capture_output=True, text=True,
+                             env=env, timeout=60)
+        assert res.returncode == 0 and not live.exists()
+
+
+def test_the_advice_for_a_corrupt_checkpoint_reruns_the_notebook_that_trains_it_and_what_follows(tmp_path,
+                                                                                                 monkeypatch):
+    import time
+
+    from bgfn import config
+    from bgfn.errors import DataError
+    from bgfn.train import checkpoints as ck
+
+    repo, _ = _fake_run(tmp_path)
+    monkeypatch.setattr(config, "PROJECT_ROOT", repo)
+    monkeypatch.setattr(config, "RESULTS_ROOT", repo / "results")
+    res_dir = repo / "results" / "smoke"
+    (res_dir / "notebooks").mkdir(parents=True)
+    time.sleep(0.05)
+    for stamp in (".profile-checked", ".data-fingerprint"):       # a finished run: checked, then every notebook
+        (res_dir / stamp).touch()
+    for nb in sorted((repo / "notebooks").glob("*.ipynb")):
+        time.sleep(0.02)
+        (res_dir / "notebooks" / nb.name).write_text("{}")
+    args = ["-n", "_notebooks", "PROFILE=smoke", f"-o{res_dir.relative_to(repo)}/.data-fingerprint"]
+    assert "papermill" not in _make(*args, cwd=repo).stdout              # nothing to redo
+    path = ck.checkpoint_path("smoke", "rtklib-drive0708", "bgfn", 0)
+    path.write_bytes(b"truncated")
+    with pytest.raises(DataError) as err:
+        ck.read_checkpoint(path)
+    advice = str(err.value).split("`")[1]
+    assert advice.startswith("rm -f results/smoke/models/") and advice.endswith("make reproduce PROFILE=smoke")
+    subprocess.run(advice.split(" && ")[0], shell=True, cwd=repo, check=True)
+    out = _make(*args, cwd=repo).stdout
+    reruns = [nb for nb in sorted(p.stem for p in (repo / "notebooks").glob("*.ipynb")) if f"notebooks/{nb}.ipynb\"" in out]
+    assert reruns[0] == "03_bgfn_training" and "04_outage_evaluation" in reruns and not path.exists()
+
+
+def test_two_book_builds_at_once_take_turns(tmp_path):
+    import time
+
+    repo, marks = _fake_run(tmp_path)
+    (repo / ".venv" / "bin" / "jupyter-book").write_text(
+        f"#!/bin/bash\nmkdir -p book/_build && echo $$ > {marks}/book.pid\n")
+    (repo / ".venv" / "bin" / "jupyter-book").chmod(0o755)
+    (repo / "results" / "smoke" / "notebooks").mkdir(parents=True)
+    for nb in (repo / "notebooks").glob("*.ipynb"):
+        (repo / "results" / "smoke" / "notebooks" / nb.name).write_text("{}")
+    with open(repo / "results" / ".book.lock", "a") as held:        # another profile's book build is running
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        make = subprocess.Popen(["make", "--no-print-directory", "book", "PROFILE=smoke"], cwd=repo,
+                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        time.sleep(3)
+        assert make.poll() is None and not (marks / "book.pid").exists()    # it waits, touching nothing of book/
+    out, _ = make.communicate(timeout=60)
+    assert make.returncode == 0, out
+    assert out.count("waiting for it") == 1 and (marks / "book.pid").exists()

@@ -253,3 +253,64 @@ def test_the_oracle_grid_gives_the_same_rows_with_one_job_and_with_two(synthetic
     grid = {"sigmas_m": [0.0, 0.5, 2.0], "seeds": [0, 1], "durations_s": [30.0]}
     one, two = (orc.oracle_runs(ctx, windows, grid, runner=Runner(j)) for j in (1, 2))
     assert one.to_csv(index=False) == two.to_csv(index=False) and len(one) == 2 * (1 + 1 + 2 * 2)
+
+
+# ----------------------------------------------------------------------------------------------- workers
+_HOLDER = """
+import os, sys, time
+from bgfn.parallel import Runner
+
+def hold(folder):
+    open(os.path.join(folder, str(os.getpid())), "w").close()
+    time.sleep(300)                      # a long run: only its owner's end can stop it early
+    return 0
+
+if __name__ == "__main__":
+    runner = Runner(jobs=2)
+    if sys.argv[2] == "start":
+        runner.start("bgfn.parallel")    # the pool started from a thread that ends at once (Runner.start)
+    runner.map(hold, [(sys.argv[1],), (sys.argv[1],)], bar=False)
+"""
+
+
+def _alive(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            return not any(line.startswith("State:") and "Z" in line.split()[1] for line in f)
+    except OSError:
+        return False
+
+
+@pytest.mark.parametrize("how", ["map", "start"])
+def test_a_killed_owner_leaves_no_pool_worker_behind(tmp_path, how):
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    script = tmp_path / "holder.py"
+    script.write_text(_HOLDER)
+    folder = tmp_path / "pids"
+    folder.mkdir()
+    owner = subprocess.Popen([sys.executable, str(script), str(folder), how], cwd=tmp_path, env=os.environ.copy())
+    try:
+        deadline = time.monotonic() + 120
+        while len(list(folder.iterdir())) < 2:
+            assert time.monotonic() < deadline and owner.poll() is None, "the workers never started"
+            time.sleep(0.2)
+        workers = [int(p.name) for p in folder.iterdir()]
+        assert all(_alive(p) for p in workers) and owner.pid not in workers
+        time.sleep(1.0)                              # the start thread (how == "start") has ended: still alive
+        assert all(_alive(p) for p in workers)
+        owner.send_signal(signal.SIGKILL)            # as a notebook's kernel killed
+        owner.wait(timeout=10)
+        deadline = time.monotonic() + 10
+        while any(_alive(p) for p in workers) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not any(_alive(p) for p in workers), "a pool worker outlived the process that started it"
+    finally:
+        if owner.poll() is None:
+            owner.kill()
+        for p in folder.iterdir():
+            if _alive(int(p.name)):
+                os.kill(int(p.name), signal.SIGKILL)

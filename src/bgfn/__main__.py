@@ -19,7 +19,7 @@ import argparse
 import sys
 import time
 
-from bgfn.config import results_dir
+from bgfn.config import results_dir, set_keys
 from bgfn.errors import DataError
 from bgfn.evaluate import evaluation_setup
 from bgfn.studies.odometer import sizes as odometer_sizes
@@ -106,6 +106,30 @@ def odometers(argv) -> int:
     return 0
 
 
+def train_config(profile: str, datasets=None, methods=None, seeds=None, jobs=None, variants: bool = False) -> dict:
+    """The profile with this command's choice of networks (``--dataset``, ``--method``, ``--seed``; None: the
+    profile's) over it, checked as a profile (errors name the command line).
+
+    The choice narrows what this command trains, not the profile: the keys that name some of the profile's networks
+    for other notebooks follow it (``energy.dataset`` / ``energy.seed``, notebook 05's network, back to their null
+    rule when not chosen; ``variant_runs``, the variants trained with ``--variants``, narrowed to the choice; no
+    variants without ``--variants``), so that a command the error messages suggest for one network passes.
+    """
+    cfg = load_profile(profile)
+    choice = {"train.datasets": datasets, "train.methods": methods, "train.seeds": seeds, "parallel.jobs": jobs}
+    cfg = set_keys(cfg, choice)
+    for key, chosen in (("dataset", datasets), ("seed", seeds)):
+        if chosen and cfg["energy"].get(key) not in chosen:
+            cfg["energy"][key] = None
+    runs = cfg.get("variant_runs") or {}
+    for key, chosen in (("datasets", datasets), ("methods", methods)):
+        if chosen and runs.get(key) is not None:
+            runs[key] = [x for x in runs[key] if x in chosen] or None
+    if not variants:
+        cfg["variants"] = {}
+    return with_overrides(cfg, {}, "command line")
+
+
 def main(argv=None) -> int:
     """Parse ``--profile``, ``--dataset``, ``--method``, ``--seed`` (each repeatable), ``--device``, ``--jobs`` and
     ``--variants``; train and print one line per finished run (:class:`bgfn.parallel.RunProgress`)."""
@@ -128,8 +152,7 @@ def main(argv=None) -> int:
                    help="also train the profile's input and protocol variants (variants:, variant_runs:)")
     a = p.parse_args(argv)
     try:
-        cfg = with_overrides(load_profile(a.profile), {"train.datasets": a.dataset, "train.methods": a.method,
-                                                       "train.seeds": a.seed, "parallel.jobs": a.jobs}, "command line")
+        cfg = train_config(a.profile, a.dataset, a.method, a.seed, a.jobs, a.variants)
         runner = Runner.of(cfg) if a.jobs is None else Runner.of(cfg, environ={})
     except DataError as exc:
         print(f"error: profile {a.profile!r}: {exc}", file=sys.stderr)

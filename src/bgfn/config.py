@@ -146,7 +146,7 @@ VARIANT_RUN_KEYS = ("datasets", "methods", "seeds")
 #: Subfolders of ``results/<profile>/``.
 RESULT_SUBDIRS: tuple[str, ...] = ("tables", "figures", "notebooks", "models")
 
-_NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]*$")
+_NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")   # as the Makefile checks PROFILE
 
 #: Distributions whose versions are recorded in :func:`run_metadata`.
 _PACKAGES: tuple[str, ...] = (
@@ -155,8 +155,8 @@ _PACKAGES: tuple[str, ...] = (
 
 
 def _check_name(profile: str) -> str:
-    if not isinstance(profile, str) or not _NAME_RE.match(profile):
-        raise DataError(PARAMS_DIR, "profile", "a profile name of letters, digits, '_' or '-' "
+    if not isinstance(profile, str) or not _NAME_RE.fullmatch(profile):   # fullmatch: no "name\n"
+        raise DataError(PARAMS_DIR, "profile", "a profile name of letters, digits, '.', '_' or '-' "
                         f"(one of {', '.join(PROFILES)} or params/<name>.yaml)", repr(profile))
     return profile
 
@@ -183,9 +183,20 @@ def merge_sections(base: dict, override: dict) -> dict:
     return out
 
 
+#: A profile file is a page of settings: one larger than this is refused before it is parsed (a YAML parser may take
+#: minutes over a huge file).
+MAX_PROFILE_BYTES = 1_000_000
+
+
 def _read_profile_file(path: Path) -> dict:
+    size = path.stat().st_size
+    if size > MAX_PROFILE_BYTES:
+        raise DataError(path, "<file>", f"a profile of at most {MAX_PROFILE_BYTES:,} bytes", f"{size:,} bytes")
     try:
-        cfg = yaml.safe_load(path.read_text(encoding="utf-8"))
+        cfg = yaml.safe_load(path.read_bytes().decode("utf-8"))
+    except UnicodeDecodeError as exc:
+        raise DataError(path, "<file>", "a YAML text file in UTF-8", f"a byte {exc.object[exc.start]:#04x} that is "
+                        f"not UTF-8 at offset {exc.start} (a binary file?)") from None
     except yaml.YAMLError as exc:
         raise DataError(path, "<yaml>", "valid YAML", str(exc).replace("\n", " ")) from exc
     if not isinstance(cfg, dict):

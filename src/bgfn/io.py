@@ -7,9 +7,11 @@ source files (:func:`sources_hash`) that decides whether a cached dataset or a t
 from __future__ import annotations
 
 import contextlib
+import errno
 import hashlib
 import json
 import os
+import shutil
 import tempfile
 from pathlib import Path
 from typing import Any, Iterator
@@ -17,23 +19,52 @@ from typing import Any, Iterator
 import numpy as np
 
 
+#: Errors of a full disk (or quota): reported with the file that could not be written.
+_FULL = (errno.ENOSPC, errno.EDQUOT)
+
+
+def shown_path(path: str | Path) -> str:
+    """``path`` as a message shows it: relative to the current folder (the repository root under ``make``) when
+    inside it, so that no machine path is printed where a short one says the same."""
+    path = Path(path).absolute()
+    try:
+        return path.relative_to(Path.cwd()).as_posix()
+    except ValueError:
+        return str(path)
+
+
+def _nearly_full(folder: Path) -> bool:
+    try:
+        return shutil.disk_usage(folder).free < 1 << 20
+    except OSError:
+        return False
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | Path) -> Iterator[Path]:
-    """Yield a temporary path beside ``path``; rename it onto ``path`` only if the block succeeds."""
+    """Yield a temporary path beside ``path``; rename it onto ``path`` only if the block succeeds. A full disk
+    raises ``OSError(ENOSPC)`` naming ``path`` (:func:`shown_path`), not the temporary file or nothing."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp" + path.suffix, dir=path.parent)
-    os.close(fd)
-    tmp = Path(tmp)
-    # mkstemp creates owner-only files; give outputs the usual permissions (0666 minus the umask).
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)
+    tmp = None
     try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp" + path.suffix, dir=path.parent)
+        os.close(fd)
+        tmp = Path(tmp)
+        # mkstemp creates owner-only files; give outputs the usual permissions (0666 minus the umask).
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
         yield tmp
         os.replace(tmp, path)
+    except Exception as exc:        # torch.save reports a full disk as a RuntimeError: the free space tells
+        if getattr(exc, "errno", None) not in _FULL and not _nearly_full(path.parent):
+            raise
+        code = getattr(exc, "errno", None) or errno.ENOSPC
+        raise OSError(code, f"{os.strerror(code)}: {shown_path(path)} could not be written (the previous copy, if "
+                      f"any, is kept; free some space and run again) [{type(exc).__name__}]") from None
     finally:
-        if tmp.exists():
+        if tmp is not None and tmp.exists():
             tmp.unlink()
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import importlib
 import os
+import re
 import sys
 import tempfile
 import threading
@@ -33,6 +34,11 @@ PARALLEL_DEFAULTS: dict[str, Any] = settings.defaults("parallel")   # their home
 BACKENDS = ("loky", "dask")
 #: Environment variables that override the profile (make passes ``JOBS=`` / ``DASK_SCHEDULER=`` as these).
 JOBS_ENV, SCHEDULER_ENV, PROGRESS_ENV = "BGFN_JOBS", "DASK_SCHEDULER", "BGFN_PROGRESS_LOG"
+#: Runs at a time on this machine at most, per core: more only queue for the cores, each a Python holding torch
+#: (hundreds of MB). A larger ``jobs`` is capped to this and says so (:meth:`Runner.describe`).
+JOBS_PER_CORE = 4
+#: A Dask scheduler's address: ``tcp://host:port`` (or ``tls://``), or ``host:port``.
+SCHEDULER_ADDRESS = re.compile(r"^(?:(?:tcp|tls)://)?[A-Za-z0-9._\[\]:-]+:\d{1,5}$")
 #: Pools being started in the background (:meth:`Runner.start`); the next :meth:`Runner.map` waits for them.
 _STARTING: list[threading.Thread] = []
 
@@ -55,6 +61,7 @@ class Runner:
     jobs: int = 1
     backend: str = "loky"
     scheduler: str | None = None
+    asked: int | None = None        # the jobs asked for, when more than this machine takes (capped to ``jobs``)
 
     @classmethod
     def of(cls, cfg: dict | None = None, environ: dict | None = None) -> "Runner":
@@ -72,7 +79,13 @@ class Runner:
         if backend == "dask" and not scheduler:
             raise DataError("parallel", "scheduler", "a Dask scheduler address (tcp://host:port) with backend dask "
                             f"(or {SCHEDULER_ENV}=...)", repr(scheduler))
-        return cls(int(jobs) if jobs is not None else machine_cores(), backend, scheduler)
+        if backend == "dask" and not SCHEDULER_ADDRESS.match(str(scheduler)):
+            raise DataError(*((SCHEDULER_ENV, "address") if env.get(SCHEDULER_ENV, "").strip() else
+                              ("parallel", "scheduler")), "a Dask scheduler address tcp://host:port or host:port "
+                            "(e.g. tcp://10.0.0.5:8786)", repr(scheduler))
+        jobs = int(jobs) if jobs is not None else machine_cores()
+        most = JOBS_PER_CORE * machine_cores()
+        return cls(min(jobs, most), backend, scheduler, jobs if jobs > most and backend == "loky" else None)
 
     def start(self, *modules: str) -> "Runner":
         """Start the pool's worker processes now, in the background, each importing ``modules`` (those whose
@@ -144,9 +157,10 @@ class Runner:
                   else LOKY_CONFIG)
         while _STARTING:                            # workers that start() is starting: wait, then reuse them
             _STARTING.pop().join()
+        owner = os.getpid() if self.backend == "loky" else None      # a Dask worker is no child of ours
         with parallel_config(**config):
             yield from Parallel(n_jobs=jobs, return_as="generator_unordered")(
-                delayed(_timed)(i, fn, tasks[i]) for i in order)
+                delayed(_timed)(i, fn, tasks[i], owner) for i in order)
 
 
 #: joblib's settings of the local pool (one thread per worker: each run sets its own torch threads). The same in
@@ -159,7 +173,8 @@ def _start_workers(jobs: int, modules: Sequence[str]) -> None:
     A failure is left to the first :meth:`Runner.map`, which meets it again and raises it there."""
     try:
         with tempfile.TemporaryDirectory(prefix="bgfn-start-") as rendezvous, parallel_config(**LOKY_CONFIG):
-            Parallel(n_jobs=jobs)(delayed(_import_modules)(modules, rendezvous, jobs) for _ in range(jobs))
+            Parallel(n_jobs=jobs)(delayed(_import_modules)(modules, rendezvous, jobs, os.getpid())
+                                  for _ in range(jobs))
     except Exception:       # noqa: BLE001 -- only a head start: the map raises whatever went wrong, in its place
         pass
 
@@ -168,10 +183,11 @@ def _start_workers(jobs: int, modules: Sequence[str]) -> None:
 START_WAIT_S = 60.0
 
 
-def _import_modules(modules: Sequence[str], rendezvous: str, jobs: int) -> int:
+def _import_modules(modules: Sequence[str], rendezvous: str, jobs: int, owner: int | None = None) -> int:
     """Import ``modules`` in a worker (what its runs will need), then wait until ``jobs`` workers have checked in
     to the folder ``rendezvous`` (at most :data:`START_WAIT_S`), so that no worker takes two of the start tasks
     while another is still starting; its process id comes back."""
+    watch_owner(owner)
     for name in modules:
         importlib.import_module(name)
     # loky takes a worker's memory after its first task as its reference and replaces the worker once it has grown
@@ -200,11 +216,39 @@ def dispatch_order(cost: Sequence[float] | None, n: int) -> list[int]:
     return sorted(range(n), key=lambda i: -float(cost[i]))
 
 
-def _timed(i: int, fn: Callable, task: tuple) -> tuple[int, Any, float]:
-    """Run one task where the pool put it; its index and wall time come back with its result."""
+def _timed(i: int, fn: Callable, task: tuple, owner: int | None = None) -> tuple[int, Any, float]:
+    """Run one task where the pool put it; its index and wall time come back with its result. In a worker of a
+    local pool, the first task starts :func:`watch_owner` (``owner``: the process that runs the map)."""
+    watch_owner(owner)
     t0 = time.perf_counter()
     result = fn(*task)
     return i, result, time.perf_counter() - t0
+
+
+#: How often a pool worker checks that the process that started it is still there, s.
+OWNER_POLL_S = 0.5
+_WATCHING: list[int] = []
+
+
+def watch_owner(owner: int | None) -> None:
+    """In a local pool's worker: a daemon thread that ends this process once its parent is no longer ``owner`` (the
+    notebook's kernel or the command that runs the map), so that a kernel killed with SIGKILL, or a make stopped
+    with SIGTERM, leaves no worker behind (the kernel's children are reparented; loky's workers would wait for
+    tasks for minutes, each holding torch). Once per process; nothing in ``owner`` itself or without one.
+
+    Not ``prctl(PR_SET_PDEATHSIG)``: its signal comes when the *thread* that started the worker ends, and
+    :meth:`Runner.start` starts the pool from a thread that ends at once.
+    """
+    if owner is None or owner == os.getpid() or _WATCHING:
+        return
+    _WATCHING.append(owner)
+
+    def watch() -> None:
+        while os.getppid() == owner:
+            time.sleep(OWNER_POLL_S)
+        os._exit(1)         # the owner is gone: nothing waits for this worker's results
+
+    threading.Thread(target=watch, daemon=True, name="bgfn-owner-watch").start()
 
 
 def _env_jobs(text: str) -> int:

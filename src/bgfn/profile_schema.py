@@ -12,6 +12,8 @@ the drive, a possible outage sweep) run in :func:`check_with_drives`, the ``make
 from __future__ import annotations
 
 import argparse
+import difflib
+import inspect
 import os
 import re
 import sys
@@ -21,15 +23,19 @@ from bgfn.config import (DEFAULT_DATASET_KEY, MAIN_VARIANT, VARIANT_NAME, VARIAN
                          odometer_datasets, profile_chain, read_profile, set_keys, variant_config)
 from bgfn.data import load_drive
 from bgfn.data.names import profile_datasets, unique_ids
+from bgfn.data.imu_errors import EKINOX_D, MPU6000, error_params
+from bgfn.data.registry import DATASETS
 from bgfn.errors import DataError
 from bgfn.evaluate import evaluate_config
 from bgfn.studies.outage_sweep.sweep import sweep_plan
 from bgfn.learning import learning_options
 from bgfn.nav.baseline import filter_start
 from bgfn.nav.outages import check_windows, is_rule, outage_entry, picked_outages
+from bgfn.models import MODELS
 from bgfn.paper import METHOD_LABELS
-from bgfn.parallel import SCHEDULER_ENV
-from bgfn.settings import ProfileError, Train, check_model, complete, fmt, merge
+from bgfn.parallel import SCHEDULER_ENV, Runner
+from bgfn.report.run_words import runner_words
+from bgfn.settings import MAX_COUNT, Data, ProfileError, Train, check_model, complete, fmt, merge
 
 __all__ = ["ProfileError", "check_with_drives", "cross_check", "load_profile", "main", "validate", "with_overrides"]
 
@@ -80,9 +86,67 @@ def _check_outage_entries(cfg: dict) -> None:
                                f"'{DEFAULT_DATASET_KEY}' entry", f"none for {', '.join(uncovered)}")
 
 
+def _unknown(path: str, key, known) -> ProfileError:
+    """An unknown key at ``path``, with the known ones and the closest of them."""
+    close = difflib.get_close_matches(str(key), list(known), n=1, cutoff=0.6)
+    hint = f" (did you mean {path.rsplit('.', 1)[0]}.{close[0]}?)" if close else ""
+    return ProfileError(path, f"one of the keys {', '.join(sorted(known))}{hint}", "unknown key")
+
+
+def _check_drive_keys(data: dict) -> None:
+    """Each ``data.<drive>`` mapping names a registered drive and only the parameters that drive takes (their types:
+    :class:`bgfn.settings.DriveParams`); a CSV folder takes its own from its ``meta.yaml``."""
+    for name, section in data.items():
+        if name in Data.model_fields:
+            continue
+        if name not in DATASETS:
+            close = difflib.get_close_matches(str(name), list(DATASETS), n=1, cutoff=0.6)
+            raise ProfileError(f"data.{name}", "a registered drive's parameters (" + ", ".join(DATASETS) + "; a CSV "
+                               "folder's go in its meta.yaml)" + (f" (did you mean data.{close[0]}?)" if close else ""),
+                               "a mapping for a drive the data step does not know")
+        for key in section or {}:
+            if key not in DATASETS[name]:
+                raise _unknown(f"data.{name}.{key}", key, DATASETS[name])
+        try:                                    # the IMU error keys, as the data step will read them
+            error_params(EKINOX_D if "ekinox" in name else MPU6000, (section or {}).get("imu_errors") or {})
+        except DataError as exc:
+            raise ProfileError(f"data.{name}.imu_errors.{exc.field}", exc.expected, exc.found) from None
+
+
+def _check_sizes(key: str, sizes: dict) -> None:
+    """``train.sizes.<method>.<size>``: every key a keyword of the method's constructor (a misspelt one: the closest),
+    a whole number of at least 1 and at most :data:`bgfn.settings.MAX_COUNT` where the constructor takes an int."""
+    for method, blocks in (sizes or {}).items():
+        if method not in MODELS:
+            raise _unknown(f"{key}.sizes.{method}", method, MODELS)
+        params = {n: p for n, p in inspect.signature(MODELS[method]).parameters.items() if n != "self"}
+        for size, block in (blocks or {}).items():
+            where = f"{key}.sizes.{method}.{size}"
+            if not isinstance(block, dict):
+                raise ProfileError(where, "a mapping of the model's keywords", fmt(block))
+            for name, value in block.items():
+                if name not in params:
+                    raise _unknown(f"{where}.{name}", name, params)
+                default = params[name].default
+                if isinstance(default, int) and not isinstance(default, bool) and not (
+                        isinstance(value, int) and not isinstance(value, bool) and 1 <= value <= MAX_COUNT):
+                    raise ProfileError(f"{where}.{name}", f"a whole number from 1 to {MAX_COUNT:,}", fmt(value))
+
+
+def _check_runner(cfg: dict) -> None:
+    """``parallel:`` as :meth:`bgfn.parallel.Runner.of` reads it (the environment's ``JOBS=`` / ``DASK_SCHEDULER=``:
+    :func:`check_keys`)."""
+    try:
+        Runner.of(cfg, environ={})
+    except DataError as exc:
+        raise ProfileError(f"parallel.{exc.field}", exc.expected, exc.found) from None
+
+
 def cross_check(cfg: dict) -> None:
     """The facts that tie keys together and need no data; :class:`ProfileError` naming the key."""
     _check_outage_entries(cfg)
+    _check_drive_keys(cfg.get("data") or {})
+    _check_runner(cfg)
     par = cfg.get("parallel") or {}
     if par.get("backend") == "dask" and not par.get("scheduler") and not os.environ.get(SCHEDULER_ENV):
         raise ProfileError("parallel.scheduler", f"a Dask scheduler address (tcp://host:8786) with backend dask, or "
@@ -101,7 +165,7 @@ def cross_check(cfg: dict) -> None:
         bad = [m for m in methods or [] if m not in METHOD_LABELS]
         if bad:
             raise ProfileError(key, f"method ids among {', '.join(METHOD_LABELS)}", fmt(bad))
-    for key, train in (("train", tr), ("evaluate.sweep.train", {**tr, **((ev.get("sweep") or {}).get("train") or {})})):
+    for key, train in (("train", tr), ("evaluate.sweep.train", merge(tr, (ev.get("sweep") or {}).get("train") or {}))):
         size = train.get("size")
         if size is None:
             continue
@@ -111,9 +175,11 @@ def cross_check(cfg: dict) -> None:
                                    f"({', '.join((train.get('sizes') or {}).get(m) or {}) or 'none'})", fmt(size))
     sw = ev.get("sweep") or {}
     fold_train = merge(tr, sw.get("train") or {})      # the fold networks' and the odometer networks' train: sections
+    _check_sizes("train", tr.get("sizes"))
     for key, train in (("evaluate.sweep.train", fold_train),
                        ("evaluate.odometer.train", merge(fold_train, (ev.get("odometer") or {}).get("train") or {}))):
         check_model(Train, train, key)
+        _check_sizes(key, train.get("sizes"))
     if "folds" in sw and "n_starts" in sw and sw["folds"] > sw["n_starts"]:
         raise ProfileError("evaluate.sweep.folds", f"at most evaluate.sweep.n_starts = {sw['n_starts']}",
                            fmt(sw["folds"]))
@@ -225,6 +291,26 @@ def with_overrides(cfg: dict, overrides: dict[str, Any], source: str = "notebook
     return out
 
 
+def check_keys(profile: str) -> list[str]:
+    """The checks that need no data (:func:`load_profile`) and the environment's ``JOBS=`` / ``DASK_SCHEDULER=``
+    (``BGFN_JOBS``, ``DASK_SCHEDULER``) over the profile's ``parallel:``: ``make reproduce`` runs them first, before
+    the environment's install, the data and anything else (``python -m bgfn.profile_schema --keys``).
+
+    Returns
+    -------
+    list of str
+        What was checked: where the runs go (a ``jobs`` above what this machine takes is capped, and said).
+
+    Raises
+    ------
+    bgfn.errors.DataError
+        Naming the profile's file and key, or the environment variable.
+    """
+    cfg = load_profile(profile)
+    runner = Runner.of(cfg)
+    return [f"every key checked; independent runs {runner_words(runner)}"]
+
+
 def check_with_drives(profile: str) -> list[str]:
     """The checks that need the data, for ``make``'s ``check-profile`` step: each dataset of the profile loads
     (built and cached when new, as notebook 01 would), no two share a dataset id (the name of their result files,
@@ -241,6 +327,7 @@ def check_with_drives(profile: str) -> list[str]:
     bgfn.errors.DataError
         Naming the profile's file and the key.
     """
+    lines = check_keys(profile)
     cfg = load_profile(profile)
     path = profile_chain(profile)[0]
     tr, ev = cfg["train"], cfg["evaluate"]
@@ -249,7 +336,6 @@ def check_with_drives(profile: str) -> list[str]:
                           + (ev.get("sweep") or {}).get("datasets", []))
     unique_ids(list(cfg["data"].get("datasets", [])) + list(names), path)   # result files must not overwrite
     spec = cfg.get("outage_windows")
-    lines = []
     for name in names:
         drive = load_drive(name, profile=profile)
         t = drive.imu["time"].to_numpy(float)
@@ -302,9 +388,10 @@ def main(argv=None) -> int:
     """``python -m bgfn.profile_schema <profile>``: check a profile, with its data, before anything runs."""
     parser = argparse.ArgumentParser(description=main.__doc__)
     parser.add_argument("profile")
+    parser.add_argument("--keys", action="store_true", help="only what needs no data (before the install and data)")
     args = parser.parse_args(argv)
     try:
-        lines = check_with_drives(args.profile)
+        lines = check_keys(args.profile) if args.keys else check_with_drives(args.profile)
     except DataError as exc:
         print(f"error: profile {args.profile!r}: {exc}", file=sys.stderr)
         return 2

@@ -23,7 +23,9 @@ Pos = Annotated[float, Field(gt=0)]
 NonNeg = Annotated[float, Field(ge=0)]
 Fraction = Annotated[float, Field(gt=0, lt=1)]
 Seed = Annotated[int, Field(ge=0)]
-Count = Annotated[int, Field(ge=1)]
+MAX_COUNT, MAX_JOBS = 1_000_000, 1024     # the most of any count (epochs ...) and of runs at a time: no typo runs for ever
+Count = Annotated[int, Field(ge=1, le=MAX_COUNT)]
+Vec3, NonNeg3 = (Annotated[list[t], Field(min_length=3, max_length=3)] for t in (float, NonNeg))
 Names = Annotated[list[str], Field(min_length=1)]
 Seeds = Annotated[list[Seed], Field(min_length=1)]
 Method = Literal["mlp", "at_lstm", "bgfn", "transformer"]
@@ -47,7 +49,7 @@ class Section(BaseModel):
 
 
 class Parallel(Section):
-    jobs: Count | None = _f(None, "runs at a time on this machine (null: its cores); JOBS=n on make's line wins")
+    jobs: Annotated[int, Field(ge=1, le=MAX_JOBS)] | None = _f(None, "runs at a time here (null: its cores); JOBS=n wins")
     backend: Literal["loky", "dask"] = _f("loky", "loky: processes here | dask: a dask.distributed cluster")
     scheduler: str | None = _f(None, "the Dask scheduler's address with backend dask (tcp://host:8786)")
 
@@ -72,10 +74,12 @@ class DriveParams(Section):
     seed: Seed = Field(None, description="seed of the drive's simulated errors")
     imu_rate_hz: Pos = Field(None, description="IMU rate, Hz")
     gnss_rate_hz: Pos = Field(None, description="GNSS fixes per second, Hz")
-    gnss_white_std_m: Annotated[list[NonNeg], Field(min_length=3, max_length=3)] = Field(
-        None, description="white GNSS noise std (N, E, D), m")
-    gnss_correlated_std_m: Annotated[list[NonNeg], Field(min_length=3, max_length=3)] = Field(
-        None, description="Gauss-Markov GNSS error std (N, E, D), m")
+    gnss_white_std_m: NonNeg3 = Field(None, description="white GNSS noise std (N, E, D), m")
+    gnss_correlated_std_m: NonNeg3 = Field(None, description="Gauss-Markov GNSS error std (N, E, D), m")
+    lever_arm_m: Vec3 = Field(None, description="GNSS antenna in the IMU's body frame (x, y, z), m")
+    smoothing_degree: Annotated[int, Field(ge=1, le=5)] = Field(None, description="degree of the truth's splines")
+    position_sigma_m: Pos = Field(None, description="truth smoothing of the reference position, m")
+    attitude_sigma_rad: Pos = Field(None, description="truth smoothing of the attitude, rad")
     gnss_correlated_tau_s: Pos = Field(None, description="its correlation time, s")
     imu_errors: dict[str, Any] = Field(None, description="overrides of the IMU error profile's keys")
     imu_time_offset_s: Annotated[float, Field(ge=-1.0, le=1.0)] = Field(None, description="added to the IMU's time, s")
@@ -204,13 +208,10 @@ class LrSearch(Section):
     max_val_windows: Count | None = _f(None, "its tuning windows at most (null: the optimizer's)")
 
 
-_SIZES = {
-    "bgfn": {"smoke": {"dim": 16, "ffn_dim": 16, "depth": 1, "heads": 2, "time_steps": 2, "kernel_size": 3},
-             "quick": {"dim": 32, "ffn_dim": 32, "depth": 1, "heads": 4, "time_steps": 2, "kernel_size": 3},
-             "paper": {"dim": 256, "ffn_dim": 256, "depth": 4, "heads": 8, "time_steps": 4, "kernel_size": 3}},
-    "transformer": {"smoke": {"dim": 16, "ffn_dim": 16, "depth": 1, "heads": 2, "time_steps": 2, "kernel_size": 3},
-                    "quick": {"dim": 32, "ffn_dim": 32, "depth": 1, "heads": 4, "time_steps": 2, "kernel_size": 3},
-                    "paper": {"dim": 256, "ffn_dim": 256, "depth": 4, "heads": 8, "time_steps": 4, "kernel_size": 3}},
+_TOKEN_SIZES = {"smoke": {"dim": 16, "ffn_dim": 16, "depth": 1, "heads": 2, "time_steps": 2, "kernel_size": 3},
+                "quick": {"dim": 32, "ffn_dim": 32, "depth": 1, "heads": 4, "time_steps": 2, "kernel_size": 3},
+                "paper": {"dim": 256, "ffn_dim": 256, "depth": 4, "heads": 8, "time_steps": 4, "kernel_size": 3}}
+_SIZES = {"bgfn": _TOKEN_SIZES, "transformer": copy.deepcopy(_TOKEN_SIZES),      # the same sizes, not the same dict
     "at_lstm": {"smoke": {"hidden": 8, "layers": 1}, "quick": {"hidden": 32, "layers": 1},
                 "paper": {"hidden": 128, "layers": 2}},
     "mlp": {"smoke": {"n_recent": 1, "hidden": 16, "layers": 2}, "quick": {"n_recent": 1, "hidden": 64, "layers": 2},
@@ -454,10 +455,15 @@ def _error(model: type[BaseModel], err: dict, prefix: str) -> ProfileError:
         return ProfileError(path, f"one of the keys {', '.join(sorted(keys))}{hint}", found)
     if kind in _BOUND:
         bound = next(iter(ctx.values()))
-        return ProfileError(path, f"a number {_BOUND[kind]} {bound:g}", found)
+        return ProfileError(path, f"a number {_BOUND[kind]} {bound:,}" if isinstance(bound, int) else
+                            f"a number {_BOUND[kind]} {bound:g}", found)
     if kind == "literal_error":
         return ProfileError(path, f"one of {str(ctx.get('expected')).replace(' or ', ', ')}", found)
     if kind in ("too_short", "too_long"):
+        field = (_model_at(model, loc[:-1]) or model).model_fields.get(str(loc[-1]))
+        lengths = [getattr(m, k, None) for m in (field.metadata if field else []) for k in ("min_length", "max_length")]
+        if lengths.count(None) == len(lengths) - 2 and len(set(lengths) - {None}) == 1:   # a vector (N, E, D)
+            return ProfileError(path, f"a list of exactly {max(n for n in lengths if n)} numbers", found)
         n = ctx.get("min_length") if kind == "too_short" else ctx.get("max_length")
         return ProfileError(path, f"a list of {'at least' if kind == 'too_short' else 'at most'} {n} item(s)", found)
     return ProfileError(path, _EXPECT.get(kind, err.get("msg", "a valid value")), found)
@@ -530,8 +536,7 @@ def _check_free(cfg: dict) -> None:
             hint = f" (did you mean data.{close[0]}?)" if close else ""
             raise ProfileError(f"data.{key}", f"one of the keys {', '.join(sorted(Data.model_fields))} or a drive's "
                                f"parameters (a mapping){hint}", fmt(value))
-        if key == "rtklib-drive0708":
-            check_model(DriveParams, value, f"data.{key}")
+        check_model(DriveParams, value, f"data.{key}")   # which keys a drive takes: the edge's check
 
 
 def merge(base: dict, override: dict) -> dict:

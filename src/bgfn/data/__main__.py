@@ -48,6 +48,7 @@ def main(argv: list[str] | None = None) -> int:
                        "$BGFN_RTKLIB_MIRROR or <repo>/../shared/data/rtklib-drive0708)")
     fetch.add_argument("--no-download", action="store_true", help="do not try the pinned URL")
     fetch.add_argument("--timeout", type=float, default=30.0, help="network timeout, s")
+    fetch.add_argument("-v", "--verbose", action="store_true", help="also what was tried for an absent optional file")
     fp = sub.add_parser("fingerprint", help="fingerprint of a profile's CSV drives (their files' sizes and times)")
     fp.add_argument("profile")
     fp.add_argument("--write", default=None, help="store it in this file when it changed (make's stamp)")
@@ -58,7 +59,8 @@ def main(argv: list[str] | None = None) -> int:
         except DataError as exc:
             print(f"error: {exc}", file=sys.stderr)
             return 2
-    logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
+    logging.basicConfig(level=logging.DEBUG if args.verbose else logging.INFO,
+                        format="%(levelname)s %(name)s: %(message)s")
     try:
         resolved = fetch_all(data_dir=args.data_dir, mirror=args.mirror, rtklib_mirror=args.rtklib_mirror,
                              download=not args.no_download, timeout_s=args.timeout)
@@ -66,17 +68,18 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     status = 0
+    absent: dict[str, list[str]] = {}        # optional files missing, by what stands in for them: one line each
     for res in resolved:
         spec = raw_files()[res.name]
-        required = spec.required
         if res.path is not None:
             print(f"{res.name:18s} {res.origin:8s} {res.checksum}  <- {res.detail}")
+        elif spec.required:
+            print(f"{res.name:18s} REQUIRED, missing: {res.detail}")
+            status = 1
         else:
-            if required:
-                print(f"{res.name:18s} REQUIRED, missing: {res.detail}")
-                status = 1
-            else:  # the details are in the warning logged by fetch_all
-                print(f"{res.name:18s} optional, missing: {spec.when_missing}")
+            absent.setdefault(spec.when_missing, []).append(res.name)
+    for when_missing, names in absent.items():
+        print(f"optional, absent: {', '.join(names)} -- {when_missing} (what was tried: python -m bgfn.data fetch -v)")
     return status
 
 

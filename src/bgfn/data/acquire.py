@@ -110,9 +110,6 @@ def raw_files() -> dict[str, RawFile]:
     return {**NAVEGO_FILES, **RTKLIB_FILES}
 
 
-_reported_missing: set[str] = set()
-
-
 class MissingFileError(DataError, FileNotFoundError):
     """A NaveGo file is in none of ``data/raw``, the mirror and the pinned URL."""
 
@@ -324,18 +321,11 @@ def require(name: str, **kwargs) -> Path:
     return res.path
 
 
-def report_missing_once(name: str, detail: str) -> None:
-    """Log (once per process and file) that an optional file is absent, and what stands in."""
-    if name not in _reported_missing:
-        _reported_missing.add(name)
-        spec = raw_files()[name]
-        log.warning("optional %s file %s is not available (%s); %s", spec.source, name, detail, spec.when_missing)
-
-
 def fetch_all(*, data_dir: str | Path | None = None, mirror: str | Path | None = None,
               rtklib_mirror: str | Path | None = None, download: bool = True,
               timeout_s: float = 30.0) -> list[Resolved]:
-    """Resolve all pinned files (see :func:`resolve`); an absent optional file is logged once.
+    """Resolve all pinned files (see :func:`resolve`); what was tried for an absent optional file is logged at the
+    debug level (its absence is the caller's one line).
 
     Parameters
     ----------
@@ -351,7 +341,7 @@ def fetch_all(*, data_dir: str | Path | None = None, mirror: str | Path | None =
     for name, spec in raw_files().items():
         folder = rtklib_mirror if name in RTKLIB_FILES else mirror
         res = resolve(name, data_dir=data_dir, mirror=folder, download=download, timeout_s=timeout_s)
-        if res.path is None and not spec.required:
-            report_missing_once(name, res.detail)
+        if res.path is None and not spec.required:   # the caller says so in one line (python -m bgfn.data fetch)
+            log.debug("optional %s file %s is not available (%s)", spec.source, name, res.detail)
         out.append(res)
     return out

@@ -5,6 +5,7 @@ one dataset and seed) and on which evaluation windows (BGFN's validation windows
 from __future__ import annotations
 
 import json
+import shlex
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -16,7 +17,7 @@ from bgfn.data.names import dataset_id
 from bgfn.errors import DataError
 from bgfn.learning import WindowSet
 from bgfn.train import TrainedModel, even_subset, load_trained, prepare_learning_data
-from bgfn.train.checkpoints import card_path, checkpoint_path, parse_checkpoint
+from bgfn.train.checkpoints import card_path, checkpoint_path, parse_checkpoint, retrain_command
 
 # ---------------------------------------------------------------------------------------------------
 # Which trained networks the energy estimate measures: BGFN and its Transformer twin of one dataset and seed.
@@ -52,8 +53,9 @@ def energy_checkpoint(profile: str, method: str, cfg: dict | None = None, datase
     if must_exist and not path.is_file():
         raise FileNotFoundError(
             f"trained {method} model not found: {path} -- notebook 03_bgfn_training.ipynb writes it "
-            f"(run `make reproduce PROFILE={profile}`, or `python -m bgfn train --profile {profile} "
-            f"--dataset {dataset} --method {method} --seed {int(seed)}`)")
+            f"(`python -m bgfn train --profile {profile} --dataset {shlex.quote(str(dataset))} --method {method} "
+            f"--seed {int(seed)}` "
+            f"trains it alone; or `{retrain_command(path)}` runs notebook 03 and every later one again)")
     return path
 
 

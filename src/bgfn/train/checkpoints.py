@@ -148,13 +148,42 @@ def read_checkpoint(path: str | Path, map_location: Any = "cpu") -> dict:
     path = Path(path)
     try:
         ck = torch.load(path, map_location=map_location, weights_only=True)
-    except (pickle.UnpicklingError, RuntimeError, EOFError, zipfile.BadZipFile, ValueError, OSError) as exc:
-        raise DataError(path, "checkpoint", f"a checkpoint written by bgfn.train (delete it and run "
-                        f"`make reproduce PROFILE={_profile_of(path)}` to train it again)",
+    except (pickle.UnpicklingError, RuntimeError, EOFError, zipfile.BadZipFile, ValueError, OSError, IndexError,
+            KeyError, TypeError, AttributeError) as exc:       # a truncated pickle fails in any of these ways
+        raise DataError(path, "checkpoint", f"a checkpoint written by bgfn.train (to train it again, delete it and "
+                        f"the executed notebook that trains it, so that make runs that notebook and every later one "
+                        f"again: `{retrain_command(path)}`)",
                         f"{type(exc).__name__}: {str(exc).splitlines()[0][:200] if str(exc) else 'unreadable'}") from None
     if not isinstance(ck, dict):
         raise DataError(path, "checkpoint", "a dict written by bgfn.train", type(ck).__name__)
     return ck
+
+
+def writer_notebook(path: str | Path) -> str:
+    """The notebook that trains the network at ``path`` (under ``results/<profile>/models/``): a sweep fold's
+    learned odometers 07, a sweep fold's networks 06, every other (the profile's own, its variants, the
+    all-windows rechecks, their learning-rate searches) 03."""
+    parts = Path(path).parts
+    folds = [i for i, p in enumerate(parts) if _FOLD_RE.match(p)]
+    if folds and ODOMETER_DIR in parts[folds[-1]:]:
+        return "07_learned_odometer"
+    return "06_outage_sweep" if folds else "03_bgfn_training"
+
+
+def retrain_command(path: str | Path) -> str:
+    """The shell line that trains the network at ``path`` again: delete it and the executed notebook that trains it
+    (:func:`writer_notebook`; make then reruns it and what follows), then ``make reproduce`` (paths relative to the
+    repository)."""
+    profile = _profile_of(Path(path))
+    executed = config.RESULTS_ROOT / profile / "notebooks" / f"{writer_notebook(path)}.ipynb"
+
+    def shown(p: Path) -> str:
+        try:
+            return p.resolve().relative_to(config.PROJECT_ROOT.resolve()).as_posix()
+        except ValueError:
+            return p.as_posix()
+
+    return f"rm -f {shown(Path(path))} {shown(executed)} && make reproduce PROFILE={profile}"
 
 
 def _profile_of(path: Path) -> str:

@@ -11,11 +11,13 @@ from bgfn import learning as L, train as T
 from bgfn.errors import DataError
 from bgfn.parallel import PROGRESS_ENV, Runner, RunProgress, dispatch_order
 from bgfn.profile_schema import load_profile
-from bgfn.report.run_words import runner_words
 
 
 # ----------------------------------------------------------------------------------------------- settings
 def test_the_profile_says_where_the_runs_go_and_the_environment_wins():
+    # imported here, not at the top: the pool's workers import this module, and the report layer is heavy to import
+    from bgfn.report.run_words import runner_words
+
     assert Runner.of({"parallel": {"jobs": 3}}, environ={}) == Runner(3, "loky", None)
     assert Runner.of({}, environ={}).jobs >= 1                                  # null: the cores here
     assert Runner.of({"parallel": {"jobs": 3}}, environ={"BGFN_JOBS": "1"}).jobs == 1

@@ -139,24 +139,41 @@ def _imported_names(tree: ast.AST, module: str | None, is_package: bool) -> set[
     return {n for n in names if n == PACKAGE or n.startswith(PACKAGE + ".")}
 
 
+_DIRECT: dict[tuple[Path, str], tuple[Path | None, set[str]]] = {}
+
+
+def _direct_imports(src: Path, name: str) -> tuple[Path | None, set[str]]:
+    """Module ``name``'s file under ``src`` and the package's modules it names (parsed once per run)."""
+    key = (src, name)
+    if key not in _DIRECT:
+        path = _module_file(src, name)
+        names: set[str] = set()
+        if path is not None:
+            tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+            names = _imported_names(tree, name, path.name == "__init__.py")
+        _DIRECT[key] = (path, names)
+    return _DIRECT[key]
+
+
 def module_closure(src: Path, roots: set[str]) -> list[Path]:
     """The files of ``roots`` and of every module of the package they import, transitively (a module's parent
     packages too: importing ``a.b`` runs ``a/__init__.py``)."""
     seen: dict[str, Path] = {}
+    done: set[str] = set()
     todo = sorted(roots)
     while todo:
         name = todo.pop()
         parts = name.split(".")
         for i in range(1, len(parts) + 1):          # the parents first: each is imported on the way
             sub = ".".join(parts[:i])
-            if sub in seen:
+            if sub in done:
                 continue
-            path = _module_file(src, sub)
+            done.add(sub)
+            path, names = _direct_imports(src, sub)
             if path is None:
                 continue                            # an attribute imported from a module, not a module
             seen[sub] = path
-            tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
-            todo.extend(_imported_names(tree, sub, path.name == "__init__.py") - set(seen))
+            todo.extend(names - done)
     return sorted(seen.values())
 
 

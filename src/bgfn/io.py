@@ -32,9 +32,23 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     try:
         yield tmp
         os.replace(tmp, path)
+        _log_output(path)
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+#: Environment variable naming a file to which every completed output's absolute path is appended (one line each):
+#: ``make`` sets it per notebook, so that a notebook that fails has its own outputs removed and not those of a
+#: notebook running beside it.
+OUTPUT_LOG_ENV = "BGFN_OUTPUT_LOG"
+
+
+def _log_output(path: Path) -> None:
+    log = os.environ.get(OUTPUT_LOG_ENV)
+    if log:
+        with open(log, "a", encoding="utf-8") as fh:    # one short line per write: appends do not interleave
+            fh.write(os.path.abspath(path) + "\n")
 
 
 def atomic_write_bytes(path: str | Path, data: bytes) -> Path:

@@ -92,6 +92,10 @@ export PYTHONHASHSEED := 0
 # core (90 of its 150 s on a 2-core machine).
 export PYTHONDONTWRITEBYTECODE :=
 export BGFN_JOBS := $(JOBS)
+# Results computed once per input and kept for the next notebook that needs them (bgfn.io.cached: each drive's
+# GPS-aided run, keyed by the drive's content, the nav: settings and the code): notebooks 03 and 06 take the INS
+# attitude from the same run, notebook 08 the runs of notebook 02.
+export BGFN_CACHE_DIR := $(CURDIR)/$(RES)/cache
 export DASK_SCHEDULER
 # the venv's IPython kernel configuration (tools/ipython_kernel_config.py, installed by `make venv`)
 KERNEL_CONFIG := $(VENV)/etc/ipython/ipython_kernel_config.py
@@ -165,9 +169,11 @@ data: $(STAMP)
 
 # ---------------------------------------------------------------- notebooks
 # papermill writes to a temporary name; only a complete run is renamed to the target, so a failed run leaves
-# no executed notebook behind (and Make redoes it next time), and the tables, figures and arrays it wrote (every
-# file of $(RES) newer than its start, outside models/ and logs/) are removed: no half of a notebook's outputs
-# stays beside the other half's older copies. Its networks stay: they are checkpoints a rerun resumes from. The notebook's runner (bgfn.parallel) writes one
+# no executed notebook behind (and Make redoes it next time), and the tables, figures and arrays it wrote (the files
+# bgfn.io logged for it and, when no other notebook ran beside it, every file of $(RES) newer than its start;
+# outside models/, logs/ and cache/) are removed: no half of a notebook's outputs stays beside the other half's
+# older copies. Its networks stay: they are checkpoints a rerun resumes from; so do the complete cache entries.
+# The notebook's runner (bgfn.parallel) writes one
 # line per finished run to $(RES)/logs/<notebook>.log (BGFN_PROGRESS_LOG); `tail` shows them here as they come
 # (the first on a line of its own, below papermill's cell bar)
 # and stops after this recipe's shell ($$$$) has ended, having shown the last ones.
@@ -190,7 +196,7 @@ $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(STAMP) | data $(KERNEL_CONFIG) cle
 	else rm -f "$$tmp"; \
 	  others=$$(find "$(RES)/logs" -name '.started-*' -not -name ".started-$*" | head -1); \
 	  { sort -u "$$written"; if [ -z "$$others" ]; then find "$(CURDIR)/$(RES)" -type f -newer "$$started"; fi; } | \
-	    grep -e "^$(CURDIR)/$(RES)/" | grep -v -e "^$(CURDIR)/$(RES)/models/" -e "^$(CURDIR)/$(RES)/logs/" \
+	    grep -e "^$(CURDIR)/$(RES)/" | grep -v -e "^$(CURDIR)/$(RES)/models/" -e "^$(CURDIR)/$(RES)/logs/" -e "^$(CURDIR)/$(RES)/cache/" \
 	      -e '/\.lock$$' | sort -u | while IFS= read -r f; do if [ -f "$$f" ]; then rm -f -- "$$f"; \
 	      echo "    removed a partial output of the failed notebook: $${f#$(CURDIR)/}"; fi; done; \
 	  rm -f "$$started"; \

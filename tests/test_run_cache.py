@@ -108,3 +108,19 @@ def test_the_content_hash_sees_every_value_and_not_the_key_order():
     assert content_hash(frame) != content_hash(other)
     assert content_hash([1.0, 2.0]) != content_hash([2.0, 1.0])
     assert content_hash(np.zeros(3)) != content_hash(np.zeros(3, dtype=np.float32))
+
+
+def test_cached_windows_are_the_windows_built_again(tmp_path, monkeypatch):
+    from bgfn import learning as L
+
+    imu, att, gnss = L.synthetic_tables(duration_s=200.0, noise=0.1, seed=3)
+    options = {"window": 50, "val_fraction": 0.2}
+    fresh = L.build_learning_data(imu, att, gnss, [(1100.0, 20.0)], **options)
+    monkeypatch.setenv(CACHE_DIR_ENV, str(tmp_path))
+    first = L.build_learning_data(imu, att, gnss, [(1100.0, 20.0)], **options)
+    again = L.build_learning_data(imu, att, gnss, [(1100.0, 20.0)], **options)
+    assert len(list((tmp_path / "learning_data").glob("*.pkl"))) == 1
+    _same(fresh, first)
+    _same(fresh, again)
+    other = L.build_learning_data(imu, att, gnss, [(1100.0, 20.0)], **{**options, "window": 40})
+    assert other.train.x.shape[1] == 40 and len(list((tmp_path / "learning_data").glob("*.pkl"))) == 2

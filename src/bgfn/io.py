@@ -175,13 +175,16 @@ def _feed(h, obj: Any) -> None:
     h.update(b";")
 
 
-def cached(kind: str, key: Any, compute: Callable[[], T]) -> T:
+def cached(kind: str, key: Any | Callable[[], Any], compute: Callable[[], T]) -> T:
     """``compute()``, kept on disk under ``<$BGFN_CACHE_DIR>/<kind>/<hash of key>.pkl`` and read back (the same
     object, bit for bit) when asked for again with the same ``key``. ``key`` must hold every input of the result
     (its data's :func:`content_hash`, its settings, the version of the code: :func:`sources_hash`); None, or no
-    ``BGFN_CACHE_DIR``: computed every time. A cache entry is only ever written by this process's own code
-    (results/<profile>/cache/), as :func:`bgfn.evaluate.kept_results` reads notebook 04's runs."""
+    ``BGFN_CACHE_DIR``: computed every time. ``key`` may be a function returning it: then called only when there is
+    a cache. A cache entry is only ever written by this code (results/<profile>/cache/), as
+    :func:`bgfn.evaluate.kept_results` reads notebook 04's runs."""
     root = os.environ.get(CACHE_DIR_ENV)
+    if root and callable(key):
+        key = key()
     if not root or key is None:
         return compute()
     digest = content_hash({"kind": kind, "key": key})

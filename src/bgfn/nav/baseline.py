@@ -168,7 +168,7 @@ def run_drive(drive, section: dict | None = None, snapshots: dict | None = None)
                           aids=gps_aids(drive, cfg, initial, noise))
 
     # computed once per drive and settings: notebooks 03, 06 and the studies take the INS attitude from it
-    return cached("gps_aided_run", run_key(drive, cfg, snapshots=snapshots), compute)
+    return cached("gps_aided_run", lambda: run_key(drive, cfg, snapshots=snapshots), compute)
 
 
 @dataclass
@@ -405,7 +405,7 @@ def run_baseline(drive, cfg: dict, windows) -> Baseline:
     Baseline
     """
     # computed once per drive, settings and outages: notebook 02 runs it, notebook 08 takes the same runs
-    return cached("baseline", run_key(drive, cfg, windows=[tuple(map(float, w)) for w in windows]),
+    return cached("baseline", lambda: run_key(drive, cfg, windows=[tuple(map(float, w)) for w in windows]),
                   lambda: _run_baseline(drive, cfg, windows))
 
 

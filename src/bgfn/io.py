@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any, Callable, Iterator, TypeVar
 
 import numpy as np
+import pandas as pd
 
 
 @contextlib.contextmanager
@@ -142,8 +143,6 @@ def content_hash(obj: Any) -> str:
 
 
 def _feed(h, obj: Any) -> None:
-    import pandas as pd   # a core module: pandas only where a frame is hashed
-
     if isinstance(obj, dict):
         h.update(b"{")
         for key in sorted(obj, key=str):

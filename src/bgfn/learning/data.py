@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from bgfn import settings
@@ -79,8 +80,6 @@ LEARNING_CACHE_VERSION = 1
 
 def _learning_key(imu, attitude, gnss, outage_windows, opt: dict) -> dict:
     """The key of :func:`build_learning_data`'s result: its tables' content, the outages, the options, the code."""
-    import numpy as np
-
     here = Path(__file__).resolve().parent
     core = here.parent
     code = sources_hash(sorted(here.glob("*.py")) + [core / "nav" / f"{m}.py" for m in ("earth", "transform", "odometer")]

@@ -29,6 +29,7 @@ import copy
 from dataclasses import dataclass
 from pathlib import Path
 
+import numba
 import numpy as np
 import pandas as pd
 
@@ -136,8 +137,6 @@ def _code_version() -> str:
 def run_key(drive, cfg: dict, **inputs) -> dict:
     """The key of a GPS-aided run of ``drive`` (:func:`bgfn.io.cached`): the drive's content (truth, IMU, GNSS,
     bias, facts), the ``nav:`` settings, the run's other ``inputs``, the code and the numerical libraries."""
-    import numba
-
     return {"drive": content_hash({"name": drive.name, "reference": drive.reference, "imu": drive.imu,
                                    "gnss": drive.gnss, "imu_bias": drive.imu_bias, "meta": drive.meta}),
             "nav": cfg, **inputs, "code": _code_version(), "version": RUN_CACHE_VERSION,

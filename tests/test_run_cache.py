@@ -86,6 +86,8 @@ def test_a_changed_input_is_computed_again(drive, tmp_path, monkeypatch):
     gnss.loc[5, "lat"] += 1e-9                                     # one fix, a millimetre off
     moved = baseline.run_baseline(Drive(drive.name, drive.reference, drive.imu, gnss, drive.meta), cfg, WINDOWS)
     assert len(list((tmp_path / "baseline").glob("*.pkl"))) == 4   # four inputs, four entries
+    baseline.run_baseline(drive, cfg, WINDOWS[1:], keep=False)     # another setup, read once: not kept
+    assert len(list((tmp_path / "baseline").glob("*.pkl"))) == 4
     _same(moved, baseline.run_baseline(Drive(drive.name, drive.reference, drive.imu, gnss, drive.meta), cfg, WINDOWS))
 
 
@@ -115,12 +117,14 @@ def test_cached_windows_are_the_windows_built_again(tmp_path, monkeypatch):
 
     imu, att, gnss = L.synthetic_tables(duration_s=200.0, noise=0.1, seed=3)
     options = {"window": 50, "val_fraction": 0.2}
-    fresh = L.build_learning_data(imu, att, gnss, [(1100.0, 20.0)], **options)
+    fresh = L.build_learning_data(imu, att, gnss, [(1100.0, 20.0)], keep=True, **options)
     monkeypatch.setenv(CACHE_DIR_ENV, str(tmp_path))
-    first = L.build_learning_data(imu, att, gnss, [(1100.0, 20.0)], **options)
-    again = L.build_learning_data(imu, att, gnss, [(1100.0, 20.0)], **options)
+    L.build_learning_data(imu, att, gnss, [(1100.0, 20.0)], **options)      # a sweep fold's: not kept
+    assert not (tmp_path / "learning_data").exists()
+    first = L.build_learning_data(imu, att, gnss, [(1100.0, 20.0)], keep=True, **options)
+    again = L.build_learning_data(imu, att, gnss, [(1100.0, 20.0)], keep=True, **options)
     assert len(list((tmp_path / "learning_data").glob("*.pkl"))) == 1
     _same(fresh, first)
     _same(fresh, again)
-    other = L.build_learning_data(imu, att, gnss, [(1100.0, 20.0)], **{**options, "window": 40})
+    other = L.build_learning_data(imu, att, gnss, [(1100.0, 20.0)], keep=True, **{**options, "window": 40})
     assert other.train.x.shape[1] == 40 and len(list((tmp_path / "learning_data").glob("*.pkl"))) == 2

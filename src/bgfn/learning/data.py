@@ -50,7 +50,7 @@ def all_windows(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.DataFrame, *
 
 
 def build_learning_data(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.DataFrame, outage_windows=(),
-                        **options) -> LearningData:
+                        keep: bool = False, **options) -> LearningData:
     """Windows, split and normalization in one call.
 
     Parameters
@@ -60,6 +60,9 @@ def build_learning_data(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.Data
     outage_windows : sequence of (start, duration)
         Evaluation outages (s) excluded from training and validation (``protocol='honest'``; with ``'leaky'``
         only from validation: :func:`bgfn.learning.split_windows`).
+    keep : bool
+        Keep the result on disk for the next caller with the same inputs (:func:`bgfn.io.cached`): the profile's own
+        windows (:func:`bgfn.train.prepare_learning_data`); not a sweep fold's or a variant's, read once.
     **options
         ``window``, ``alignment``, ``yaw_encoding``, ``target_frame``, ``extra_channels``, ``epoch_stride``,
         ``margin_s``, ``val_fraction``, ``val_position``, ``target_screen_sigma``, ``protocol`` (defaults:
@@ -69,7 +72,9 @@ def build_learning_data(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.Data
     if unknown:
         raise DataError("train", sorted(unknown)[0], f"one of {', '.join(LEARNING_DEFAULTS)}")
     opt = learning_options(options)
-    # built once per drive, INS solution, outages and options: notebooks 03 and 06 (and the studies) share them
+    if not keep:
+        return _build(imu, attitude, gnss, outage_windows, opt)
+    # built once per drive, INS solution, outages and options: notebooks 03, 04, 05 and 06 share the profile's
     return cached("learning_data", lambda: _learning_key(imu, attitude, gnss, outage_windows, opt),
                   lambda: _build(imu, attitude, gnss, outage_windows, opt))
 

@@ -387,7 +387,7 @@ class Baseline:
                 f"{c['zupt_epochs']} of them ZUPT (still {100 * c['still_fraction']:.0f} % of the IMU rows)"]
 
 
-def run_baseline(drive, cfg: dict, windows) -> Baseline:
+def run_baseline(drive, cfg: dict, windows, keep: bool = True) -> Baseline:
     """Full-drive GPS/INS run, then the standalone INS in each outage from the saved state at its start, without
     and with the vehicle constraints (``INS``, ``INS+NHC``: :func:`outage_constraints`).
 
@@ -398,11 +398,16 @@ def run_baseline(drive, cfg: dict, windows) -> Baseline:
         Output of :func:`nav_config`.
     windows : sequence of (start, duration)
         The outages, s (:func:`bgfn.nav.outages.outage_windows`).
+    keep : bool
+        Keep the run on disk for the next caller with the same inputs (:func:`bgfn.io.cached`): the profile's own
+        runs (notebooks 02 and 08); another filter setup, read once, passes False.
 
     Returns
     -------
     Baseline
     """
+    if not keep:
+        return _run_baseline(drive, cfg, windows)
     # computed once per drive, settings and outages: notebook 02 runs it, notebook 08 takes the same runs
     return cached("baseline", lambda: run_key(drive, cfg, windows=[tuple(map(float, w)) for w in windows]),
                   lambda: _run_baseline(drive, cfg, windows))
@@ -548,7 +553,7 @@ def gate_comparison(drive, cfg: dict, windows, probability: float, baseline: Bas
         cfg = {**cfg, "noise_scale": baseline.setup.noise_scale}
     for gate in (None, probability):
         same = baseline is not None and gate == cfg["innovation_gate"]
-        b = baseline if same else run_baseline(drive, {**cfg, "innovation_gate": gate}, windows)
+        b = baseline if same else run_baseline(drive, {**cfg, "innovation_gate": gate}, windows, keep=False)
         upd = b.full.updates
         row = {"dataset": drive.name, "innovation_gate": "none" if gate is None else f"{gate:g}",
                "gnss_fixes": int(len(upd)), "gnss_rejected": int((~upd["accepted"]).sum()),

@@ -48,7 +48,7 @@ def run_log(log: GalleryLog, folder: Path, cfg: dict) -> GalleryRun:
     folder = Path(folder).resolve()
     drive = load_drive(folder)
     windows = outage_windows(cfg, drive, str(folder))
-    b = run_baseline(drive, nav_config(cfg["nav"]), windows)
+    b = run_baseline(drive, nav_config(cfg["nav"]), windows, keep=False)   # a gallery log: read once
     decisions = []
     if "gnss_offset" in drive.meta:            # the clocks (with gnss_latency_s: auto, the latency taken off)
         decisions.append(f"{drive.name}: {drive.meta['gnss_offset']['line']}")

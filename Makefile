@@ -8,8 +8,9 @@
 #   make bench | make strip | make clean | make distclean | make lock | make help
 #
 # Make's file dependencies keep a second `make reproduce` cheap: an executed notebook is redone only when its
-# source notebook, params/$(PROFILE).yaml, a src/bgfn/*.py file, the environment or the previous executed
-# notebook changed; the book only when an executed notebook or a book source changed.
+# source notebook, a profile section it reads, a src/bgfn module it imports, the environment or an executed
+# notebook whose outputs it reads changed (tools/notebook_deps.py); the book only when an executed notebook or a
+# book source changed. Notebooks that read none of each other's outputs run side by side (NOTEBOOK_SLOTS).
 
 SHELL := bash
 .SHELLFLAGS := -eu -o pipefail -c
@@ -107,6 +108,10 @@ export PYTHONHASHSEED := 0
 # core (90 of its 150 s on a 2-core machine).
 export PYTHONDONTWRITEBYTECODE :=
 export BGFN_JOBS := $(JOBS)
+# Results computed once per input and kept for the next notebook that needs them (bgfn.io.cached: each drive's
+# GPS-aided run, keyed by the drive's content, the nav: settings and the code): notebooks 03 and 06 take the INS
+# attitude from the same run, notebook 08 the runs of notebook 02.
+export BGFN_CACHE_DIR := $(CURDIR)/$(RES)/cache
 export DASK_SCHEDULER
 # the venv's IPython kernel configuration (tools/ipython_kernel_config.py, installed by `make venv`)
 KERNEL_CONFIG := $(VENV)/etc/ipython/ipython_kernel_config.py
@@ -175,25 +180,36 @@ data: $(STAMP)
 
 # ---------------------------------------------------------------- notebooks
 # papermill writes to a temporary name; only a complete run is renamed to the target, so a failed run leaves
-# no executed notebook behind (and Make redoes it next time), and the tables, figures and arrays it wrote (every
-# file of $(RES) newer than its start, outside models/ and logs/) are removed: no half of a notebook's outputs
-# stays beside the other half's older copies. Its networks stay: they are checkpoints a rerun resumes from. The notebook's runner (bgfn.parallel) writes one
+# no executed notebook behind (and Make redoes it next time), and the tables, figures and arrays it wrote (the files
+# bgfn.io logged for it and, when no other notebook ran beside it, every file of $(RES) newer than its start;
+# outside models/, logs/ and cache/) are removed: no half of a notebook's outputs stays beside the other half's
+# older copies. Its networks stay: they are checkpoints a rerun resumes from; so do the complete cache entries.
+# The notebook's runner (bgfn.parallel) writes one
 # line per finished run to $(RES)/logs/<notebook>.log (BGFN_PROGRESS_LOG); `tail` shows them here as they come
 # (the first on a line of its own, below papermill's cell bar)
 # and stops after this recipe's shell ($$$$) has ended, having shown the last ones.
-$(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(PARAMS) $(SRC) $(STAMP) | data $(KERNEL_CONFIG)
+# Each notebook also depends on the profile sections it reads and the modules it imports ($(RES)/.deps.mk,
+# below), not on the whole profile and every src/bgfn file. Notebooks run side by side (-j, NOTEBOOK_SLOTS): each
+# line a notebook prints then starts with its number, and its outputs (bgfn.io logs each file it writes to
+# $(RES)/logs/<notebook>.written, BGFN_OUTPUT_LOG) are told apart from its neighbours' when it fails.
+# Debris of an interrupted run is removed once, before the first notebook (clean-debris, order-only).
+$(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(STAMP) | data $(KERNEL_CONFIG) clean-debris $(RES)/.profile-checked
 	@mkdir -p $(@D) $(RES)/logs
-	@$(MAKE) clean-debris
 	@echo "==> [$(PROFILE)] papermill $<"
 	@tmp="$(@D)/.$*.running-$$$$.ipynb"; log="$(RES)/logs/$*.log"; : > "$$log"; \
-	started="$(RES)/logs/.started-$*"; touch "$$started"; \
-	tail --pid=$$$$ -s 0.5 -n +1 -f "$$log" 2>/dev/null | sed -u 's/^/    /; 1s/^/\n/' & \
-	if BGFN_PROGRESS_LOG="$(CURDIR)/$$log" $(VENV_ABS)/bin/papermill "$<" "$$tmp" -p profile $(PROFILE) \
-	     --cwd "$(CURDIR)" -k python3 --progress-bar $(PAPERMILL_FLAGS); then \
+	started="$(RES)/logs/.started-$*"; touch "$$started"; written="$(RES)/logs/$*.written"; : > "$$written"; \
+	run() { BGFN_PROGRESS_LOG="$(CURDIR)/$$log" BGFN_OUTPUT_LOG="$(CURDIR)/$$written" \
+	  $(VENV_ABS)/bin/papermill "$<" "$$tmp" -p profile $(PROFILE) --cwd "$(CURDIR)" -k python3 "$$@" $(PAPERMILL_FLAGS); }; \
+	if [[ "$(MAKEFLAGS)" =~ (^|[[:space:]])-j([^1]|1[0-9]) ]]; then prefix="[$*] "; else prefix=""; fi; \
+	tail --pid=$$$$ -s 0.5 -n +1 -f "$$log" 2>/dev/null | sed -u "s/^/    $$prefix/; 1s/^/\n/" & \
+	if if [ -z "$$prefix" ]; then run --progress-bar; else run --no-progress-bar 2>&1 | sed -u "s/^/$$prefix/"; fi; then \
 	  mv -f "$$tmp" "$@"; rm -f "$$started"; \
 	else rm -f "$$tmp"; \
-	  find "$(RES)" -type f -newer "$$started" -not -path "$(RES)/models/*" -not -path "$(RES)/logs/*" \
-	    -not -name .lock -print -delete | sed 's/^/    removed a partial output of the failed notebook: /'; \
+	  others=$$(find "$(RES)/logs" -name '.started-*' -not -name ".started-$*" | head -1); \
+	  { sort -u "$$written"; if [ -z "$$others" ]; then find "$(CURDIR)/$(RES)" -type f -newer "$$started"; fi; } | \
+	    grep -e "^$(CURDIR)/$(RES)/" | grep -v -e "^$(CURDIR)/$(RES)/models/" -e "^$(CURDIR)/$(RES)/logs/" -e "^$(CURDIR)/$(RES)/cache/" \
+	      -e '/\.lock$$' | sort -u | while IFS= read -r f; do if [ -f "$$f" ]; then rm -f -- "$$f"; \
+	      echo "    removed a partial output of the failed notebook: $${f#$(CURDIR)/}"; fi; done; \
 	  rm -f "$$started"; \
 	  echo "error: $< failed under PROFILE=$(PROFILE); nothing written to $@, and none of its tables, figures or" \
 	       "arrays kept (its networks stay in $(RES)/models/: training resumes; log: $$log)" >&2; \
@@ -216,36 +232,57 @@ $(RES)/.profile-checked: $(PARAMS) $(SRC) $(STAMP) | data
 	@echo "==> [$(PROFILE)] numba kernels into the cache, in the background ($(RES)/logs/kernels.log)"
 	@$(PY) -m bgfn kernels --profile $(PROFILE) > $(RES)/logs/kernels.log 2>&1 < /dev/null 9>&- &
 	@touch $@
-$(RES)/notebooks/01_data_prep.ipynb: $(RES)/.profile-checked $(RES)/.data-fingerprint
+$(RES)/notebooks/01_data_prep.ipynb: $(RES)/.data-fingerprint
 
-# The profile's own CSV drives (a folder in `datasets:`): their files' sizes and times, rewritten only when they
-# changed (python -m bgfn.data fingerprint), so an edited or touched drive reruns every notebook, and only then.
-$(RES)/.data-fingerprint: FORCE | $(STAMP)
-	@mkdir -p $(@D) && $(PY) -m bgfn.data fingerprint $(PROFILE) --write $@ > /dev/null
+# What each notebook reads of the profile and which modules it imports: $(RES)/.deps.mk, remade by
+# tools/notebook_deps.py on every run of the notebooks (an included makefile: make remakes it first, even under
+# -n). The script writes each resolved profile section to $(RES)/.sections/<section>.json and the fingerprint of
+# the profile's own CSV drives (a folder in `datasets:`: their files' sizes and times) to $(RES)/.data-fingerprint,
+# each only when it changed: an edited setting reruns the notebooks that read it, an edited or touched drive
+# every notebook (through 01), and nothing else does.
+DEPS_MK := $(RES)/.deps.mk
+# a dry run (make -n): its flags' first word holds an n
+DRY = $(findstring n,$(filter-out --% %=%,$(firstword $(MAKEFLAGS))))
+ifneq ($(filter _reproduce _notebooks $(RES)/%,$(MAKECMDGOALS)),)
+include $(DEPS_MK)
+endif
+# It needs the venv, made first; but make remakes an included makefile even under -n (make -n on a fresh clone
+# must not install a venv), so a dry run without a venv writes no rules.
+$(DEPS_MK): FORCE $(if $(DRY),,| $(STAMP))
+	@mkdir -p $(@D); if [ -x "$(PY)" ]; then $(PY) tools/notebook_deps.py $(PROFILE) --results $(RES); \
+	elif [ ! -f $@ ]; then echo "# no venv yet ($(PY)): make venv" > $@; fi
+$(RES)/.data-fingerprint: $(DEPS_MK)
 FORCE:
 
-# Each notebook reads what the previous one wrote.
+# The notebooks whose outputs a notebook reads. Notebook 01 builds the drives' caches every other one loads.
 $(RES)/notebooks/02_kf_baseline.ipynb: $(RES)/notebooks/01_data_prep.ipynb
 $(RES)/notebooks/03_bgfn_training.ipynb: $(RES)/notebooks/02_kf_baseline.ipynb
 $(RES)/notebooks/04_outage_evaluation.ipynb: $(RES)/notebooks/03_bgfn_training.ipynb
 $(RES)/notebooks/05_energy_estimate.ipynb: $(RES)/notebooks/04_outage_evaluation.ipynb
-# The studies beyond the paper: 06 reads notebook 04's runs and notebook 03's learning rates; 07 trains its own
-# odometers; 08 compares our INS with NaveGo's measured run.
-$(RES)/notebooks/06_outage_sweep.ipynb: $(RES)/notebooks/05_energy_estimate.ipynb
-$(RES)/notebooks/07_learned_odometer.ipynb: $(RES)/notebooks/06_outage_sweep.ipynb
-$(RES)/notebooks/08_ins_fidelity.ipynb: $(RES)/notebooks/07_learned_odometer.ipynb $(wildcard data/measured/navego_check.csv)
-# 09 (the gallery of own logs) needs only the data and the navigation.
-$(RES)/notebooks/09_own_logs.ipynb: $(RES)/notebooks/08_ins_fidelity.ipynb
+# The studies beyond the paper: 06 reads notebook 04's runs (evaluation/) and notebook 03's learning rates
+# (tables/lr_search.csv); 07 trains its own odometers, 08 reruns the GPS-aided filter and compares our INS with
+# NaveGo's measured run, 09 (the gallery of own logs) needs only the data and the navigation: they read no other
+# notebook's outputs, so they run beside notebooks 02-06 under -j.
+$(RES)/notebooks/06_outage_sweep.ipynb: $(RES)/notebooks/04_outage_evaluation.ipynb
+$(RES)/notebooks/07_learned_odometer.ipynb: $(RES)/notebooks/01_data_prep.ipynb
+$(RES)/notebooks/08_ins_fidelity.ipynb: $(RES)/notebooks/01_data_prep.ipynb $(wildcard data/measured/navego_check.csv)
+$(RES)/notebooks/09_own_logs.ipynb: $(RES)/notebooks/01_data_prep.ipynb
 # 10 (the results page) reads every earlier output, the paper's published values and the odometers' run at the
 # paper's size recorded from a GPU (python -m bgfn odometers --record).
-$(RES)/notebooks/10_results.ipynb: $(RES)/notebooks/09_own_logs.ipynb data/paper/outage_max_errors.csv \
-  data/paper/claims.yaml $(wildcard data/measured/odometer_sizes.csv)
+$(RES)/notebooks/10_results.ipynb: $(filter-out $(RES)/notebooks/10_results.ipynb,$(EXEC)) \
+  data/paper/outage_max_errors.csv data/paper/claims.yaml $(wildcard data/measured/odometer_sizes.csv)
 # ... and, when they have been run, the variant profiles its "Variants" section compares (notebook parameter
 # `variants`), so a later `make reproduce PROFILE=quick-heading` is picked up by the next `make reproduce`.
 VARIANTS := quick-heading
 $(RES)/notebooks/10_results.ipynb: $(wildcard $(filter-out $(RES)/%,$(VARIANTS:%=results/%/notebooks/06_outage_sweep.ipynb)))
 
 _notebooks: $(EXEC)
+
+# Notebooks at a time under `make reproduce` / `make notebooks` (1: one after the other, papermill's progress bar
+# shown). Each notebook's runner keeps every core (JOBS, else the profile's parallel.jobs, else the cores): the
+# chain 02-06 is the longest path, and when the studies beside it are done it must have all of them again; while
+# two notebooks run, the system shares the cores between their processes. No table depends on either number.
+NOTEBOOK_SLOTS ?= 2
 
 # ---------------------------------------------------------------- book
 # The book shows the executed notebooks of $(PROFILE) (copied to the gitignored book/notebooks/) and the
@@ -299,7 +336,6 @@ _book-build:
 LOCK := $(RES)/.lock
 CHECK_KEYS = echo "==> [$(PROFILE)] check params/$(PROFILE).yaml (every key; JOBS, DASK_SCHEDULER)" && \
   $(if $(DRY),echo )$(PY) -m bgfn.profile_schema --keys $(PROFILE)
-DRY = $(findstring n,$(filter-out --% %=%,$(firstword $(MAKEFLAGS))))
 reproduce notebooks:
 	@if [ -x "$(PY)" ]; then $(CHECK_KEYS); fi
 	@mkdir -p $(RES); exec 9>>"$(LOCK)"; \
@@ -315,7 +351,7 @@ reproduce notebooks:
 	trap '[ $$run = 0 ] || kill -TERM -- -$$run 2>/dev/null || true; : > "$(LOCK)"; exec 9>&- 8>>"$(LOCK)"; \
 	  flock -w 10 8 || true' EXIT; \
 	if [ ! -x "$(PY)" ]; then $(MAKE) venv; $(CHECK_KEYS); fi; \
-	setsid $(MAKE) _$@ & run=$$!; \
+	setsid $(MAKE) -j$(NOTEBOOK_SLOTS) _$@ & run=$$!; \
 	rc=0; wait $$run || rc=$$?; while kill -0 $$run 2>/dev/null; do wait $$run || rc=$$?; done; exit $$rc
 
 _reproduce: $(BOOK_STAMP)

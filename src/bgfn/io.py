@@ -1,7 +1,8 @@
 """Atomic file output: write to a temporary file in the same folder, then rename.
 
 A crash or a bad input never leaves a half-written table, figure or cache entry behind. Also the fingerprint of
-source files (:func:`sources_hash`) that decides whether a cached dataset or a trained network is still current.
+source files (:func:`sources_hash`) that decides whether a cached dataset or a trained network is still current,
+and results computed once and kept on disk under a key of their inputs (:func:`cached`).
 """
 
 from __future__ import annotations
@@ -11,12 +12,14 @@ import errno
 import hashlib
 import json
 import os
+import pickle
 import shutil
 import tempfile
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any, Callable, Iterator, TypeVar
 
 import numpy as np
+import pandas as pd
 
 
 #: Errors of a full disk (or quota): reported with the file that could not be written.
@@ -57,6 +60,7 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         os.chmod(tmp, 0o666 & ~umask)
         yield tmp
         os.replace(tmp, path)
+        _log_output(path)
     except Exception as exc:        # torch.save reports a full disk as a RuntimeError: the free space tells
         if getattr(exc, "errno", None) not in _FULL and not _nearly_full(path.parent):
             raise
@@ -66,6 +70,19 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     finally:
         if tmp is not None and tmp.exists():
             tmp.unlink()
+
+
+#: Environment variable naming a file to which every completed output's absolute path is appended (one line each):
+#: ``make`` sets it per notebook, so that a notebook that fails has its own outputs removed and not those of a
+#: notebook running beside it.
+OUTPUT_LOG_ENV = "BGFN_OUTPUT_LOG"
+
+
+def _log_output(path: Path) -> None:
+    log = os.environ.get(OUTPUT_LOG_ENV)
+    if log:
+        with open(log, "a", encoding="utf-8") as fh:    # one short line per write: appends do not interleave
+            fh.write(os.path.abspath(path) + "\n")
 
 
 def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
@@ -140,3 +157,79 @@ def sources_hash(paths) -> str:
         if p.is_file():
             h.update(p.read_bytes())
     return h.hexdigest()
+
+
+#: Environment variable naming the folder of :func:`cached` (``make`` sets ``results/<profile>/cache``); unset, every
+#: result is computed where it is asked for.
+CACHE_DIR_ENV = "BGFN_CACHE_DIR"
+T = TypeVar("T")
+
+
+def content_hash(obj: Any) -> str:
+    """SHA-256 (hex) of a value's content: mappings (key order aside), sequences, numbers, strings, numpy arrays
+    (dtype, shape and bytes) and pandas frames and series (columns, dtypes, index and every value), nested."""
+    h = hashlib.sha256()
+    _feed(h, obj)
+    return h.hexdigest()
+
+
+def _feed(h, obj: Any) -> None:
+    if isinstance(obj, dict):
+        h.update(b"{")
+        for key in sorted(obj, key=str):
+            _feed(h, str(key))
+            _feed(h, obj[key])
+        h.update(b"}")
+    elif isinstance(obj, (list, tuple)):
+        h.update(b"[")
+        for item in obj:
+            _feed(h, item)
+        h.update(b"]")
+    elif isinstance(obj, np.ndarray):
+        if obj.dtype == object:
+            _feed(h, obj.tolist())
+        else:
+            h.update(f"a{obj.dtype.str}{obj.shape}".encode())
+            h.update(np.ascontiguousarray(obj).tobytes())
+    elif isinstance(obj, (pd.DataFrame, pd.Series)):
+        columns = list(obj.columns) if isinstance(obj, pd.DataFrame) else [obj.name]
+        dtypes = list(obj.dtypes) if isinstance(obj, pd.DataFrame) else [obj.dtype]
+        h.update(f"p{type(obj).__name__}{list(map(str, columns))}{list(map(str, dtypes))}".encode())
+        h.update(pd.util.hash_pandas_object(obj, index=True).to_numpy().tobytes())
+    elif isinstance(obj, float):
+        h.update(b"f" + np.float64(obj).tobytes())
+    elif isinstance(obj, np.generic):
+        _feed(h, obj.item())
+    else:
+        h.update(f"{type(obj).__name__}:{obj!r}".encode())
+    h.update(b";")
+
+
+def cached(kind: str, key: Any | Callable[[], Any], compute: Callable[[], T]) -> T:
+    """``compute()``, kept on disk under ``<$BGFN_CACHE_DIR>/<kind>/<hash of key>.pkl`` and read back (the same
+    object, bit for bit) when asked for again with the same ``key``. ``key`` must hold every input of the result
+    (its data's :func:`content_hash`, its settings, the version of the code: :func:`sources_hash`); None, or no
+    ``BGFN_CACHE_DIR``: computed every time. ``key`` may be a function returning it: then called only when there is
+    a cache. A cache entry is only ever written by this code (results/<profile>/cache/), as
+    :func:`bgfn.evaluate.kept_results` reads notebook 04's runs."""
+    root = os.environ.get(CACHE_DIR_ENV)
+    if root and callable(key):
+        key = key()
+    if not root or key is None:
+        return compute()
+    digest = content_hash({"kind": kind, "key": key})
+    path = Path(root) / kind / f"{digest[:32]}.pkl"
+    if path.is_file():
+        try:
+            stored_digest, value = pickle.loads(path.read_bytes())
+            if stored_digest == digest:
+                return value
+        except Exception:   # a truncated or foreign file: computed again and replaced
+            pass
+    value = compute()
+    try:
+        blob = pickle.dumps((digest, value), protocol=pickle.HIGHEST_PROTOCOL)
+    except Exception:       # a result that cannot be pickled is simply not kept
+        return value
+    atomic_write_bytes(path, blob)
+    return value

@@ -49,7 +49,7 @@ def compile_kernels(nav_section: dict | None = None) -> float:
     drive = warmup_drive()
     start = float(drive.imu["time"].iloc[0]) + OUTAGE[0]
     window = [(start, OUTAGE[1])]
-    baseline.run_baseline(drive, baseline.nav_config(nav_section), window)    # GPS/INS, INS and INS+NHC
+    baseline.run_baseline(drive, baseline.nav_config(nav_section), window, keep=False)   # GPS/INS, INS and INS+NHC
     ctx = navigation_context(drive, nav_section, [start])                     # the evaluation's context
     epochs = np.arange(start - 5.0, start + OUTAGE[1] + 5.0, 1.0)
     track = no.SpeedTrack(epochs, np.full(epochs.size, 8.0), np.full(epochs.size, 0.5))

@@ -4,11 +4,14 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from bgfn import settings
 from bgfn.errors import DataError
+from bgfn.io import cached, content_hash, sources_hash
 from bgfn.learning.normalize import Normalizer
 from bgfn.learning.references import reference_columns, reference_rmse
 from bgfn.learning.split import block_label, split_windows
@@ -47,7 +50,7 @@ def all_windows(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.DataFrame, *
 
 
 def build_learning_data(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.DataFrame, outage_windows=(),
-                        **options) -> LearningData:
+                        keep: bool = False, **options) -> LearningData:
     """Windows, split and normalization in one call.
 
     Parameters
@@ -57,6 +60,9 @@ def build_learning_data(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.Data
     outage_windows : sequence of (start, duration)
         Evaluation outages (s) excluded from training and validation (``protocol='honest'``; with ``'leaky'``
         only from validation: :func:`bgfn.learning.split_windows`).
+    keep : bool
+        Keep the result on disk for the next caller with the same inputs (:func:`bgfn.io.cached`): the profile's own
+        windows (:func:`bgfn.train.prepare_learning_data`); not a sweep fold's or a variant's, read once.
     **options
         ``window``, ``alignment``, ``yaw_encoding``, ``target_frame``, ``extra_channels``, ``epoch_stride``,
         ``margin_s``, ``val_fraction``, ``val_position``, ``target_screen_sigma``, ``protocol`` (defaults:
@@ -66,6 +72,29 @@ def build_learning_data(imu: pd.DataFrame, attitude: pd.DataFrame, gnss: pd.Data
     if unknown:
         raise DataError("train", sorted(unknown)[0], f"one of {', '.join(LEARNING_DEFAULTS)}")
     opt = learning_options(options)
+    if not keep:
+        return _build(imu, attitude, gnss, outage_windows, opt)
+    # built once per drive, INS solution, outages and options: notebooks 03, 04, 05 and 06 share the profile's
+    return cached("learning_data", lambda: _learning_key(imu, attitude, gnss, outage_windows, opt),
+                  lambda: _build(imu, attitude, gnss, outage_windows, opt))
+
+
+#: Bumped when the windows change in a way the hashed sources do not show (:func:`_learning_key`).
+LEARNING_CACHE_VERSION = 1
+
+
+def _learning_key(imu, attitude, gnss, outage_windows, opt: dict) -> dict:
+    """The key of :func:`build_learning_data`'s result: its tables' content, the outages, the options, the code."""
+    here = Path(__file__).resolve().parent
+    core = here.parent
+    code = sources_hash(sorted(here.glob("*.py")) + [core / "nav" / f"{m}.py" for m in ("earth", "transform", "odometer")]
+                        + [core / f"{m}.py" for m in ("settings", "schema", "errors", "io")])
+    return {"tables": content_hash({"imu": imu, "attitude": attitude, "gnss": gnss}),
+            "outage_windows": [list(map(float, o)) for o in outage_windows], "options": opt, "code": code,
+            "version": LEARNING_CACHE_VERSION, "libraries": [np.__version__, pd.__version__]}
+
+
+def _build(imu, attitude, gnss, outage_windows, opt: dict) -> LearningData:
     ws = all_windows(imu, attitude, gnss, **opt)
     tr, va, info = split_windows(ws, outage_windows, margin_s=float(opt["margin_s"]),
                                  val_fraction=float(opt["val_fraction"]), val_position=opt["val_position"],

@@ -14,13 +14,14 @@ import copy
 from dataclasses import dataclass
 from pathlib import Path
 
+import numba
 import numpy as np
 import pandas as pd
 
 from .. import paper, settings
 from ..config import DEFAULT_DATASET_KEY
 from ..errors import DataError
-from ..io import atomic_write_csv
+from ..io import atomic_write_csv, cached, content_hash, sources_hash
 from . import constraints as cn, metrics, navego_setup
 from .alignment import ALIGNMENT_DEFAULTS, MODES, Alignment, align
 from .consistency import nis_summary
@@ -107,6 +108,27 @@ def outage_constraints(drive, cfg: dict, solution: FilterResult):
                                 heading_std=heading_std)
 
 
+#: Bumped when a GPS-aided run changes in a way the hashed sources do not show (:func:`run_key`).
+RUN_CACHE_VERSION = 1
+
+
+def _code_version() -> str:
+    """The sources a GPS-aided run is made by: the navigation package and the core facts it imports."""
+    here = Path(__file__).resolve().parent
+    core = here.parent
+    return sources_hash(sorted(here.glob("*.py")) + [core / f"{m}.py" for m in ("settings", "paper", "schema",
+                                                                               "config", "errors", "io")])
+
+
+def run_key(drive, cfg: dict, **inputs) -> dict:
+    """The key of a GPS-aided run of ``drive`` (:func:`bgfn.io.cached`): the drive's content (truth, IMU, GNSS,
+    bias, facts), the ``nav:`` settings, the run's other ``inputs``, the code and the numerical libraries."""
+    return {"drive": content_hash({"name": drive.name, "reference": drive.reference, "imu": drive.imu,
+                                   "gnss": drive.gnss, "imu_bias": drive.imu_bias, "meta": drive.meta}),
+            "nav": cfg, **inputs, "code": _code_version(), "version": RUN_CACHE_VERSION,
+            "libraries": [np.__version__, pd.__version__, numba.__version__]}
+
+
 def run_drive(drive, section: dict | None = None, snapshots: dict | None = None) -> FilterResult:
     """GPS/INS filter over a whole drive with every GNSS fix (the paper's online-training mode).
 
@@ -123,10 +145,15 @@ def run_drive(drive, section: dict | None = None, snapshots: dict | None = None)
     FilterResult
     """
     cfg = nav_config(section)
-    initial, noise = initial_and_noise(drive, cfg)
-    return run_filter(filter_imu(drive, cfg), initial, noise, drive.gnss, _lever(drive), snapshots=snapshots,
-                      gate_probability=cfg["innovation_gate"], source=drive.name,
-                      aids=gps_aids(drive, cfg, initial, noise))
+
+    def compute() -> FilterResult:
+        initial, noise = initial_and_noise(drive, cfg)
+        return run_filter(filter_imu(drive, cfg), initial, noise, drive.gnss, _lever(drive), snapshots=snapshots,
+                          gate_probability=cfg["innovation_gate"], source=drive.name,
+                          aids=gps_aids(drive, cfg, initial, noise))
+
+    # computed once per drive and settings: notebooks 03, 06 and the studies take the INS attitude from it
+    return cached("gps_aided_run", lambda: run_key(drive, cfg, snapshots=snapshots), compute)
 
 
 @dataclass
@@ -344,7 +371,7 @@ class Baseline:
     reference_equals_gnss: bool = False
 
 
-def run_baseline(drive, cfg: dict, windows) -> Baseline:
+def run_baseline(drive, cfg: dict, windows, keep: bool = True) -> Baseline:
     """Full-drive GPS/INS run, then the standalone INS in each outage from the saved state at its start, without
     and with the vehicle constraints (``INS``, ``INS+NHC``: :func:`outage_constraints`).
 
@@ -355,11 +382,22 @@ def run_baseline(drive, cfg: dict, windows) -> Baseline:
         Output of :func:`nav_config`.
     windows : sequence of (start, duration)
         The outages, s (:func:`bgfn.nav.outages.outage_windows`).
+    keep : bool
+        Keep the run on disk for the next caller with the same inputs (:func:`bgfn.io.cached`): the profile's own
+        runs (notebooks 02 and 08); another filter setup, read once, passes False.
 
     Returns
     -------
     Baseline
     """
+    if not keep:
+        return _run_baseline(drive, cfg, windows)
+    # computed once per drive, settings and outages: notebook 02 runs it, notebook 08 takes the same runs
+    return cached("baseline", lambda: run_key(drive, cfg, windows=[tuple(map(float, w)) for w in windows]),
+                  lambda: _run_baseline(drive, cfg, windows))
+
+
+def _run_baseline(drive, cfg: dict, windows) -> Baseline:
     setup = prepare_filter(drive, cfg)
     initial, noise = setup.initial, setup.noise
     # the filter may start after the reference's first row (self-alignment): outages must come after its start;
@@ -500,7 +538,7 @@ def gate_comparison(drive, cfg: dict, windows, probability: float, baseline: Bas
         cfg = {**cfg, "noise_scale": baseline.setup.noise_scale}
     for gate in (None, probability):
         same = baseline is not None and gate == cfg["innovation_gate"]
-        b = baseline if same else run_baseline(drive, {**cfg, "innovation_gate": gate}, windows)
+        b = baseline if same else run_baseline(drive, {**cfg, "innovation_gate": gate}, windows, keep=False)
         upd = b.full.updates
         row = {"dataset": drive.name, "innovation_gate": "none" if gate is None else f"{gate:g}",
                "gnss_fixes": int(len(upd)), "gnss_rejected": int((~upd["accepted"]).sum()),

@@ -137,7 +137,7 @@ def prepare_learning_data(cfg: dict, dataset: str, attitude=None, drive=None, ou
     if drive is None:
         drive = load_drive(dataset, profile=cfg["profile"])
     attitude, outage_windows, opts = _learning_inputs(cfg, drive, attitude, outage_windows, dataset)
-    return build_learning_data(drive.imu, attitude, drive.gnss, outage_windows, **opts)
+    return build_learning_data(drive.imu, attitude, drive.gnss, outage_windows, keep=True, **opts)
 
 
 def _learning_inputs(cfg: dict, drive, attitude=None, outage_windows=None, dataset: str | None = None) -> tuple:

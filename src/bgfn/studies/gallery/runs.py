@@ -54,7 +54,7 @@ def run_log(log: GalleryLog, folder: Path, cfg: dict) -> GalleryRun:
     folder = Path(folder).resolve()
     drive = load_drive(folder)
     windows = outage_windows(cfg, drive, str(folder))
-    b = run_baseline(drive, nav_config(cfg["nav"]), windows)
+    b = run_baseline(drive, nav_config(cfg["nav"]), windows, keep=False)   # a gallery log: read once
     base = {"log": drive.name, "kind": log.kind, "platform": drive.meta.get("platform", DEFAULT_PLATFORM),
             "duration_s": float(drive.imu["time"].iloc[-1] - drive.imu["time"].iloc[0]), "imu_rows": len(drive.imu),
             "gnss_fixes": len(drive.gnss), "noise_scale": float(b.setup.noise_scale) if b.setup is not None else 1.0,

@@ -113,7 +113,7 @@ def ins_tuning_table(drive, cfg: dict, windows, baseline: Baseline | None = None
     for tuning in navego_setup.INS_TUNINGS:
         c = {**cfg, "ins_tuning": tuning}
         same = baseline is not None and tuning == cfg["ins_tuning"]
-        b = baseline if same else run_baseline(drive, c, windows)
+        b = baseline if same else run_baseline(drive, c, windows, keep=False)   # another setup: read once
         ins = b.outage_table
         if "method" in ins.columns:                   # the standalone INS only (not the INS+NHC rows)
             ins = ins[ins["method"] == "INS"]

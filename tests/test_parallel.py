@@ -3,6 +3,7 @@ they finish in, one progress line per run, and the same tables with 1 job, 2 lok
 
 from __future__ import annotations
 
+import os
 import time
 
 import pytest
@@ -57,11 +58,23 @@ def _slow_square(x: int, delay: float) -> int:
     return x * x
 
 
+def _square_when(x: int, mark: str, wait_for: tuple[str, ...]) -> int:
+    # a barrier through files: the run waits (30 s at most) until the runs it names have finished, so the order in
+    # which runs finish is fixed whatever the load on the machine, then leaves its own mark
+    deadline = time.time() + 30.0
+    while not all(os.path.exists(f) for f in wait_for) and time.time() < deadline:
+        time.sleep(0.02)
+    open(mark, "w").close()
+    return x * x
+
+
 @pytest.mark.parametrize("jobs", [1, 2])
-def test_results_come_back_in_the_order_of_the_runs(jobs):
-    # the first run is the slowest: with 2 processes it finishes last, and still comes first
+def test_results_come_back_in_the_order_of_the_runs(jobs, tmp_path):
+    # the first run finishes last (with 2 processes it waits for the other two), and its result still comes first
+    a, b, c = (str(tmp_path / name) for name in "abc")
+    runs = [(3, a, (b, c) if jobs == 2 else ()), (1, b, ()), (2, c, ())]
     lines = []
-    out = Runner(jobs).map(_slow_square, [(3, 0.6), (1, 0.0), (2, 0.0)], labels=["a", "b", "c"],
+    out = Runner(jobs).map(_square_when, runs, labels=["a", "b", "c"],
                            summary=lambda r: f"got {r}", desc="squares", echo=lines.append, bar=False)
     assert out == [9, 1, 4]
     assert len(lines) == 3 and all(line.startswith("[squares] ") for line in lines)

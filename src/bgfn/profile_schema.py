@@ -34,7 +34,6 @@ from bgfn.nav.outages import check_windows, is_rule, outage_entry, picked_outage
 from bgfn.models import MODELS
 from bgfn.paper import METHOD_LABELS
 from bgfn.parallel import SCHEDULER_ENV, Runner
-from bgfn.report.run_words import runner_words
 from bgfn.settings import MAX_COUNT, Data, ProfileError, Train, check_model, complete, fmt, merge
 
 __all__ = ["ProfileError", "check_with_drives", "cross_check", "load_profile", "main", "validate", "with_overrides"]
@@ -308,7 +307,9 @@ def check_keys(profile: str) -> list[str]:
     """
     cfg = load_profile(profile)
     runner = Runner.of(cfg)
-    return [f"every key checked; independent runs {runner_words(runner)}"]
+    where = (f"on the Dask cluster at {runner.scheduler}" if runner.backend == "dask" else
+             f"{runner.jobs} at a time here" + (f" ({runner.asked} asked: capped)" if runner.asked else ""))
+    return [f"every key checked; independent runs {where}"]
 
 
 def check_with_drives(profile: str) -> list[str]:

@@ -36,11 +36,12 @@ BUDGET = ("train: {methods: [bgfn, transformer, mlp], seeds: [0], size: smoke, l
           "energy: {allow_untrained: true}\n")
 
 
-def demo_log(folder: Path, name: str = "demo-car", seed: int = 7, source: str = "tools/demo_log.py (synthetic)") -> Path:
+def demo_log(folder: Path, name: str = "demo-car", seed: int = 7, source: str = "tools/demo_log.py (synthetic)",
+             duration_s: float = DURATION_S) -> Path:
     """The drive of the module docstring, written in the CSV schema (atomically per file); ``name`` in its
-    ``meta.yaml``. The IMU's white noise and the filter's error model agree (std x sqrt(0.01 s) = density); the
-    biases are the model's turn-on biases."""
-    truth = sim.demo_trajectory(DURATION_S, 400.0)
+    ``meta.yaml``; ``duration_s`` long. The IMU's white noise and the filter's error model agree
+    (std x sqrt(0.01 s) = density); the biases are the model's turn-on biases."""
+    truth = sim.demo_trajectory(duration_s, 400.0)
     truth["time"] = truth["time"] + T0
     rng = np.random.default_rng(seed)
     fine = sim.imu_from_trajectory(truth)                      # 2.5 ms rows; a logger's steps of 7.5-12.5 ms

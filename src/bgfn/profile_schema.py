@@ -31,7 +31,7 @@ from bgfn.evaluate import evaluate_config
 from bgfn.studies.outage_sweep.sweep import sweep_plan
 from bgfn.learning import learning_options
 from bgfn.nav.baseline import filter_start
-from bgfn.nav.outages import check_windows, is_rule, outage_entry, picked_outages
+from bgfn.nav.outages import check_windows, is_rule, outage_entry, picked_outages, snap_windows
 from bgfn.paper import METHOD_LABELS
 from bgfn.parallel import SCHEDULER_ENV
 from bgfn.settings import ProfileError, Train, check_model, complete, fmt, merge
@@ -264,7 +264,8 @@ def check_with_drives(profile: str) -> list[str]:
         entry = outage_entry(cfg, name)
         rule = is_rule(entry)
         try:                                    # a rule picks the windows from the drive (the notebooks' reader)
-            windows = picked_outages(cfg, drive, name).windows if rule else _windows(entry)
+            windows = [w.window for w in snap_windows(picked_outages(cfg, drive, name).windows if rule
+                                                       else _windows(entry), t)]      # on the IMU epochs
         except DataError as exc:
             raise DataError(path, f"{key}.{exc.field}", f"{exc.expected} in the drive {name}", exc.found) from None
         try:

@@ -115,6 +115,66 @@ def epochs_before(imu_time, starts, source: str = "outage_windows") -> np.ndarra
 
 
 
+@dataclass(frozen=True)
+class SnappedWindow:
+    """An outage window as asked (``asked``: ``(start, duration)``, s) and as run (``window``), its edges moved onto
+    the IMU epochs (:func:`snap_windows`); ``moved`` when they differ."""
+
+    asked: tuple
+    window: tuple
+
+    @property
+    def moved(self) -> bool:
+        """Whether snapping moved an edge."""
+        return self.asked != self.window
+
+
+def snap_windows(windows, imu_time) -> list[SnappedWindow]:
+    """Outage windows with both edges on IMU epochs inside the data.
+
+    The filter runs from IMU epoch to IMU epoch, so an outage ``[start, end)`` ends at the last IMU row before
+    ``end``; a window whose edges lie off the IMU grid (a rule's whole-second starts on a log stamped at .xx1 s, a
+    user's typed times) would end after the data or start between two rows. Each edge goes to the nearest IMU
+    epoch (a tie to the earlier one), the end to one no later than the last; an edge within :data:`TIME_TOL` of an
+    epoch keeps its value, so windows already on the grid come back unchanged, to the bit; an edge more than one IMU
+    interval outside the data is left as it is (:func:`check_windows` names it: an outage does not shrink
+    silently).
+
+    Parameters
+    ----------
+    windows : iterable of (start, duration)
+    imu_time : array_like
+        IMU epochs, s, increasing.
+
+    Returns
+    -------
+    list of SnappedWindow
+        In the given order; a window that would shrink to nothing keeps its asked edges (:func:`check_windows`
+        then names it).
+    """
+    t = np.asarray(imu_time, dtype=float)
+    step = float(np.max(np.diff(t))) if t.size > 1 else 0.0
+
+    def snap(x: float) -> float:
+        i = int(np.clip(np.searchsorted(t, x), 1, len(t) - 1))
+        j = i - 1 if x - t[i - 1] <= t[i] - x else i            # the nearest, a tie to the earlier
+        if x > t[-1]:
+            j = len(t) - 1
+        gap = abs(t[j] - x)
+        return x if gap <= TIME_TOL or gap > step else float(t[j])     # beyond one step: outside, not moved
+
+    out = []
+    for start, duration in windows:
+        start, duration = float(start), float(duration)
+        if t.size < 2 or not (np.isfinite(start) and np.isfinite(duration)):
+            out.append(SnappedWindow((start, duration), (start, duration)))
+            continue
+        a, b = snap(start), snap(start + duration)
+        window = (start, duration) if (a == start and b == start + duration) or not b > a else (a, b - a)
+        out.append(SnappedWindow((start, duration), window))
+    return out
+
+
 def outage_entry(profile: dict, dataset: str | None = None):
     """The profile's ``outage_windows`` entry for ``dataset``: a list of ``[start, duration]`` or a rule mapping.
 
@@ -186,19 +246,30 @@ def outage_windows(profile: dict, drive=None, dataset: str | None = None) -> lis
         outside the drive.
     """
     name = dataset if dataset is not None else getattr(drive, "name", None)
+    if drive is None:
+        entry = outage_entry(profile, name)
+        if is_rule(entry):
+            raise DataError(f"profile {profile.get('profile')!r}", f"outage_windows.{name}",
+                            "the drive as well: a rule picks the windows from its reference", f"rule {entry}")
+        return [(float(s), float(d)) for s, d in entry]
+    return [w.window for w in snapped_outages(profile, drive, name)]
+
+
+def snapped_outages(profile: dict, drive, dataset: str | None = None) -> list[SnappedWindow]:
+    """The outages of one drive as the profile asks them (its list, or what its rule picks) and as they run, on
+    the drive's IMU epochs (:func:`snap_windows`), checked against its span; :func:`outage_windows` returns the
+    latter, and the notebooks and the profile check all read them through it."""
+    name = dataset if dataset is not None else getattr(drive, "name", None)
     entry = outage_entry(profile, name)
     source = f"{name}: profile outage_windows" if name is not None else "profile outage_windows"
     if is_rule(entry):
-        if drive is None:
-            raise DataError(f"profile {profile.get('profile')!r}", f"outage_windows.{name}",
-                            "the drive as well: a rule picks the windows from its reference", f"rule {entry}")
         pairs = picked_outages(profile, drive, name).windows
     else:
         pairs = [(float(s), float(d)) for s, d in entry]
-    if drive is not None:
-        t = drive.imu["time"].to_numpy(dtype=float)
-        check_windows(pairs, float(drive.reference["time"].iloc[0]), float(t[-1]), source)
-    return pairs
+    t = drive.imu["time"].to_numpy(dtype=float)
+    snapped = snap_windows(pairs, t)
+    check_windows([w.window for w in snapped], float(drive.reference["time"].iloc[0]), float(t[-1]), source)
+    return snapped
 
 
 def picked_outages(profile: dict, drive, dataset: str | None = None):

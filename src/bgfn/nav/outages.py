@@ -274,13 +274,17 @@ def snapped_outages(profile: dict, drive, dataset: str | None = None) -> list[Sn
 
 def picked_outages(profile: dict, drive, dataset: str | None = None):
     """What the profile's rule for ``dataset`` picks on ``drive`` (:class:`bgfn.nav.outage_rules.PickedOutages`),
-    or None when its entry is a list. The training margin of the rule's check is ``train.margin_s``."""
+    or None when its entry is a list. The training margin of the rule's check is ``train.margin_s``; the warm-up
+    counts from the filter's start under the profile's ``nav:`` (:func:`bgfn.nav.baseline.filter_start`)."""
     name = dataset if dataset is not None else getattr(drive, "name", None)
     entry = outage_entry(profile, name)
     if not is_rule(entry):
         return None
+    from .baseline import filter_start      # here: baseline imports this module
+
     margin = float(profile["train"]["margin_s"])
-    return outage_rules.pick_windows(entry, drive.reference, margin, f"{name}: profile outage_windows")
+    return outage_rules.pick_windows(entry, drive.reference, margin, f"{name}: profile outage_windows",
+                                     t_first=filter_start(drive, profile.get("nav")))
 
 
 def describe_windows(profile: dict, drive, dataset: str | None = None) -> list[str]:

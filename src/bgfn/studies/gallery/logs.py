@@ -137,11 +137,11 @@ def walk_trajectory(duration_s: float = WALK_DURATION_S, rate_hz: float = 100.0,
                          "yaw": np.angle(np.exp(1j * yaw))})
 
 
-def walker_log(folder: Path, seed: int = WALK_SEED) -> Path:
-    """:func:`walk_trajectory` with a consumer MEMS IMU (the MPU-6000 profile's noise and bias instability, its
+def walker_log(folder: Path, seed: int = WALK_SEED, duration_s: float = WALK_DURATION_S) -> Path:
+    """:func:`walk_trajectory` (``duration_s`` long, the stops inside it) with a consumer MEMS IMU (the MPU-6000 profile's noise and bias instability, its
     gyro turn-on bias calibrated at boot, no vehicle vibration) and 1 Hz fixes of 1.5 m / 3 m; the reference at
     5 Hz without attitude (an RTK rover's); ``platform: walker``."""
-    truth = walk_trajectory()
+    truth = walk_trajectory(duration_s, stops=[(a, b) for a, b in WALK_STOPS_S if a + b < duration_s])
     params = error_params("mpu6000", {"vibration_gyro_std": [0.0] * 3, "vibration_accel_std": [0.0] * 3,
                                       "accel_turn_on_bias_std": [0.05] * 3})
     speed = np.hypot(truth["v_n"], truth["v_e"]).to_numpy()[1:]

@@ -227,11 +227,14 @@ def _scaled_outages(cfg: dict, drives: dict, starts: dict, typed) -> tuple[dict,
         for s in scaled:
             s.update(reason="short_log", factor=f, spans_s=spans)
         return facts, over, scaled
-    span = {n: float(drives[n].imu["time"].iloc[-1]) - starts[n] for n in drives}
+    span = {drives[n].name: float(drives[n].imu["time"].iloc[-1]) - starts[n] for n in drives}
     exc = first_error
-    key = f"outage_windows.{keys[0]}.duration_s" if keys else exc.field
+    held = [f"outage_windows.{k}.{p}" for k in keys for p in ("duration_s", "warmup_s", "gap_s", "min_training_s")
+            if typed(f"outage_windows.{k}.{p}")] + (["train.margin_s"] if typed("train.margin_s") else [])
+    key = (held[0] if held else f"outage_windows.{keys[0]}.duration_s") if keys else exc.field
     holds = ", ".join(f"{n}: {s:.1f} s after the filter's start" for n, s in span.items())
-    advice = (f"; no outages of the rule of {MIN_OUTAGE_S:g} s or more fit it" if keys else
+    advice = ((f"; with {', '.join(held)} as typed, no scaling of the other times fits it" if held else
+               f"; no outages of the rule of {MIN_OUTAGE_S:g} s or more fit it") if keys else
               "; shorten the listed outages or train.margin_s, or record a longer log")
     raise DataError(exc.source, key, f"{exc.expected}: the log holds {holds}{advice}", exc.found)
 

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 from typing import Any, Sequence
 
 from bgfn import settings
-from bgfn.data import acquire
+from bgfn.data import acquire, dataset_id
 from bgfn.errors import DataError
 from bgfn.nav import outages
 from bgfn.paper import METHOD_LABELS, TESTS, nhc_label
@@ -151,11 +151,16 @@ class EvaluationSetup:
         """Lines saying what is evaluated: profile, IMUs, datasets, methods, seeds, outages, pseudo-GPS."""
         ecfg = self.config
         lines = [f"profile {self.profile!r}: {self.description}"]
+        names = list(dict.fromkeys(list(self.datasets) + list(self.sweep_datasets)))
+        simulated = [d for d in names if d in REAL_IMU_DATASETS]          # the only drives with simulated IMUs
+        recorded = [dataset_id(d) for d in names if d not in REAL_IMU_DATASETS]
         if ecfg["real_imu"]:
             lines += [f"real_imu: {line}" for line in dict.fromkeys(self.notes + self.sweep_notes)]
-        else:
-            lines.append("real_imu: false -> simulated IMUs (set real_imu=True to use NaveGo's recorded IMU "
-                         "files when present)")
+        else:                                   # one line: which IMUs are simulated, which recorded
+            kinds = ([f"real_imu: false -> simulated IMUs for {', '.join(simulated)} (set real_imu=True to use "
+                      "NaveGo's recorded IMU files when present)"] if simulated else [])
+            kinds += [f"recorded IMUs: {', '.join(recorded)}"] if recorded else []
+            lines.append("; ".join(kinds))
         lines.append(f"tables: {self.datasets} | methods: {ecfg['methods']} | seeds: {ecfg['seeds']} | "
                      f"seed aggregate: {ecfg['seed_aggregate']}")
         lines.append(f"outages (start, duration) s: {[list(w) for w in self.windows]}"

@@ -29,9 +29,10 @@ Modules (pyins style, one concept each; SI units, radians, NED, tables as in CON
 - :mod:`~bgfn.nav.filter` -- ``run_filter(imu, initial, noise, gnss, lever_arm, outage_windows,
   pseudo_gps, t_end, snapshots, aids=[...]) -> FilterResult`` and ``run_outage(imu, start_state, window, noise,
   lever_arm, pseudo_gps, aids=[...])`` (one outage from a saved state): the engine with these aids.
-- :mod:`~bgfn.nav.outages` -- ``OutageWindow``, ``check_windows``, ``outage_windows(profile, drive, dataset)``
-  (the profile's one key: one list, or per dataset a list or a rule), the pseudo-GPS hook (``PseudoFix``,
-  ``PseudoGpsContext``, ``IncrementPseudoGps`` = Eq. pred-gps, ``TablePseudoGps``).
+- :mod:`~bgfn.nav.outage_window` -- ``OutageWindow``, ``check_windows``, ``snap_windows`` (edges onto the IMU
+  epochs), the pseudo-GPS hook (``PseudoFix``, ``PseudoGpsContext``, ``IncrementPseudoGps`` = Eq. pred-gps,
+  ``TablePseudoGps``); :mod:`~bgfn.nav.outages` re-exports them above the filter and reads
+  ``outage_windows(profile, drive, dataset)`` (the profile's one key: one list, or per dataset a list or a rule).
 - :mod:`~bgfn.nav.outage_rules` -- ``pick_windows(rule, reference, margin_s)``: a drive's outages picked by a
   rule (``cruise_and_manoeuvre``: one cruising, one manoeuvring, as the paper's field test).
 - :mod:`~bgfn.nav.constraints` -- the vehicle constraints of the ``+NHC`` rows, an aid of the filter engine:
@@ -40,9 +41,8 @@ Modules (pyins style, one concept each; SI units, radians, NED, tables as in CON
   -> Constraints``, which ``run_filter`` / ``run_outage`` take in ``aids``.
 - :mod:`~bgfn.nav.odometer` -- ``Odometer(vehicle, SpeedTrack)``: a forward speed as an aid, joint with the
   vehicle constraints' NHC rows (``aids=[constraints, odometer]``, ``aid_list``).
-- :mod:`~bgfn.nav.outages` -- ``OutageWindow``, ``check_windows``, ``outage_windows(profile, drive)`` (the profile's one key),
-  the pseudo-GPS hook (``PseudoFix``, ``PseudoGpsContext``, ``IncrementPseudoGps`` = Eq. pred-gps,
-  ``TablePseudoGps``).
+- :mod:`~bgfn.nav.outages` -- ``outage_windows(profile, drive)`` (the profile's one key, on the IMU epochs; a
+  rule's warm-up from the filter's start), and :mod:`~bgfn.nav.outage_window`'s windows and pseudo-GPS hook.
 - :mod:`~bgfn.nav.metrics` -- ``navigation_errors``, ``outage_metrics`` (max |east|, max |north|,
   horizontal RMSE, end error), ``rms_table``; ``reference_rows`` (a drive's spans where the reference is not
   trusted, ``meta["reference_excluded_s"]``, left out of every comparison).

@@ -59,9 +59,13 @@ class GalleryLog:
     base: str
     profile: dict = field(default_factory=dict)
     shows: str = ""
+    own: bool = False        # a log the running profile names itself: ``base`` is that profile
 
     def profile_text(self, folder: Path) -> str:
-        """The user's ``params/<name>.yaml`` for this log in ``folder`` (absolute path)."""
+        """The user's ``params/<name>.yaml`` for this log in ``folder`` (absolute path); for the running profile's own
+        log only its name (the page shows no machine path)."""
+        if self.own:
+            return f"params/{self.base}.yaml, the profile of this run (its folder: {Path(folder).name})\n"
         body = {"base": self.base, "datasets": [str(Path(folder).resolve())], **self.profile}
         return yaml.safe_dump(body, sort_keys=False, default_flow_style=None, width=110)
 

@@ -261,3 +261,13 @@ def test_training_and_evaluation_take_each_datasets_outages():
     assert setup.windows == default
     assert setup.describe()[3] == (f"outages (start, duration) s: {[list(w) for w in default]}; sim: rule "
                                    "cruise_and_manoeuvre (picked from the drive); other: [[138800.0, 10.0]]")
+
+
+def test_the_shipped_smoke_profile_is_planned_unchanged(params):
+    """The run plan (bgfn.run_plan) of a shipped profile changes nothing; its real drive keeps the rule's windows."""
+    from bgfn.profile_schema import check_and_plan
+
+    lines, plan = check_and_plan("smoke")
+    assert plan.overrides == {} and plan.scaled == [] and plan.off == []
+    assert plan.drives["rtklib-drive0708"]["outages"] == [{"asked": [243538.0, 30.0], "run": [243538.0, 30.0]},
+                                                          {"asked": [243627.0, 30.0], "run": [243627.0, 30.0]}]

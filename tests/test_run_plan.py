@@ -121,11 +121,3 @@ def test_a_plan_for_an_earlier_version_of_the_profile_is_refused(logs, params, t
         load_profile(profile)
     assert str(err.value.source) == str(plan_path(profile))
     assert load_profile(profile, planned=False)["train"]["margin_s"] == 10.0
-
-
-def test_the_shipped_smoke_profile_is_planned_unchanged(params, tmp_path, monkeypatch):
-    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path / "results")
-    lines, plan = check_and_plan("smoke")
-    assert plan.overrides == {} and plan.scaled == [] and plan.off == []
-    assert plan.drives["rtklib-drive0708"]["outages"] == [{"asked": [243538.0, 30.0], "run": [243538.0, 30.0]},
-                                                          {"asked": [243627.0, 30.0], "run": [243627.0, 30.0]}]

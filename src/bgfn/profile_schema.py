@@ -307,7 +307,7 @@ def check_and_plan(profile: str) -> tuple[list[str], RunPlan]:
     try:
         plan, refused = make_plan(raw, load, lambda key: _typed(profile, key)), None
     except DataError as exc:           # the checks below may name a more precise cause first
-        plan, refused = None, DataError(path, exc.field, f"{exc.expected} (in {exc.source})", exc.found)
+        plan, refused = None, DataError(path, exc.field, f"{exc.expected} in the drive {exc.source}", exc.found)
         if exc.field.startswith("outage_windows."):     # a rule that no scaling fits: its key, as the plan saw it
             raise refused from None
     cfg = validate(set_keys(raw, plan.overrides)) if plan is not None else raw

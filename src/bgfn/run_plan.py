@@ -236,7 +236,7 @@ def _scaled_outages(cfg: dict, drives: dict, starts: dict, typed) -> tuple[dict,
     advice = ((f"; with {', '.join(held)} as typed, no scaling of the other times fits it" if held else
                f"; no outages of the rule of {MIN_OUTAGE_S:g} s or more fit it") if keys else
               "; shorten the listed outages or train.margin_s, or record a longer log")
-    raise DataError(exc.source, key, f"{exc.expected}: the log holds {holds}{advice}", exc.found)
+    raise DataError(", ".join(span), key, f"{exc.expected}: the log holds {holds}{advice}", exc.found)
 
 
 def _sweep_fits(cfg: dict, drive, sw: dict) -> str | None:

@@ -161,7 +161,7 @@ class EvaluationSetup:
                       "NaveGo's recorded IMU files when present)"] if simulated else [])
             kinds += [f"recorded IMUs: {', '.join(recorded)}"] if recorded else []
             lines.append("; ".join(kinds))
-        lines.append(f"tables: {self.datasets} | methods: {ecfg['methods']} | seeds: {ecfg['seeds']} | "
+        lines.append(f"tables: {[dataset_id(d) for d in self.datasets]} | methods: {ecfg['methods']} | seeds: {ecfg['seeds']} | "
                      f"seed aggregate: {ecfg['seed_aggregate']}")
         lines.append(f"outages (start, duration) s: {[list(w) for w in self.windows]}"
                      + "".join(f"; {line}" for line in self.outage_lines))
@@ -197,8 +197,8 @@ def evaluation_setup(cfg: dict) -> EvaluationSetup:
     for name in names:                     # datasets whose outages are not the default list
         entry = outages.outage_entry(cfg, name)
         if outages.is_rule(entry):
-            lines.append(f"{name}: rule {entry['rule']} (picked from the drive)")
+            lines.append(f"{dataset_id(name)}: rule {entry['rule']} (picked from the drive)")
         elif outages.outage_windows(cfg, dataset=name) != default:
-            lines.append(f"{name}: {[list(w) for w in outages.outage_windows(cfg, dataset=name)]}")
+            lines.append(f"{dataset_id(name)}: {[list(w) for w in outages.outage_windows(cfg, dataset=name)]}")
     return EvaluationSetup(cfg["profile"], cfg["description"], ecfg, names, notes, sweep_names,
                            sweep_notes, default, lines, Runner.of(cfg))

@@ -36,7 +36,7 @@ from bgfn.learning import odometry as lo
 from bgfn.learning.split import split_windows
 from bgfn.nav.baseline import filter_start
 from bgfn.nav.constraints import DEFAULT_PLATFORM
-from bgfn.nav.outages import is_rule, outage_entry, picked_outages, snapped_outages
+from bgfn.nav.outages import is_rule, outage_entry, outage_windows, picked_outages, snapped_outages
 from bgfn.settings import complete
 from bgfn.studies.outage_sweep.sweep import profile_sweep_plan, sweep_train_config
 
@@ -319,24 +319,32 @@ def _odometer(cfg: dict, load) -> tuple[dict, list]:
             continue                                        # a walker's bars are skipped by notebook 07 itself
         plan = profile_sweep_plan(cfg, drive, sw)
         dmax = max(float(d) for d in sw["durations_s"])
-        window, _ = lo.window_samples(drive.imu, float(od.get("window_s", 2.0)))
+        window, _ = lo.window_samples(drive.imu, float(od["window_s"]))
         t = drive.imu["time"].to_numpy(float)
         epochs = np.arange(np.ceil(t[0] * rate) / rate, t[-1], 1.0 / rate)
         ws = lo.speed_windows(drive.imu, epochs, window, np.ones(epochs.size))
-        for k in sorted(plan["fold"].unique()):
-            fw = [(float(s), dmax) for s in plan.loc[plan["fold"] == k, "start_s"]]
+        # the bars' folds (and the paper's outages as one more), then the ridge curve's fold counts (notebook 07)
+        folds = [(f"fold {k}", [(float(s), dmax) for s in plan.loc[plan["fold"] == k, "start_s"]], True)
+                 for k in sorted(plan["fold"].unique())]
+        if od["paper_outages"]:
+            folds.append(("the paper's outages", [tuple(w) for w in outage_windows(cfg, drive, name)], True))
+        for n in sorted({min(int(n), int(plan["fold"].size)) for n in od["curve_folds"]}):
+            curve = profile_sweep_plan(cfg, drive, {**sw, "folds": n})
+            folds += [(f"fold {k} of the ridge curve's {n}", [(float(s), dmax) for s in
+                                                             curve.loc[curve["fold"] == k, "start_s"]], False)
+                      for k in sorted(curve["fold"].unique())]
+        for label, held, calibrated in folds:
             try:
                 with warnings.catch_warnings(), np.errstate(all="ignore"):   # an empty split's normalizer
                     warnings.simplefilter("ignore", RuntimeWarning)
-                    data = lo.build_speed_data(ws, fw, margin, val_fraction, int(od.get("val_blocks", 1)),
-                                               bool(od.get("calibration_blocks", False)))
-                ok = len(data.train) >= 2 and len(data.calibration_windows) >= 1
+                    data = lo.build_speed_data(ws, held, margin, val_fraction, int(od["val_blocks"]),
+                                               bool(od["calibration_blocks"]) and calibrated)
+                ok = len(data.train) >= 2 and len(data.calibration_windows if calibrated else data.val) >= 1
             except DataError:
                 ok = False
             if not ok:
-                return (off,
-                        [{"part": "evaluate.odometer.datasets", "reason": "fold_windows",
-                          "dataset": drive.name, "fold": int(k)}])
+                return off, [{"part": "evaluate.odometer.datasets", "reason": "fold_windows",
+                              "dataset": drive.name, "fold": label}]
     return {}, []
 
 

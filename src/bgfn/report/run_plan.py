@@ -57,8 +57,8 @@ def off_line(entry: dict) -> str:
                        f"{entry.get('warmup_s', '?')} s, durations {entry.get('durations_s', '?')} s"
                        if "room_s" in entry else f"no room for the sweep's starts in {entry.get('datasets')}"),
            "fold_training": "its folds leave their networks too few training windows outside the outages",
-           "fold_windows": (f"fold {entry.get('fold')} of {entry.get('dataset')} leaves fewer than 2 training and 1 "
-                            "validation speed window")}.get(entry.get("reason"), entry.get("reason", ""))
+           "fold_windows": (f"{entry.get('fold')} of {entry.get('dataset')} leaves fewer than 2 training and 1 "
+                            "validation speed window outside its outages")}.get(entry.get("reason"), entry.get("reason", ""))
     return f"off: {what}: {why}"
 
 

@@ -64,21 +64,49 @@ def test_the_rule_finds_the_straight_fast_part_and_the_turning_part():
     assert R.pick_windows(RULE, drive_reference(rate_hz=100.0), margin_s=30.0).windows == picked.windows
 
 
-def test_the_cruise_keeps_its_gap_from_the_manoeuvre_and_the_warm_up_is_counted_from_the_first_motion():
+def test_the_cruise_keeps_its_gap_from_the_manoeuvre_and_the_warm_up_is_counted_from_the_filters_start():
     ref = drive_reference()
     # a gap that forbids the fast part's best window: the cruise moves away, at least duration + gap apart
     wide = R.pick_windows({**RULE, "gap_s": 150.0}, ref)
     (c, d), (m, _) = wide.windows
     assert m == TURN_PEAK_S + 1000.0 - 15.0 and abs(c - m) >= d + 150.0
     assert wide.scores["mean_speed_mps"].iloc[0] < 17.0               # not the straight any more
-    # the vehicle first reaches 2 m/s at 22.5 s: no window starts before 22.5 + warm-up
+    # the filter starts at the reference's first row (1000 s; it stands until 22.5 s): no window before + warm-up
     late = R.pick_windows({**RULE, "warmup_s": 250.0}, ref)
-    assert min(s for s, _ in late.windows) >= 1000.0 + 22.5 + 250.0 - 1e-9
+    assert min(s for s, _ in late.windows) >= 1000.0 + 250.0 - 1e-9
+    assert late.thresholds["t_first"] == 1000.0 and late.thresholds["earliest_s"] == 1250.0
+    # a self-aligned filter that starts at 1150 s: the warm-up counts from there (alignment included)
+    aligned = R.pick_windows({**RULE, "warmup_s": 100.0}, ref, t_first=1150.0)
+    assert aligned.thresholds["earliest_s"] == 1250.0 and aligned.windows == late.windows
     assert late.windows[1] == wide.windows[1] or late.windows[1][0] == TURN_PEAK_S + 1000.0 - 15.0
     # a warm-up past the turning part: no manoeuvre left, an error naming the threshold
     with pytest.raises(DataError, match="manoeuvre_min_yaw_rate_dps") as err:
         R.pick_windows({**RULE, "warmup_s": 430.0}, ref, source="sim: profile outage_windows")
     assert err.value.source == "sim: profile outage_windows"
+
+
+def test_the_manoeuvre_threshold_comes_from_the_drives_own_turn_rates():
+    ref = drive_reference()
+    # a gentle drive: every yaw rate a fifth (the turning part peaks at 4 deg/s; its best 30 s window ~2.7 deg/s)
+    rate = np.radians(0.2 * (1.0 * np.sin(2 * np.pi * (ref["time"] - 1000.0) / 50.0)) + 0.2 * 20.0
+                      * np.exp(-((ref["time"] - 1000.0 - TURN_PEAK_S) / 12.0) ** 2))
+    t = ref["time"].to_numpy()
+    yaw = 0.3 + np.concatenate([[0.0], np.cumsum(0.5 * (rate.to_numpy()[1:] + rate.to_numpy()[:-1]) * np.diff(t))])
+    speed = np.hypot(ref["v_n"], ref["v_e"])
+    gentle = ref.assign(v_n=speed * np.cos(yaw), v_e=speed * np.sin(yaw))
+    with pytest.raises(DataError, match="at most 2"):                   # the paper's car threshold alone: refused
+        R.pick_windows({**RULE, "manoeuvre_yaw_rate_percentile": None}, gentle)
+    picked = R.pick_windows(RULE, gentle)                                # the drive's own 75th percentile
+    motion = R.motion_series(gentle, 1.0, 2.0)
+    both = (motion["speed_mps"].to_numpy()[1:] >= 2.0) & (motion["speed_mps"].to_numpy()[:-1] >= 2.0)
+    p75 = np.percentile(np.abs(motion["yaw_rate_dps"].to_numpy()[1:][both]), 75.0)
+    assert picked.thresholds["percentile_dps"] == pytest.approx(p75) and p75 < 5.0
+    assert picked.thresholds["manoeuvre_dps"] == pytest.approx(p75)
+    assert picked.thresholds["cruise_dps"] == pytest.approx(min(3.0, p75))   # a cruise turns less than that
+    assert abs(picked.windows[1][0] - (TURN_PEAK_S + 1000.0 - 15.0)) <= 1.0   # still the turning part
+    # a drive that passes the fixed threshold keeps its windows: the percentile only lowers the bar
+    assert R.pick_windows(RULE, ref).windows == R.pick_windows({**RULE, "manoeuvre_yaw_rate_percentile": None},
+                                                               ref).windows
 
 
 def test_the_rule_refuses_what_it_cannot_do():
@@ -234,3 +262,13 @@ def test_training_and_evaluation_take_each_datasets_outages():
     assert setup.windows == default
     assert evaluation_words.setup_lines(setup)[3] == (f"outages (start, duration) s: {[list(w) for w in default]}; sim: rule "
                                    "cruise_and_manoeuvre (picked from the drive); other: [[138800.0, 10.0]]")
+
+
+def test_the_shipped_smoke_profile_is_planned_unchanged(params):
+    """The run plan (bgfn.run_plan) of a shipped profile changes nothing; its real drive keeps the rule's windows."""
+    from bgfn.profile_schema import check_and_plan
+
+    lines, plan = check_and_plan("smoke")
+    assert plan.overrides == {} and plan.scaled == [] and plan.off == []
+    assert plan.drives["rtklib-drive0708"]["outages"] == [{"asked": [243538.0, 30.0], "run": [243538.0, 30.0]},
+                                                          {"asked": [243627.0, 30.0], "run": [243627.0, 30.0]}]

@@ -117,3 +117,10 @@ def test_an_underestimated_accelerometer_bias_makes_the_check_fail():
                                                         "accel_bias_instability": [1e-6] * 3})
     assert N.verdict(float(np.median(honest))) == "consistent"
     assert N.verdict(float(np.median(told_small))) == "overconfident" and told_small.mean() > 5 * honest.mean()
+
+
+def test_the_scan_runs_only_durations_the_sweep_ran():
+    """A short log's sweep of 10 and 30 s: the scan speaks of 30 s, not of 60 s it never ran."""
+    assert N.scan_durations({"durations_s": [10.0, 30.0, 60.0, 120.0]}) == [30.0, 60.0]
+    assert N.scan_durations({"durations_s": [10.0, 30.0]}) == [30.0]
+    assert N.scan_durations({"durations_s": [10.0, 20.0]}) == [20.0]

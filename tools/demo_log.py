@@ -1,13 +1,14 @@
 """Write an example own log (a CSV folder as a logger leaves it) and a profile that names it by its absolute path.
 
-``python tools/demo_log.py FOLDER PROFILE [--walker]`` writes a 240 s synthetic car drive into ``FOLDER`` (``imu.csv`` at a
-jittery ~100 Hz, ``gnss.csv`` at 1 Hz with a lever arm, ``reference.csv`` at 5 Hz, ``meta.yaml``; GPS time of week)
-and ``params/<PROFILE>.yaml``: the README's two lines with the absolute path (``base: own``), one outage (the demo
-drive turns too gently for the rule's manoeuvre) and the smallest budget, so that ``make reproduce
-PROFILE=<PROFILE>`` runs the whole chain on it in a few minutes. CI runs exactly that (``.ci/run``): the
-documented own-log path by absolute path, end to end, every notebook and the book. With ``--walker`` the log is the
-gallery's synthetic walk instead (:func:`bgfn.studies.gallery.logs.walker_log`, ``platform: walker``) and the profile is
-based on ``params/own-walker.yaml``, with the outages picked by its rule and a four-start sweep.
+``python tools/demo_log.py FOLDER PROFILE [--walker] [--duration S]`` writes a synthetic car drive of ``S`` seconds
+(default 60 s: a short phone-like log) into ``FOLDER`` (``imu.csv`` at a jittery ~100 Hz, ``gnss.csv`` at 1 Hz with a
+lever arm, ``reference.csv`` at 5 Hz, ``meta.yaml``; GPS time of week) and ``params/<PROFILE>.yaml``: the README's two
+lines with the absolute path (``base: own``) and the smallest budget, nothing else: the profile check's run plan
+(:mod:`bgfn.run_plan`) fits the outages, margins and the sweep to the log or switches off what it cannot hold, so that
+``make reproduce PROFILE=<PROFILE>`` runs the whole chain on it in a few minutes. CI runs exactly that
+(``.ci/run``): the documented own-log path by absolute path, end to end, every notebook and the book. With
+``--walker`` the log is the gallery's synthetic walk instead (:func:`bgfn.studies.gallery.logs.walker_log`, ``platform:
+walker``, default 134 s) and the profile is based on ``params/own-walker.yaml``.
 """
 
 from __future__ import annotations
@@ -28,7 +29,8 @@ from bgfn.nav import sim
 T0 = 243000.0                    # GPS time of week of the first epoch, s
 DURATION_S = 240.0
 LEVER = [-0.4, 0.0, -1.0]        # GNSS antenna in the body frame, m
-OUTAGE = [T0 + 150.0, 30.0]      # one 30 s outage, s
+#: The CLI's default lengths: a car log of a minute, a walk of 134 s (the logs notebook 09's own-log runs are made for).
+CLI_CAR_S, CLI_WALK_S = 60.0, 134.0
 #: The smallest budget of the demo profiles (the numbers mean nothing; the chain runs through).
 BUDGET = ("train: {methods: [bgfn, transformer, mlp], seeds: [0], size: smoke, lr_search: {grid: null},\n"
           "        optimizer: {epochs: 2, max_train_windows: 64, max_val_windows: 32}}\n"
@@ -36,11 +38,12 @@ BUDGET = ("train: {methods: [bgfn, transformer, mlp], seeds: [0], size: smoke, l
           "energy: {allow_untrained: true}\n")
 
 
-def demo_log(folder: Path, name: str = "demo-car", seed: int = 7, source: str = "tools/demo_log.py (synthetic)") -> Path:
+def demo_log(folder: Path, name: str = "demo-car", seed: int = 7, source: str = "tools/demo_log.py (synthetic)",
+             duration_s: float = DURATION_S) -> Path:
     """The drive of the module docstring, written in the CSV schema (atomically per file); ``name`` in its
-    ``meta.yaml``. The IMU's white noise and the filter's error model agree (std x sqrt(0.01 s) = density); the
-    biases are the model's turn-on biases."""
-    truth = sim.demo_trajectory(DURATION_S, 400.0)
+    ``meta.yaml``; ``duration_s`` long. The IMU's white noise and the filter's error model agree
+    (std x sqrt(0.01 s) = density); the biases are the model's turn-on biases."""
+    truth = sim.demo_trajectory(duration_s, 400.0)
     truth["time"] = truth["time"] + T0
     rng = np.random.default_rng(seed)
     fine = sim.imu_from_trajectory(truth)                      # 2.5 ms rows; a logger's steps of 7.5-12.5 ms
@@ -63,15 +66,16 @@ def demo_log(folder: Path, name: str = "demo-car", seed: int = 7, source: str = 
 
 
 def demo_profile(name: str, folder: Path) -> Path:
-    """``params/<name>.yaml`` naming ``folder`` by its absolute path (module docstring)."""
+    """``params/<name>.yaml`` naming ``folder`` by its absolute path, the smallest budget and a four-start sweep
+    (module docstring)."""
     path = PARAMS_DIR / f"{name}.yaml"
-    path.write_text(f'base: own\ndatasets: ["{Path(folder).resolve()}"]\noutage_windows: [{OUTAGE}]\n' + BUDGET
-                    + "evaluate: {methods: [bgfn, transformer, mlp], sweep: {datasets: []}}\n", encoding="utf-8")
+    path.write_text(f'base: own\ndatasets: ["{Path(folder).resolve()}"]\n' + BUDGET
+                    + "evaluate: {methods: [bgfn, transformer, mlp], sweep: {n_starts: 4}}\n", encoding="utf-8")
     return path
 
 
 def walker_profile(name: str, folder: Path) -> Path:
-    """``params/<name>.yaml`` for the walk in ``folder``: ``base: own-walker``, the rule's outages, a short sweep."""
+    """``params/<name>.yaml`` for the walk in ``folder``: ``base: own-walker``, the smallest budget, a short sweep."""
     path = PARAMS_DIR / f"{name}.yaml"
     path.write_text(f'base: own-walker\ndatasets: ["{Path(folder).resolve()}"]\n' + BUDGET
                     + "evaluate: {methods: [bgfn, transformer, mlp], sweep: {n_starts: 4}}\n", encoding="utf-8")
@@ -83,11 +87,14 @@ def main(argv=None) -> int:
     p.add_argument("folder")
     p.add_argument("profile")
     p.add_argument("--walker", action="store_true", help="the gallery's synthetic walk (platform walker)")
+    p.add_argument("--duration", type=float, help=f"the log's length, s (default {CLI_CAR_S:g}; a walk {CLI_WALK_S:g})")
     a = p.parse_args(argv)
     if a.walker:
-        print("wrote", walker_log(Path(a.folder)), "and", walker_profile(a.profile, Path(a.folder)))
+        log = walker_log(Path(a.folder), duration_s=a.duration or CLI_WALK_S)
+        print("wrote", log, "and", walker_profile(a.profile, Path(a.folder)))
     else:
-        print("wrote", demo_log(Path(a.folder)), "and", demo_profile(a.profile, Path(a.folder)))
+        log = demo_log(Path(a.folder), duration_s=a.duration or CLI_CAR_S)
+        print("wrote", log, "and", demo_profile(a.profile, Path(a.folder)))
     return 0
 
 

@@ -226,6 +226,11 @@ def _read_chain(profile: str) -> list[tuple[Path, dict]]:
     return chain
 
 
+def own_settings(profile: str) -> dict:
+    """What the profile's own file says (parsed, no base merged, no default filled): the keys its author typed."""
+    return _read_chain(profile)[0][1]
+
+
 def profile_chain(profile: str) -> list[Path]:
     """The profile's file followed by the files of its ``base:`` chain (``params/<base>.yaml``, ...)."""
     return [path for path, _ in _read_chain(profile)]

@@ -20,20 +20,23 @@ import sys
 from typing import Any
 
 from bgfn.config import (DEFAULT_DATASET_KEY, MAIN_VARIANT, VARIANT_NAME, VARIANT_RUN_KEYS, file_setting,
-                         odometer_datasets, profile_chain, read_profile, set_keys, variant_config)
+                         odometer_datasets, own_settings, profile_chain, read_profile, set_keys, variant_config)
 from bgfn.data import load_drive
 from bgfn.data.names import profile_datasets, unique_ids
 from bgfn.data.imu_errors import EKINOX_D, MPU6000, error_params
 from bgfn.data.registry import DATASETS
 from bgfn.errors import DataError
+from bgfn.io import atomic_write_text
+from bgfn.report.run_plan import plan_lines
 from bgfn.evaluate import evaluate_config
 from bgfn.studies.outage_sweep.sweep import sweep_plan
 from bgfn.learning import learning_options
 from bgfn.nav.baseline import filter_start
-from bgfn.nav.outages import check_windows, is_rule, outage_entry, picked_outages
+from bgfn.nav.outages import check_windows, is_rule, outage_entry, picked_outages, snap_windows
 from bgfn.models import MODELS
 from bgfn.paper import METHOD_LABELS
 from bgfn.parallel import SCHEDULER_ENV, Runner
+from bgfn.run_plan import RunPlan, fingerprint, make_plan, plan_json, plan_path, read_plan
 from bgfn.settings import MAX_COUNT, Data, ProfileError, Train, check_model, complete, fmt, merge
 
 __all__ = ["ProfileError", "check_with_drives", "cross_check", "load_profile", "main", "validate", "with_overrides"]
@@ -239,7 +242,7 @@ def validate(cfg: dict) -> dict:
 
 
 def load_profile(profile: str, overrides: dict[str, Any] | None = None,
-                 source: str = "notebook parameters") -> dict[str, Any]:
+                 source: str = "notebook parameters", planned: bool = True) -> dict[str, Any]:
     """``params/<profile>.yaml`` read and merged (:func:`bgfn.config.read_profile`), then checked against the schema;
     with ``overrides`` (a notebook's parameters, ``{"section.key": value}``, None values skipped) set over it
     (:func:`with_overrides`, errors naming ``source``).
@@ -260,7 +263,33 @@ def load_profile(profile: str, overrides: dict[str, Any] | None = None,
         cross_check(cfg)
     except ProfileError as exc:
         raise DataError(file_setting(profile, exc.path), exc.path, exc.expected, exc.found) from None
+    if planned:
+        cfg = with_plan(profile, cfg)
     return with_overrides(cfg, overrides, source) if overrides else cfg
+
+
+def with_plan(profile: str, cfg: dict) -> dict:
+    """``cfg`` with the run plan's overrides (:mod:`bgfn.run_plan`: what the profile check scaled to the drives or
+    switched off), when the check wrote one for this version of the profile.
+
+    Raises
+    ------
+    bgfn.errors.DataError
+        A plan that changes the profile was made for another version of it (edited since the check ran).
+    """
+    plan = read_plan(profile)
+    if plan is None:
+        return cfg
+    if plan.fingerprint != fingerprint(cfg):
+        if not plan.changes:
+            return cfg
+        raise DataError(plan_path(profile), "fingerprint", f"a run plan made for this version of the profile: run "
+                        f"the profile check first (python -m bgfn.profile_schema {profile}; make reproduce runs it)",
+                        "a plan for an earlier version")
+    try:
+        return validate(set_keys(cfg, plan.overrides))
+    except ProfileError as exc:
+        raise DataError(plan_path(profile), exc.path, exc.expected, exc.found) from None
 
 
 def with_overrides(cfg: dict, overrides: dict[str, Any], source: str = "notebook parameters") -> dict:
@@ -305,23 +334,43 @@ def check_keys(profile: str) -> list[str]:
     bgfn.errors.DataError
         Naming the profile's file and key, or the environment variable.
     """
-    cfg = load_profile(profile)
+    cfg = load_profile(profile, planned=False)        # the plan is remade by the check with the drives
     runner = Runner.of(cfg)
     where = (f"on the Dask cluster at {runner.scheduler}" if runner.backend == "dask" else
              f"{runner.jobs} at a time here" + (f" ({runner.asked} asked: capped)" if runner.asked else ""))
     return [f"every key checked; independent runs {where}"]
 
 
+def _typed(profile: str, key: str) -> bool:
+    """Whether the profile's own file (not a base) sets the dotted ``key``."""
+    node = own_settings(profile)
+    for k in key.split("."):
+        if not isinstance(node, dict) or k not in node:
+            return False
+        node = node[k]
+    return True
+
+
 def check_with_drives(profile: str) -> list[str]:
+    """:func:`check_and_plan`'s lines."""
+    return check_and_plan(profile)[0]
+
+
+def check_and_plan(profile: str) -> tuple[list[str], RunPlan]:
     """The checks that need the data, for ``make``'s ``check-profile`` step: each dataset of the profile loads
     (built and cached when new, as notebook 01 would), no two share a dataset id (the name of their result files,
     :func:`bgfn.data.names.dataset_id`), the outages lie inside every drive of notebooks 02-04,
     the input window is shorter than the GPS-available data, and the outage sweep has its starts.
 
+    First the run plan (:func:`bgfn.run_plan.make_plan`): what every notebook needs of the drives, scaled to them or
+    switched off; the checks below then run on the profile with the plan laid over it, as the notebooks will read it.
+
     Returns
     -------
     list of str
         One line per dataset, what was checked.
+    RunPlan
+        The plan (``main`` writes it to ``results/<profile>/run_plan.json``).
 
     Raises
     ------
@@ -329,8 +378,22 @@ def check_with_drives(profile: str) -> list[str]:
         Naming the profile's file and the key.
     """
     lines = check_keys(profile)
-    cfg = load_profile(profile)
+    raw = load_profile(profile, planned=False)
     path = profile_chain(profile)[0]
+    loaded: dict = {}
+
+    def load(name):
+        if name not in loaded:
+            loaded[name] = load_drive(name, profile=profile)
+        return loaded[name]
+
+    try:
+        plan, refused = make_plan(raw, load, lambda key: _typed(profile, key)), None
+    except DataError as exc:           # the checks below may name a more precise cause first
+        plan, refused = None, DataError(path, exc.field, f"{exc.expected} in the drive {exc.source}", exc.found)
+        if exc.field.startswith("outage_windows."):     # a rule that no scaling fits: its key, as the plan saw it
+            raise refused from None
+    cfg = validate(set_keys(raw, plan.overrides)) if plan is not None else raw
     tr, ev = cfg["train"], cfg["evaluate"]
     opts = learning_options(tr)                 # the window and margin notebook 03 uses, defaults filled in
     names = dict.fromkeys(cfg["nav"].get("datasets", []) + tr.get("datasets", []) + ev.get("datasets", [])
@@ -338,7 +401,7 @@ def check_with_drives(profile: str) -> list[str]:
     unique_ids(list(cfg["data"].get("datasets", [])) + list(names), path)   # result files must not overwrite
     spec = cfg.get("outage_windows")
     for name in names:
-        drive = load_drive(name, profile=profile)
+        drive = load(name)
         t = drive.imu["time"].to_numpy(float)
         t0, t1 = filter_start(drive, cfg["nav"]), float(t[-1])     # a self-aligned filter starts late
         key = (f"outage_windows.{name if name in spec else DEFAULT_DATASET_KEY}" if isinstance(spec, dict)
@@ -346,7 +409,8 @@ def check_with_drives(profile: str) -> list[str]:
         entry = outage_entry(cfg, name)
         rule = is_rule(entry)
         try:                                    # a rule picks the windows from the drive (the notebooks' reader)
-            windows = picked_outages(cfg, drive, name).windows if rule else _windows(entry)
+            windows = [w.window for w in snap_windows(picked_outages(cfg, drive, name).windows if rule
+                                                       else _windows(entry), t)]      # on the IMU epochs
         except DataError as exc:
             raise DataError(path, f"{key}.{exc.field}", f"{exc.expected} in the drive {name}", exc.found) from None
         try:
@@ -375,14 +439,16 @@ def check_with_drives(profile: str) -> list[str]:
                      f"window {window_s:g} s")
     sw = evaluate_config(ev, tr)["sweep"]
     for name in sw["datasets"]:
-        drive = load_drive(name, profile=profile)
+        drive = load(name)
         try:
-            plan = sweep_plan(drive, sw, int(opts["window"]), t_first=filter_start(drive, cfg["nav"]))
+            starts = sweep_plan(drive, sw, int(opts["window"]), t_first=filter_start(drive, cfg["nav"]))
         except DataError as exc:
             raise DataError(path, "evaluate.sweep.n_starts/durations_s/warmup_s", f"{exc.expected} in {name}",
                             exc.found) from None
-        lines.append(f"{name}: outage sweep of {len(plan)} starts in {sw.get('folds')} folds")
-    return lines
+        lines.append(f"{name}: outage sweep of {len(starts)} starts in {sw.get('folds')} folds")
+    if refused is not None:
+        raise refused
+    return lines, plan
 
 
 def main(argv=None) -> int:
@@ -392,11 +458,15 @@ def main(argv=None) -> int:
     parser.add_argument("--keys", action="store_true", help="only what needs no data (before the install and data)")
     args = parser.parse_args(argv)
     try:
-        lines = check_keys(args.profile) if args.keys else check_with_drives(args.profile)
+        if args.keys:
+            lines = check_keys(args.profile)
+        else:
+            lines, plan = check_and_plan(args.profile)
+            atomic_write_text(plan_path(args.profile), plan_json(plan))
     except DataError as exc:
         print(f"error: profile {args.profile!r}: {exc}", file=sys.stderr)
         return 2
-    for line in lines:
+    for line in lines + plan_lines(plan):
         print(f"    profile {args.profile}: {line}")
     return 0
 

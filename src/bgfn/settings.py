@@ -60,10 +60,14 @@ class OutageRule(Section):
     rule: Literal["cruise_and_manoeuvre"] = Field(description="the rule that picks the windows")
     duration_s: Pos = _f(30.0, "each outage, s (the paper's 30 s)")
     step_s: Pos = _f(1.0, "grid of the speed and yaw-rate series and of the starts, s")
-    warmup_s: NonNeg = _f(60.0, "no start earlier after the platform first moves, s")
+    warmup_s: NonNeg = _f(60.0, "no start earlier after the filter's start (its alignment included), s")
     min_speed_mps: NonNeg = _f(2.0, "slower counts as standing (the course is no heading), m/s")
     cruise_max_yaw_rate_dps: NonNeg = _f(3.0, "a cruise window's mean |yaw rate| at most, deg/s")
-    manoeuvre_min_yaw_rate_dps: NonNeg = _f(5.0, "the manoeuvre window's mean |yaw rate| at least, deg/s")
+    manoeuvre_min_yaw_rate_dps: NonNeg = _f(5.0, "the manoeuvre window's mean |yaw rate| at least, deg/s (or the "
+                                            "drive's percentile below, when lower)")
+    manoeuvre_yaw_rate_percentile: Annotated[float, Field(gt=0, le=100)] | None = _f(
+        75.0, "the drive's own manoeuvre threshold: this percentile of its |yaw rate| while moving, deg/s, when "
+        "below manoeuvre_min_yaw_rate_dps (null: the fixed value alone)")
     gap_s: NonNeg = _f(30.0, "between the two outages at least, s")
     min_training_s: NonNeg = _f(120.0, "GPS time left to training outside the outages +- train.margin_s, s")
 

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 from typing import Any, Sequence
 
 from bgfn import settings
-from bgfn.data import acquire
+from bgfn.data import acquire, dataset_id
 from bgfn.errors import DataError
 from bgfn.nav import outages
 from bgfn.paper import METHOD_LABELS, TESTS, nhc_label
@@ -175,8 +175,8 @@ def evaluation_setup(cfg: dict) -> EvaluationSetup:
     for name in names:                     # datasets whose outages are not the default list
         entry = outages.outage_entry(cfg, name)
         if outages.is_rule(entry):
-            lines.append(f"{name}: rule {entry['rule']} (picked from the drive)")
+            lines.append(f"{dataset_id(name)}: rule {entry['rule']} (picked from the drive)")
         elif outages.outage_windows(cfg, dataset=name) != default:
-            lines.append(f"{name}: {[list(w) for w in outages.outage_windows(cfg, dataset=name)]}")
+            lines.append(f"{dataset_id(name)}: {[list(w) for w in outages.outage_windows(cfg, dataset=name)]}")
     return EvaluationSetup(cfg["profile"], cfg["description"], ecfg, names, notes, sweep_names,
                            sweep_notes, default, lines, Runner.of(cfg))

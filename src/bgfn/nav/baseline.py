@@ -28,7 +28,7 @@ from .consistency import nis_summary
 from .error_model import PHI_D, STATE_NAMES
 from .filter import FilterResult, run_filter, run_outage
 from .gnss_aid import gate_thresholds
-from .outages import check_windows, epochs_before
+from .outage_window import check_windows, epochs_before
 from .reference_attitude import check_attitude
 from .state import FilterNoise, FilterState, initial_covariance, initial_state, noise_from_imu_errors, save_states
 from .tuning import NOISE_SEARCH_DEFAULTS, NoiseTuning, search_noise_scale

@@ -17,7 +17,7 @@ from ..errors import DataError
 from . import error_model as em
 from .engine import Stepper
 from .gnss_aid import GnssFixes, PseudoGps, WindowStarts, check_gnss, gate_thresholds
-from .outages import OutageWindow, check_windows
+from .outage_window import OutageWindow, check_windows
 from .state import FilterNoise, FilterState
 from .strapdown import imu_steps, trajectory_frame
 

@@ -22,7 +22,7 @@ from ..errors import DataError
 from ..schema import GNSS_FIX_COLUMNS
 from . import error_model as em
 from .engine import EPOCH_TOL, Measurement, Stepper
-from .outages import PseudoGpsContext
+from .outage_window import PseudoGpsContext
 from .strapdown import radii_nb
 
 

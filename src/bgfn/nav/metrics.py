@@ -15,7 +15,7 @@ import pandas as pd
 
 from ..errors import DataError
 from . import earth, transform
-from .outages import OutageWindow
+from .outage_window import OutageWindow
 
 #: Columns of :func:`navigation_errors`.
 ERROR_COLUMNS = ["time", "north", "east", "down", "horizontal", "v_n", "v_e", "v_d", "roll", "pitch", "yaw"]

@@ -17,13 +17,16 @@ whole multiples of ``step_s``, GPS time of week):
   grid epochs (a car does not slide, so course rate and yaw rate agree; the course needs no reference
   attitude, which a recorded drive may lack). A step where either epoch is slower than ``min_speed_mps``
   counts as no turn: there the course is noise, and a car turning on the spot does not exist;
-- the earliest start is ``warmup_s`` after the vehicle first reaches ``min_speed_mps`` (the filter aligns its
-  heading once moving, converges, and the network needs its input window before the outage); a window ends
-  by the last reference epoch;
-- *manoeuvre*: the window with the highest mean |yaw rate|; it must reach ``manoeuvre_min_yaw_rate_dps``;
+- the earliest start is ``warmup_s`` after the filter's start (``t_first``: the reference's first row, or the
+  end of a self-alignment, which waits for motion; the filter converges and the network needs its input window
+  before the outage); a window ends by the last reference epoch;
+- *manoeuvre*: the window with the highest mean |yaw rate|; it must reach the manoeuvre threshold: the drive's
+  own ``manoeuvre_yaw_rate_percentile``-th percentile of |yaw rate| over its moving steps, capped at
+  ``manoeuvre_min_yaw_rate_dps`` (a drive that turns gently, a highway, still has its sharpest turns; one whose
+  sharpest window passes the fixed value keeps its windows, since the rule takes the sharpest window anyway);
 - *cruise*: among windows at least ``gap_s`` apart from the manoeuvre window and with mean |yaw rate| at most
-  ``cruise_max_yaw_rate_dps``, the one with the highest mean speed (the manoeuvre is chosen first: it is the
-  rarer of the two, so the cruise cannot take its place);
+  ``cruise_max_yaw_rate_dps`` (and no more than the manoeuvre threshold), the one with the highest mean speed
+  (the manoeuvre is chosen first: it is the rarer of the two, so the cruise cannot take its place);
 - the GPS-available time left to training (the reference span minus both windows widened by the training
   margin ``train.margin_s``) must be at least ``min_training_s``.
 
@@ -66,6 +69,10 @@ class PickedOutages:
         GPS-available time left outside the windows widened by the training margin, s.
     rule : dict
         The rule with its defaults filled in.
+    thresholds : dict
+        What the drive made of the rule: ``manoeuvre_dps`` (the threshold applied), ``percentile_dps`` (the
+        drive's percentile of |yaw rate|, None without one), ``cruise_dps`` (the cruise's cap applied),
+        ``t_first`` (s, what the warm-up counts from) and ``earliest_s`` (the earliest start).
     """
 
     windows: list
@@ -73,6 +80,7 @@ class PickedOutages:
     scores: pd.DataFrame
     training_s: float
     rule: dict = field(default_factory=dict)
+    thresholds: dict = field(default_factory=dict)
 
 
 def rule_params(rule: dict, source: str = "outage_windows") -> dict:
@@ -90,7 +98,8 @@ def rule_params(rule: dict, source: str = "outage_windows") -> dict:
     unknown = sorted(set(rule) - set(defaults) - {"rule"})
     if unknown:
         raise DataError(source, unknown[0], f"a parameter of rule {name}: {', '.join(defaults)}", "unknown key")
-    params = {"rule": name, **defaults, **{k: float(v) for k, v in rule.items() if k != "rule"}}
+    params = {"rule": name, **defaults, **{k: (None if v is None else float(v)) for k, v in rule.items()
+                                           if k != "rule"}}
     for key in ("duration_s", "step_s"):
         if not params[key] > 0:
             raise DataError(source, key, "a positive time, s", repr(params[key]))
@@ -163,8 +172,23 @@ def training_time(t_first: float, t_last: float, windows, margin_s: float) -> fl
     return (t_last - t_first) - covered
 
 
+def manoeuvre_threshold(motion: pd.DataFrame, fixed_dps: float, percentile: float | None,
+                        min_speed_mps: float) -> tuple[float, float | None]:
+    """The manoeuvre threshold of a drive: ``min(fixed_dps, P)``, P the ``percentile``-th percentile of |yaw rate|
+    over the steps of ``motion`` (:func:`motion_series`) whose both ends move at ``min_speed_mps`` or more (a
+    standing step is no turn, and is left out). Returns ``(threshold, P)``; P is None when ``percentile`` is None
+    or no step moves (then the fixed value alone)."""
+    speed = motion["speed_mps"].to_numpy(float)
+    rate = np.abs(motion["yaw_rate_dps"].to_numpy(float))
+    steps = rate[1:][(speed[1:] >= min_speed_mps) & (speed[:-1] >= min_speed_mps)]
+    if percentile is None or steps.size == 0:
+        return float(fixed_dps), None
+    p = float(np.percentile(steps, float(percentile)))
+    return min(float(fixed_dps), p), p
+
+
 def cruise_and_manoeuvre(reference: pd.DataFrame, rule: dict, margin_s: float = 0.0,
-                         source: str = "outage_windows") -> PickedOutages:
+                         source: str = "outage_windows", t_first: float | None = None) -> PickedOutages:
     """The rule ``cruise_and_manoeuvre`` on one drive (see the module's docstring).
 
     Parameters
@@ -177,6 +201,8 @@ def cruise_and_manoeuvre(reference: pd.DataFrame, rule: dict, margin_s: float = 
         Training margin around each outage (``train.margin_s``), s.
     source : str
         Named in error messages (the drive and the profile key).
+    t_first : float, optional
+        The filter's start, s (:func:`bgfn.nav.baseline.filter_start`); default the reference's first row.
 
     Raises
     ------
@@ -191,18 +217,26 @@ def cruise_and_manoeuvre(reference: pd.DataFrame, rule: dict, margin_s: float = 
     if moving.empty:
         raise DataError(source, "min_speed_mps", "a drive that reaches this speed",
                         f"top speed {motion['speed_mps'].max():.2f} m/s")
-    earliest = float(moving.iloc[0]) + p["warmup_s"]
+    start = float(reference["time"].iloc[0]) if t_first is None else max(float(t_first),
+                                                                          float(reference["time"].iloc[0]))
+    earliest = start + p["warmup_s"]
     scores = window_scores(motion, dur, step)
     scores = scores[scores["start_s"] >= earliest - 1e-9].reset_index(drop=True)
     if scores.empty:
-        raise DataError(source, "warmup_s", f"a {dur:g} s window between {earliest:.1f} s (first motion + warm-up) "
-                        "and the end of the drive", f"the drive ends at {float(motion['time'].iloc[-1]):.1f} s")
+        raise DataError(source, "warmup_s", f"a {dur:g} s window between {earliest:.1f} s (the filter's start "
+                        "+ warm-up) and the end of the drive",
+                        f"the drive ends at {float(motion['time'].iloc[-1]):.1f} s")
+    threshold, pct = manoeuvre_threshold(motion, p["manoeuvre_min_yaw_rate_dps"],
+                                         p["manoeuvre_yaw_rate_percentile"], p["min_speed_mps"])
     man = scores.iloc[int(np.argmax(scores["mean_abs_yaw_rate_dps"].to_numpy()))]   # first maximum: earliest
-    if man["mean_abs_yaw_rate_dps"] < p["manoeuvre_min_yaw_rate_dps"]:
-        raise DataError(source, "manoeuvre_min_yaw_rate_dps", "a window turning at least this fast (mean |yaw "
-                        "rate|, deg/s)", f"at most {man['mean_abs_yaw_rate_dps']:.2f} deg/s")
+    if man["mean_abs_yaw_rate_dps"] < threshold:
+        raise DataError(source, "manoeuvre_min_yaw_rate_dps", "a window turning at least "
+                        f"{threshold:.2f} deg/s (mean |yaw rate|: this key or the drive's "
+                        f"{p['manoeuvre_yaw_rate_percentile']}th percentile of its |yaw rate|, the lower)",
+                        f"at most {man['mean_abs_yaw_rate_dps']:.2f} deg/s")
+    cruise_cap = min(p["cruise_max_yaw_rate_dps"], threshold)
     apart = (scores["start_s"] - man["start_s"]).abs() >= dur + p["gap_s"] - 1e-9
-    calm = scores["mean_abs_yaw_rate_dps"] <= p["cruise_max_yaw_rate_dps"]
+    calm = scores["mean_abs_yaw_rate_dps"] <= cruise_cap
     cruise_candidates = scores[apart & calm]
     if cruise_candidates.empty:
         raise DataError(source, "cruise_max_yaw_rate_dps", f"a window at least gap_s = {p['gap_s']:g} s apart "
@@ -217,7 +251,9 @@ def cruise_and_manoeuvre(reference: pd.DataFrame, rule: dict, margin_s: float = 
     if left < p["min_training_s"]:
         raise DataError(source, "min_training_s", f"at least this much GPS time outside the outages +- "
                         f"{margin_s:g} s (train.margin_s) for training", f"{left:.1f} s")
-    return PickedOutages(windows, picked["kind"].tolist(), picked, float(left), p)
+    return PickedOutages(windows, picked["kind"].tolist(), picked, float(left), p,
+                         {"manoeuvre_dps": threshold, "percentile_dps": pct, "cruise_dps": cruise_cap,
+                          "t_first": start, "earliest_s": earliest})
 
 
 #: Rule name -> the function that applies it.
@@ -225,6 +261,7 @@ RULES = {"cruise_and_manoeuvre": cruise_and_manoeuvre}
 
 
 def pick_windows(rule: dict, reference: pd.DataFrame, margin_s: float = 0.0,
-                 source: str = "outage_windows") -> PickedOutages:
-    """Apply the profile's rule entry ``rule`` (its ``rule:`` key names it) to a drive's reference."""
-    return RULES[rule_params(rule, source)["rule"]](reference, rule, margin_s, source)
+                 source: str = "outage_windows", t_first: float | None = None) -> PickedOutages:
+    """Apply the profile's rule entry ``rule`` (its ``rule:`` key names it) to a drive's reference; the warm-up
+    counts from ``t_first`` (the filter's start; default the reference's first row)."""
+    return RULES[rule_params(rule, source)["rule"]](reference, rule, margin_s, source, t_first)

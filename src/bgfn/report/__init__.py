@@ -19,6 +19,7 @@ from bgfn.report.provenance import (cards_line, meta_line, model_cards, outage_d
 from bgfn.report.reading import ProfileResults, missing_note, read_csv, read_json, read_results, rel
 from bgfn.report.sections import (OutageSection, energy_section, header_section, kf_section, outage_section,
                                   odometer_section, shown_tests, sweep_section, training_section)
+from bgfn.report.run_plan import part_off_line, plan_lines
 from bgfn.report.sentences import (BASELINES, EXTRA_METHODS, EXTRA_TAGS, bullets, comparison_sentences,
                                    energy_sentences, paper_name, reduction_sentences, summary_sentence, win_counts)
 from bgfn.report.tables import (REFERENCE_LABELS, TABLE_STYLES, TRAINING_COLUMNS, best_mask, compact, energy_table,
@@ -49,4 +50,6 @@ __all__ = [
     "extra_figure_section", "draw_diagrams", "bullets", "run_meta",
     # a test the paper has no table of (the real drive): which tests the page shows, how it names the paper's
     "shown_tests", "paper_name",
+    # the run plan in words (bgfn.run_plan: notebook 01, the profile check)
+    "plan_lines", "part_off_line",
 ]

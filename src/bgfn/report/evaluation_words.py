@@ -8,7 +8,8 @@ from typing import Mapping
 import pandas as pd
 
 from bgfn import paper
-from bgfn.evaluate.setup import METRIC_COLUMNS, EvaluationSetup
+from bgfn.data import dataset_id
+from bgfn.evaluate.setup import METRIC_COLUMNS, REAL_IMU_DATASETS, EvaluationSetup
 from bgfn.evaluate.tables import error_reduction
 from bgfn.paper import nhc_label
 from bgfn.stats import too_few_for_statistics
@@ -20,13 +21,18 @@ def setup_lines(setup: EvaluationSetup) -> list[str]:
     datasets, methods, seeds, outages, pseudo-GPS."""
     ecfg = setup.config
     lines = [f"profile {setup.profile!r}: {setup.description}"]
+    names = list(dict.fromkeys(list(setup.datasets) + list(setup.sweep_datasets)))
+    simulated = [d for d in names if d in REAL_IMU_DATASETS]          # the only drives with simulated IMUs
+    recorded = [dataset_id(d) for d in names if d not in REAL_IMU_DATASETS]
     if ecfg["real_imu"]:
         lines += [f"real_imu: {line}" for line in dict.fromkeys(setup.notes + setup.sweep_notes)]
-    else:
-        lines.append("real_imu: false -> simulated IMUs (set real_imu=True to use NaveGo's recorded IMU "
-                     "files when present)")
-    lines.append(f"tables: {setup.datasets} | methods: {ecfg['methods']} | seeds: {ecfg['seeds']} | "
-                 f"seed aggregate: {ecfg['seed_aggregate']}")
+    else:                                   # one line: which IMUs are simulated, which recorded
+        kinds = ([f"real_imu: false -> simulated IMUs for {', '.join(simulated)} (set real_imu=True to use "
+                  "NaveGo's recorded IMU files when present)"] if simulated else [])
+        kinds += [f"recorded IMUs: {', '.join(recorded)}"] if recorded else []
+        lines.append("; ".join(kinds))
+    lines.append(f"tables: {[dataset_id(d) for d in setup.datasets]} | methods: {ecfg['methods']} | "
+                 f"seeds: {ecfg['seeds']} | seed aggregate: {ecfg['seed_aggregate']}")
     lines.append(f"outages (start, duration) s: {[list(w) for w in setup.windows]}"
                  + "".join(f"; {line}" for line in setup.outage_lines))
     lines.append(f"pseudo-GPS: {ecfg['pseudo_gps']}")

@@ -13,7 +13,9 @@ from typing import Sequence
 import numpy as np
 import pandas as pd
 
-from bgfn.config import RESULTS_ROOT, SHARED_TABLES, profile_chain
+from bgfn.config import RESULTS_ROOT, SHARED_TABLES, profile_chain, read_profile
+from bgfn.data.names import dataset_folder
+from bgfn.errors import DataError
 from bgfn.report.sweep_words import describe_sweep
 from bgfn.paper import TESTS, label
 from bgfn.report.provenance import short_source
@@ -39,6 +41,16 @@ def compared_profiles(profile: str, variants: Sequence[str],
     root = Path(results_root or RESULTS_ROOT)
     shown = [p for p in names if (root / p / "tables" / SHARED_TABLES["training_summary"]).exists()]
     return shown, [p for p in names[1:] if p not in shown]
+
+
+def own_log_profile(profile: str) -> bool:
+    """Whether ``profile`` runs logs of its own (a CSV folder among ``data.datasets``): its page asks for no variant
+    of the shipped drives to be run beside it."""
+    try:
+        names = read_profile(profile)["data"]["datasets"]
+    except DataError:
+        return False
+    return any(dataset_folder(name) is not None for name in names)
 
 
 def profile_tables(profiles: Sequence[str], file: str, results_root: str | Path | None = None) -> dict:
@@ -141,6 +153,8 @@ def variants_section(profile: str, variants: Sequence[str], results_root: str | 
     """
     root = Path(results_root or RESULTS_ROOT)
     shown, missing = compared_profiles(profile, variants, root)
+    if own_log_profile(profile):   # the shipped variants run other drives, and own/own-walker are bases: no request
+        missing = []
     pieces: list = [missing_note(root / v / "tables" / SHARED_TABLES["training_summary"], f"the variant `{v}`",
                                  f"`make reproduce PROFILE={v}`") for v in missing]
     if len(shown) < 2:                     # nothing to put beside this profile

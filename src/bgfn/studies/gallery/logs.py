@@ -59,9 +59,13 @@ class GalleryLog:
     base: str
     profile: dict = field(default_factory=dict)
     shows: str = ""
+    own: bool = False        # a log the running profile names itself: ``base`` is that profile
 
     def profile_text(self, folder: Path) -> str:
-        """The user's ``params/<name>.yaml`` for this log in ``folder`` (absolute path)."""
+        """The user's ``params/<name>.yaml`` for this log in ``folder`` (absolute path); for the running profile's own
+        log only its name (the page shows no machine path)."""
+        if self.own:
+            return f"params/{self.base}.yaml, the profile of this run (its folder: {Path(folder).name})\n"
         body = {"base": self.base, "datasets": [str(Path(folder).resolve())], **self.profile}
         return yaml.safe_dump(body, sort_keys=False, default_flow_style=None, width=110)
 
@@ -137,11 +141,11 @@ def walk_trajectory(duration_s: float = WALK_DURATION_S, rate_hz: float = 100.0,
                          "yaw": np.angle(np.exp(1j * yaw))})
 
 
-def walker_log(folder: Path, seed: int = WALK_SEED) -> Path:
-    """:func:`walk_trajectory` with a consumer MEMS IMU (the MPU-6000 profile's noise and bias instability, its
+def walker_log(folder: Path, seed: int = WALK_SEED, duration_s: float = WALK_DURATION_S) -> Path:
+    """:func:`walk_trajectory` (``duration_s`` long, the stops inside it) with a consumer MEMS IMU (the MPU-6000 profile's noise and bias instability, its
     gyro turn-on bias calibrated at boot, no vehicle vibration) and 1 Hz fixes of 1.5 m / 3 m; the reference at
     5 Hz without attitude (an RTK rover's); ``platform: walker``."""
-    truth = walk_trajectory()
+    truth = walk_trajectory(duration_s, stops=[(a, b) for a, b in WALK_STOPS_S if a + b < duration_s])
     params = error_params("mpu6000", {"vibration_gyro_std": [0.0] * 3, "vibration_accel_std": [0.0] * 3,
                                       "accel_turn_on_bias_std": [0.05] * 3})
     speed = np.hypot(truth["v_n"], truth["v_e"]).to_numpy()[1:]

@@ -18,7 +18,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from bgfn.data import load_drive
+from bgfn.data import dataset_id, load_drive
+from bgfn.data.csv_meta import META_FILE, read_meta
+from bgfn.data.names import dataset_folder
 from bgfn.studies.gallery.logs import GalleryLog
 from bgfn.nav.baseline import Baseline, nav_config, run_baseline
 from bgfn.nav.constraints import DEFAULT_PLATFORM, platform_aids
@@ -69,6 +71,21 @@ def run_log(log: GalleryLog, folder: Path, cfg: dict) -> GalleryRun:
     meta_text = (folder / "meta.yaml").read_text(encoding="utf-8")
     return GalleryRun(log, log.profile_text(folder), meta_text, pd.DataFrame(rows, columns=list(GALLERY_COLUMNS)),
                       drive, list(windows), b, picked_outages(cfg, drive, str(folder)), str(folder))
+
+
+def own_logs(cfg: dict) -> list[tuple[GalleryLog, Path]]:
+    """The CSV folders the profile names itself (``data.datasets``), as logs of the page with their folders: notebook
+    09 shows them rather than the built-in gallery; [] for a profile of the shipped drives."""
+    out = []
+    for name in cfg["data"]["datasets"]:
+        folder = dataset_folder(name)
+        if folder is None:
+            continue
+        meta = read_meta(folder / META_FILE)
+        platform = str(meta.get("platform", DEFAULT_PLATFORM))
+        out.append((GalleryLog(dataset_id(name), platform, cfg["profile"], {}, "this profile's own log", own=True),
+                    folder))
+    return out
 
 
 def _aided_label(platform: str) -> str:

@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 
 from bgfn.config import SHARED_TABLES
-from bgfn.data import load_drive
+from bgfn.data import dataset_id, load_drive
 from bgfn.errors import DataError
 from bgfn.evaluate.setup import COLORS
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
@@ -56,7 +56,7 @@ BREAKEVEN_COLUMNS: tuple[str, ...] = (
 #: :func:`crossing_sigma` outcomes: the curve crosses the level inside the grid; it is above the level already at
 #: the smallest sigma; it stays below the level over the whole grid.
 CROSSED, NEVER_BELOW, BEYOND_GRID = "crossed", "never_below", "beyond_grid"
-#: Figure of one dataset, ``results/<profile>/figures/``.
+#: Figure of one dataset (its short name, :func:`bgfn.data.names.dataset_id`), ``results/<profile>/figures/``.
 FIGURE_FILE = "outage_oracle_{dataset}.png"
 
 
@@ -536,5 +536,5 @@ def run_oracle(cfg: dict, profile: str, setup, out=None, results: dict | None = 
         atomic_write_csv(tables / SHARED_TABLES["oracle_breakeven"], be, float_format="%.4f")
         atomic_write_csv(tables / SHARED_TABLES["oracle_runs"], runs, float_format="%.4f")
         for name, fig in result.figures.items():
-            save_figure(fig, Path(out) / "figures" / FIGURE_FILE.format(dataset=name))
+            save_figure(fig, Path(out) / "figures" / FIGURE_FILE.format(dataset=dataset_id(name)))   # no path in a name
     return result

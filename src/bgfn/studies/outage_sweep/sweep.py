@@ -21,6 +21,7 @@ from bgfn.studies.outage_sweep.increments import AntennaTruth, increment_rmse
 from bgfn.evaluate.networks import load_model
 from bgfn.learning import build_learning_data, learning_options
 from bgfn.nav.baseline import filter_start
+from bgfn.nav.outages import snap_windows
 from bgfn.paper import METHOD_LABELS, NHC_SUFFIX, nhc_label
 from bgfn.parallel import Runner
 from bgfn.stats import bootstrap_ci, paired_comparison, wilcoxon_p
@@ -37,7 +38,7 @@ def sweep_plan(drive, sweep: dict, window_samples: int = 200, t_first: float | N
     Returns
     -------
     DataFrame
-        ``start_s`` (rounded to 0.1 s), ``fold`` (0 .. folds-1).
+        ``start_s`` (rounded to 0.1 s, then onto the nearest IMU epoch), ``fold`` (0 .. folds-1).
     """
     t = drive.imu["time"].to_numpy(float)
     rate = 1.0 / float(np.median(np.diff(t)))
@@ -53,6 +54,8 @@ def sweep_plan(drive, sweep: dict, window_samples: int = 200, t_first: float | N
         raise DataError(drive.name, "time", f"room for {n} outages of {max(sweep['durations_s'])} s after a "
                         f"{sweep['warmup_s']} s warm-up", f"{t[-1] - t0:.0f} s of data")
     starts = np.round(np.linspace(lo, hi, n) if n > 1 else np.array([0.5 * (lo + hi)]), 1)
+    # on the IMU epochs, as every outage window (a log stamped at .xx1 s; on a whole-hundredth grid: unchanged)
+    starts = np.array([w.window[0] for w in snap_windows([(s, 1.0) for s in starts], t)])
     folds = np.concatenate([np.full(len(b), k) for k, b in enumerate(np.array_split(np.arange(n),
                                                                                      int(sweep["folds"])))])
     return pd.DataFrame({"start_s": starts, "fold": folds.astype(int)})

@@ -366,6 +366,22 @@ def test_paired_test_detects_a_shift_and_not_a_null():
     assert np.isnan(stats.paired_comparison([1.0, 2.0], [1.0, 2.0])["p_value"])
 
 
+def test_holm_adjusts_a_hand_computed_family():
+    # k = 4 finite p-values (the NaN is no test): sorted 0.005, 0.01, 0.03, 0.04 -> times 4, 3, 2, 1 =
+    # 0.02, 0.03, 0.06, 0.04; the running maximum lifts the last to 0.06 (the adjusted keep the raw order)
+    got = stats.holm_adjust([0.01, 0.04, 0.03, 0.005, np.nan])
+    np.testing.assert_allclose(got[:4], [0.03, 0.06, 0.06, 0.02])
+    assert np.isnan(got[4])
+    # capped at 1: 0.02 * 3 = 0.06, 0.5 * 2 = 1.0, 0.7 * 1 -> lifted to 1.0 by the running maximum
+    np.testing.assert_allclose(stats.holm_adjust([0.5, 0.02, 0.7]), [1.0, 0.06, 1.0])
+    # one test: unchanged; none: empty; never below the raw p
+    assert stats.holm_adjust([0.014]).tolist() == [0.014] and stats.holm_adjust([]).size == 0
+    raw = np.random.default_rng(0).random(9)
+    assert np.all(stats.holm_adjust(raw) >= raw)
+    with pytest.raises(DataError, match="p_values"):
+        stats.holm_adjust([0.5, 1.5])
+
+
 def test_sweep_summary_and_comparisons():
     rows = []
     rng = np.random.default_rng(1)

@@ -5,6 +5,8 @@
   together, since runs of the same start share the trajectory and are not independent).
 - :func:`paired_comparison`: how often method A beats method B on paired runs, the median paired difference
   and the Wilcoxon signed-rank test (two-sided) of ``A - B``.
+- :func:`holm_adjust`: Holm's step-down adjusted p-values of a family of tests, for a page that names the best of
+  several candidates (the smallest of k raw p-values is small by chance alone).
 
 Every random draw takes a seed (``numpy.random.default_rng(seed)``).
 """
@@ -116,4 +118,36 @@ def paired_comparison(a, b) -> dict:
             "p_value": wilcoxon_p(d)}
 
 
-__all__ = ["bootstrap_ci", "paired_comparison", "wilcoxon_p"]
+def holm_adjust(p_values) -> np.ndarray:
+    """Holm(-Bonferroni) adjusted p-values of one family of tests (Holm 1979).
+
+    With the ``k`` finite p-values sorted ascending, ``p_(1) <= ... <= p_(k)``, the adjusted value of the ``i``-th
+    (1-based) is ``max_{j <= i} min(1, (k - j + 1) p_(j))``: the running maximum keeps the adjusted values in the
+    raw values' order, and the cap keeps them probabilities. Rejecting where the adjusted p is below ``alpha``
+    controls the family-wise error rate at ``alpha`` under any dependence between the tests.
+
+    Parameters
+    ----------
+    p_values : array_like [n]
+        Raw p-values; NaN (a test not run) is no member of the family and stays NaN.
+
+    Returns
+    -------
+    ndarray [n]
+        The adjusted p-values in the input's order.
+    """
+    p = np.asarray(p_values, dtype=float).ravel()
+    if np.any((p < 0) | (p > 1)):
+        raise DataError("holm_adjust", "p_values", "p-values in [0, 1] (or NaN)", repr(p[(p < 0) | (p > 1)][:3]))
+    out = np.full(p.shape, np.nan)
+    ok = np.flatnonzero(np.isfinite(p))
+    k = len(ok)
+    if k == 0:
+        return out
+    order = ok[np.argsort(p[ok], kind="stable")]
+    scaled = np.minimum(1.0, (k - np.arange(k)) * p[order])                # (k - j + 1) p_(j), j = 1..k
+    out[order] = np.maximum.accumulate(scaled)
+    return out
+
+
+__all__ = ["bootstrap_ci", "holm_adjust", "paired_comparison", "wilcoxon_p"]

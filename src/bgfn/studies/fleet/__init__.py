@@ -8,7 +8,7 @@ A profile's ``fleet:`` section (:class:`bgfn.settings.Fleet`) names the drives; 
 """
 
 from bgfn.studies.fleet.drives import PREPARATION_COLUMNS, PreparedDrive, fleet_drives, prepare_fleet
-from bgfn.studies.fleet.study import FleetResult, check_fleet, fleet_enabled, run_fleet
+from bgfn.studies.fleet.study import FLEET_TABLES, FleetResult, check_fleet, fleet_enabled, run_fleet, write_fleet_tables
 
 __all__ = ["PREPARATION_COLUMNS", "PreparedDrive", "fleet_drives", "prepare_fleet", "FleetResult", "check_fleet",
-           "fleet_enabled", "run_fleet"]
+           "fleet_enabled", "run_fleet", "FLEET_TABLES", "write_fleet_tables"]

@@ -251,7 +251,7 @@ def curve_rows(test: TestDrive, by_name: dict, train: list[str], fleet: dict, pa
         tracks[runs[-1].label] = track
         series = speed_series(test.windows.t_end, test.truth, test.outages, {bars.RIDGE: track})
         parts = error_parts_table(test.name, series, [d])
-        facts.append({"test_drive": test.name, "n_train": len(combo), "train_drives": list(combo),
+        facts.append({"test_drive": test.name, "n_train": len(combo), "train_drives": "; ".join(combo),
                       "train_min": training_minutes(data, params["aid_rate_hz"]),
                       "offset_rms_mps": float(parts["offset_rms_mps"].iloc[0]) if len(parts) else np.nan,
                       "speed_rmse_mps": float(parts["speed_rmse_mps"].iloc[0]) if len(parts) else np.nan})

@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 
 from bgfn.errors import DataError
+from bgfn.io import atomic_write_csv
 from bgfn.parallel import Runner
 from bgfn.studies.fleet import coverage as cv
 from bgfn.studies.fleet import protocol as fp
@@ -86,7 +87,7 @@ def run_fleet(cfg: dict, profile: str, runner: Runner | None = None, drives=None
         if fleet["curve"]:
             curves.append(fp.curve_rows(test, by_name, train, fleet, params, oc, ecfg["pseudo_gps"], runner))
         longest = f[f["duration_s"] == test.dmax]
-        split_rows.append({"test_drive": test_name, "train_drives": list(train),
+        split_rows.append({"test_drive": test_name, "train_drives": "; ".join(train),
                            "train_min": fp.training_minutes(data, params["aid_rate_hz"]),
                            "n_train_windows": len(data.train), "ridge_std_mps": model.std_mps,
                            "ridge_correlation": model.correlation, "outages": len(test.starts),
@@ -105,3 +106,18 @@ def run_fleet(cfg: dict, profile: str, runner: Runner | None = None, drives=None
         curve=pd.concat(curves, ignore_index=True) if curves else pd.DataFrame(columns=list(fp.CURVE_COLUMNS)),
         facts={"wall_s": time.perf_counter() - t0, "pieces": fleet.get("pieces"), "protocol": fleet["protocol"],
                "rate_hz": float(np.unique([p.rate_hz for p in prepared])[0]), "networks": bool(fleet["networks"])})
+
+
+#: ``results/<profile>/tables/`` file of each table of a :class:`FleetResult`.
+FLEET_TABLES = {"preparation": "fleet_preparation.csv", "splits": "fleet_splits.csv", "rows": "fleet_odometer.csv",
+                "summary": "fleet_summary.csv", "offsets": "fleet_offsets.csv", "motion": "fleet_motion.csv",
+                "flags": "fleet_coverage.csv", "curve": "fleet_curve.csv"}
+
+
+def write_fleet_tables(result: FleetResult, out) -> list:
+    """Every table of ``result`` under ``out / "tables"`` (:data:`FLEET_TABLES`); the paths written."""
+    paths = []
+    for key, name in FLEET_TABLES.items():
+        paths.append(out / "tables" / name)
+        atomic_write_csv(paths[-1], getattr(result, key))
+    return paths

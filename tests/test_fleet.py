@@ -136,3 +136,35 @@ def test_pieces_are_contiguous_and_labelled():
 def test_holm_on_a_hand_example():
     # sorted 0.01, 0.02, 0.04 (k = 3): 3 * 0.01 = 0.03, 2 * 0.02 = 0.04, 1 * 0.04 = 0.04; NaN stays out
     np.testing.assert_allclose(holm_adjust([0.04, np.nan, 0.01, 0.02]), [0.04, np.nan, 0.03, 0.04])
+
+
+
+def test_fleet_summary_pools_drives_and_adjusts_per_family():
+    """Hand-made rows of two test drives whose starts share their times: pooled, each start stays its own drive's;
+    two learned odometers form the Holm family; the out-of-range outages are summarized apart."""
+    import pandas as pd
+
+    from bgfn.stats import wilcoxon_p
+    from bgfn.studies.fleet.summary import fleet_summary
+
+    rng = np.random.default_rng(0)
+    rows, flags = [], []
+    for drive, shift in (("a", 0.0), ("b", 3.0)):
+        for k, start in enumerate(np.arange(100.0, 1000.0, 100.0)):
+            nhc = 20.0 + rng.uniform(0, 5)
+            for method, err in (("INS+NHC", nhc), ("RIDGE-ODO", nhc - 2.0 - shift), ("MLP-ODO", nhc + rng.normal())):
+                rows.append({"dataset": drive, "start_s": start, "duration_s": 60.0, "method": method,
+                             "sigma_mps": np.nan, "seed": 0, "fold": 0, "max_h_m": err, "rmse_h_m": err,
+                             "final_h_m": err, "speed_rmse_mps": 1.0, "coverage_2sigma": 0.9})
+            flags.append({"dataset": drive, "start_s": start, "duration_s": 60.0, "out_of_range": drive == "b" and k < 3})
+    s = fleet_summary(pd.DataFrame(rows), pd.DataFrame(flags)).set_index(["speed_range", "dataset", "method"])
+    assert s.loc[("all", "pooled", "RIDGE-ODO"), "runs"] == 18                  # 9 starts of each drive, none merged
+    p = [wilcoxon_p(np.full(18, -1.0) - np.r_[np.zeros(9), np.full(9, 3.0)]),
+         s.loc[("all", "pooled", "MLP-ODO"), "p_vs_nhc"]]
+    assert s.loc[("all", "pooled", "RIDGE-ODO"), "p_vs_nhc"] == pytest.approx(p[0])
+    np.testing.assert_allclose([s.loc[("all", "pooled", m), "p_vs_nhc_holm"] for m in ("RIDGE-ODO", "MLP-ODO")],
+                               holm_adjust(p))
+    assert np.isnan(s.loc[("all", "pooled", "INS+NHC"), "p_vs_nhc_holm"])       # the baseline is no candidate
+    assert s.loc[("out", "b", "RIDGE-ODO"), "runs"] == 3 and ("out", "a", "RIDGE-ODO") not in s.index
+    assert s.loc[("in", "pooled", "RIDGE-ODO"), "runs"] == 15
+    assert s.loc[("out", "b", "RIDGE-ODO"), "ratio_to_nhc"] < s.loc[("in", "a", "RIDGE-ODO"), "ratio_to_nhc"]

@@ -65,6 +65,19 @@ def test_resampled_to_the_lowest_rate_and_one_bandwidth():
     assert amp[20.0] < 0.02                                          # 80 Hz not aliased to 20 Hz
 
 
+def test_a_gap_in_the_imu_stays_a_gap():
+    d = fleet_drive("gappy", duration=60.0, seed=5)
+    t = d.imu["time"].to_numpy()
+    d.imu = d.imu[(t < 30.0) | (t > 31.0)].reset_index(drop=True)      # one second missing
+    (p,) = fd.prepare_fleet([d], FLEET)
+    assert p.facts["imu_gaps"] == 1
+    ti = p.imu["time"].to_numpy()
+    assert not ((ti > 30.0 + 1e-9) & (ti < 31.0 - 1e-9)).any()          # nothing made up inside it
+    w = fp.drive_windows(p, np.arange(20.0, 45.0), 2.0)
+    assert not ((w.t_end > 30.0) & (w.t_end < 33.0)).any()              # no window reaches across it
+    assert ((w.t_end >= 33.0) & (w.t_end < 45.0)).sum() == 12
+
+
 def test_label_left_out_where_gnss_disagrees():
     d = fleet_drive("odd", duration=120.0, gnss_offset=(40.0, 60.0, 2.0), seed=3)
     t, label, facts = fd.speed_label(d, 0.5, "drop", 2.0)

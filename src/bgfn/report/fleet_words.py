@@ -54,6 +54,8 @@ def preparation_lines(prep: pd.DataFrame) -> list[str]:
                  + ("left out" if r.label_action == "drop" else "labelled from the GNSS speed"))
         rate = (f"resampled from {r.native_rate_hz:g} Hz to {r.rate_hz:g} Hz" if abs(r.native_rate_hz - r.rate_hz) > 1e-6
                 else f"at {r.rate_hz:g} Hz")
+        if r.imu_gaps:
+            rate += f" ({r.imu_gaps} IMU gap{'s' if r.imu_gaps > 1 else ''} kept as gaps)"
         lines.append(f"{r.drive} ({r.duration_s / 60:.1f} min, up to {r.speed_max_mps:.1f} m/s): {level}; {rate}, "
                      f"low-passed at {r.cutoff_hz:g} Hz; {label}.")
     return lines

@@ -35,7 +35,7 @@ from bgfn.schema import ACCEL_COLUMNS, GYRO_COLUMNS
 PREPARATION_COLUMNS: tuple[str, ...] = (
     "drive", "duration_s", "mounting_roll_deg", "mounting_pitch_deg", "mounting_yaw_deg", "standstill_s",
     "tilt_roll_deg", "tilt_pitch_deg", "accel_scale", "gyro_bias_x_dps", "gyro_bias_y_dps", "gyro_bias_z_dps",
-    "native_rate_hz", "rate_hz", "cutoff_hz", "label_checked", "label_disagree_s", "label_action",
+    "native_rate_hz", "rate_hz", "cutoff_hz", "imu_gaps", "label_checked", "label_disagree_s", "label_action",
     "label_kept_share", "speed_max_mps")
 #: Name of piece ``i`` of ``n`` of a drive: a stand-in for a fleet, labelled as what it is.
 PIECE_FORMAT = "{name} piece {i} of {n}"
@@ -158,26 +158,35 @@ def level_scale_bias(imu: pd.DataFrame, still: np.ndarray, gravity: float) -> tu
 
 
 def common_rate(imu: pd.DataFrame, rate_hz: float, bandwidth_fraction: float) -> tuple[pd.DataFrame, dict]:
-    """The IMU on a uniform grid at ``rate_hz`` (interpolated onto its own rate's uniform grid first, then
-    :func:`scipy.signal.resample_poly`), low-passed at ``bandwidth_fraction`` of ``rate_hz / 2`` (zero-phase
-    Butterworth of order 4), and the numbers: ``native_rate_hz``, ``rate_hz``, ``cutoff_hz``."""
+    """The IMU on a uniform grid at ``rate_hz`` (each gap-free stretch interpolated onto its own rate's uniform grid,
+    then :func:`scipy.signal.resample_poly`), low-passed at ``bandwidth_fraction`` of ``rate_hz / 2`` (zero-phase
+    Butterworth of order 4), and the numbers: ``native_rate_hz``, ``rate_hz``, ``cutoff_hz``, ``imu_gaps`` (time
+    gaps over 1.5 sample intervals: the stretches are processed apart, so no window bridges a gap)."""
     t = imu["time"].to_numpy(float)
     native = imu_rate(imu)
     if rate_hz > native * (1 + 1e-6):
         raise DataError("fleet", "rate_hz", f"at most the slowest drive's rate ({native:.4g} Hz)", f"{rate_hz:g}")
     cols = list(ACCEL_COLUMNS + GYRO_COLUMNS)
-    grid = t[0] + np.arange(int(np.floor((t[-1] - t[0]) * native + 1e-6)) + 1) / native
-    x = np.column_stack([np.interp(grid, t, imu[c].to_numpy(float)) for c in cols])
     ratio = Fraction(float(rate_hz) / native).limit_denominator(1000)
-    if ratio != 1:
-        x = resample_poly(x, ratio.numerator, ratio.denominator, axis=0)
-    new_t = t[0] + np.arange(len(x)) / float(rate_hz)
     cutoff = float(bandwidth_fraction) * float(rate_hz) / 2.0
     sos = butter(4, cutoff, btype="low", fs=float(rate_hz), output="sos")
-    x = sosfiltfilt(sos, x, axis=0)
-    out = pd.DataFrame(x, columns=cols)
-    out.insert(0, "time", new_t)
-    return out, {"native_rate_hz": native, "rate_hz": float(rate_hz), "cutoff_hz": cutoff}
+    cuts = np.flatnonzero(np.diff(t) > 1.5 / native) + 1
+    parts = []
+    for a, b in zip(np.r_[0, cuts], np.r_[cuts, t.size]):
+        ts = t[a:b]
+        grid = ts[0] + np.arange(int(np.floor((ts[-1] - ts[0]) * native + 1e-6)) + 1) / native
+        x = np.column_stack([np.interp(grid, ts, imu[c].to_numpy(float)[a:b]) for c in cols])
+        if ratio != 1:
+            x = resample_poly(x, ratio.numerator, ratio.denominator, axis=0)
+        if len(x) <= 3 * (2 * len(sos) + 1):                # too short to filter: a stretch no window fits in
+            continue
+        part = pd.DataFrame(sosfiltfilt(sos, x, axis=0), columns=cols)
+        part.insert(0, "time", ts[0] + np.arange(len(x)) / float(rate_hz))
+        parts.append(part)
+    if not parts:
+        raise DataError("fleet", "imu", "a gap-free stretch of IMU samples long enough to filter", "none")
+    return pd.concat(parts, ignore_index=True), {"native_rate_hz": native, "rate_hz": float(rate_hz),
+                                                 "cutoff_hz": cutoff, "imu_gaps": int(cuts.size)}
 
 
 def speed_label(drive: Drive, max_diff: float, action: str, min_s: float) -> tuple[np.ndarray, np.ndarray, dict]:

@@ -181,3 +181,15 @@ def test_fleet_summary_pools_drives_and_adjusts_per_family():
     assert s.loc[("out", "b", "RIDGE-ODO"), "runs"] == 3 and ("out", "a", "RIDGE-ODO") not in s.index
     assert s.loc[("in", "pooled", "RIDGE-ODO"), "runs"] == 15
     assert s.loc[("out", "b", "RIDGE-ODO"), "ratio_to_nhc"] < s.loc[("in", "a", "RIDGE-ODO"), "ratio_to_nhc"]
+
+
+def test_preparation_is_said_per_drive(fleet):
+    from bgfn.report.fleet_words import preparation_lines
+
+    _, prepared = fleet
+    lines = preparation_lines(fd.preparation_table(prepared[:2]))
+    assert "levelled by roll +3.60 deg and pitch -1.9" in lines[0] and "scaled by 1.010" in lines[0]   # 1 / 0.99
+    d = fleet_drive("rolling", duration=60.0, seed=6)
+    d = d.crop(12.0, 25.0)                                              # after the first standstill, before the stop
+    (p,) = fd.prepare_fleet([d], FLEET)
+    assert np.isnan(p.facts["accel_scale"]) and "not levelled" in preparation_lines(fd.preparation_table([p]))[0]

@@ -127,14 +127,16 @@ def curve_lines(curve: pd.DataFrame) -> list[str]:
 
 def plot_curve(curve: pd.DataFrame):
     """The learning curve: the offset per outage, the speed RMSE and the median max error against training minutes,
-    a line per test drive."""
+    a dot per training set, a line per test drive through the medians per number of training drives."""
     fig, axes = plt.subplots(1, 3, figsize=(10, 3.2))
     cols = [("offset_rms_mps", "offset per outage, RMS (m/s)"), ("speed_rmse_mps", "speed RMSE (m/s)"),
             ("median_max_h_m", "median max error (m)")]
     for ax, (c, label) in zip(axes, cols):
         for test, g in curve.groupby("test_drive", sort=False):
-            g = g.sort_values("train_min")
-            ax.plot(g["train_min"], g[c], "o-", ms=3, label=test)
+            # each training set a dot, the line through the median per number of training drives
+            med = g.groupby("n_train")[["train_min", c]].median()
+            line = ax.plot(med["train_min"], med[c], "-", lw=1.2, label=test)[0]
+            ax.plot(g["train_min"], g[c], "o", ms=3, alpha=0.6, color=line.get_color())
         ax.set_xlabel("training minutes")
         ax.set_ylabel(label)
         ax.set_ylim(bottom=0)

@@ -193,3 +193,16 @@ def test_preparation_is_said_per_drive(fleet):
     d = d.crop(12.0, 25.0)                                              # after the first standstill, before the stop
     (p,) = fd.prepare_fleet([d], FLEET)
     assert np.isnan(p.facts["accel_scale"]) and "not levelled" in preparation_lines(fd.preparation_table([p]))[0]
+
+
+def test_a_fleet_section_that_cannot_run_is_one_error_naming_the_key(params):
+    from bgfn.profile_schema import load_profile
+
+    for name, body, key in (
+            ("two", "fleet: {drives: [a, b], pieces: 3}", "fleet.drives"),
+            ("one", "fleet: {drives: [a]}", "fleet.drives"),
+            ("named", "fleet: {drives: [a, b, c], protocol: named, train: [a, b]}", "fleet.test"),
+            ("long", "fleet: {drives: [a, b], curve_duration_s: 500.0}", "fleet.curve_duration_s")):
+        (params / f"{name}.yaml").write_text(f"profile: {name}\nbase: smoke\ndescription: x\n{body}\n")
+        with pytest.raises(DataError, match=key.replace(".", r"\.")):
+            load_profile(name)

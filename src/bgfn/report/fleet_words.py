@@ -68,6 +68,8 @@ def fleet_markdown(summary: pd.DataFrame, speed_range: str = "all") -> str:
     if s.empty:
         return f"No rows for {RANGE_WORDS[speed_range]}."
     wide = odometer_table(s.drop(columns=["speed_range"]))
+    drives = [d for d in dict.fromkeys(s["dataset"]) if d != POOLED] + [POOLED]        # the pooled rows last
+    wide = wide.iloc[sorted(range(len(wide)), key=lambda i: (drives.index(wide.index[i][0]), i))]
     head = "| test drive | method | " + " | ".join(wide.columns) + " |"
     body = [f"| {drive_words(ds)} | {m} | " + " | ".join(_num(v, ".1f") for v in r) + " |"
             for (ds, m), r in wide.iterrows()]

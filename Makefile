@@ -87,7 +87,10 @@ chain_of = $(if $(filter $(1),$(2)),,$(1) $(call bases_of,$(call base_of,$(1)),$
 bases_of = $(if $(1),$(if $(call is_name,$(1)),$(call chain_of,$(1),$(2)),$(error profile '$(PROFILE)': `base: $(1)` in params/$(lastword $(2)).yaml is not a profile name: expected letters, digits, '.', '_' or '-')))
 PARAMS := $(patsubst %,params/%.yaml,$(call chain_of,$(PROFILE)))
 RES := results/$(PROFILE)
-EXEC := $(NOTEBOOKS:%=$(RES)/notebooks/%.ipynb)
+# A profile whose chain has a `fleet:` section runs notebook 11 (a fleet of drives) after the results page.
+FLEET := $(if $(strip $(shell grep -l '^fleet:' $(PARAMS) 2>/dev/null)),11_fleet)
+FLEET_EXEC := $(FLEET:%=$(RES)/notebooks/%.ipynb)
+EXEC := $(NOTEBOOKS:%=$(RES)/notebooks/%.ipynb) $(FLEET_EXEC)
 SRC := $(shell find src/bgfn -name '*.py' -not -path '*/__pycache__/*' | sort)
 BOOK_SRC := $(shell find book \( -path book/_build -o -path book/notebooks -o -path book/_generated -o -path book/api \) -prune \
               -o -type f -print | sort)
@@ -267,9 +270,10 @@ $(RES)/notebooks/06_outage_sweep.ipynb: $(RES)/notebooks/04_outage_evaluation.ip
 $(RES)/notebooks/07_learned_odometer.ipynb: $(RES)/notebooks/01_data_prep.ipynb
 $(RES)/notebooks/08_ins_fidelity.ipynb: $(RES)/notebooks/01_data_prep.ipynb $(wildcard data/measured/navego_check.csv)
 $(RES)/notebooks/09_own_logs.ipynb: $(RES)/notebooks/01_data_prep.ipynb
+$(RES)/notebooks/11_fleet.ipynb: $(RES)/notebooks/01_data_prep.ipynb
 # 10 (the results page) reads every earlier output, the paper's published values and the odometers' run at the
 # paper's size recorded from a GPU (python -m bgfn odometers --record).
-$(RES)/notebooks/10_results.ipynb: $(filter-out $(RES)/notebooks/10_results.ipynb,$(EXEC)) \
+$(RES)/notebooks/10_results.ipynb: $(filter-out $(RES)/notebooks/10_results.ipynb $(FLEET_EXEC),$(EXEC)) \
   data/paper/outage_max_errors.csv data/paper/claims.yaml $(wildcard data/measured/odometer_sizes.csv)
 # ... and, when they have been run, the variant profiles its "Variants" section compares (notebook parameter
 # `variants`), so a later `make reproduce PROFILE=quick-heading` is picked up by the next `make reproduce`.
@@ -292,7 +296,7 @@ NOTEBOOK_SLOTS ?= 2
 define build_book
 	@echo "==> book from $(RES)/notebooks"
 	@rm -rf book/notebooks book/_generated book/api && mkdir -p book/notebooks book/_generated
-	@cp $(EXEC) book/notebooks/
+	@cp $(filter-out $(FLEET_EXEC),$(EXEC)) book/notebooks/   # the book's pages: 01-10 (11 stays in results/)
 	@$(PY) -m bgfn.report.book_notebooks book/notebooks/*.ipynb   # one parameters cell: the run's values
 	@for d in tables figures; do if [ -d "$(RES)/$$d" ]; then cp -r "$(RES)/$$d" book/_generated/; fi; done
 	@find book/notebooks book/_generated -name '.*' -type f -delete   # never a temporary or hidden file

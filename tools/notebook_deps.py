@@ -54,6 +54,7 @@ NOTEBOOK_SECTIONS: dict[str, tuple[str, ...]] = {
     "08_ins_fidelity": (*_DRIVES, *_EVALUATE, "evaluate.sweep"),
     "09_own_logs": _DRIVES,
     "10_results": ("*",),
+    "11_fleet": (*_DRIVES, *_EVALUATE, "evaluate.sweep", "evaluate.odometer", "fleet", "description"),
 }
 #: Profiles a notebook reads besides its own (their files and base chains): 03 estimates the paper's training
 #: time from the ``paper`` profile; 09 runs the gallery's logs under the ``own`` and ``own-walker`` profiles.

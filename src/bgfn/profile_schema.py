@@ -201,7 +201,32 @@ def cross_check(cfg: dict) -> None:
                            "measured)", fmt(en["dataset"]))
     if en.get("seed") is not None and en["seed"] not in (tr.get("seeds") or []):
         raise ProfileError("energy.seed", f"one of train.seeds {tr.get('seeds')}", fmt(en["seed"]))
+    _check_fleet(cfg)
     _check_variants(cfg)          # last: the profile itself passed, so an error here is the variant's
+
+
+def _check_fleet(cfg: dict) -> None:
+    """A ``fleet:`` section's facts (notebook 11; off while ``fleet.drives`` is empty)."""
+    fl = cfg.get("fleet") or {}
+    drives = fl.get("drives") or []
+    if not drives:
+        return
+    if fl.get("pieces") and len(drives) != 1:
+        raise ProfileError("fleet.drives", "one drive to cut into fleet.pieces", fmt(drives))
+    if not fl.get("pieces") and len(drives) < 2:
+        raise ProfileError("fleet.drives", "at least 2 drives (or one with fleet.pieces)", fmt(drives))
+    if fl.get("protocol") == "named":
+        for key in ("train", "test"):
+            if not fl.get(key):
+                raise ProfileError(f"fleet.{key}", "the drives' names with protocol: named", fmt(fl.get(key)))
+        if set(fl["train"]) & set(fl["test"]):
+            raise ProfileError("fleet.test", "drives none of fleet.train", fmt(fl["test"]))
+    longest = max((cfg.get("evaluate") or {}).get("sweep", {}).get("durations_s") or [0.0])
+    if fl.get("curve") and fl.get("curve_duration_s", 0.0) > longest:
+        raise ProfileError("fleet.curve_duration_s", f"at most evaluate.sweep.durations_s's longest {longest:g} s",
+                           fmt(fl.get("curve_duration_s")))
+    if fl.get("networks") and not (cfg.get("evaluate") or {}).get("odometer", {}).get("methods"):
+        raise ProfileError("fleet.networks", "evaluate.odometer.methods naming the networks to train", "none")
 
 
 def _check_variants(cfg: dict) -> None:

@@ -336,6 +336,34 @@ class Evaluate(Section):
     odometer: Odometer = _f({}, "the learned odometer's bars")
 
 
+class Fleet(Section):
+    """Beyond the paper: several drives of one vehicle, the learned odometer trained on some and tested on the others
+    (bgfn.studies.fleet; notebook 11). Off while ``drives`` is empty."""
+
+    drives: list[str] = _f([], "built-in dataset keys or own-log folders of one vehicle ([]: no fleet)")
+    pieces: Annotated[int, Field(ge=2)] | None = _f(None, "cut the one drive of drives into this many contiguous "
+                                                          "pieces, a stand-in labelled pieces of one drive (null: none)")
+    protocol: Literal["leave_one_out", "named"] = _f("leave_one_out", "each drive tested on the others | train/test")
+    train: list[str] = _f([], "protocol named: the training drives (names as the fleet's table shows them)")
+    test: list[str] = _f([], "protocol named: the test drives")
+    rate_hz: Pos | None = _f(None, "one sample rate for the fleet (null: the lowest of its drives), Hz")
+    bandwidth_fraction: Fraction = _f(0.8, "every drive low-passed at this fraction of that rate's Nyquist")
+    stationary_max_speed_mps: Pos = _f(0.05, "reference speed under which the vehicle stands, m/s")
+    stationary_min_s: Pos = _f(3.0, "shortest standstill that levels, scales and de-biases a drive, s")
+    gravity_mps2: Pos = _f(9.80665, "the specific force's norm at a standstill (accelerometer scale), m/s^2")
+    label_max_diff_mps: Pos = _f(0.5, "reference and GNSS speed disagree beyond this, m/s")
+    label_disagree: Literal["drop", "gnss"] = _f("drop", "a disagreeing stretch: left out | labelled from GNSS")
+    label_min_s: NonNeg = _f(2.0, "a disagreement shorter than this is noise, not a stretch, s")
+    out_of_range_share: Fraction = _f(0.1, "an outage is out of range when more of its epochs than this share lie "
+                                           "outside the training drives' speeds")
+    networks: bool = _f(False, "the odometer networks too (evaluate.odometer.methods; false: RIDGE-ODO only)")
+    curve: bool = _f(True, "the learning curve (1 .. N-1 training drives)")
+    curve_max_combinations: Count = _f(10, "learning curve: every combination of training drives, else this many "
+                                           "drawn per size")
+    curve_seed: Seed = _f(0, "the draw of those combinations")
+    curve_duration_s: Pos = _f(60.0, "the curve's median max error at this sweep duration, s")
+
+
 class Energy(Section):
     """Notebook 05: synaptic-operation energy, 45 nm (Horowitz 2014)."""
 
@@ -368,6 +396,7 @@ class Profile(Section):
     variant_runs: VariantRuns = _f({}, "which networks every variant trains")
     evaluate: Evaluate = _f({}, "notebook 04")
     energy: Energy = _f({}, "notebook 05")
+    fleet: Fleet = _f({}, "beyond the paper: a fleet of drives (notebook 11)")
 
 
 #: Top-level keys without a default: every profile chain sets them.

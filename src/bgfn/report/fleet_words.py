@@ -1,0 +1,152 @@
+"""The fleet study's words (notebook 11): its tables' labels, the lines under them and the learning curve's figure,
+made from :mod:`bgfn.studies.fleet`'s numbers."""
+
+from __future__ import annotations
+
+import math
+
+import matplotlib.pyplot as plt
+import pandas as pd
+
+from bgfn.paper import nhc_label
+from bgfn.studies.fleet.summary import POOLED
+from bgfn.studies.odometer.bars import HOLD, RIDGE
+from bgfn.studies.odometer.section import odometer_table
+
+#: The ``speed_range`` codes in words.
+RANGE_WORDS = {"all": "every outage", "in": "outages inside the training drives' speeds",
+               "out": "outages outside the training drives' speeds"}
+#: The pooled rows' name in words.
+POOLED_WORDS = "all test drives (pooled)"
+
+
+def drive_words(name: str) -> str:
+    """A drive's name as a table shows it (the pooled rows in words)."""
+    return POOLED_WORDS if name == POOLED else name
+
+
+def fleet_title(facts: dict) -> str:
+    """What the fleet is, in one line: pieces of one drive are said to be that."""
+    if facts.get("pieces"):
+        return (f"A stand-in for a fleet: one drive cut into {facts['pieces']} contiguous pieces (pieces of one drive, "
+                "one mount and one day, not drives of a fleet); protocol "
+                f"{facts['protocol'].replace('_', '-')}, at {facts['rate_hz']:g} Hz.")
+    return f"A fleet of drives; protocol {facts['protocol'].replace('_', '-')}, at {facts['rate_hz']:g} Hz."
+
+
+def _num(v, fmt: str = ".2f") -> str:
+    return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, fmt)
+
+
+def preparation_lines(prep: pd.DataFrame) -> list[str]:
+    """Per drive: how it was made comparable (levelling, scale, gyro bias, rate, bandwidth, label)."""
+    lines = []
+    for r in prep.itertuples():
+        if r.standstill_s > 0:
+            level = (f"levelled by roll {r.tilt_roll_deg:+.2f} deg and pitch {r.tilt_pitch_deg:+.2f} deg, accelerometer "
+                     f"scaled by {r.accel_scale:.4f} and gyro de-biased by ({r.gyro_bias_x_dps:+.3f}, "
+                     f"{r.gyro_bias_y_dps:+.3f}, {r.gyro_bias_z_dps:+.3f}) deg/s from {r.standstill_s:.0f} s standing")
+        else:
+            level = "no standstill long enough: not levelled, scaled or de-biased"
+        label = ("its speed label unchecked (no GNSS velocity)" if not r.label_checked else
+                 "its speed label agreeing with the GNSS speed throughout" if r.label_disagree_s == 0 else
+                 f"{r.label_disagree_s:.0f} s where the reference and GNSS speeds disagree "
+                 + ("left out" if r.label_action == "drop" else "labelled from the GNSS speed"))
+        rate = (f"resampled from {r.native_rate_hz:g} Hz to {r.rate_hz:g} Hz" if abs(r.native_rate_hz - r.rate_hz) > 1e-6
+                else f"at {r.rate_hz:g} Hz")
+        if r.imu_gaps:
+            rate += f" ({r.imu_gaps} IMU gap{'s' if r.imu_gaps > 1 else ''} kept as gaps)"
+        lines.append(f"{r.drive} ({r.duration_s / 60:.1f} min, up to {r.speed_max_mps:.1f} m/s): {level}; {rate}, "
+                     f"low-passed at {r.cutoff_hz:g} Hz; {label}.")
+    return lines
+
+
+def fleet_markdown(summary: pd.DataFrame, speed_range: str = "all") -> str:
+    """The odometer table of the fleet (median max horizontal error, m, per test drive and pooled, a column per
+    duration) for one speed range, as Markdown."""
+    s = summary[summary["speed_range"] == speed_range]
+    if s.empty:
+        return f"No rows for {RANGE_WORDS[speed_range]}."
+    wide = odometer_table(s.drop(columns=["speed_range"]))
+    drives = [d for d in dict.fromkeys(s["dataset"]) if d != POOLED] + [POOLED]        # the pooled rows last
+    wide = wide.iloc[sorted(range(len(wide)), key=lambda i: (drives.index(wide.index[i][0]), i))]
+    head = "| test drive | method | " + " | ".join(wide.columns) + " |"
+    body = [f"| {drive_words(ds)} | {m} | " + " | ".join(_num(v, ".1f") for v in r) + " |"
+            for (ds, m), r in wide.iterrows()]
+    return "\n".join([f"Median max horizontal error (m), {RANGE_WORDS[speed_range]}:", "", head,
+                      "|---" * (len(wide.columns) + 2) + "|", *body])
+
+
+def verdict_lines(summary: pd.DataFrame, offsets: pd.DataFrame) -> list[str]:
+    """Per test drive and pooled, at the longest duration: RIDGE-ODO's median max error against INS+NHC (ratio,
+    Wilcoxon p, Holm-adjusted p) and its offset per outage against the held speed's."""
+    s = summary[summary["speed_range"] == "all"]
+    if s.empty:
+        return []
+    d = float(s["duration_s"].max())
+    lines = []
+    for ds, g in s[s["duration_s"] == d].groupby("dataset", sort=False):
+        r, n = g[g["method"] == RIDGE], g[g["method"] == nhc_label("INS")]
+        if r.empty or n.empty:
+            continue
+        r, n = r.iloc[0], n.iloc[0]
+        o = offsets[(offsets["speed_range"] == "all") & (offsets["dataset"] == ds) & (offsets["duration_s"] == d)]
+        off = {m: o.loc[o["method"] == m, "offset_rms_mps"] for m in (RIDGE, HOLD)}
+        off_text = (f"; its offset per outage {off[RIDGE].iloc[0]:.2f} m/s RMS against the held speed's "
+                    f"{off[HOLD].iloc[0]:.2f} m/s" if len(off[RIDGE]) and len(off[HOLD]) else "")
+        lines.append(f"{drive_words(ds)}, {d:g} s outages ({int(r['runs'])}): {RIDGE} {r['max_h_m']:.1f} m against "
+                     f"{nhc_label('INS')} {n['max_h_m']:.1f} m (median per-start ratio {r['ratio_to_nhc']:.2f}, "
+                     f"Wilcoxon p {_num(r['p_vs_nhc'])}, Holm-adjusted {_num(r['p_vs_nhc_holm'])}){off_text}.")
+    return lines
+
+
+def coverage_lines(motion: pd.DataFrame, flags: pd.DataFrame) -> list[str]:
+    """Per test drive: its speeds and turn rates against its training drives', and the outages out of range."""
+    lines = []
+    for test, g in motion.groupby("test_drive", sort=False):
+        t, tr = g[g["role"] == "test"].iloc[0], g[g["role"] == "training"].iloc[0]
+        f = flags[(flags["dataset"] == test) & (flags["duration_s"] == flags["duration_s"].max())]
+        lines.append(f"{test}: speed median {t.speed_p50_mps:.1f}, 95th percentile {t.speed_p95_mps:.1f}, max "
+                     f"{t.speed_max_mps:.1f} m/s against the training drives' {tr.speed_p50_mps:.1f}, "
+                     f"{tr.speed_p95_mps:.1f}, {tr.speed_max_mps:.1f} m/s; turn rate 95th percentile "
+                     f"{t.turn_p95_dps:.1f} against {tr.turn_p95_dps:.1f} deg/s; {int(f['out_of_range'].sum())} of "
+                     f"{len(f)} outages of {f['duration_s'].max():g} s outside the training speeds.")
+    return lines
+
+
+def curve_lines(curve: pd.DataFrame) -> list[str]:
+    """The learning curve per number of training drives: the median over test drives and training sets."""
+    if curve.empty:
+        return []
+    g = curve.groupby("n_train").agg(minutes=("train_min", "median"), offset=("offset_rms_mps", "median"),
+                                     rmse=("speed_rmse_mps", "median"), maxh=("median_max_h_m", "median"),
+                                     sets=("offset_rms_mps", "size"))
+    return ["RIDGE-ODO against its training data (median over the test drives and training sets): "
+            + "; ".join(f"{n} drive{'s' if n > 1 else ''} ({r.minutes:.1f} min, {int(r.sets)} sets): offset per "
+                        f"outage {r.offset:.2f} m/s, speed RMSE {r.rmse:.2f} m/s, median max error {r.maxh:.1f} m"
+                        for n, r in g.iterrows()) + "."]
+
+
+def plot_curve(curve: pd.DataFrame):
+    """The learning curve: the offset per outage, the speed RMSE and the median max error against training minutes,
+    a dot per training set, a line per test drive through the medians per number of training drives."""
+    fig, axes = plt.subplots(1, 3, figsize=(10, 3.2))
+    cols = [("offset_rms_mps", "offset per outage, RMS (m/s)"), ("speed_rmse_mps", "speed RMSE (m/s)"),
+            ("median_max_h_m", "median max error (m)")]
+    for ax, (c, label) in zip(axes, cols):
+        for test, g in curve.groupby("test_drive", sort=False):
+            # each training set a dot, the line through the median per number of training drives
+            med = g.groupby("n_train")[["train_min", c]].median()
+            line = ax.plot(med["train_min"], med[c], "-", lw=1.2, label=test)[0]
+            ax.plot(g["train_min"], g[c], "o", ms=3, alpha=0.6, color=line.get_color())
+        ax.set_xlabel("training minutes")
+        ax.set_ylabel(label)
+        ax.set_ylim(bottom=0)
+    axes[0].legend(fontsize=6)
+    fig.suptitle("RIDGE-ODO on drives it never saw, against the minutes it trained on", fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+__all__ = ["RANGE_WORDS", "POOLED_WORDS", "drive_words", "fleet_title", "preparation_lines", "fleet_markdown",
+           "verdict_lines", "coverage_lines", "curve_lines", "plot_curve"]

@@ -1,0 +1,267 @@
+"""The learned odometer trained on some drives of a fleet and tested on drives it never saw (beyond the paper).
+
+Leave-one-drive-out (``fleet.protocol: leave_one_out``): every drive is tested once, trained on all the others;
+``named``: the ``fleet.train`` drives train, each of ``fleet.test`` is tested. The learned odometers learn from
+every labelled window of the training drives (their GPS-available time: a training drive holds no outage of the
+test), pooled (:func:`pooled_speed_data`), with the within-drive study's validation blocks and ridge
+(:class:`bgfn.learning.odometry.RidgeOdometer`, ``evaluate.odometer``); the networks (``fleet.networks``) through
+:func:`bgfn.studies.odometer.bars.network_odometers`. Each test drive runs the odometer table's rows in its sweep
+windows (:func:`bgfn.studies.outage_sweep.sweep.profile_sweep_plan`, every start one fold: no start was trained
+on), with the same runs and row format (:mod:`bgfn.studies.odometer.bars`), and its honest speed series gives the
+offset per outage (:func:`bgfn.studies.odometer.errors.error_parts_table`).
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pandas as pd
+
+from bgfn.errors import DataError
+from bgfn.evaluate.hybrid import navigation_context, window_metrics
+from bgfn.learning import odometry as lo
+from bgfn.learning.split import overlaps
+from bgfn.nav import odometer as no
+from bgfn.paper import nhc_label
+from bgfn.parallel import Runner
+from bgfn.studies.fleet.drives import PreparedDrive
+from bgfn.studies.odometer import bars
+from bgfn.studies.odometer.errors import error_parts_table
+from bgfn.studies.outage_sweep.sweep import profile_sweep_plan
+
+#: Seconds between two drives' clocks in pooled windows: no window of one drive pairs with another's
+#: (validation purge, error autocorrelation).
+DRIVE_TIME_SHIFT_S = 1.0e7
+#: The learned odometers of the table (the family of the Holm adjustment).
+LEARNED = (bars.RIDGE, *bars.NETWORK_ODOMETERS, *bars.ENSEMBLE_ODOMETERS)
+
+
+def fleet_splits(names: list[str], fleet: dict) -> list[tuple[str, list[str]]]:
+    """``[(test drive, [training drives]), ...]`` of the protocol (module docstring)."""
+    if fleet["protocol"] == "leave_one_out":
+        return [(n, [m for m in names if m != n]) for n in names]
+    train, test = list(fleet["train"]), list(fleet["test"])
+    for key, chosen in (("train", train), ("test", test)):
+        unknown = [n for n in chosen if n not in names]
+        if unknown or not chosen:
+            raise DataError("fleet", key, f"names among the fleet's drives ({', '.join(names)})",
+                            ", ".join(unknown) or "none")
+    if set(train) & set(test):
+        raise DataError("fleet", "train/test", "disjoint lists", ", ".join(sorted(set(train) & set(test))))
+    return [(n, train) for n in test]
+
+
+def learning_params(cfg: dict) -> dict:
+    """What the fleet's learned odometers take from a profile: ``evaluate.odometer``'s window, ridge, validation and
+    correlation keys, ``train.val_fraction`` and the aid rate ``nav.nhc.rate_hz``."""
+    oc = cfg["evaluate"]["odometer"]
+    return {"window_s": float(oc["window_s"]), "ridge_alpha": float(oc["ridge_alpha"]),
+            "max_lag_s": float(oc["correlation_max_lag_s"]), "correlation": bool(oc["correlation"]),
+            "val_fraction": float(cfg["train"]["val_fraction"]), "val_blocks": int(oc["val_blocks"]),
+            "calibration_blocks": bool(oc["calibration_blocks"]),
+            "aid_rate_hz": float(((cfg.get("nav") or {}).get("nhc") or {}).get("rate_hz") or 1.0)}
+
+
+def drive_windows(p: PreparedDrive, epochs, window_s: float, labelled: bool = True) -> lo.SpeedWindows:
+    """The prepared IMU's windows of ``window_s`` ending at ``epochs`` (s), with the speed label (or NaN)."""
+    window = int(round(window_s * p.rate_hz))
+    epochs = np.asarray(epochs, dtype=float)
+    return lo.speed_windows(p.imu, epochs, window, p.label_at(epochs) if labelled else None)
+
+
+def aid_epochs(t0: float, t1: float, rate_hz: float) -> np.ndarray:
+    """The aid grid ``k / rate_hz`` inside ``[t0, t1)``, s."""
+    return np.arange(np.ceil(t0 * rate_hz) / rate_hz, t1, 1.0 / rate_hz)
+
+
+def concat_windows(parts: list[lo.SpeedWindows]) -> lo.SpeedWindows:
+    """Windows of several drives as one set, drive ``i``'s times shifted by ``i`` :data:`DRIVE_TIME_SHIFT_S`."""
+    shift = [np.full(len(w), i * DRIVE_TIME_SHIFT_S) for i, w in enumerate(parts)]
+    return lo.SpeedWindows(np.concatenate([w.x for w in parts]), np.concatenate([w.speed for w in parts]),
+                           np.concatenate([w.t_end for w in parts]) + np.concatenate(shift),
+                           np.concatenate([w.t_start for w in parts]) + np.concatenate(shift))
+
+
+def pooled_speed_data(train: list[PreparedDrive], params: dict) -> lo.SpeedData:
+    """Every labelled window of the training drives (NaN labels left out) pooled, split into training, validation
+    and calibration blocks as within a drive (:func:`bgfn.learning.odometry.build_speed_data`, no outage: none of
+    the test drive's time is in them), ``val_blocks`` per training drive."""
+    parts = []
+    for p in train:
+        epochs = aid_epochs(p.label_time[0], p.label_time[-1], params["aid_rate_hz"])
+        w = drive_windows(p, epochs, params["window_s"])
+        parts.append(w.subset(np.isfinite(w.speed)))
+    return lo.build_speed_data(concat_windows(parts), (), 0.0, params["val_fraction"],
+                               params["val_blocks"] * len(train), params["calibration_blocks"])
+
+
+def fit_ridge(data: lo.SpeedData, rate_hz: float, params: dict) -> lo.RidgeOdometer:
+    """``RIDGE-ODO`` on pooled training data (its std and correlation from the calibration windows)."""
+    return lo.RidgeOdometer.fit(data.train, data.calibration_windows, rate_hz, params["ridge_alpha"],
+                                params["max_lag_s"])
+
+
+def ridge_track(model: lo.RidgeOdometer, windows: lo.SpeedWindows, params: dict) -> no.SpeedTrack:
+    """The ridge's track over a test drive's windows (fused with its correlation when ``correlation``)."""
+    return model.track(windows).correlated(model.correlation if params["correlation"] else 1.0)
+
+
+def speed_series(t, truth, outages, tracks: dict) -> dict:
+    """The honest speed series of :func:`bgfn.studies.odometer.errors.error_parts_table`: each track's speed and std
+    inside the ``outages`` ``[(start, duration), ...]``, NaN elsewhere."""
+    t, truth = np.asarray(t, dtype=float), np.asarray(truth, dtype=float)
+    inside = overlaps(t, t, np.array([[s, s + d] for s, d in outages], dtype=float).reshape(-1, 2))
+    out = {}
+    for label, track in tracks.items():
+        speed, std = np.full(t.size, np.nan), np.full(t.size, np.nan)
+        speed[inside], std[inside] = track.at(t[inside])
+        out[label] = (speed, std)
+    return {"time": t, "truth": truth, "outages": list(outages), "tracks": out}
+
+
+def held_track(epochs, starts, duration: float, speed_at_start, std: float) -> no.SpeedTrack:
+    """The speed at each outage start held over that outage (``INS+NHC+HOLD`` in one track), std ``std``; NaN
+    outside the outages."""
+    epochs = np.asarray(epochs, dtype=float)
+    v = np.full(epochs.size, np.nan)
+    for s in sorted(starts):
+        v[(epochs > s) & (epochs <= s + duration + 1e-6)] = float(speed_at_start(s))
+    return no.SpeedTrack(epochs, v, np.full(epochs.size, float(std)))
+
+
+class TestDrive:
+    """A test drive ready for the odometer rows: its GPS-aided run with a state at every sweep start
+    (:func:`bgfn.evaluate.hybrid.navigation_context`), its aid epochs, its prepared windows there, the reference's
+    speed and the GPS-aided solution's forward speed (the held speed's)."""
+
+    def __init__(self, cfg: dict, p: PreparedDrive, params: dict):
+        sw = cfg["evaluate"]["sweep"]
+        self.prepared, self.name = p, p.name
+        self.plan = profile_sweep_plan(cfg, p.drive, sw)
+        self.starts = [float(s) for s in self.plan["start_s"]]
+        self.durations = [float(d) for d in sw["durations_s"]]
+        self.dmax = max(self.durations)
+        self.ctx = navigation_context(p.drive, cfg.get("nav"), self.starts)
+        self.con = self.ctx.constraints
+        self.rate = float(self.con.config.nhc_rate_hz)
+        traj = self.ctx.full.trajectory
+        self.tt = traj["time"].to_numpy(float)
+        self.solution_speed = lo.forward_speed(traj, self.con.mounting_at(self.tt))
+        self.windows = drive_windows(p, aid_epochs(self.tt[0], self.tt[-1], self.rate), params["window_s"], False)
+        self.truth = bars.reference_speed(p.drive, self.windows.t_end)
+        self.outages = [(s, self.dmax) for s in self.starts]
+
+    def start_speed(self, s: float) -> float:
+        """The GPS-aided solution's forward speed at ``s`` (what ``INS+NHC+HOLD`` holds)."""
+        return float(np.interp(s, self.tt, self.solution_speed))
+
+
+def test_runs(test: TestDrive, learned: dict, oc: dict) -> tuple[list, dict]:
+    """The odometer table's runs in a test drive's outages (:class:`bgfn.studies.odometer.bars.OdometerRun`, one
+    fold, 0): INS+NHC, the held speed per start, the oracle grid, and each learned track of ``learned``
+    (``{(label, seed): SpeedTrack}``); and the tracks by run label."""
+    con, gate, fw, name = test.con, oc["gate_probability"], test.outages, test.name
+    runs, tracks = [bars.OdometerRun(f"{name} {nhc_label('INS')}", fw, con, nhc_label("INS"), np.nan, 0, 0)], {}
+    for (label, seed), track in learned.items():
+        runs.append(bars.OdometerRun(f"{name} {label} seed {seed}", fw, no.Odometer(con, track, gate), label,
+                                     np.nan, int(seed), 0))
+        tracks[runs[-1].label] = track
+    epochs = test.windows.t_end
+    for s, d in fw:
+        held = no.SpeedTrack(epochs, np.full(epochs.size, test.start_speed(s)),
+                             np.full(epochs.size, float(oc["hold_std_mps"])))
+        runs.append(bars.OdometerRun(f"{name} {s:.0f} s {bars.HOLD}", [(s, d)], no.Odometer(con, held, gate),
+                                     bars.HOLD, np.nan, 0, 0))
+        tracks[runs[-1].label] = held
+    walks = [(bars.ORACLE, 0.0)] + ([(bars.ORACLE_WALK, float(oc["walk_mps_per_sqrt_s"]))]
+                                    if oc["walk_mps_per_sqrt_s"] > 0 else [])
+    for (method, walk), sigma, seed in ((w, s, e) for w in walks for s in oc["sigmas_mps"] for e in oc["seeds"]):
+        track = bars.oracle_track(epochs, test.truth, float(sigma), walk, int(seed), test.rate)
+        runs.append(bars.OdometerRun(f"{name} {method} {sigma:g} m/s seed {seed}", fw, no.Odometer(con, track, gate),
+                                     method, float(sigma), int(seed), 0))
+        tracks[runs[-1].label] = track
+    return runs, tracks
+
+
+def run_rows(test: TestDrive, runs: list, tracks: dict, pseudo: dict, runner: Runner | None,
+             durations=None) -> pd.DataFrame:
+    """The runs in the test drive's outages, scored as the odometer table's rows
+    (:data:`bgfn.studies.odometer.bars.ODOMETER_COLUMNS`) at each of ``durations`` (the sweep's)."""
+    results = (runner or Runner()).map(bars.odometer_run, [(test.ctx, r, pseudo) for r in runs],
+                                       labels=[r.label for r in runs], desc=f"fleet rows {test.name}")
+    rows = []
+    for run, outs in zip(runs, results):
+        track = tracks.get(run.label)
+        for r in outs:
+            for du in (durations or test.durations):
+                m = window_metrics(r.errors, r.start, float(du))
+                rows.append({"dataset": test.name, "start_s": r.start, "duration_s": float(du), "method": run.method,
+                             "sigma_mps": run.sigma_mps, "seed": run.seed, "fold": run.fold,
+                             **{c: m[c] for c in ("max_h_m", "rmse_h_m", "final_h_m")},
+                             **no.speed_errors(track, test.windows.t_end, test.truth, r.start, float(du))})
+    return pd.DataFrame(rows, columns=list(bars.ODOMETER_COLUMNS))
+
+
+def network_tracks(cfg: dict, profile: str, key: str, data: lo.SpeedData, test: TestDrive,
+                   runner: Runner | None) -> dict:
+    """The odometer networks (``evaluate.odometer.methods``, their seeds and ensembles) trained on the pooled
+    ``data`` as one fold and run over the test drive's windows (:func:`bgfn.studies.odometer.bars.network_odometers`;
+    checkpoints under the model key ``key``): ``{(label, seed): SpeedTrack}``."""
+    ecfg = cfg["evaluate"]
+    oc = {**ecfg["odometer"], "network_datasets": None}
+    rate = test.prepared.rate_hz
+    nets = bars.network_odometers(cfg, profile, key, {**ecfg, "odometer": oc},
+                                  {0: lo.with_inputs(data, oc["inputs"], rate)},
+                                  lo.network_inputs(test.windows, oc["inputs"], rate), runner)
+    return {(label, seed): track for (label, _, seed), (track, _) in nets.items()}
+
+
+def training_minutes(data: lo.SpeedData, aid_rate_hz: float) -> float:
+    """Minutes of labelled windows the odometer trained on (its training windows at the aid rate)."""
+    return len(data.train) / aid_rate_hz / 60.0
+
+
+def curve_combinations(train: list[str], fleet: dict) -> list[tuple[str, ...]]:
+    """The training sets of the learning curve: for 1 .. len(train) drives every combination, or
+    ``curve_max_combinations`` of them drawn with ``curve_seed`` where there are more (the full set always)."""
+    rng = np.random.default_rng(int(fleet["curve_seed"]))
+    out = []
+    for k in range(1, len(train) + 1):
+        combos = list(itertools.combinations(train, k))
+        if len(combos) > int(fleet["curve_max_combinations"]):
+            pick = rng.choice(len(combos), int(fleet["curve_max_combinations"]), replace=False)
+            combos = [combos[i] for i in sorted(pick)]
+        out += combos
+    return out
+
+
+def curve_rows(test: TestDrive, by_name: dict, train: list[str], fleet: dict, params: dict, oc: dict,
+               pseudo: dict, runner: Runner | None) -> pd.DataFrame:
+    """The ridge's learning curve on one test drive (:data:`CURVE_COLUMNS`): per training set of
+    :func:`curve_combinations`, its training minutes, the offset per outage and the speed RMSE in the test's outages
+    over their first ``curve_duration_s``, and the median max horizontal error there."""
+    d = float(fleet["curve_duration_s"])
+    runs, tracks, facts = [], {}, []
+    for i, combo in enumerate(curve_combinations(train, fleet)):
+        data = pooled_speed_data([by_name[n] for n in combo], params)
+        track = ridge_track(fit_ridge(data, test.prepared.rate_hz, params), test.windows, params)
+        runs.append(bars.OdometerRun(f"{test.name} curve {i} {bars.RIDGE}", test.outages,
+                                     no.Odometer(test.con, track, oc["gate_probability"]), bars.RIDGE, np.nan, 0, i))
+        tracks[runs[-1].label] = track
+        series = speed_series(test.windows.t_end, test.truth, test.outages, {bars.RIDGE: track})
+        parts = error_parts_table(test.name, series, [d])
+        facts.append({"test_drive": test.name, "n_train": len(combo), "train_drives": "; ".join(combo),
+                      "train_min": training_minutes(data, params["aid_rate_hz"]),
+                      "offset_rms_mps": float(parts["offset_rms_mps"].iloc[0]) if len(parts) else np.nan,
+                      "speed_rmse_mps": float(parts["speed_rmse_mps"].iloc[0]) if len(parts) else np.nan})
+    rows = run_rows(test, runs, tracks, pseudo, runner, [d])
+    med = rows.groupby("fold")["max_h_m"].median()
+    for i, f in enumerate(facts):
+        f["median_max_h_m"] = float(med.get(i, np.nan))
+    return pd.DataFrame(facts, columns=list(CURVE_COLUMNS))
+
+
+#: Columns of ``tables/fleet_curve.csv`` (:func:`curve_rows`).
+CURVE_COLUMNS: tuple[str, ...] = ("test_drive", "n_train", "train_drives", "train_min", "offset_rms_mps",
+                                  "speed_rmse_mps", "median_max_h_m")

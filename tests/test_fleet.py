@@ -1,0 +1,208 @@
+"""The fleet study (beyond the paper): drives made comparable, leave-one-drive-out, coverage flags, Holm.
+
+A synthetic fleet (:mod:`synthetic_fleet`): the speed is a known function of the vibration spectrum, and every drive's
+IMU is tilted, rescaled and biased differently; only the speed path is run here (no filter), so the file stays fast.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from bgfn.errors import DataError
+from bgfn.settings import defaults
+from bgfn.stats import holm_adjust
+from bgfn.studies.fleet import drives as fd
+from bgfn.studies.fleet import protocol as fp
+from bgfn.studies.fleet.coverage import outage_flags, speed_range
+from bgfn.studies.odometer.errors import error_parts_table
+from synthetic_fleet import fleet_drive
+
+FLEET = defaults("fleet")
+PARAMS = {"window_s": 2.0, "ridge_alpha": 1.0, "max_lag_s": 10.0, "correlation": True, "val_fraction": 0.2,
+          "val_blocks": 2, "calibration_blocks": True, "aid_rate_hz": 1.0}
+MOUNTS = [((3.6, -2.0), 0.99, (0.002, -0.001, 0.003)), ((-5.0, 9.1), 1.06, (-0.002, 0.001, 0.0)),
+          ((1.0, 4.0), 1.03, (0.0, 0.002, -0.002)), ((-7.0, -3.0), 0.97, (0.001, 0.0, 0.001))]
+
+
+@pytest.fixture(scope="module")
+def fleet():
+    """Four remounted drives of 3-14 m/s and one faster (18-25 m/s) drive, prepared together."""
+    drives = [fleet_drive(f"drive {i + 1}", tilt_deg=m, scale=s, gyro_bias=b, seed=i)
+              for i, (m, s, b) in enumerate(MOUNTS)]
+    drives.append(fleet_drive("fast drive", v_lo=18.0, v_hi=25.0, tilt_deg=(2.0, 2.0), scale=1.02, seed=9))
+    return drives, fd.prepare_fleet(drives, FLEET)
+
+
+def test_levelling_scale_and_bias_recover_the_mount(fleet):
+    _, prepared = fleet
+    for p, (tilt, scale, bias) in zip(prepared, MOUNTS):
+        f = p.facts
+        assert f["standstill_s"] > 10.0                              # the first 10 s and the middle stop
+        assert f["tilt_roll_deg"] == pytest.approx(tilt[0], abs=0.05)
+        assert f["tilt_pitch_deg"] == pytest.approx(tilt[1], abs=0.05)
+        assert f["accel_scale"] == pytest.approx(1.0 / scale, rel=1e-3)
+        np.testing.assert_allclose([f[f"gyro_bias_{a}_dps"] for a in "xyz"], np.degrees(bias), atol=0.02)
+        still = p.imu["time"].to_numpy() < 9.0                       # levelled: gravity along -z at rest
+        np.testing.assert_allclose(p.imu.loc[still, ["accel_x", "accel_y", "accel_z"]].mean().to_numpy(),
+                                   [0.0, 0.0, -9.80665], atol=0.02)
+
+
+def test_resampled_to_the_lowest_rate_and_one_bandwidth():
+    slow = fleet_drive("slow", duration=60.0, rate=100.0, seed=1)
+    fast = fleet_drive("fast", duration=60.0, rate=200.0, seed=2)
+    t = fast.imu["time"].to_numpy()
+    fast.imu["accel_y"] += np.sin(2 * np.pi * 10.0 * t) + np.sin(2 * np.pi * 80.0 * t)   # 80 Hz: above 50 Hz
+    prepared = fd.prepare_fleet([slow, fast], FLEET)
+    assert [p.rate_hz for p in prepared] == [100.0, 100.0]
+    assert prepared[1].facts["native_rate_hz"] == pytest.approx(200.0)
+    assert prepared[1].facts["cutoff_hz"] == pytest.approx(0.8 * 50.0)
+    y = prepared[1].imu["accel_y"].to_numpy()[500:-500]
+    spec = np.abs(np.fft.rfft(y - y.mean())) * 2 / y.size
+    freq = np.fft.rfftfreq(y.size, 1 / 100.0)
+    amp = {f: spec[np.argmin(np.abs(freq - f))] for f in (10.0, 20.0)}
+    assert amp[10.0] == pytest.approx(1.0, abs=0.05)                 # kept
+    assert amp[20.0] < 0.02                                          # 80 Hz not aliased to 20 Hz
+
+
+def test_a_gap_in_the_imu_stays_a_gap():
+    d = fleet_drive("gappy", duration=60.0, seed=5)
+    t = d.imu["time"].to_numpy()
+    d.imu = d.imu[(t < 30.0) | (t > 31.0)].reset_index(drop=True)      # one second missing
+    (p,) = fd.prepare_fleet([d], FLEET)
+    assert p.facts["imu_gaps"] == 1
+    ti = p.imu["time"].to_numpy()
+    assert not ((ti > 30.0 + 1e-9) & (ti < 31.0 - 1e-9)).any()          # nothing made up inside it
+    w = fp.drive_windows(p, np.arange(20.0, 45.0), 2.0)
+    assert not ((w.t_end > 30.0) & (w.t_end < 33.0)).any()              # no window reaches across it
+    assert ((w.t_end >= 33.0) & (w.t_end < 45.0)).sum() == 12
+
+
+def test_label_left_out_where_gnss_disagrees():
+    d = fleet_drive("odd", duration=120.0, gnss_offset=(40.0, 60.0, 2.0), seed=3)
+    t, label, facts = fd.speed_label(d, 0.5, "drop", 2.0)
+    assert facts["label_checked"]
+    assert facts["label_disagree_s"] == pytest.approx(20.0, abs=2.0)
+    assert np.isnan(label[(t > 42) & (t < 58)]).all() and np.isfinite(label[(t < 35) | (t > 66)]).all()
+    _, relabel, _ = fd.speed_label(d, 0.5, "gnss", 2.0)
+    inside = (t > 42) & (t < 58)
+    np.testing.assert_allclose(relabel[inside] - d.reference["v_n"].to_numpy()[inside], 2.0, atol=0.05)  # 1 Hz GNSS
+
+
+def lodo_offsets(prepared, test_index, train_index, durations=(30.0,)):
+    """The ridge trained on ``train_index`` drives, its and the held speed's offsets in the test drive's outages."""
+    test, train = prepared[test_index], [prepared[i] for i in train_index]
+    model = fp.fit_ridge(fp.pooled_speed_data(train, PARAMS), test.rate_hz, PARAMS)
+    windows = fp.drive_windows(test, fp.aid_epochs(test.label_time[0], test.label_time[-1], 1.0), 2.0, False)
+    truth = fd.reference_speed_at(test.drive, windows.t_end)
+    starts = np.arange(20.0, 200.0, 30.0)
+    held = fp.held_track(windows.t_end, starts, 30.0, lambda s: float(test.label_at([s])[0]), 1.0)
+    series = fp.speed_series(windows.t_end, truth, [(s, 30.0) for s in starts],
+                             {"RIDGE-ODO": fp.ridge_track(model, windows, PARAMS), "HOLD": held})
+    table = error_parts_table(test.name, series, durations).set_index("method")
+    return table, windows, truth, starts, train
+
+
+def test_leave_one_drive_out_recovers_the_speed(fleet):
+    _, prepared = fleet
+    for k in range(4):
+        table, *_ = lodo_offsets(prepared, k, [i for i in range(4) if i != k])
+        ridge, hold = table.loc["RIDGE-ODO"], table.loc["HOLD"]
+        assert ridge["offset_rms_mps"] < 0.5                         # the speed came back on a drive never seen
+        assert ridge["offset_rms_mps"] < 0.3 * hold["offset_rms_mps"]
+        assert ridge["speed_rmse_mps"] < 0.4 * hold["speed_rmse_mps"]
+
+
+def test_a_faster_test_drive_is_flagged_out_of_range(fleet):
+    _, prepared = fleet
+    _, windows, truth, starts, train = lodo_offsets(prepared, 4, [0, 1, 2, 3])
+    lo, hi = speed_range(train)
+    assert hi < 15.0
+    flags = outage_flags("fast drive", windows.t_end, truth, starts, [30.0], lo, hi, 0.1)
+    moving = starts > 30.0
+    assert flags["out_of_range"].to_numpy()[moving].all()
+    _, w_in, t_in, s_in, tr_in = lodo_offsets(prepared, 0, [1, 2, 3])
+    inside = outage_flags("drive 1", w_in.t_end, t_in, s_in, [30.0], *speed_range(tr_in), 0.1)
+    assert not inside["out_of_range"].any()                          # the same speeds as its training drives
+
+
+def test_protocol_splits():
+    names = ["a", "b", "c"]
+    assert fp.fleet_splits(names, FLEET) == [("a", ["b", "c"]), ("b", ["a", "c"]), ("c", ["a", "b"])]
+    named = {**FLEET, "protocol": "named", "train": ["a", "b"], "test": ["c"]}
+    assert fp.fleet_splits(names, named) == [("c", ["a", "b"])]
+    with pytest.raises(DataError, match="d"):
+        fp.fleet_splits(names, {**named, "test": ["d"]})
+    with pytest.raises(DataError, match="disjoint"):
+        fp.fleet_splits(names, {**named, "test": ["b"]})
+
+
+def test_pieces_are_contiguous_and_labelled():
+    d = fleet_drive("one", duration=90.0, seed=4)
+    pieces = fd.drive_pieces(d, 3)
+    assert [p.name for p in pieces] == ["one piece 1 of 3", "one piece 2 of 3", "one piece 3 of 3"]
+    ends = [(p.reference["time"].iloc[0], p.reference["time"].iloc[-1]) for p in pieces]
+    assert ends[0][0] == 0.0 and ends[-1][1] == pytest.approx(90.0)
+    assert all(b[0] - a[1] <= 0.01 + 1e-9 for a, b in zip(ends, ends[1:]))
+
+
+def test_holm_on_a_hand_example():
+    # sorted 0.01, 0.02, 0.04 (k = 3): 3 * 0.01 = 0.03, 2 * 0.02 = 0.04, 1 * 0.04 = 0.04; NaN stays out
+    np.testing.assert_allclose(holm_adjust([0.04, np.nan, 0.01, 0.02]), [0.04, np.nan, 0.03, 0.04])
+
+
+
+def test_fleet_summary_pools_drives_and_adjusts_per_family():
+    """Hand-made rows of two test drives whose starts share their times: pooled, each start stays its own drive's;
+    two learned odometers form the Holm family; the out-of-range outages are summarized apart."""
+    import pandas as pd
+
+    from bgfn.stats import wilcoxon_p
+    from bgfn.studies.fleet.summary import fleet_summary
+
+    rng = np.random.default_rng(0)
+    rows, flags = [], []
+    for drive, shift in (("a", 0.0), ("b", 3.0)):
+        for k, start in enumerate(np.arange(100.0, 1000.0, 100.0)):
+            nhc = 20.0 + rng.uniform(0, 5)
+            for method, err in (("INS+NHC", nhc), ("RIDGE-ODO", nhc - 2.0 - shift), ("MLP-ODO", nhc + rng.normal())):
+                rows.append({"dataset": drive, "start_s": start, "duration_s": 60.0, "method": method,
+                             "sigma_mps": np.nan, "seed": 0, "fold": 0, "max_h_m": err, "rmse_h_m": err,
+                             "final_h_m": err, "speed_rmse_mps": 1.0, "coverage_2sigma": 0.9})
+            flags.append({"dataset": drive, "start_s": start, "duration_s": 60.0, "out_of_range": drive == "b" and k < 3})
+    s = fleet_summary(pd.DataFrame(rows), pd.DataFrame(flags)).set_index(["speed_range", "dataset", "method"])
+    assert s.loc[("all", "pooled", "RIDGE-ODO"), "runs"] == 18                  # 9 starts of each drive, none merged
+    p = [wilcoxon_p(np.full(18, -1.0) - np.r_[np.zeros(9), np.full(9, 3.0)]),
+         s.loc[("all", "pooled", "MLP-ODO"), "p_vs_nhc"]]
+    assert s.loc[("all", "pooled", "RIDGE-ODO"), "p_vs_nhc"] == pytest.approx(p[0])
+    np.testing.assert_allclose([s.loc[("all", "pooled", m), "p_vs_nhc_holm"] for m in ("RIDGE-ODO", "MLP-ODO")],
+                               holm_adjust(p))
+    assert np.isnan(s.loc[("all", "pooled", "INS+NHC"), "p_vs_nhc_holm"])       # the baseline is no candidate
+    assert s.loc[("out", "b", "RIDGE-ODO"), "runs"] == 3 and ("out", "a", "RIDGE-ODO") not in s.index
+    assert s.loc[("in", "pooled", "RIDGE-ODO"), "runs"] == 15
+    assert s.loc[("out", "b", "RIDGE-ODO"), "ratio_to_nhc"] < s.loc[("in", "a", "RIDGE-ODO"), "ratio_to_nhc"]
+
+
+def test_preparation_is_said_per_drive(fleet):
+    from bgfn.report.fleet_words import preparation_lines
+
+    _, prepared = fleet
+    lines = preparation_lines(fd.preparation_table(prepared[:2]))
+    assert "levelled by roll +3.60 deg and pitch -1.9" in lines[0] and "scaled by 1.010" in lines[0]   # 1 / 0.99
+    d = fleet_drive("rolling", duration=60.0, seed=6)
+    d = d.crop(12.0, 25.0)                                              # after the first standstill, before the stop
+    (p,) = fd.prepare_fleet([d], FLEET)
+    assert np.isnan(p.facts["accel_scale"]) and "not levelled" in preparation_lines(fd.preparation_table([p]))[0]
+
+
+def test_a_fleet_section_that_cannot_run_is_one_error_naming_the_key(params):
+    from bgfn.profile_schema import load_profile
+
+    for name, body, key in (
+            ("two", "fleet: {drives: [a, b], pieces: 3}", "fleet.drives"),
+            ("one", "fleet: {drives: [a]}", "fleet.drives"),
+            ("named", "fleet: {drives: [a, b, c], protocol: named, train: [a, b]}", "fleet.test"),
+            ("long", "fleet: {drives: [a, b], curve_duration_s: 500.0}", "fleet.curve_duration_s")):
+        (params / f"{name}.yaml").write_text(f"profile: {name}\nbase: smoke\ndescription: x\n{body}\n")
+        with pytest.raises(DataError, match=key.replace(".", r"\.")):
+            load_profile(name)

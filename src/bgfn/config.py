@@ -22,7 +22,7 @@ from typing import Any
 
 import yaml
 
-from bgfn import settings
+from bgfn import settings, settings_check
 from bgfn.errors import DataError
 
 
@@ -238,7 +238,7 @@ def profile_chain(profile: str) -> list[Path]:
 
 def read_profile(profile: str) -> dict[str, Any]:
     """Read ``params/<profile>.yaml``, merge its ``base:`` chain over the defaults and check every key
-    (:func:`bgfn.settings.complete`); :func:`bgfn.profile_schema.load_profile` adds the facts that tie keys together:
+    (:func:`bgfn.settings_check.complete`); :func:`bgfn.profile_schema.load_profile` adds the facts that tie keys together:
     call it where a checked profile is needed.
 
     A profile may name another one as ``base:``; it then holds only what differs: its sections are laid
@@ -298,8 +298,8 @@ def read_profile(profile: str) -> dict[str, Any]:
     if cfg["profile"] != profile:
         raise DataError(path, "profile", f"the file's own name {profile!r}", repr(cfg["profile"]))
     try:
-        return settings.complete(cfg)
-    except settings.ProfileError as exc:
+        return settings_check.complete(cfg)
+    except settings_check.ProfileError as exc:
         raise DataError(file_setting(profile, exc.path), exc.path, exc.expected, exc.found) from None
 
 

@@ -37,7 +37,8 @@ from bgfn.models import MODELS
 from bgfn.paper import METHOD_LABELS
 from bgfn.parallel import SCHEDULER_ENV, Runner
 from bgfn.run_plan import RunPlan, fingerprint, make_plan, plan_json, plan_path, read_plan
-from bgfn.settings import MAX_COUNT, Data, ProfileError, Train, check_model, complete, fmt, merge
+from bgfn.settings import MAX_COUNT, Data, Train
+from bgfn.settings_check import ProfileError, check_model, complete, fmt, merge
 
 __all__ = ["ProfileError", "check_with_drives", "cross_check", "load_profile", "main", "validate", "with_overrides"]
 
@@ -72,7 +73,7 @@ def _check_window_list(path: str, entry: list, t0, t1) -> None:
 
 def _check_outage_entries(cfg: dict) -> None:
     """Each list of windows inside the data, without overlaps; a mapping answers for every dataset (the entries'
-    form: :func:`bgfn.settings.complete`)."""
+    form: :func:`bgfn.settings_check.complete`)."""
     data = cfg.get("data") or {}
     t0, t1 = data.get("t_start"), data.get("t_end")
     if t0 is not None and t1 is not None and t1 <= t0:
@@ -260,7 +261,7 @@ def _check_variants(cfg: dict) -> None:
 
 
 def validate(cfg: dict) -> dict:
-    """The whole profile checked (:func:`bgfn.settings.complete`, then :func:`cross_check`); with its defaults."""
+    """The whole profile checked (:func:`bgfn.settings_check.complete`, then :func:`cross_check`); with its defaults."""
     out = complete(cfg)
     cross_check(out)
     return out

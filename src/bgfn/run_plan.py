@@ -37,7 +37,7 @@ from bgfn.learning.split import split_windows
 from bgfn.nav.baseline import filter_start
 from bgfn.nav.constraints import DEFAULT_PLATFORM
 from bgfn.nav.outages import is_rule, outage_entry, outage_windows, picked_outages, snapped_outages
-from bgfn.settings import complete
+from bgfn.settings_check import complete
 from bgfn.studies.outage_sweep.sweep import profile_sweep_plan, sweep_train_config
 
 #: The plan's file under ``results/<profile>/``.

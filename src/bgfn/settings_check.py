@@ -214,5 +214,5 @@ def listing(model: type[BaseModel] = Profile, indent: str = "") -> list[str]:
     return out
 
 
-if __name__ == "__main__":   # python -m bgfn.settings: every key, its default and its meaning
+if __name__ == "__main__":   # python -m bgfn.settings_check: every key, its default and its meaning
     print("\n".join(listing()))

@@ -34,8 +34,7 @@ CLI_CAR_S, CLI_WALK_S = 60.0, 134.0
 #: The smallest budget of the demo profiles (the numbers mean nothing; the chain runs through).
 BUDGET = ("train: {methods: [bgfn, transformer, mlp], seeds: [0], size: smoke, lr_search: {grid: null},\n"
           "        optimizer: {epochs: 2, max_train_windows: 64, max_val_windows: 32}}\n"
-          "variant_runs: {methods: [bgfn], seeds: [0]}\n"
-          "energy: {allow_untrained: true}\n")
+          "variant_runs: {methods: [bgfn], seeds: [0]}\n")
 
 
 def demo_log(folder: Path, name: str = "demo-car", seed: int = 7, source: str = "tools/demo_log.py (synthetic)",

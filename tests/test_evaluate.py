@@ -693,7 +693,7 @@ def test_sweep_tables_and_lines():
 def test_evaluation_record_is_what_the_results_page_reads(tmp_path):
     import json
 
-    from bgfn import report
+    from bgfn.report import page as report
 
     cfg = load_profile("smoke")
     setup = ev.evaluation_setup(with_overrides(cfg, {"evaluate.sweep.datasets": []}))

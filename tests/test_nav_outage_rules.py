@@ -223,7 +223,7 @@ def test_check_with_drives_applies_the_rule_to_each_drive(params, monkeypatch):
             "nav: {datasets: [sim]}\ntrain: {datasets: [sim]}\n"
             "evaluate: {datasets: [sim], sweep: {datasets: []}}\nvariant_runs: {datasets: null}\n")
     path.write_text(head + "outage_windows: {sim: {rule: cruise_and_manoeuvre}}\n")
-    (line,) = check_with_drives("mine")
+    (line,) = [line for line in check_with_drives("mine") if line.startswith("sim: ")]   # after the keys' line
     assert "outages picked by the rule [[1225.0, 30.0], [1385.0, 30.0]]" in line
     path.write_text(head + "outage_windows: {sim: {rule: cruise_and_manoeuvre, min_training_s: 1000.0}}\n")
     with pytest.raises(DataError) as err:

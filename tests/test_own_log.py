@@ -92,7 +92,7 @@ def test_a_csv_log_named_by_its_path_runs_notebooks_01_to_04(tmp_path, monkeypat
     cfg = load_profile("mine")
     assert cfg["profile"] == "mine"                               # the file's name
     assert cfg["description"] == "profile 'mine': 'quick' with its own settings"     # none written
-    assert check_with_drives("mine")[0].startswith(f"{log}: {T0:.2f}..")    # make's check step, with the data
+    assert any(line.startswith(f"{log}: {T0:.2f}..") for line in check_with_drives("mine"))    # make's check step, with the data
     name = str(log)
     assert [cfg[s]["datasets"] for s in ("data", "nav", "train", "evaluate")] == [[name]] * 4
     assert cfg["evaluate"]["sweep"]["datasets"] == []             # the file's own section wins

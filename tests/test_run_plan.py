@@ -17,7 +17,7 @@ from bgfn.evaluate import evaluate_config
 from bgfn.io import atomic_write_text
 from bgfn.nav.outages import outage_windows
 from bgfn.profile_schema import check_and_plan, check_with_drives, load_profile
-from bgfn.report import plan_lines
+from bgfn.report.run_plan import plan_lines
 from bgfn.run_plan import MIN_TRAIN_WINDOWS, PARTS, plan_json, plan_path, read_plan
 from bgfn.studies.gallery.logs import walker_log
 from bgfn.studies.outage_sweep.sweep import profile_sweep_plan

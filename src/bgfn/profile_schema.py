@@ -35,7 +35,7 @@ from bgfn.nav.baseline import filter_start
 from bgfn.nav.outages import check_windows, is_rule, outage_entry, picked_outages, snap_windows
 from bgfn.models import MODELS
 from bgfn.paper import METHOD_LABELS
-from bgfn.parallel import SCHEDULER_ENV, Runner
+from bgfn.parallel import JOBS_PER_CORE, SCHEDULER_ENV, Runner, machine_cores
 from bgfn.run_plan import RunPlan, fingerprint, make_plan, plan_json, plan_path, read_plan
 from bgfn.settings import MAX_COUNT, Data, Train
 from bgfn.settings_check import ProfileError, check_model, complete, fmt, merge
@@ -363,7 +363,8 @@ def check_keys(profile: str) -> list[str]:
     cfg = load_profile(profile, planned=False)        # the plan is remade by the check with the drives
     runner = Runner.of(cfg)
     where = (f"on the Dask cluster at {runner.scheduler}" if runner.backend == "dask" else
-             f"{runner.jobs} at a time here" + (f" ({runner.asked} asked: capped)" if runner.asked else ""))
+             f"{runner.jobs} processes on this machine" + (f" ({runner.asked} asked: at most {JOBS_PER_CORE} per "
+                                                          f"core of the {machine_cores()} here)" if runner.asked else ""))
     return [f"every key checked; independent runs {where}"]
 
 

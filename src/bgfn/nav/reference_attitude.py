@@ -70,6 +70,8 @@ def check_attitude(reference: pd.DataFrame, imu: pd.DataFrame, options: dict | N
         out["yaw_minus_course_deg"] = [med, p05, p95]
         if abs(med) > tol or max(abs(p05), abs(p95)) > 2 * tol:
             out.update(usable=False, reason="yaw_vs_course")
+    if not {"accel_x", "accel_y", "accel_z", "gyro_x", "gyro_y", "gyro_z"} <= set(imu.columns):
+        return out                      # no specific force to level with: the course alone is checked
     t_rest = rest_end(imu, o["still_window_s"], o["still_accel_std_mps2"], np.radians(o["still_gyro_std_dps"]))
     ti = imu["time"].to_numpy(float)
     if t_rest is not None and t_rest - ti[0] >= o["still_min_s"] and (t <= t_rest).any():

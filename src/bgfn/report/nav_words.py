@@ -24,8 +24,8 @@ def picked_outage_lines(picked: PickedOutages) -> list[str]:
 
 def describe_windows(profile: dict, drive, dataset: str | None = None) -> list[str]:
     """Lines for a notebook: the outages of one drive and, for a rule, what it picked and why."""
-    name = dataset if dataset is not None else drive.name
-    return window_lines(name, outage_windows(profile, drive, name), picked_outages(profile, drive, name))
+    name = dataset if dataset is not None else drive.name     # the profile's entry (an own log: its folder's path)
+    return window_lines(drive.name, outage_windows(profile, drive, name), picked_outages(profile, drive, name))
 
 
 def window_lines(name: str, windows, picked: PickedOutages | None) -> list[str]:

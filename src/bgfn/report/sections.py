@@ -107,7 +107,7 @@ def energy_section(res: ProfileResults) -> list:
                             "Energy per prediction and reduction, ours beside the paper's claim")]
     if energy:
         pieces.append(provenance(res.out / RUN_RECORDS["energy"], energy.get("metadata"), res.current,
-                                 dataset=f"`{energy.get('dataset')}`", seed=energy.get("seed"),
+                                 dataset=f"`{dataset_id(energy['dataset']) if energy.get('dataset') else None}`", seed=energy.get("seed"),
                                  time_steps=energy.get("time_steps"),
                                  checkpoints=", ".join(f"`{p}`" for p in energy.get("checkpoints", {}).values()),
                                  validation_windows=energy.get("windows", {}).get("n_windows")))

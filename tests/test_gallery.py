@@ -80,3 +80,10 @@ def test_a_walker_is_moving_at_a_walkers_pace_for_notebook_01(tmp_path):
     states = imu_levels.motion_states(walk).value_counts()
     assert states["driving"] > 0.7 * len(walk.imu) and states["still"] > 0
     assert len(imu_levels.imu_psd(walk)) > 100
+
+
+def test_a_gallery_logs_profile_names_its_folder_without_the_machine_path(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)                      # the notebooks run in the repository's root
+    log = next(g for g in G.GALLERY if not g.own)
+    text = log.profile_text(tmp_path / "results" / "p" / "gallery" / log.name)
+    assert f"results/p/gallery/{log.name}" in text and str(tmp_path) not in text

@@ -31,7 +31,7 @@ from bgfn.data.csv_drive import write_csv_drive
 from bgfn.data.csv_meta import META_FILE
 from bgfn.data.drive import Drive
 from bgfn.data.imu_errors import apply_imu_errors, error_params
-from bgfn.io import atomic_write_csv, atomic_write_text
+from bgfn.io import atomic_write_csv, atomic_write_text, shown_path
 from bgfn.nav import sim
 from bgfn.nav.transform import dcm_from_euler
 
@@ -62,11 +62,12 @@ class GalleryLog:
     own: bool = False        # a log the running profile names itself: ``base`` is that profile
 
     def profile_text(self, folder: Path) -> str:
-        """The user's ``params/<name>.yaml`` for this log in ``folder`` (absolute path); for the running profile's own
+        """The user's ``params/<name>.yaml`` for this log in ``folder`` (relative to the repository); for the running profile's own
         log only its name (the page shows no machine path)."""
         if self.own:
             return f"params/{self.base}.yaml, the profile of this run (its folder: {Path(folder).name})\n"
-        body = {"base": self.base, "datasets": [str(Path(folder).resolve())], **self.profile}
+        # relative to the repository (the notebooks' folder) where the log lies inside it: no machine path on a page
+        body = {"base": self.base, "datasets": [shown_path(Path(folder).resolve())], **self.profile}
         return yaml.safe_dump(body, sort_keys=False, default_flow_style=None, width=110)
 
 

@@ -314,3 +314,10 @@ def test_an_unfinished_profile_of_ones_own_does_not_fail_the_suite(params, monke
     subprocess.run(["git", "add", "smoke.yaml", "quick.yaml"], cwd=params, check=True)
     (params / "mine.yaml").write_text("base: smoke\ntrain: {windw: 3}\n")     # untracked, half-written
     assert "mine" not in shipped_profiles() and {"smoke", "quick"} <= set(shipped_profiles())
+
+
+def test_the_key_check_of_the_command_line_prints_its_lines_and_passes(capsys):
+    # what `make reproduce` runs first: no data, no run plan
+    from bgfn.profile_schema import main
+    assert main(["smoke", "--keys"]) == 0
+    assert "profile smoke: every key checked; independent runs" in capsys.readouterr().out

@@ -484,6 +484,7 @@ def main(argv=None) -> int:
     parser.add_argument("profile")
     parser.add_argument("--keys", action="store_true", help="only what needs no data (before the install and data)")
     args = parser.parse_args(argv)
+    plan = None
     try:
         if args.keys:
             lines = check_keys(args.profile)
@@ -493,7 +494,7 @@ def main(argv=None) -> int:
     except DataError as exc:
         print(f"error: profile {args.profile!r}: {exc}", file=sys.stderr)
         return 2
-    for line in lines + plan_lines(plan):
+    for line in lines + (plan_lines(plan) if plan is not None else []):
         print(f"    profile {args.profile}: {line}")
     return 0
 

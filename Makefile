@@ -297,7 +297,7 @@ define build_book
 	@echo "==> book from $(RES)/notebooks"
 	@rm -rf book/notebooks book/_generated book/api && mkdir -p book/notebooks book/_generated
 	@cp $(filter-out $(FLEET_EXEC),$(EXEC)) book/notebooks/   # the book's pages: 01-10 (11 stays in results/)
-	@$(PY) -m bgfn.report.book_notebooks book/notebooks/*.ipynb   # one parameters cell: the run's values
+	@$(PY) -m bgfn.report.book_notebooks --profile $(PROFILE) book/notebooks/*.ipynb   # one parameters cell: the run's values
 	@for d in tables figures; do if [ -d "$(RES)/$$d" ]; then cp -r "$(RES)/$$d" book/_generated/; fi; done
 	@find book/notebooks book/_generated -name '.*' -type f -delete   # never a temporary or hidden file
 	@if [ -f "$(RES)/findings.md" ]; then cp "$(RES)/findings.md" book/_generated/; else \
@@ -307,6 +307,8 @@ define build_book
 	  "commit \`$$(git rev-parse --short HEAD 2>/dev/null || echo unknown)\`." > book/_generated/build_info.md
 	@rm -f book/_build/.built-*
 	$(VENV_ABS)/bin/jupyter-book build book --all -W -n --keep-going
+	@# the code pages show module constants' values, some of them paths in this checkout: relative, as the notebooks'
+	@{ grep -rlF --include='*.html' '$(CURDIR)' book/_build/html 2>/dev/null || true; } | xargs -r sed -i 's|$(CURDIR)/||g; s|$(CURDIR)|.|g'
 	@touch $(BOOK_STAMP)
 	@echo "book: $(BOOK_HTML)"
 endef

@@ -603,3 +603,17 @@ def test_a_warning_in_an_executed_notebook_stops_the_book(tmp_path):
     nb["cells"][0]["outputs"] = nb["cells"][0]["outputs"][1:]
     path.write_text(json.dumps(nb))
     assert book_main([str(path)]) == 0
+
+
+def test_the_book_shows_no_machine_path(tmp_path):
+    from bgfn.config import PROJECT_ROOT
+    from bgfn.report.book_notebooks import machine_paths, without_machine_paths
+    root = str(PROJECT_ROOT.resolve())
+    log = tmp_path / "my drive log"
+    paths = {**{str(log): "my-drive-log"}, **machine_paths(None)}
+    nb = {"cells": [{"cell_type": "code", "source": "x", "outputs": [
+        {"output_type": "stream", "name": "stdout", "text": [f"{log}: outages [[1.0, 2.0]]\n"]},
+        {"output_type": "execute_result", "data": {"text/plain": f"PosixPath('{root}/results/p/figures/a.png')"}}]}]}
+    out = without_machine_paths(nb, paths)["cells"][0]["outputs"]
+    assert out[0]["text"] == ["my-drive-log: outages [[1.0, 2.0]]\n"]
+    assert out[1]["data"]["text/plain"] == "PosixPath('results/p/figures/a.png')"

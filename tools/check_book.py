@@ -216,8 +216,11 @@ def check(root: Path) -> list[str]:
             parsed[target] = _parse(target)
         return parsed[target].ids
 
+    repo = str(Path(__file__).resolve().parents[1])        # this checkout: its path is the machine's, never a page's
     for page, info in list(parsed.items()):
         rel = page.relative_to(root)
+        if repo in page.read_text(encoding="utf-8", errors="replace"):
+            problems.append(f"{rel}: shows the machine path of the repository (a page names files relative to it)")
         if info.tracebacks:
             problems.append(f"{rel}: {info.tracebacks} traceback output(s) from a failed cell")
         for kind, url, line in info.refs:

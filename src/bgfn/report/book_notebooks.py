@@ -4,8 +4,10 @@ papermill keeps a notebook's own ``parameters`` cell and inserts a copy with the
 would show both. :func:`one_parameters_cell` writes the run's values into the notebook's own cell (its comments
 kept) and drops the copy; ``make book`` applies it to the copies under ``book/notebooks/``. The same step refuses a
 notebook that printed a warning (:func:`warnings_in`): a ``RuntimeWarning`` or ``UserWarning`` there is a defect of
-ours the reader would otherwise see. ``python -m bgfn.report.book_notebooks FILE.ipynb ...`` rewrites each file in
-place, then exits 1 naming every warning found.
+ours the reader would otherwise see. No machine path reaches a page (:func:`without_machine_paths`): the
+repository's folder is cut from the outputs, and an own log's folder becomes its dataset id.
+``python -m bgfn.report.book_notebooks [--profile P] FILE.ipynb ...`` rewrites each file in place, then exits 1
+naming every warning found.
 """
 
 from __future__ import annotations
@@ -16,6 +18,9 @@ import re
 import sys
 from pathlib import Path
 
+from bgfn.config import PROJECT_ROOT, read_profile
+from bgfn.data.names import dataset_folder, dataset_id
+from bgfn.errors import DataError
 from bgfn.io import atomic_write_text
 
 #: The tags papermill reads and writes.
@@ -79,18 +84,63 @@ def warnings_in(nb: dict) -> list[str]:
     return out
 
 
-def rewrite(path: str | Path) -> None:
-    """Apply :func:`one_parameters_cell` to a notebook file in place (atomically)."""
+def machine_paths(profile: str | None) -> dict[str, str]:
+    """``{machine path: what a page shows}``: each own-log folder of ``profile`` (its ``data.datasets``) by its
+    dataset id, the repository's folder by nothing (its files by their relative paths); longest first."""
+    out: dict[str, str] = {}
+    if profile:
+        try:
+            names = read_profile(profile)["data"]["datasets"]
+        except DataError:
+            names = []
+        for name in names:
+            folder = dataset_folder(name)
+            if folder is not None:
+                for shown in {str(name), str(folder), str(folder.resolve())}:
+                    out[shown] = dataset_id(name)
+    out[str(PROJECT_ROOT.resolve()) + "/"] = ""
+    out[str(PROJECT_ROOT.resolve())] = "."
+    return dict(sorted(out.items(), key=lambda kv: -len(kv[0])))
+
+
+def without_machine_paths(nb: dict, paths: dict[str, str]) -> dict:
+    """``nb`` with every key of ``paths`` in its cells' outputs replaced by its value (:func:`machine_paths`)."""
+    def clean(value):
+        if isinstance(value, str):
+            for path, shown in paths.items():
+                value = value.replace(path, shown)
+            return value
+        if isinstance(value, list):
+            return [clean(v) for v in value]
+        if isinstance(value, dict):
+            return {k: clean(v) for k, v in value.items()}
+        return value
+
+    for cell in nb.get("cells", []):
+        if "outputs" in cell:
+            cell["outputs"] = clean(cell["outputs"])
+    return nb
+
+
+def rewrite(path: str | Path, paths: dict[str, str] | None = None) -> None:
+    """Apply :func:`one_parameters_cell` and :func:`without_machine_paths` to a notebook file in place
+    (atomically)."""
     path = Path(path)
     nb = one_parameters_cell(json.loads(path.read_text(encoding="utf-8")))
+    nb = without_machine_paths(nb, paths if paths is not None else machine_paths(None))
     atomic_write_text(path, json.dumps(nb, indent=1, ensure_ascii=False) + "\n")
 
 
 def main(paths) -> int:
     """Rewrite each notebook (:func:`rewrite`); 1 when any printed a warning (each named), else 0."""
+    paths = list(paths)
+    profile = None
+    if paths[:1] == ["--profile"] and len(paths) >= 2:
+        profile, paths = paths[1], paths[2:]
+    shown = machine_paths(profile)
     found = []
     for name in paths:
-        rewrite(name)
+        rewrite(name, shown)
         found += [f"{name}: {w}" for w in warnings_in(json.loads(Path(name).read_text(encoding="utf-8")))]
     if found:
         print("error: warnings in the executed notebooks (fix their cause; the book does not show them):\n  "

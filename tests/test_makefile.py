@@ -10,6 +10,7 @@ import subprocess
 import pytest
 
 from bgfn.config import PROJECT_ROOT
+from processes import alive
 
 MAKEFILE = PROJECT_ROOT / "Makefile"
 pytestmark = pytest.mark.skipif(shutil.which("make") is None, reason="GNU make not installed")
@@ -135,13 +136,6 @@ def test_jobs_and_the_scheduler_reach_python_as_text_never_as_make_code(tmp_path
     assert res.returncode == 0 and not (repo / "pwned").exists()
 
 
-def _alive(pid: int) -> bool:
-    """The process runs (a zombie waiting for its parent to reap it has ended)."""
-    try:
-        with open(f"/proc/{pid}/status") as f:
-            return not any(line.startswith("State:") and "Z" in line.split()[1] for line in f)
-    except OSError:
-        return False
 
 
 def _fake_run(tmp_path, papermill="exec sleep 300", keys="exit 0"):
@@ -179,9 +173,9 @@ def _gone(pid: int, timeout: float = 10.0) -> None:
     import time
 
     deadline = time.monotonic() + timeout
-    while _alive(pid) and time.monotonic() < deadline:
+    while alive(pid) and time.monotonic() < deadline:
         time.sleep(0.1)
-    assert not _alive(pid), f"process {pid} outlived its run"
+    assert not alive(pid), f"process {pid} outlived its run"
 
 
 def _wait_for(path, timeout=60.0):
@@ -205,14 +199,14 @@ def test_a_stopped_run_ends_every_process_it_started_and_releases_its_lock(tmp_p
     try:
         pids = [_wait_for(marks / "papermill.pid"), _wait_for(marks / "kernels.pid")]
         lock = repo / "results" / "smoke" / ".lock"
-        assert lock.read_text().strip() and all(_alive(p) for p in pids)
+        assert lock.read_text().strip() and all(alive(p) for p in pids)
         # Ctrl-C reaches the terminal's foreground group (make and its recipe shells); `kill` reaches make alone
         os.killpg(make.pid, signal.SIGINT) if sig == "SIGINT" else make.send_signal(signal.SIGTERM)
         make.wait(timeout=30)
         deadline = time.monotonic() + 10
-        while any(_alive(p) for p in pids) and time.monotonic() < deadline:
+        while any(alive(p) for p in pids) and time.monotonic() < deadline:
             time.sleep(0.1)
-        assert not any(_alive(p) for p in pids), make.stdout.read()
+        assert not any(alive(p) for p in pids), make.stdout.read()
         with open(lock, "a") as f:                     # the lock is free at once, and names no PID
             fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
         assert lock.read_text() == ""

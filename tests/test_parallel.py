@@ -12,6 +12,7 @@ from bgfn import learning as L, train as T
 from bgfn.errors import DataError
 from bgfn.parallel import PROGRESS_ENV, Runner, RunProgress, dispatch_order
 from bgfn.profile_schema import load_profile
+from processes import alive
 
 
 # ----------------------------------------------------------------------------------------------- settings
@@ -288,12 +289,6 @@ if __name__ == "__main__":
 """
 
 
-def _alive(pid: int) -> bool:
-    try:
-        with open(f"/proc/{pid}/status") as f:
-            return not any(line.startswith("State:") and "Z" in line.split()[1] for line in f)
-    except OSError:
-        return False
 
 
 @pytest.mark.parametrize("how", ["map", "start"])
@@ -314,18 +309,18 @@ def test_a_killed_owner_leaves_no_pool_worker_behind(tmp_path, how):
             assert time.monotonic() < deadline and owner.poll() is None, "the workers never started"
             time.sleep(0.2)
         workers = [int(p.name) for p in folder.iterdir()]
-        assert all(_alive(p) for p in workers) and owner.pid not in workers
+        assert all(alive(p) for p in workers) and owner.pid not in workers
         time.sleep(1.0)                              # the start thread (how == "start") has ended: still alive
-        assert all(_alive(p) for p in workers)
+        assert all(alive(p) for p in workers)
         owner.send_signal(signal.SIGKILL)            # as a notebook's kernel killed
         owner.wait(timeout=10)
         deadline = time.monotonic() + 10
-        while any(_alive(p) for p in workers) and time.monotonic() < deadline:
+        while any(alive(p) for p in workers) and time.monotonic() < deadline:
             time.sleep(0.1)
-        assert not any(_alive(p) for p in workers), "a pool worker outlived the process that started it"
+        assert not any(alive(p) for p in workers), "a pool worker outlived the process that started it"
     finally:
         if owner.poll() is None:
             owner.kill()
         for p in folder.iterdir():
-            if _alive(int(p.name)):
+            if alive(int(p.name)):
                 os.kill(int(p.name), signal.SIGKILL)

@@ -173,14 +173,8 @@ def available_profiles() -> list[str]:
 
 def merge_sections(base: dict, override: dict) -> dict:
     """``override`` laid over ``base``: mappings merge key by key (recursively); any other value, lists
-    included, replaces the base's. Neither argument is modified."""
-    out = copy.deepcopy(base)
-    for key, value in override.items():
-        if isinstance(value, dict) and isinstance(out.get(key), dict):
-            out[key] = merge_sections(out[key], value)
-        else:
-            out[key] = copy.deepcopy(value)
-    return out
+    included, replaces the base's. Neither argument is modified (:func:`bgfn.settings_check.merge`)."""
+    return settings_check.merge(base, override)
 
 
 #: A profile file is a page of settings: one larger than this is refused before it is parsed (a YAML parser may take

@@ -110,9 +110,6 @@ WORD_HOMES = ("report/", "__main__.py", "profile_schema.py")
 WORD_EXCEPTIONS = {
     # a progress line for the terminal or the log of a long run, not a sentence of a page
     "parallel.py:RunProgress.line",
-    # the clock offset estimated at load, quoted by the load errors of bgfn.data.csv_drive and kept in the drive's
-    # meta; its numbers and its words are to be parted (numbers in data, words in report)
-    "data/time_offset.py:OffsetEstimate.line",
 }
 
 

@@ -113,6 +113,26 @@ def test_the_rule_needs_significance_agreement_and_no_worse_along_track_error():
     assert gross.applied_s == 0.0 and gross.gross_s == 18.0 and gross.gross_method == "reference"
 
 
+
+def test_the_clock_decision_is_numbers_and_its_sentence_is_made_in_report():
+    """The drive keeps the decision's numbers and codes (meta["gnss_offset"]); report words them: the estimate as
+    found, and with gnss_latency_s: auto what was taken off and why."""
+    from bgfn.report.data_checks import clock_offset_line
+
+    lag, est = rc.Lag(0.30, 0.01, 200, 1.0, 0.2), OffsetEstimate(0.30, 0.9, 200, 0.05)
+    applied = {**decide_clock(est, lag, True, lambda s: 1.0 - s).record()}
+    assert all(not isinstance(v, str) or v in ("applied", "reference") for v in applied.values())   # no sentence
+    assert clock_offset_line(applied, "car", "car") == (
+        "car: GNSS latency 0.30 s taken off (gnss_latency_s: auto, applied); estimated: GNSS-IMU clock offset: the "
+        "fixes' stamps are +0.30 s late against the IMU's (turn rates correlate 0.90 over 200 moving fixes); "
+        "platform car")
+    typed = decide_clock(est, lag, False).record()
+    assert clock_offset_line(typed) == ("GNSS-IMU clock offset: the fixes' stamps are +0.30 s late against the "
+                                        "IMU's (turn rates correlate 0.90 over 200 moving fixes)")
+    none = decide_clock(OffsetEstimate(float("nan"), float("nan"), 10), None, False).record()
+    assert clock_offset_line(none, "walk") == ("walk: GNSS-IMU clock offset: not estimable (10 moving fixes, best "
+                                               "correlation none of the turn rates)")
+
 @pytest.mark.parametrize("auto", [False, True])
 def test_an_18_s_offset_on_gentle_turns_is_one_error_naming_the_cause(tmp_path, auto):
     """The demo log's turns are too gentle for the turn rates (not estimable): the reference check sees the 18 s."""

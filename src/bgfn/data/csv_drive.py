@@ -150,7 +150,8 @@ def _on_imu_clock(imu: pd.DataFrame, gnss: pd.DataFrame, reference: pd.DataFrame
     (:func:`bgfn.data.reference_check.reference_lag`) and taken off only when ``auto`` and the rule of
     :func:`bgfn.data.time_offset.decide_clock` holds; one error naming both files when an offset beyond
     :data:`~bgfn.data.time_offset.TOLERANCE_S` is left. A reference that is the GNSS itself says nothing of the clock.
-    Returns the fixes and the facts (``meta["gnss_offset"]``)."""
+    Returns the fixes and the facts (``meta["gnss_offset"]``: :meth:`~bgfn.data.time_offset.ClockDecision.record`
+    and ``applied_latency_s``; worded by :func:`bgfn.report.data_checks.clock_offset_line`)."""
     est = estimate_gnss_offset(imu, gnss)
     lag = None if reference_equals_gnss(reference, gnss, lever_arm_m) else \
         reference_lag(reference, gnss, lever_arm_m)
@@ -164,9 +165,7 @@ def _on_imu_clock(imu: pd.DataFrame, gnss: pd.DataFrame, reference: pd.DataFrame
                         f"(a known delay: gnss_latency_s or imu_time_offset_s in {meta_path})",
                         f"stamps {decision.gross_s:+.2f} s late ({how}){leap}")
     gnss = gnss.assign(time=gnss["time"] - decision.applied_s)
-    line = (f"GNSS latency {decision.applied_s:.2f} s taken off (gnss_latency_s: auto, {decision.status}); "
-            f"estimated: {est.line()}" if auto else est.line())
-    return gnss, {**decision.record(), "applied_latency_s": decision.applied_s, "line": line}
+    return gnss, {**decision.record(), "applied_latency_s": decision.applied_s}
 
 
 def rotate_imu(imu: pd.DataFrame, mounting_deg) -> pd.DataFrame:

@@ -72,14 +72,6 @@ class OffsetEstimate:
     def estimable(self) -> bool:
         return bool(np.isfinite(self.offset_s))
 
-    def line(self) -> str:
-        """One sentence for notebook 01."""
-        if not self.estimable:
-            return (f"GNSS-IMU clock offset: not estimable ({self.fixes} moving fixes, best correlation "
-                    f"{self.correlation:.2f} of the turn rates)")
-        return (f"GNSS-IMU clock offset: the fixes' stamps are {self.offset_s:+.2f} s late against the IMU's "
-                f"(turn rates correlate {self.correlation:.2f} over {self.fixes} moving fixes)")
-
 
 def course_rate(gnss: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
     """``(time, |course rate|)`` at the midpoints between successive fixes where the platform moves (rad/s)."""

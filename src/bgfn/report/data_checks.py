@@ -39,6 +39,28 @@ def _pm(x, s, unit: str = "s") -> str:
     return f"{x:+.2f} {unit}" + (f" +- {s:.2f} {unit}" if s is not None else "")
 
 
+def _estimate_words(offset: dict) -> str:
+    """The turn-rate estimate of a clock decision's record, as notebook 01 said it at load."""
+    corr = "none" if offset["correlation"] is None else f"{offset['correlation']:.2f}"
+    if offset["turn_rate_s"] is None:
+        return (f"GNSS-IMU clock offset: not estimable ({offset['fixes']} moving fixes, best correlation {corr} of "
+                "the turn rates)")
+    return (f"GNSS-IMU clock offset: the fixes' stamps are {offset['turn_rate_s']:+.2f} s late against the IMU's "
+            f"(turn rates correlate {corr} over {offset['fixes']} moving fixes)")
+
+
+def clock_offset_line(offset: dict, name: str | None = None, platform: str | None = None) -> str:
+    """A CSV drive's clocks as decided at load (``meta["gnss_offset"]``,
+    :meth:`bgfn.data.time_offset.ClockDecision.record`) in one sentence: the turn-rate estimate, and with
+    ``gnss_latency_s: auto`` the latency taken off and why (its status code); ``name:`` before it and ``; platform
+    <platform>`` after it when given."""
+    text = _estimate_words(offset)
+    if offset["status"] != "not_asked":                 # gnss_latency_s: auto
+        text = (f"GNSS latency {offset['applied_s']:.2f} s taken off (gnss_latency_s: auto, {offset['status']}); "
+                f"estimated: {text}")
+    return (f"{name}: " if name else "") + text + (f"; platform {platform}" if platform else "")
+
+
 def reference_lines(name: str, checks: dict) -> list[str]:
     """The checks of one drive (:func:`bgfn.data.reference_check.drive_checks`), one sentence each."""
     ref, att, clock = checks["reference"], checks["attitude"], checks["clock"]

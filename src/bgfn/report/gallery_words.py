@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from bgfn.report.data_checks import clock_offset_line
 from bgfn.report.nav_words import baseline_lines, window_lines
 from bgfn.studies.gallery.runs import GalleryRun
 
@@ -14,7 +15,7 @@ def gallery_decisions(run: GalleryRun) -> list[str]:
     filter's decisions (:func:`bgfn.report.nav_words.baseline_lines`)."""
     drive, decisions = run.drive, []
     if "gnss_offset" in drive.meta:            # the clocks (with gnss_latency_s: auto, the latency taken off)
-        decisions.append(f"{drive.name}: {drive.meta['gnss_offset']['line']}")
+        decisions.append(clock_offset_line(drive.meta["gnss_offset"], drive.name))
     mounting = drive.meta.get("imu_mounting_deg") or [0.0, 0.0, 0.0]
     if np.any(mounting):
         decisions.append(f"{drive.name}: IMU rows rotated into the body frame by the mounting "

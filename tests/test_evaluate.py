@@ -454,9 +454,13 @@ def test_real_imu_switch_falls_back_to_the_simulated_datasets(monkeypatch, tmp_p
         return acquire.Resolved(name, path, "raw" if path else "missing", None, "test")
 
     monkeypatch.setattr(acquire, "resolve", fake_resolve)
-    names, notes = ev.choose_datasets(["turin-sim-ekinox", "turin-sim-mpu6000"], real_imu=True)
+    names, choices = ev.choose_datasets(["turin-sim-ekinox", "turin-sim-mpu6000"], real_imu=True)
     assert names == ["navego-ekinox", "turin-sim-mpu6000"]
-    assert "absent" in notes[1] and "navego-mpu6000" in notes[1]
+    assert choices[0] == ev.RealImuChoice("turin-sim-ekinox", "navego-ekinox", "ekinox_imu.mat", "raw")
+    assert choices[1].origin is None and choices[1].twin == "navego-mpu6000"           # absent: the simulated one
+    assert evaluation_words.real_imu_words(choices[1]) == (
+        "mpu6000_imu.mat absent (the recorded NaveGo IMU is not available here): turin-sim-mpu6000 (simulated IMU) "
+        "stands in for navego-mpu6000")
     assert ev.choose_datasets(["turin-sim-ekinox"], real_imu=False) == (["turin-sim-ekinox"], [])
     assert paper.test_of("navego-ekinox") == "dataset" and paper.test_of("navego-mpu6000") == "field"
 
@@ -577,8 +581,9 @@ def test_evaluation_setup_applies_the_notebook_parameters_over_the_profile(monke
     monkeypatch.setattr(acquire, "resolve", lambda name, **kw: acquire.Resolved(name, None, "missing", None, "t"))
     real = ev.evaluation_setup(with_overrides(cfg, {"evaluate.real_imu": True,
                                                  "evaluate.sweep.datasets": ["turin-sim-mpu6000"]}))
-    assert real.datasets == section["datasets"] and len(real.notes) == 2 and real.sweep_notes == real.notes[1:]
-    assert [ln for ln in evaluation_words.setup_lines(real) if ln.startswith("real_imu:")] == [f"real_imu: {n}" for n in real.notes]
+    assert real.datasets == section["datasets"] and len(real.choices) == 2 and real.sweep_choices == real.choices[1:]
+    assert [ln for ln in evaluation_words.setup_lines(real) if ln.startswith("real_imu:")] == [
+        f"real_imu: {evaluation_words.real_imu_words(c)}" for c in real.choices]
 
 
 def test_reductions_beside_the_paper_and_its_quoted_claims():

@@ -12,7 +12,7 @@ Modules, in the order of the protocol: ``setup``, ``hybrid``, ``networks``, ``ta
 from bgfn.evaluate.claims import REDUCTION_COLUMNS, ours_above_paper, reduction_table
 from bgfn.evaluate.setup import (COLORS, EVALUATE_DEFAULTS, FIGURE_METHODS, METRIC_COLUMNS, REAL_IMU_DATASETS,
                                   SWEEP_COLUMNS, TABLE_COLUMNS, TABLE_FILES, TABLE_METHODS, EvaluationSetup,
-                                  choose_datasets, evaluate_config, evaluation_setup)
+                                  OwnOutages, RealImuChoice, choose_datasets, evaluate_config, evaluation_setup)
 from bgfn.evaluate.hybrid import (NavContext, OutageRun, gps_run, navigation_context, pseudo_gps_positions, run_outages,
                                   window_metrics)
 from bgfn.evaluate.networks import ensure_models, load_model
@@ -27,7 +27,7 @@ from bgfn.evaluate.tables import (TableResult, aggregate_seeds, error_reduction,
 __all__ = [
     "REDUCTION_COLUMNS", "ours_above_paper", "reduction_table", "COLORS",
     "EVALUATE_DEFAULTS", "FIGURE_METHODS", "METRIC_COLUMNS", "REAL_IMU_DATASETS", "SWEEP_COLUMNS", "TABLE_COLUMNS",
-    "TABLE_FILES", "TABLE_METHODS", "EvaluationSetup", "choose_datasets", "evaluate_config", "evaluation_setup",
+    "TABLE_FILES", "TABLE_METHODS", "EvaluationSetup", "OwnOutages", "RealImuChoice", "choose_datasets", "evaluate_config", "evaluation_setup",
     "NavContext", "OutageRun", "gps_run", "navigation_context", "pseudo_gps_positions", "run_outages",
     "window_metrics", "ensure_models", "load_model", "outage_figures", "plot_gps_row", "plot_outage",
     "plot_sweep_boxes", "RECORD_FILE", "evaluation_record", "write_evaluation_record", "TableResult",

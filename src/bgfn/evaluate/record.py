@@ -5,6 +5,7 @@ page reads it (:func:`bgfn.report.outage_datasets`: which dataset stands for whi
 
 from __future__ import annotations
 
+from dataclasses import asdict
 from pathlib import Path
 from typing import Mapping
 
@@ -40,7 +41,7 @@ def evaluation_record(setup: EvaluationSetup, results: Mapping[str, TableResult]
         ``profile``, ``evaluate`` (the configuration), ``outage_windows`` (``[[start, duration], ...]``, s: the
         profile's default list), ``outage_windows_by_dataset`` (``{dataset: [[start, duration], ...]}``: the
         windows each table was evaluated in),
-        ``datasets``, ``real_imu_notes``, ``tables`` and ``reduction_vs_ins_pct`` (keyed by the paper's test),
+        ``datasets``, ``real_imu_choices`` (:class:`~bgfn.evaluate.setup.RealImuChoice`'s fields), ``tables`` and ``reduction_vs_ins_pct`` (keyed by the paper's test),
         ``paper_claims`` (the BGFN reductions the paper quotes, %),
         ``timings_s``, ``constraints`` (per test the vehicle constraints' facts of the ``+NHC`` rows, or None).
     """
@@ -49,7 +50,7 @@ def evaluation_record(setup: EvaluationSetup, results: Mapping[str, TableResult]
         "outage_windows_by_dataset": {name: [list(w) for w in (res.windows if res.windows is not None
                                                                else setup.windows)]
                                       for name, res in results.items()},
-        "datasets": setup.datasets, "real_imu_notes": setup.notes,
+        "datasets": setup.datasets, "real_imu_choices": [asdict(c) for c in setup.choices],
         "tables": {res.test: res.table.to_dict(orient="records") for res in results.values()},
         "reduction_vs_ins_pct": {results[n].test: r.to_dict(orient="records") for n, r in reductions.items()},
         "paper_claims": paper.claims()["bgfn_reduction_vs_ins_pct"],

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 from typing import Any, Sequence
 
 from bgfn import settings
-from bgfn.data import acquire, dataset_id
+from bgfn.data import acquire
 from bgfn.errors import DataError
 from bgfn.nav import outages
 from bgfn.paper import METHOD_LABELS, TESTS, nhc_label
@@ -82,30 +82,62 @@ def evaluate_config(section: dict | None, train_section: dict | None = None) -> 
     return cfg
 
 
-def choose_datasets(datasets: Sequence[str], real_imu: bool) -> tuple[list[str], list[str]]:
+@dataclass(frozen=True)
+class RealImuChoice:
+    """What ``real_imu`` chose for one simulated dataset (:func:`choose_datasets`).
+
+    Attributes
+    ----------
+    asked : str
+        The profile's dataset (simulated IMU).
+    twin : str
+        The dataset with NaveGo's recorded IMU (:data:`REAL_IMU_DATASETS`).
+    file : str
+        The recorded IMU's file.
+    origin : str or None
+        Where the file was found (:func:`bgfn.data.acquire.resolve`); None: absent, ``asked`` stands in.
+    """
+
+    asked: str
+    twin: str
+    file: str
+    origin: str | None
+
+    @property
+    def used(self) -> str:
+        """The dataset evaluated."""
+        return self.twin if self.origin is not None else self.asked
+
+
+def choose_datasets(datasets: Sequence[str], real_imu: bool) -> tuple[list[str], list[RealImuChoice]]:
     """The datasets to evaluate: with ``real_imu`` the NaveGo recorded-IMU twin when its file is present.
 
     Returns
     -------
     names : list of str
-    notes : list of str
-        One line per dataset saying what is used and why.
+    choices : list of RealImuChoice
+        One per dataset that has a recorded-IMU twin (none without ``real_imu``).
     """
-    names, notes = [], []
+    names, choices = [], []
     for d in datasets:
         if not real_imu or d not in REAL_IMU_DATASETS:
             names.append(d)
             continue
         real, fname = REAL_IMU_DATASETS[d]
         res = acquire.resolve(fname, download=False)
-        if res.path is not None:
-            names.append(real)
-            notes.append(f"{fname} present ({res.origin}): evaluating {real} instead of {d}")
-        else:
-            names.append(d)
-            notes.append(f"{fname} absent (the recorded NaveGo IMU is not available here): {d} "
-                         f"(simulated IMU) stands in for {real}")
-    return names, notes
+        choices.append(RealImuChoice(d, real, fname, res.origin if res.path is not None else None))
+        names.append(choices[-1].used)
+    return names, choices
+
+
+@dataclass(frozen=True)
+class OwnOutages:
+    """A dataset of the tables whose outages are not the profile's default list: a ``rule`` that picks them from
+    the drive (its name), else its own ``windows`` ``[[start, duration], ...]``, s."""
+
+    dataset: str
+    rule: str | None = None
+    windows: list | None = None
 
 
 @dataclass
@@ -122,16 +154,17 @@ class EvaluationSetup:
     datasets : list of str
         Datasets of the two tables (``tab-out1-exin``, ``tab-real``), after the real-IMU choice
         (:func:`choose_datasets`).
-    notes : list of str
-        One line per table dataset on that choice (empty without ``real_imu``).
-    sweep_datasets, sweep_notes : list of str
+    choices : list of RealImuChoice
+        What ``real_imu`` chose for the table datasets (empty without it).
+    sweep_datasets : list of str
+    sweep_choices : list of RealImuChoice
         The same for the outage sweep.
     windows : list of (float, float)
         The evaluation outages ``(start, duration)``, s, of the profile's one list or ``default`` entry
         (:func:`bgfn.nav.outages.default_windows`; empty when that is a rule); each dataset's own are in its
         :class:`~bgfn.evaluate.tables.TableResult` (``windows``).
-    outage_lines : list of str
-        Per dataset of the tables whose entry differs from ``windows``: its list, or the rule that picks them.
+    own_outages : list of OwnOutages
+        The datasets of the tables whose entry differs from ``windows``: its list, or the rule that picks them.
     runner : bgfn.parallel.Runner
         Where the independent runs of the sweep and the oracle go (the profile's ``parallel:`` section).
     """
@@ -140,11 +173,11 @@ class EvaluationSetup:
     description: str
     config: dict
     datasets: list[str]
-    notes: list[str]
+    choices: list[RealImuChoice]
     sweep_datasets: list[str]
-    sweep_notes: list[str]
+    sweep_choices: list[RealImuChoice]
     windows: list = field(default_factory=list)
-    outage_lines: list = field(default_factory=list)
+    own_outages: list[OwnOutages] = field(default_factory=list)
     runner: Runner = field(default_factory=Runner)
 
 
@@ -168,15 +201,15 @@ def evaluation_setup(cfg: dict) -> EvaluationSetup:
     EvaluationSetup
     """
     ecfg = evaluate_config(cfg.get("evaluate"), cfg.get("train"))
-    names, notes = choose_datasets(ecfg["datasets"], ecfg["real_imu"])
-    sweep_names, sweep_notes = choose_datasets(ecfg["sweep"]["datasets"], ecfg["real_imu"])
+    names, choices = choose_datasets(ecfg["datasets"], ecfg["real_imu"])
+    sweep_names, sweep_choices = choose_datasets(ecfg["sweep"]["datasets"], ecfg["real_imu"])
     default = outages.default_windows(cfg) or []
-    lines = []
+    own = []
     for name in names:                     # datasets whose outages are not the default list
         entry = outages.outage_entry(cfg, name)
         if outages.is_rule(entry):
-            lines.append(f"{dataset_id(name)}: rule {entry['rule']} (picked from the drive)")
+            own.append(OwnOutages(name, rule=entry["rule"]))
         elif outages.outage_windows(cfg, dataset=name) != default:
-            lines.append(f"{dataset_id(name)}: {[list(w) for w in outages.outage_windows(cfg, dataset=name)]}")
-    return EvaluationSetup(cfg["profile"], cfg["description"], ecfg, names, notes, sweep_names,
-                           sweep_notes, default, lines, Runner.of(cfg))
+            own.append(OwnOutages(name, windows=[list(w) for w in outages.outage_windows(cfg, dataset=name)]))
+    return EvaluationSetup(cfg["profile"], cfg["description"], ecfg, names, choices, sweep_names,
+                           sweep_choices, default, own, Runner.of(cfg))

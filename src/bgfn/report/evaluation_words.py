@@ -9,11 +9,26 @@ import pandas as pd
 
 from bgfn import paper
 from bgfn.data import dataset_id
-from bgfn.evaluate.setup import METRIC_COLUMNS, REAL_IMU_DATASETS, EvaluationSetup
+from bgfn.evaluate.setup import METRIC_COLUMNS, REAL_IMU_DATASETS, EvaluationSetup, OwnOutages, RealImuChoice
 from bgfn.evaluate.tables import error_reduction
 from bgfn.paper import nhc_label
 from bgfn.stats import too_few_for_statistics
 from bgfn.report.run_words import runner_words
+
+
+def real_imu_words(choice: RealImuChoice) -> str:
+    """What ``real_imu`` chose for one dataset (:class:`~bgfn.evaluate.setup.RealImuChoice`) and why."""
+    if choice.origin is not None:
+        return f"{choice.file} present ({choice.origin}): evaluating {choice.twin} instead of {choice.asked}"
+    return (f"{choice.file} absent (the recorded NaveGo IMU is not available here): {choice.asked} (simulated IMU) "
+            f"stands in for {choice.twin}")
+
+
+def own_outages_words(own: OwnOutages) -> str:
+    """A dataset's outages that are not the default list (:class:`~bgfn.evaluate.setup.OwnOutages`)."""
+    if own.rule is not None:
+        return f"{dataset_id(own.dataset)}: rule {own.rule} (picked from the drive)"
+    return f"{dataset_id(own.dataset)}: {own.windows}"
 
 
 def setup_lines(setup: EvaluationSetup) -> list[str]:
@@ -25,7 +40,7 @@ def setup_lines(setup: EvaluationSetup) -> list[str]:
     simulated = [d for d in names if d in REAL_IMU_DATASETS]          # the only drives with simulated IMUs
     recorded = [dataset_id(d) for d in names if d not in REAL_IMU_DATASETS]
     if ecfg["real_imu"]:
-        lines += [f"real_imu: {line}" for line in dict.fromkeys(setup.notes + setup.sweep_notes)]
+        lines += [f"real_imu: {real_imu_words(c)}" for c in dict.fromkeys(setup.choices + setup.sweep_choices)]
     else:                                   # one line: which IMUs are simulated, which recorded
         kinds = ([f"real_imu: false -> simulated IMUs for {', '.join(simulated)} (set real_imu=True to use "
                   "NaveGo's recorded IMU files when present)"] if simulated else [])
@@ -34,7 +49,7 @@ def setup_lines(setup: EvaluationSetup) -> list[str]:
     lines.append(f"tables: {[dataset_id(d) for d in setup.datasets]} | methods: {ecfg['methods']} | "
                  f"seeds: {ecfg['seeds']} | seed aggregate: {ecfg['seed_aggregate']}")
     lines.append(f"outages (start, duration) s: {[list(w) for w in setup.windows]}"
-                 + "".join(f"; {line}" for line in setup.outage_lines))
+                 + "".join(f"; {own_outages_words(own)}" for own in setup.own_outages))
     lines.append(f"pseudo-GPS: {ecfg['pseudo_gps']}")
     lines.append(f"independent runs: {runner_words(setup.runner)}")
     return lines

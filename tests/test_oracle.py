@@ -251,6 +251,21 @@ def test_run_oracle_writes_its_tables_and_figure(drive, ctx, tmp_path):
     assert empty.table.empty and sweep_words.oracle_lines(empty) == []
 
 
+def test_a_drive_without_sweep_starts_is_a_record_and_report_words_it(drive):
+    """A sweep whose warm-up outlasts the drive: the oracle keeps the paper's outages and says why, as a
+    record (the plan's refusal); the sentence is made in report."""
+    ecfg = ev.evaluate_config({"sweep": {"n_starts": 3, "durations_s": [20.0], "warmup_s": 1.0e5},
+                               "oracle": _oracle([0.0, 0.5], durations=[20.0])}, {"seeds": [0]})
+    cfg = {"nav": NAV, "train": {"window": 20}, "evaluate": {}}
+    wins, no = orc.oracle_windows(cfg, drive, ecfg, [(40.0, 30.0)])
+    assert wins == [("1", 40.0, 30.0)] and isinstance(no, orc.NoSweepStarts) and no.dataset == drive.name
+    assert sweep_words.no_sweep_starts_words(no) == (f"{drive.name}: no sweep starts ({no.expected}; found "
+                                                     f"{no.found}): the paper's outages only")
+    ok = ev.evaluate_config({"sweep": {"n_starts": 3, "durations_s": [20.0], "warmup_s": 30.0},
+                             "oracle": _oracle([0.0, 0.5], durations=[20.0])}, {"seeds": [0]})
+    wins, no = orc.oracle_windows(cfg, drive, ok, [(40.0, 30.0)])
+    assert no is None and [w[0] for w in wins] == ["1"] + [orc.SWEEP_OUTAGE] * 3
+
 def test_profiles_define_the_oracle_and_its_durations_fit_the_sweep():
     for name in ("smoke", "quick", "paper"):
         cfg = load_profile(name)

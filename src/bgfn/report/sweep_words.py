@@ -8,7 +8,8 @@ import pandas as pd
 
 from bgfn.evaluate.setup import TABLE_METHODS
 from bgfn.paper import label, nhc_label
-from bgfn.studies.outage_sweep.oracle import BEYOND_GRID, CROSSED, NEVER_BELOW, SWEEP_OUTAGE, OracleResult
+from bgfn.studies.outage_sweep.oracle import (BEYOND_GRID, CROSSED, NEVER_BELOW, SWEEP_OUTAGE, NoSweepStarts,
+                                             OracleResult)
 from bgfn.studies.outage_sweep.sweep import sweep_train_config
 
 
@@ -104,7 +105,13 @@ def describe_oracle(breakeven: pd.DataFrame) -> list[str]:
     return lines
 
 
+def no_sweep_starts_words(no: NoSweepStarts) -> str:
+    """Why a drive's oracle rows are of the paper's outages only
+    (:class:`~bgfn.studies.outage_sweep.oracle.NoSweepStarts`)."""
+    return f"{no.dataset}: no sweep starts ({no.expected}; found {no.found}): the paper's outages only"
+
+
 def oracle_lines(result: OracleResult) -> list[str]:
-    """The oracle rows of notebook 06 (:class:`~bgfn.studies.outage_sweep.oracle.OracleResult`) in words: its
-    notes, then :func:`describe_oracle`."""
-    return list(result.notes) + describe_oracle(result.breakeven)
+    """The oracle rows of notebook 06 (:class:`~bgfn.studies.outage_sweep.oracle.OracleResult`) in words: the
+    drives without sweep starts, then :func:`describe_oracle`."""
+    return [no_sweep_starts_words(n) for n in result.no_sweep_starts] + describe_oracle(result.breakeven)

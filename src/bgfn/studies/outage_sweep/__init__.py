@@ -9,8 +9,8 @@ beats INS+NHC; :mod:`~bgfn.studies.outage_sweep.variant_outages` trains and eval
 """
 
 from bgfn.studies.outage_sweep.increments import AntennaTruth, increment_errors, increment_rmse
-from bgfn.studies.outage_sweep.oracle import (BREAKEVEN_COLUMNS, ORACLE_COLUMNS, OracleIncrements, OracleResult,
-                                              breakeven_table, crossing_sigma, curve_at, method_levels,
+from bgfn.studies.outage_sweep.oracle import (BREAKEVEN_COLUMNS, ORACLE_COLUMNS, NoSweepStarts, OracleIncrements,
+                                              OracleResult, breakeven_table, crossing_sigma, curve_at, method_levels,
                                               oracle_interval_table, oracle_runs, oracle_table, oracle_windows,
                                               plot_oracle, run_oracle)
 from bgfn.studies.outage_sweep.sweep import (pairs_style, profile_sweep_plan, run_sweep, run_sweeps, sweep_comparisons,
@@ -19,8 +19,8 @@ from bgfn.studies.outage_sweep.variant_outages import (NO_VARIANT, VARIANT_COLUM
                                                        load_variant_network, variant_pivot, variant_runs, variant_table)
 
 __all__ = [
-    "AntennaTruth", "increment_errors", "increment_rmse", "BREAKEVEN_COLUMNS", "ORACLE_COLUMNS", "OracleIncrements",
-    "OracleResult", "breakeven_table", "crossing_sigma", "curve_at", "method_levels",
+    "AntennaTruth", "increment_errors", "increment_rmse", "BREAKEVEN_COLUMNS", "ORACLE_COLUMNS", "NoSweepStarts",
+    "OracleIncrements", "OracleResult", "breakeven_table", "crossing_sigma", "curve_at", "method_levels",
     "oracle_interval_table", "oracle_runs", "oracle_table", "oracle_windows", "plot_oracle", "run_oracle",
     "pairs_style", "profile_sweep_plan",
     "run_sweep", "run_sweeps", "sweep_comparisons", "sweep_interval_table", "sweep_plan", "sweep_summary",

@@ -105,7 +105,18 @@ class OracleIncrements:
 
 
 # ----------------------------------------------------------------------------------------------- runs
-def oracle_windows(cfg: dict, drive, ecfg: dict, windows) -> tuple[list[tuple[str, float, float]], list[str]]:
+@dataclass(frozen=True)
+class NoSweepStarts:
+    """A drive that the sweep's plan gives no starts (:func:`oracle_windows`): its oracle rows are of the paper's
+    outages only; ``expected`` and ``found``: the plan's refusal (the :class:`bgfn.errors.DataError`'s)."""
+
+    dataset: str
+    expected: str
+    found: str
+
+
+def oracle_windows(cfg: dict, drive, ecfg: dict, windows) -> tuple[list[tuple[str, float, float]],
+                                                                   NoSweepStarts | None]:
     """The windows of one drive: the paper's outages, then the sweep's starts (its plan for this drive).
 
     Returns
@@ -113,13 +124,13 @@ def oracle_windows(cfg: dict, drive, ecfg: dict, windows) -> tuple[list[tuple[st
     windows : list of (outage, start, duration)
         ``outage`` ``"1"``, ``"2"``, ... or :data:`SWEEP_OUTAGE`; the sweep's starts with the longest oracle
         duration (the shorter ones are prefixes, as in the sweep).
-    notes : list of str
-        Why a drive has no sweep starts.
+    no_starts : NoSweepStarts or None
+        Why the drive has no sweep starts (None: it has them, or the oracle runs no duration).
     """
     out = [(str(k + 1), float(s), float(d)) for k, (s, d) in enumerate(windows)]
     sw, durations = ecfg["sweep"], ecfg["oracle"]["durations_s"]
     if not durations:
-        return out, []
+        return out, None
     if max(durations) > max(sw["durations_s"]):
         raise DataError("params evaluate.oracle", "durations_s", f"durations up to evaluate.sweep.durations_s's "
                         f"longest {max(sw['durations_s']):g} s (the sweep's starts leave room for no more)",
@@ -127,8 +138,8 @@ def oracle_windows(cfg: dict, drive, ecfg: dict, windows) -> tuple[list[tuple[st
     try:        # the sweep's own starts (a self-aligned filter starts late: none before it)
         plan = profile_sweep_plan(cfg, drive, sw)
     except DataError as exc:
-        return out, [f"{drive.name}: no sweep starts ({exc.expected}; found {exc.found}): the paper's outages only"]
-    return out + [(SWEEP_OUTAGE, float(s), float(max(durations))) for s in plan["start_s"]], []
+        return out, NoSweepStarts(drive.name, str(exc.expected), str(exc.found))
+    return out + [(SWEEP_OUTAGE, float(s), float(max(durations))) for s in plan["start_s"]], None
 
 
 def oracle_runs(ctx, windows, oracle: dict, pseudo: dict | None = None,
@@ -392,7 +403,8 @@ class OracleResult:
         ``{dataset: matplotlib Figure}``.
     timings : dict
         ``{"oracle_<dataset>_s": wall time, s}``.
-    notes : list of str
+    no_sweep_starts : list of NoSweepStarts
+        The drives whose oracle rows are of the paper's outages only, and why.
     """
 
     runs: pd.DataFrame
@@ -401,7 +413,7 @@ class OracleResult:
     breakeven: pd.DataFrame
     figures: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
-    notes: list = field(default_factory=list)
+    no_sweep_starts: list[NoSweepStarts] = field(default_factory=list)
 
 
 def plot_oracle(table: pd.DataFrame, levels: pd.DataFrame, breakeven: pd.DataFrame, dataset: str):
@@ -503,7 +515,7 @@ def run_oracle(cfg: dict, profile: str, setup, out=None, results: dict | None = 
     oc, sw = ecfg["oracle"], ecfg["sweep"]
     results = results or {}
     names = list(dict.fromkeys(list(setup.datasets) + list(setup.sweep_datasets))) if oc["sigmas_m"] else []
-    parts, levels, interval, timings, notes = [], [], {}, {}, []
+    parts, levels, interval, timings, no_starts = [], [], {}, {}, []
     for name in names:
         t0 = time.perf_counter()
         res = results.get(name)
@@ -513,7 +525,7 @@ def run_oracle(cfg: dict, profile: str, setup, out=None, results: dict | None = 
         else:
             own = outage_windows(cfg, drive, name) if cfg.get("outage_windows") else setup.windows
         wins, why = oracle_windows(cfg, drive, ecfg, own)
-        notes += why
+        no_starts += [why] if why is not None else []
         ctx = navigation_context(drive, cfg.get("nav"), [s for _, s, _ in wins])
         interval[name] = float(ctx.gnss_interval_s)
         runs = oracle_runs(ctx, wins, oc, ecfg["pseudo_gps"], runner)
@@ -527,7 +539,7 @@ def run_oracle(cfg: dict, profile: str, setup, out=None, results: dict | None = 
     lv = pd.concat(levels, ignore_index=True) if levels else pd.DataFrame(columns=list(LEVEL_COLUMNS))
     table = oracle_table(runs, interval, int(sw["n_boot"]), float(sw["level"]), int(sw["boot_seed"]))
     be = breakeven_table(table, lv)
-    result = OracleResult(runs, table, lv, be, timings=timings, notes=notes)
+    result = OracleResult(runs, table, lv, be, timings=timings, no_sweep_starts=no_starts)
     if figures:
         result.figures = {name: plot_oracle(table, lv, be, name) for name in names}
     if out is not None:

@@ -25,7 +25,7 @@ from bgfn.nav.filter import run_filter, run_outage
 from bgfn.nav.outages import OutageWindow, TablePseudoGps
 from synthetic_drive import demo_drive
 from bgfn.profile_schema import with_overrides
-from bgfn.report import evaluation_words, sweep_words
+from bgfn.report import evaluation_words, ins_fidelity_words, sweep_words
 
 WINDOWS = [(60.0, 20.0), (110.0, 20.0)]
 NAV = {"init": {"position_std_m": 1.0, "height_std_m": 2.0, "velocity_std_mps": 0.1, "level_std_deg": 0.2,
@@ -515,6 +515,10 @@ def test_innovation_gate_reaches_the_gps_aided_runs(drive5):
     assert table["innovation_gate"].tolist() == ["none", "0.999"]
     assert table.loc[0, "gnss_rejected"] == 0 and table.loc[1, "gnss_rejected"] >= 1
     assert table.loc[1, "max_h_m"] < 0.5 * table.loc[0, "max_h_m"]    # the jump no longer pulls the solution
+    (line,) = ins_fidelity_words.gate_lines(table)                  # notebook 08's sentence, from report
+    assert line == (f"{drive5.name}: the gate (0.999) rejects {table.loc[1, 'gnss_rejected']} of "
+                    f"{table.loc[1, 'gnss_fixes']} fixes; horizontal RMS {table.loc[0, 'rms_h_m']:.2f} -> "
+                    f"{table.loc[1, 'rms_h_m']:.2f} m, max {table.loc[0, 'max_h_m']:.2f} -> {table.loc[1, 'max_h_m']:.2f} m")
     # notebook 02's own run is reused for the setting it was made with, giving the same table
     reused = baseline.gate_comparison(jumped, cfg, WINDOWS, 0.999, baseline=baseline.run_baseline(jumped, cfg, WINDOWS))
     pd.testing.assert_frame_equal(reused, table)

@@ -104,6 +104,19 @@ def twin_lines(table: pd.DataFrame | None, tolerance: float = 1.25) -> list[str]
              f"{implied_setting(table):.3g} deg/s (evaluate.imu_twin.settle_setting).")]
 
 
+def gate_lines(table: pd.DataFrame) -> list[str]:
+    """One sentence per drive of :func:`bgfn.nav.baseline.gate_comparison`'s table (its first row without the gate,
+    its second with it): the fixes the gate rejects, and the GPS-aided horizontal RMS and max error without and
+    with it."""
+    lines = []
+    for name, g in table.groupby("dataset", sort=False):
+        off, on = g.iloc[0], g.iloc[1]
+        lines.append(f"{name}: the gate ({on['innovation_gate']}) rejects {on['gnss_rejected']} of {on['gnss_fixes']} "
+                     f"fixes; horizontal RMS {off['rms_h_m']:.2f} -> {on['rms_h_m']:.2f} m, max "
+                     f"{off['max_h_m']:.2f} -> {on['max_h_m']:.2f} m")
+    return lines
+
+
 def _share(pct: float) -> str:
     if not np.isfinite(pct):
         return "there is no gap to explain"

@@ -28,6 +28,7 @@ from bgfn.data.registry import DATASETS
 from bgfn.errors import DataError
 from bgfn.io import atomic_write_text
 from bgfn.report.run_plan import plan_lines
+from bgfn.report.run_words import runner_words
 from bgfn.evaluate import evaluate_config
 from bgfn.studies.outage_sweep.sweep import sweep_plan
 from bgfn.learning import learning_options
@@ -35,7 +36,7 @@ from bgfn.nav.baseline import filter_start
 from bgfn.nav.outages import check_windows, is_rule, outage_entry, picked_outages, snap_windows
 from bgfn.models import MODELS
 from bgfn.paper import METHOD_LABELS
-from bgfn.parallel import JOBS_PER_CORE, SCHEDULER_ENV, Runner, machine_cores
+from bgfn.parallel import SCHEDULER_ENV, Runner
 from bgfn.run_plan import RunPlan, fingerprint, make_plan, plan_json, plan_path, read_plan
 from bgfn.settings import MAX_COUNT, Data, Train
 from bgfn.settings_check import ProfileError, check_model, complete, fmt, merge
@@ -361,11 +362,7 @@ def check_keys(profile: str) -> list[str]:
         Naming the profile's file and key, or the environment variable.
     """
     cfg = load_profile(profile, planned=False)        # the plan is remade by the check with the drives
-    runner = Runner.of(cfg)
-    where = (f"on the Dask cluster at {runner.scheduler}" if runner.backend == "dask" else
-             f"{runner.jobs} processes on this machine" + (f" ({runner.asked} asked: at most {JOBS_PER_CORE} per "
-                                                          f"core of the {machine_cores()} here)" if runner.asked else ""))
-    return [f"every key checked; independent runs {where}"]
+    return [f"every key checked; independent runs {runner_words(Runner.of(cfg))}"]
 
 
 def _typed(profile: str, key: str) -> bool:
@@ -395,7 +392,8 @@ def check_and_plan(profile: str) -> tuple[list[str], RunPlan]:
     Returns
     -------
     list of str
-        One line per dataset, what was checked.
+        One line per dataset, what was checked (the keys' line is :func:`check_keys`'s, which ``make`` prints
+        first: its checks run here again, its line is not repeated).
     RunPlan
         The plan (``main`` writes it to ``results/<profile>/run_plan.json``).
 
@@ -404,7 +402,8 @@ def check_and_plan(profile: str) -> tuple[list[str], RunPlan]:
     bgfn.errors.DataError
         Naming the profile's file and the key.
     """
-    lines = check_keys(profile)
+    check_keys(profile)
+    lines: list[str] = []
     raw = load_profile(profile, planned=False)
     path = profile_chain(profile)[0]
     loaded: dict = {}

@@ -62,9 +62,14 @@ def test_energy_totals_by_hand():
     frame = t.frame(66.3)
     assert frame.loc["energy reduction vs Transformer (%)"].tolist() == pytest.approx([t.reduction_pct, 66.3])
     assert frame["paper"].isna().sum() == 3                        # the paper gives only the reduction
-    lines = energy_words.totals_lines(t)
+    lines = energy_words.totals_lines(t, 64)
     assert "110 MACs + 40 SOPs" in lines[0] and "84.6 %" in lines[0]
-    assert "72.7 % of the twin's" in lines[1] and "7.7 % of BGFN's" in lines[1] and lines[1].endswith("20.0 %")
+    assert "72.7 % of the twin's" in lines[1] and "7.7 % of BGFN's" in lines[1]
+    # one trained network measured: each line says so (its windows enough, its seed alone)
+    assert all(ln.endswith(" (one seed, 64 windows: no spread between training seeds)") for ln in lines)
+    assert lines[1].endswith("20.0 % (one seed, 64 windows: no spread between training seeds)")
+    assert energy_words.totals_lines(t, 3)[1].endswith("20.0 % (one seed, 3 windows: no statistics)")
+    assert energy_words.totals_lines(t, 64, n_seeds=3)[1].endswith("20.0 %")          # enough of both: nothing
 
 
 def test_stacked_tables_are_checked_and_show_the_input_trains():
@@ -196,6 +201,7 @@ def test_energy_summary_has_what_the_results_page_reads():
     assert s["reduction_pct"] == totals.reduction_pct and s["reduction_pct_without_attention"] == pytest.approx(20.0)
     json.dumps(s)                                                  # writable as JSON
     md = energy_words.result_markdown(s)
+    assert md.startswith("**Result (smoke profile, d, seed 1; one seed, 3 windows: no statistics):** ")
     assert "BGFN 0.00026 µJ vs Transformer twin 0.0011 µJ" in md and "**76.4 % less energy** (paper: 66.3 %)" in md
     assert "takes 73 % of its energy" in md and "the reduction is 20.0 %" in md and md.endswith("it is 50.0 %.")
     assert s["improved"] == {"bgfn": True, "transformer": True}                  # the twin's card says nothing

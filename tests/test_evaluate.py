@@ -562,6 +562,23 @@ def _table_result(dataset="turin-sim-ekinox", bgfn=(2.0, 4.0), seeds=(0,)):
     return ev.TableResult(dataset, paper.test_of(dataset), pd.DataFrame(runs), pd.DataFrame(rows), [], {})
 
 
+def test_the_per_outage_lines_say_how_many_seeds_and_windows_they_rest_on():
+    """Notebook 04's sentence of each outage names the networks' seeds and the table's outages when too few for
+    statistics (report.sample_words.sample_clause); with the runs not kept nothing is claimed of them."""
+    def with_gps(res):
+        gps = pd.DataFrame([{"outage": o, "method": "GPS", "max_east_m": 1.0, "max_north_m": 1.0, "rmse_h_m": 0.5,
+                             "final_h_m": 0.5} for o in (1, 2)])
+        res.table = pd.concat([res.table, gps], ignore_index=True)
+        return res
+    one = evaluation_words.describe_tables([with_gps(_table_result())])
+    assert [ln.split("): ")[0] for ln in one] == [
+        f"turin-sim-ekinox (dataset test), outage {o} (one seed, 2 windows: no statistics" for o in (1, 2)]
+    three = evaluation_words.describe_tables([with_gps(_table_result(seeds=(0, 1, 2)))])
+    assert three[0].startswith("turin-sim-ekinox (dataset test), outage 1 (3 seeds, 2 windows: no statistics): ")
+    kept_not = with_gps(_table_result())
+    kept_not.per_seed = pd.DataFrame()
+    assert evaluation_words.describe_tables([kept_not])[0].startswith("turin-sim-ekinox (dataset test), outage 1: ")
+
 def test_evaluation_setup_applies_the_notebook_parameters_over_the_profile(monkeypatch):
     from bgfn.data import acquire
     from bgfn.nav.outages import outage_windows

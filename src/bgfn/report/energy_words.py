@@ -6,6 +6,7 @@ from __future__ import annotations
 from bgfn.energy.checkpoint import EvaluationWindows, MeasuredModels
 from bgfn.energy.crosscheck import Crosscheck
 from bgfn.energy.tables import SPEED_KEYS, EnergyTotals
+from bgfn.report.sample_words import sample_clause
 
 
 def measured_lines(measured: MeasuredModels) -> list[str]:
@@ -25,14 +26,23 @@ def windows_line(windows: EvaluationWindows, dataset: str, time_steps: int) -> s
             f"week); T_s = {time_steps}")
 
 
-def totals_lines(totals: EnergyTotals) -> list[str]:
+def _sample(n_windows: int, n_seeds: int = 1) -> str:
+    """The energy is measured on one trained network (one seed) over ``n_windows`` validation windows:
+    :func:`bgfn.report.sample_words.sample_clause` in parentheses, a space before it."""
+    clause = sample_clause(n_seeds, n_windows)
+    return f" ({clause})" if clause else ""
+
+
+def totals_lines(totals: EnergyTotals, n_windows: int, n_seeds: int = 1) -> list[str]:
     """Where BGFN's energy goes, and how much of the gap the attention products make
-    (:class:`~bgfn.energy.tables.EnergyTotals`)."""
+    (:class:`~bgfn.energy.tables.EnergyTotals`), each line saying that it rests on ``n_seeds`` trained networks
+    (one: the checkpoint measured) and ``n_windows`` windows when too few for statistics."""
+    sample = _sample(n_windows, n_seeds)
     return [f"BGFN: {totals.macs:,.0f} MACs + {totals.sops:,.0f} SOPs; "
-            f"the MAC layers (encoder, readout) take {100 * totals.mac_share:.1f} % of its energy",
+            f"the MAC layers (encoder, readout) take {100 * totals.mac_share:.1f} % of its energy{sample}",
             f"attention products: {100 * totals.attention_uj['transformer'] / totals.twin_uj:.1f} % of the twin's "
             f"energy, {100 * totals.attention_uj['bgfn'] / totals.bgfn_uj:.1f} % of BGFN's; reduction without "
-            f"them in both models: {totals.reduction_without_attention_pct:.1f} %"]
+            f"them in both models: {totals.reduction_without_attention_pct:.1f} %{sample}"]
 
 
 def break_even_note(rate: float) -> str:
@@ -65,16 +75,20 @@ def speed_notes(bench: dict, path: str = "results/bench.json") -> list[str]:
 
 
 def result_markdown(summary: dict) -> str:
-    """The result of notebook 05 in one paragraph (Markdown), from :func:`energy_summary`'s dict."""
+    """The result of notebook 05 in one paragraph (Markdown), from :func:`energy_summary`'s dict; its lead says
+    that it rests on one trained network (and too few windows, when so)."""
     s = summary
     e, attn = s["energy_uj_per_prediction"], s["attention_energy_uj"]
+    n_windows = (s.get("windows") or {}).get("n_windows")
+    clause = sample_clause(1, int(n_windows)) if n_windows else ""          # one network measured
+    lead = f"**Result ({s['profile']} profile, {s['dataset']}, seed {s['seed']}{'; ' + clause if clause else ''}):**"
     if not (s.get("improved") or {}).get("bgfn", True):
-        return (f"**Result ({s['profile']} profile, {s['dataset']}, seed {s['seed']}):** BGFN did not train (its best "
+        return (f"{lead} BGFN did not train (its best "
                 f"epoch is 0: training never improved on its initial network), so its firing rates are an untrained "
                 f"network's and no energy saving against the Transformer twin is claimed (BGFN {e['bgfn']:.4g} µJ, "
                 f"twin {e['transformer']:.4g} µJ per prediction; paper: {s['paper_reduction_pct']} % less).")
     return (
-        f"**Result ({s['profile']} profile, {s['dataset']}, seed {s['seed']}):** BGFN {e['bgfn']:.4g} µJ vs "
+        f"{lead} BGFN {e['bgfn']:.4g} µJ vs "
         f"Transformer twin {e['transformer']:.4g} µJ per prediction: **{s['reduction_pct']:.1f} % less energy** "
         f"(paper: {s['paper_reduction_pct']} %), at a mean input firing rate of {s['mean_input_firing_rate']:.3f} "
         f"(break-even {s['break_even_firing_rate']:.3f}). The twin's softmax attention (2N²D MACs per block) "

@@ -12,8 +12,8 @@ from bgfn.data import dataset_id
 from bgfn.evaluate.setup import METRIC_COLUMNS, REAL_IMU_DATASETS, EvaluationSetup, OwnOutages, RealImuChoice
 from bgfn.evaluate.tables import error_reduction
 from bgfn.paper import nhc_label
-from bgfn.stats import too_few_for_statistics
 from bgfn.report.run_words import runner_words
+from bgfn.report.sample_words import sample_clause
 
 
 def real_imu_words(choice: RealImuChoice) -> str:
@@ -55,17 +55,37 @@ def setup_lines(setup: EvaluationSetup) -> list[str]:
     return lines
 
 
+def _network_seeds(result, outage, methods) -> int:
+    """The training seeds of the networks ``methods`` in one outage of a table (``per_seed``; 0: runs not kept)."""
+    per = result.per_seed
+    if not {"outage", "method", "seed"} <= set(per.columns):
+        return 0
+    sel = per[(per["outage"] == outage) & per["method"].isin(list(methods))]
+    return int(sel.groupby("method")["seed"].nunique().max()) if len(sel) else 0
+
+
+def _sample_note(n_seeds: int, n_windows: int) -> str:
+    """:func:`bgfn.report.sample_words.sample_clause` in parentheses with a space before it; empty when the sample
+    is large enough or its seeds unknown (the runs were not kept)."""
+    clause = sample_clause(n_seeds, n_windows) if n_seeds > 0 else ""
+    return f" ({clause})" if clause else ""
+
+
 def describe_tables(results) -> list[str]:
-    """Plain-language lines on the outage tables (what beats what), computed from the numbers."""
+    """Plain-language lines on the outage tables (what beats what), computed from the numbers; a line on networks
+    says how many training seeds and windows (the table's outages) it rests on when too few for statistics
+    (:func:`bgfn.report.sample_words.sample_clause`)."""
     lines = []
     for r in results:
         red = error_reduction(r.table).set_index(["outage", "method"])
+        n_windows = int(r.table["outage"].nunique())
         for o, g in r.table.groupby("outage"):
             g = g.set_index("method")
             score = (g["max_east_m"] + g["max_north_m"]) / 2.0
             learned = [m for m in ("MLP", "AT-LSTM", "BGFN", "Transformer") if m in g.index]
             best = min(learned, key=lambda m: score[m]) if learned else None
-            txt = (f"{r.dataset} ({r.test} test), outage {o}: max east/north error INS "
+            sample = _sample_note(_network_seeds(r, o, learned), n_windows) if learned else ""
+            txt = (f"{r.dataset} ({r.test} test), outage {o}{sample}: max east/north error INS "
                    f"{g.loc['INS', 'max_east_m']:.1f}/{g.loc['INS', 'max_north_m']:.1f} m, GPS "
                    f"{g.loc['GPS', 'max_east_m']:.1f}/{g.loc['GPS', 'max_north_m']:.1f} m")
             if "BGFN" in g.index:
@@ -112,9 +132,9 @@ def claim_lines(reductions: Mapping[str, pd.DataFrame]) -> list[str]:
     -------
     list of str
         ``BGFN vs INS, <test title>, outage <k>: paper quotes E % east / N % north; ours ...`` (``not
-        evaluated`` when no dataset of that test, or no BGFN row, was run), ended by ``(n seed(s), m window(s):
-        no statistics)`` when ours rests on one seed or fewer than :data:`bgfn.stats.MIN_WINDOWS` windows (the
-        table's ``n_seeds``, ``n_windows``); the quotes are of the paper's own tests, so a test it has no table of
+        evaluated`` when no dataset of that test, or no BGFN row, was run), ended by
+        :func:`bgfn.report.sample_words.sample_clause` in parentheses when ours rests on one seed or fewer than
+        :data:`bgfn.stats.MIN_WINDOWS` windows (the table's ``n_seeds``, ``n_windows``); the quotes are of the paper's own tests, so a test it has no table of
         (the real drive) gets no line.
     """
     claims = paper.claims()
@@ -134,10 +154,7 @@ def claim_lines(reductions: Mapping[str, pd.DataFrame]) -> list[str]:
             got = (f"ours {row['east_%'].item():.1f} % east / {row['north_%'].item():.1f} % north"
                    if row is not None and len(row) else "not evaluated")
             if row is not None and len(row) and {"n_seeds", "n_windows"} <= set(row.columns):
-                seeds, windows = int(row["n_seeds"].item()), int(row["n_windows"].item())
-                if seeds > 0 and too_few_for_statistics(seeds, windows):
-                    got += (f" ({'one seed' if seeds == 1 else f'{seeds} seeds'}, "
-                            f"{'one window' if windows == 1 else f'{windows} windows'}: no statistics)")
+                got += _sample_note(int(row["n_seeds"].item()), int(row["n_windows"].item()))
             lines.append(f"BGFN vs INS, {spec['title']}, outage {outage}: paper quotes {stated['east']} % east / "
                          f"{stated['north']} % north; {got}")
     return lines

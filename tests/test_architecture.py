@@ -103,7 +103,11 @@ def test_imports_inside_functions_are_the_few_optional_ones():
 
 
 #: Names that make sentences, labels or a page's prose: below ``report/`` a module returns numbers, tables and codes.
-WORD_FUNCTION = re.compile(r"^(lines?|sentences?|describe\w*|\w+_lines|\w+_sentences?|\w+_words|\w+_markdown)$")
+WORD_FUNCTION = re.compile(r"^(lines?|notes?|sentences?|describe\w*|\w+_lines?|\w+_notes?|\w+_sentences?|\w+_words"
+                           r"|\w+_markdown)$")
+#: Names of a field or a dict key that holds sentences (a result's ``notes``, a drive's ``meta["line"]``): the
+#: words would be made where the value is filled. (A bare ``note`` is a user's own text, kept as a column.)
+WORD_FIELD = re.compile(r"^(lines?|notes|sentences?|\w+_lines?|\w+_notes|\w+_sentences?|\w+_words|\w+_markdown)$")
 #: The edge may word its own messages (the command line, the profile check); ``report/`` words everything else.
 WORD_HOMES = ("report/", "__main__.py", "profile_schema.py")
 #: Word-making functions allowed below ``report/``, each with why.
@@ -114,23 +118,31 @@ WORD_EXCEPTIONS = {
 
 
 def word_makers(package: Path) -> list[str]:
-    """``<module path>:<function>`` / ``<module path>:<class>.<method>`` named like a word-making function
-    (:data:`WORD_FUNCTION`), and ``<module path>:<NAME>`` of a module-level ``*_WORDS`` constant, in every module
-    under ``package`` outside :data:`WORD_HOMES`."""
+    """Every place below ``report/`` (modules under ``package`` outside :data:`WORD_HOMES`) that makes words:
+    ``<module path>:<function>`` / ``<module path>:<class>.<method>`` named like a word-making function
+    (:data:`WORD_FUNCTION`); ``<module path>:<NAME>`` of a module-level ``*_WORDS`` constant;
+    ``<module path>:<class>.<field>`` of a class's annotated field and ``<module path>:[<key>]`` of a dict
+    literal's key named like words (:data:`WORD_FIELD`)."""
     found = []
     for path in sorted(package.rglob("*.py")):
         rel = path.relative_to(package).as_posix()
         if rel.startswith(WORD_HOMES):
             continue
-        for node in ast.parse(path.read_text(encoding="utf-8")).body:
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for node in tree.body:
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and WORD_FUNCTION.match(node.name):
                 found.append(f"{rel}:{node.name}")
             elif isinstance(node, ast.ClassDef):
                 found += [f"{rel}:{node.name}.{m.name}" for m in node.body
                           if isinstance(m, (ast.FunctionDef, ast.AsyncFunctionDef)) and WORD_FUNCTION.match(m.name)]
+                found += [f"{rel}:{node.name}.{m.target.id}" for m in node.body
+                          if isinstance(m, ast.AnnAssign) and isinstance(m.target, ast.Name)
+                          and WORD_FIELD.match(m.target.id)]
             elif isinstance(node, (ast.Assign, ast.AnnAssign)):
                 targets = node.targets if isinstance(node, ast.Assign) else [node.target]
                 found += [f"{rel}:{t.id}" for t in targets if isinstance(t, ast.Name) and t.id.endswith("_WORDS")]
+        found += [f"{rel}:[{k.value!r}]" for d in ast.walk(tree) if isinstance(d, ast.Dict) for k in d.keys
+                  if isinstance(k, ast.Constant) and isinstance(k.value, str) and WORD_FIELD.match(k.value)]
     return found
 
 
@@ -146,6 +158,13 @@ def test_sentences_are_made_in_report_only():
     ("studies/gallery/planted.py", "def decision_words(code):\n    return code\n",
      "studies/gallery/planted.py:decision_words"),
     ("energy/planted.py", "PLANTED_WORDS: dict = {'a': 'an a'}\n", "energy/planted.py:PLANTED_WORDS"),
+    # a result's field of sentences, filled where the numbers are made
+    ("studies/outage_sweep/planted.py", "class Result:\n    table: object\n    notes: list\n",
+     "studies/outage_sweep/planted.py:Result.notes"),
+    # a sentence kept in a record (a drive's meta) under a key
+    ("data/planted.py", "def meta(x):\n    return {'offset_s': x, 'line': f'{x} s late'}\n",
+     "data/planted.py:['line']"),
+    ("evaluate/planted.py", "def gate_line(x):\n    return str(x)\n", "evaluate/planted.py:gate_line"),
 ])
 def test_the_word_check_finds_a_planted_word_maker(tmp_path, where, body, name):
     package = _copy(tmp_path) / "bgfn"

@@ -516,9 +516,10 @@ def test_innovation_gate_reaches_the_gps_aided_runs(drive5):
     assert table.loc[0, "gnss_rejected"] == 0 and table.loc[1, "gnss_rejected"] >= 1
     assert table.loc[1, "max_h_m"] < 0.5 * table.loc[0, "max_h_m"]    # the jump no longer pulls the solution
     (line,) = ins_fidelity_words.gate_lines(table)                  # notebook 08's sentence, from report
-    assert line == (f"{drive5.name}: the gate (0.999) rejects {table.loc[1, 'gnss_rejected']} of "
-                    f"{table.loc[1, 'gnss_fixes']} fixes; horizontal RMS {table.loc[0, 'rms_h_m']:.2f} -> "
-                    f"{table.loc[1, 'rms_h_m']:.2f} m, max {table.loc[0, 'max_h_m']:.2f} -> {table.loc[1, 'max_h_m']:.2f} m")
+    off, on = table.iloc[0], table.iloc[1]
+    assert line == (f"{drive5.name}: the gate (0.999) rejects {on['gnss_rejected']} of {on['gnss_fixes']} fixes; "
+                    f"horizontal RMS {off['rms_h_m']:.2f} -> {on['rms_h_m']:.2f} m, max {off['max_h_m']:.2f} -> "
+                    f"{on['max_h_m']:.2f} m")
     # notebook 02's own run is reused for the setting it was made with, giving the same table
     reused = baseline.gate_comparison(jumped, cfg, WINDOWS, 0.999, baseline=baseline.run_baseline(jumped, cfg, WINDOWS))
     pd.testing.assert_frame_equal(reused, table)

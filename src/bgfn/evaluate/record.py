@@ -41,7 +41,8 @@ def evaluation_record(setup: EvaluationSetup, results: Mapping[str, TableResult]
         ``profile``, ``evaluate`` (the configuration), ``outage_windows`` (``[[start, duration], ...]``, s: the
         profile's default list), ``outage_windows_by_dataset`` (``{dataset: [[start, duration], ...]}``: the
         windows each table was evaluated in),
-        ``datasets``, ``real_imu_choices`` (:class:`~bgfn.evaluate.setup.RealImuChoice`'s fields), ``tables`` and ``reduction_vs_ins_pct`` (keyed by the paper's test),
+        ``datasets``, ``real_imu_choices`` (:class:`~bgfn.evaluate.setup.RealImuChoice`'s fields), ``tables``
+        and ``reduction_vs_ins_pct`` (keyed by the paper's test),
         ``paper_claims`` (the BGFN reductions the paper quotes, %),
         ``timings_s``, ``constraints`` (per test the vehicle constraints' facts of the ``+NHC`` rows, or None).
     """

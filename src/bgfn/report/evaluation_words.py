@@ -134,8 +134,8 @@ def claim_lines(reductions: Mapping[str, pd.DataFrame]) -> list[str]:
         ``BGFN vs INS, <test title>, outage <k>: paper quotes E % east / N % north; ours ...`` (``not
         evaluated`` when no dataset of that test, or no BGFN row, was run), ended by
         :func:`bgfn.report.sample_words.sample_clause` in parentheses when ours rests on one seed or fewer than
-        :data:`bgfn.stats.MIN_WINDOWS` windows (the table's ``n_seeds``, ``n_windows``); the quotes are of the paper's own tests, so a test it has no table of
-        (the real drive) gets no line.
+        :data:`bgfn.stats.MIN_WINDOWS` windows (the table's ``n_seeds``, ``n_windows``); the quotes are of the
+        paper's own tests, so a test it has no table of (the real drive) gets no line.
     """
     claims = paper.claims()
     by_test: dict[str, pd.DataFrame] = {}

@@ -1,0 +1,53 @@
+"""What moved each drive, as the run recorded it, and the tables written with the aids that ran on it.
+
+Notebook 02 records each drive's platform with its constraints (``kf_baseline.json``); a table of the ``+NHC``
+rows is written with the label of the aids that ran there (:func:`bgfn.paper.ran_labels`: ``INS+ZUPT`` for a
+walker), while the code keys the rows ``+NHC`` throughout and reads the tables back so
+(:func:`bgfn.paper.key_labels`).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pandas as pd
+
+from bgfn.config import RUN_RECORDS
+from bgfn.data.names import dataset_id
+from bgfn.io import atomic_write_csv
+from bgfn.nav.constraints import DEFAULT_PLATFORM, PLATFORM_AIDS, platform_aids
+from bgfn.paper import ran_labels
+
+
+def recorded_platforms(out: str | Path) -> dict[str, str]:
+    """``{dataset id: platform}`` of the drives notebook 02 ran (``kf_baseline.json`` under ``out``, ``results/<p>``);
+    empty before it ran."""
+    path = Path(out) / RUN_RECORDS["kf_baseline"]
+    record = json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
+    return {dataset_id(name): str(((facts or {}).get("constraints") or {}).get("platform", DEFAULT_PLATFORM))
+            for name, facts in (record.get("datasets") or {}).items()}
+
+
+def recorded_platform(out: str | Path, dataset: str) -> str:
+    """The platform of ``dataset`` as notebook 02 recorded it; ``car`` when it says nothing."""
+    return recorded_platforms(out).get(dataset_id(dataset), DEFAULT_PLATFORM)
+
+
+def platform_aid_names(platform: str) -> tuple[str, ...]:
+    """The aids ``platform`` takes (a platform not known reads as the default's)."""
+    return platform_aids(platform if platform in PLATFORM_AIDS else DEFAULT_PLATFORM)
+
+
+def write_ran_table(path: str | Path, frame: pd.DataFrame, out: str | Path, **kwargs) -> Path:
+    """Write ``frame`` (rows of several drives, a ``dataset`` column) to ``path`` with each row's ``+NHC`` label
+    named by the aids that ran on its drive (:func:`recorded_platforms` of ``out``); a car's table byte for byte as
+    before."""
+    platforms = recorded_platforms(out)
+    aids = {d: platform_aid_names(platforms.get(dataset_id(d), DEFAULT_PLATFORM))
+            for d in (frame["dataset"].unique() if "dataset" in frame.columns else ())}
+    table = ran_labels(frame, aids.__getitem__) if aids else frame
+    return atomic_write_csv(path, table, **kwargs)
+
+
+__all__ = ["platform_aid_names", "recorded_platform", "recorded_platforms", "write_ran_table"]

@@ -45,8 +45,9 @@ def write_ran_table(path: str | Path, frame: pd.DataFrame, out: str | Path, **kw
     before."""
     platforms = recorded_platforms(out)
     aids = {d: platform_aid_names(platforms.get(dataset_id(d), DEFAULT_PLATFORM))
-            for d in (frame["dataset"].unique() if "dataset" in frame.columns else ())}
-    table = ran_labels(frame, aids.__getitem__) if aids else frame
+            for d in (frame["dataset"].unique() if "dataset" in frame.columns else ()) if isinstance(d, str)}
+    default = platform_aid_names(DEFAULT_PLATFORM)          # a row of no drive (none so far) as a car's
+    table = ran_labels(frame, lambda d: aids.get(d, default)) if aids else frame
     return atomic_write_csv(path, table, **kwargs)
 
 

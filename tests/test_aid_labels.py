@@ -92,3 +92,22 @@ def test_a_walkers_baseline_tables_say_zupt_where_no_nhc_ran(walk_baseline, tmp_
     assert "INS+ZUPT_east_m" in pd.read_csv(tables / "kf_outage_max_errors_walk.csv").columns
     metrics = read_csv(tables / "kf_outage_metrics_walk.csv")
     assert list(metrics["method"]) == list(b.outage_table["method"])   # read back with the code's keys
+
+
+def test_the_results_pages_sweep_table_names_a_walkers_rows_by_its_zupt(tmp_path):
+    from types import SimpleNamespace
+
+    from bgfn.config import SHARED_TABLES
+    from bgfn.report.sections import sweep_section
+
+    out = tmp_path / "results"
+    (out / "tables").mkdir(parents=True)
+    (out / RUN_RECORDS["kf_baseline"]).write_text(json.dumps(
+        {"datasets": {"walk": {"constraints": {"platform": "walker"}}, "car": {"constraints": {"platform": "car"}}}}))
+    summary = pd.DataFrame([{"dataset": d, "duration_s": 10.0, "method": m, "n": 4, "n_starts": 4, "median_m": 5.0,
+                             "ci_lo_m": 4.0, "ci_hi_m": 6.0} for d in ("walk", "car") for m in ("INS", "INS+NHC")])
+    path = write_ran_table(out / "tables" / SHARED_TABLES["sweep_summary"], summary, out, float_format="%.4f")
+    res = SimpleNamespace(profile="p", out=out, sweep=read_csv(path), sweep_pairs=None, evaluation=None,
+                          sweep_record=None, current={}, table=lambda name: out / "tables" / name)
+    shown = sweep_section(res)[0].data                                   # the table the page styles
+    assert sorted(shown.index) == [("car", "INS"), ("car", "INS+NHC"), ("walk", "INS"), ("walk", "INS+ZUPT")]

@@ -327,6 +327,9 @@ def test_an_alias_bomb_is_one_early_error_naming_the_file(params, tmp_path):
     path.write_text("profile: mine\nbase: smoke\ndescription: &d [1, *d]\n")
     with pytest.raises(DataError, match="contains itself through an alias"):
         load_profile("mine")
+    path.write_text("profile: mine\nbase: smoke\ndescription: " + "[" * 100_000)       # 100 kB of nesting
+    with pytest.raises(DataError, match="a nesting too deep to parse"):
+        load_profile("mine")
     # a log's meta.yaml, the other settings file a user writes, likewise
     meta = tmp_path / "log" / "meta.yaml"
     meta.parent.mkdir()

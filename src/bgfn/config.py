@@ -230,7 +230,8 @@ def safe_yaml(text: str, path: str | Path, max_values: int = MAX_YAML_VALUES):
         try:
             node = loader.get_single_node()
         except RecursionError:
-            raise DataError(path, "<yaml>", "settings nested a few levels deep", "a nesting too deep to parse") from None
+            raise DataError(path, "<yaml>", "settings nested a few levels deep",
+                            "a nesting too deep to parse") from None
         if node is None:
             return None
         values = _expanded_values(node, Path(path))

@@ -111,3 +111,12 @@ def test_the_results_pages_sweep_table_names_a_walkers_rows_by_its_zupt(tmp_path
                           sweep_record=None, current={}, table=lambda name: out / "tables" / name)
     shown = sweep_section(res)[0].data                                   # the table the page styles
     assert sorted(shown.index) == [("car", "INS"), ("car", "INS+NHC"), ("walk", "INS"), ("walk", "INS+ZUPT")]
+
+
+def test_a_walk_that_notebook_02_did_not_run_is_named_by_its_own_meta(tmp_path):
+    folder = G.walker_log(tmp_path / "my walk")                  # meta.yaml: platform walker
+    out = tmp_path / "results"
+    (out / "tables").mkdir(parents=True)
+    frame = _rows([str(folder)] * 4)
+    path = write_ran_table(out / "tables" / "walk.csv", frame, out)
+    assert list(pd.read_csv(path)["method"]) == ["INS", "INS+ZUPT", "BGFN+ZUPT", "INS+ZUPT+HOLD"]

@@ -39,6 +39,42 @@ endif
 # JOBS and DASK_SCHEDULER reach Python (which checks them) as environment values, never as make code.
 override JOBS := $(value JOBS)
 override DASK_SCHEDULER := $(value DASK_SCHEDULER)
+# Every other setting a user may pass is make code as well when it comes from the command line or the environment,
+# and a recipe's shell would run what it expands to: its raw text is checked here like PROFILE's, before anything
+# expands it. A path (VENV, PYTHON; PY and RES, which tests point elsewhere) is one word of a path's characters;
+# options (PIP_FLAGS, PAPERMILL_FLAGS, PYTEST_ARGS) words of an option's (no quote, `$`, `;`, `|`, `&`, `<`, `>`,
+# parenthesis, backquote or line break); NOTEBOOK_SLOTS a count; CI a word. A command-line variable that is none of
+# these settings is refused (the data step's command, DATA_FETCH, included): nothing else reaches a shell from outside.
+comma := ,
+space := $(subst ,, )
+PATH_CHARS := $(NAME_CHARS) / + ~
+OPTION_CHARS := $(PATH_CHARS) = : , @ % [ ]
+DIGITS := 0 1 2 3 4 5 6 7 8 9
+COUNTS := $(filter-out 0%,$(DIGITS) $(foreach d,$(DIGITS),$(addprefix $(d),$(DIGITS))))
+PATH_SETTINGS := VENV PYTHON PY RES
+OPTION_SETTINGS := PIP_FLAGS PAPERMILL_FLAGS PYTEST_ARGS
+SETTINGS := PROFILE JOBS DASK_SCHEDULER NOTEBOOK_SLOTS CI $(PATH_SETTINGS) $(OPTION_SETTINGS)
+from_outside = $(filter command line environment environment override,$(origin $(1)))
+is_path = $(and $(filter 1,$(words $(1))),$(filter-out -%,$(1)),$(if $(call drop_chars,$(1),$(PATH_CHARS)),,ok))
+is_options = $(if $(subst $(space),,$(call drop_chars,$(1),$(OPTION_CHARS))),,ok)
+is_count = $(and $(filter 1,$(words $(1))),$(if $(call drop_chars,$(1),$(DIGITS)),,ok),$(filter $(1),$(COUNTS)))
+$(foreach v,$(.VARIABLES),$(if $(filter command line,$(origin $(v))),$(if $(filter $(v),$(SETTINGS)),,$(error \
+  $(v) is not a setting of this Makefile (settings: $(SETTINGS)); nothing was run))))
+$(foreach v,$(PATH_SETTINGS),$(if $(call from_outside,$(v)),$(if $(call is_path,$(value $(v))),,$(error \
+  $(v) "$(value $(v))" is not a path: expected one word of letters, digits and . _ - / + ~ (not first: -)))))
+$(foreach v,$(OPTION_SETTINGS),$(if $(call from_outside,$(v)),$(if $(call is_options,$(value $(v))),,$(error \
+  $(v) "$(value $(v))" is not a list of options: expected words of letters, digits and . _ - / + ~ = : $(comma) @ % [ ] \
+  (no quote, $$, ;, |, &, <, >, parenthesis, backquote or line break)))))
+ifneq ($(call from_outside,NOTEBOOK_SLOTS),)
+ifeq ($(call is_count,$(value NOTEBOOK_SLOTS)),)
+$(error NOTEBOOK_SLOTS "$(value NOTEBOOK_SLOTS)" is not a count: expected a whole number from 1 to 99 (notebooks at a time))
+endif
+endif
+ifneq ($(and $(call from_outside,CI),$(value CI)),)
+ifeq ($(call is_name,$(value CI)),)
+$(error CI "$(value CI)" is not a word: expected letters, digits, '.', '_' or '-' (CI=true streams the notebooks' output))
+endif
+endif
 
 # Every path below is relative to the repository root. `make -f <root>/Makefile` from elsewhere re-runs make
 # there (`make -C <root>` needs nothing: make changes directory first).
@@ -56,7 +92,7 @@ PYTHON ?= $(shell command -v python3.11 2>/dev/null || command -v python3)
 # Extra pip options, e.g. off this machine: PIP_FLAGS="--extra-index-url https://download.pytorch.org/whl/cpu"
 PIP_FLAGS ?=
 # Data step (module written by bgfn.data): resolve data/raw -> mirror -> pinned URL and verify checksums.
-DATA_FETCH ?= $(PY) -m bgfn.data fetch
+DATA_FETCH = $(PY) -m bgfn.data fetch
 # Extra papermill options; in CI (CI=true) cell output is streamed to the log.
 PAPERMILL_FLAGS ?= $(if $(filter true 1,$(CI)),--log-output,)
 PYTEST_ARGS ?=

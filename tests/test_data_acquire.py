@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import datetime
 import hashlib
 import logging
 
@@ -141,3 +142,44 @@ def test_cli_exit_status(tmp_path, mirror, capsys):
     assert cli_main(["fetch", "--data-dir", str(tmp_path / "b"), "--mirror", str(tmp_path / "none"),
                      "--no-download"]) == 1
     assert "REQUIRED, missing" in capsys.readouterr().out
+
+
+def test_a_failed_optional_download_is_marked_once_and_skipped_until_a_retry(tmp_path, monkeypatch, capsys):
+    """No network (the download is faked): one failure per optional file, then one line per run and no attempt."""
+    tried = []
+
+    def offline(url, timeout_s):
+        tried.append(url.rsplit("/", 1)[-1])
+        raise ConnectionError(f"download of {url} failed: network disabled in tests")
+
+    monkeypatch.setattr(acquire, "_download", offline)
+    data, empty = tmp_path / "data", tmp_path / "empty"
+    first = {r.name: r for r in acquire.fetch_all(data_dir=data, mirror=empty, rtklib_mirror=empty)}
+    optional = [n for n, f in acquire.raw_files().items() if not f.required]
+    required = [n for n, f in acquire.raw_files().items() if f.required]
+    assert sorted(tried) == sorted(acquire.raw_files())                    # every file tried once
+    today = datetime.datetime.now(datetime.timezone.utc).date().isoformat()
+    for name in optional:
+        assert first[name].path is None and acquire.failed_on(name, data) == today
+        assert "network disabled" in acquire.failed_mark(name, data).read_text()
+    assert not any(acquire.failed_mark(n, data).exists() for n in required)   # a needed file is tried each run
+
+    tried.clear()
+    assert cli_main(["fetch", "--data-dir", str(data), "--mirror", str(empty), "--rtklib-mirror", str(empty)]) == 1
+    assert sorted(tried) == sorted(required)                                # the optional ones: not again
+    lines = [line for line in capsys.readouterr().out.splitlines() if line.startswith("optional, absent")]
+    assert len(lines) == 1 and all(n in lines[0] for n in optional)
+    assert f"failed on {today} and is skipped since (to retry: python -m bgfn.data fetch --retry)" in lines[0]
+    again = acquire.resolve(optional[0], data_dir=data, mirror=empty)
+    assert again.origin == "missing" and f"download skipped: it failed on {today}" in again.detail
+
+    # --retry tries again; a download that then succeeds (a file of this test's own, pinned) clears its mark
+    spec = acquire.RawFile("extra.mat", None, acquire.git_blob_id(b"abc"), False)
+    monkeypatch.setitem(acquire.NAVEGO_FILES, "extra.mat", spec)
+    assert acquire.resolve("extra.mat", data_dir=data, mirror=empty).origin == "missing"
+    assert acquire.failed_mark("extra.mat", data).is_file()
+    monkeypatch.setattr(acquire, "_download", lambda url, timeout_s: b"abc")
+    assert acquire.resolve("extra.mat", data_dir=data, mirror=empty).origin == "missing"          # skipped
+    res = acquire.resolve("extra.mat", data_dir=data, mirror=empty, retry=True)
+    assert res.origin == "download" and res.path.read_bytes() == b"abc"
+    assert not acquire.failed_mark("extra.mat", data).exists()

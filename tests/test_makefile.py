@@ -130,6 +130,45 @@ def test_a_base_chain_is_followed_to_any_depth_and_a_bad_base_name_runs_nothing(
     assert _make("-n", "help", "PROFILE=f", cwd=repo).returncode == 0
 
 
+#: Every other setting a user may pass, with the words of its error.
+SETTINGS = {"VENV": "is not a path", "PYTHON": "is not a path", "PY": "is not a path", "RES": "is not a path",
+            "PIP_FLAGS": "is not a list of options", "PAPERMILL_FLAGS": "is not a list of options",
+            "PYTEST_ARGS": "is not a list of options", "NOTEBOOK_SLOTS": "is not a count", "CI": "is not a word"}
+
+
+@pytest.mark.parametrize("setting", sorted(SETTINGS))
+def test_every_setting_with_shell_metacharacters_runs_nothing_and_is_one_error(tmp_path, setting):
+    repo = _checkout(tmp_path)
+    before = sorted(p.relative_to(repo) for p in repo.rglob("*"))
+    for payload in PAYLOADS:
+        if setting.endswith(("FLAGS", "ARGS")) and payload in ("a b", "-rf"):
+            continue                                  # options: words, and a word may start with '-'
+        for how in ("command line", "environment"):
+            env = {**os.environ, setting: payload} if how == "environment" else None
+            res = subprocess.run(["make", "--no-print-directory", "-n", "reproduce", "PROFILE=smoke",
+                                  *([] if env else [f"{setting}={payload}"])],
+                                 cwd=repo, capture_output=True, text=True, timeout=60, env=env)
+            assert res.returncode != 0, (setting, payload, how, res.stdout)
+            assert res.stderr.count(f"{setting} ") == 1 and res.stderr.count(SETTINGS[setting]) == 1, res.stderr
+            assert res.stdout == "", (setting, payload, how)
+            assert sorted(p.relative_to(repo) for p in repo.rglob("*")) == before         # nothing created
+            assert not (PROJECT_ROOT / "pwned").exists() and not (tmp_path / "pwned").exists()
+
+
+def test_the_settings_take_their_documented_values_and_nothing_else_is_a_setting(tmp_path):
+    repo = _checkout(tmp_path)
+    ok = ["VENV=/opt/conda/envs/bgfn", "PYTHON=/usr/bin/python3.11", "NOTEBOOK_SLOTS=1", "CI=true",
+          "PIP_FLAGS=--extra-index-url https://download.pytorch.org/whl/cpu",         # the README's
+          "PYTEST_ARGS=-x -k walker tests/test_gallery.py::test_a[1]", "PAPERMILL_FLAGS=--log-output"]
+    res = _make("-n", "help", *ok, cwd=repo)
+    assert res.returncode == 0, res.stderr
+    for bad, words in (("NOTEBOOK_SLOTS=0", "is not a count"), ("NOTEBOOK_SLOTS=100", "is not a count"),
+                       ("DATA_FETCH=touch pwned", "DATA_FETCH is not a setting"), ("LOCK=x", "LOCK is not a setting")):
+        res = _make("-n", "reproduce", "PROFILE=smoke", bad, cwd=repo)
+        assert res.returncode != 0 and res.stderr.count(words) == 1 and res.stdout == "", (bad, res.stderr)
+    assert not (repo / "pwned").exists()
+
+
 def test_jobs_and_the_scheduler_reach_python_as_text_never_as_make_code(tmp_path):
     repo = _checkout(tmp_path)
     res = _make("-n", "help", "JOBS=$(shell touch pwned)", "DASK_SCHEDULER=$(shell touch pwned)", cwd=repo)

@@ -305,6 +305,42 @@ def test_a_binary_or_huge_profile_is_one_error_naming_the_file(params):
     assert err.value.source == str(path)
 
 
+def _alias_bomb(levels: int = 9) -> str:
+    """YAML of a few hundred bytes whose aliases nest: 10 ** ``levels`` strings once expanded ("billion laughs")."""
+    lines = ['l0: &l0 ["lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol"]']
+    lines += [f"l{k}: &l{k} [" + ", ".join([f"*l{k - 1}"] * 10) + "]" for k in range(1, levels + 1)]
+    return "\n".join(lines) + "\n"
+
+
+def test_an_alias_bomb_is_one_early_error_naming_the_file(params, tmp_path):
+    from bgfn.data.csv_meta import read_meta
+
+    path = params / "mine.yaml"
+    path.write_text("profile: mine\nbase: smoke\n" + _alias_bomb())
+    assert path.stat().st_size < 1_000
+    # l0 holds 1 + 10 values, l_k 1 + 10 l_(k-1): 11, 111, ..., 11,111,111,111, summed 12,345,679,010; with the
+    # mapping, its 12 keys and the two names: 12,345,679,025
+    with pytest.raises(DataError, match=r"at most 100,000 values once its aliases .* found 12,345,679,025 values"
+                       ) as err:
+        load_profile("mine")                         # refused from the parsed nodes, before any value is built
+    assert err.value.source == str(path) and err.value.field == "<yaml>"
+    path.write_text("profile: mine\nbase: smoke\ndescription: &d [1, *d]\n")
+    with pytest.raises(DataError, match="contains itself through an alias"):
+        load_profile("mine")
+    path.write_text("profile: mine\nbase: smoke\ndescription: " + "[" * 100_000)       # 100 kB of nesting
+    with pytest.raises(DataError, match="a nesting too deep to parse"):
+        load_profile("mine")
+    # a log's meta.yaml, the other settings file a user writes, likewise
+    meta = tmp_path / "log" / "meta.yaml"
+    meta.parent.mkdir()
+    meta.write_text(_alias_bomb())
+    with pytest.raises(DataError, match="once its aliases"):
+        read_meta(meta)
+    # anchors and merge keys of a real size still read (params/quick.yaml's variants use them)
+    path.write_text("profile: mine\nbase: smoke\ndescription: &d a walk\nseed: 3\n")
+    assert load_profile("mine")["seed"] == 3
+
+
 def test_an_unfinished_profile_of_ones_own_does_not_fail_the_suite(params, monkeypatch):
     import subprocess
 

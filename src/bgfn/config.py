@@ -182,12 +182,73 @@ def merge_sections(base: dict, override: dict) -> dict:
 MAX_PROFILE_BYTES = 1_000_000
 
 
+#: The most values (keys, items, scalars) a settings file may hold once its aliases (``*name``) are expanded. The
+#: parser shares an alias's value, but every later walk over the settings (the check, a merge, a JSON record) visits
+#: it once per use, so a file of a few kB whose aliases nest ("billion laughs") would run it out of memory; a real
+#: profile holds a few hundred values.
+MAX_YAML_VALUES = 100_000
+
+
+def _yaml_children(node: yaml.Node) -> list:
+    if isinstance(node, yaml.SequenceNode):
+        return list(node.value)
+    if isinstance(node, yaml.MappingNode):
+        return [n for pair in node.value for n in pair]
+    return []
+
+
+def _expanded_values(root: yaml.Node, path: Path) -> int:
+    """How many values ``root`` holds with every alias expanded: counted over the parsed nodes (each once, so in
+    time linear in the file); a value that contains itself through an alias is refused."""
+    size: dict[int, int] = {}
+    open_nodes: set[int] = set()
+    stack = [(root, False)]
+    while stack:
+        node, closing = stack.pop()
+        key = id(node)
+        if closing:
+            open_nodes.discard(key)
+            size[key] = 1 + sum(size[id(c)] for c in _yaml_children(node))
+            continue
+        if key in size:
+            continue
+        if key in open_nodes:
+            raise DataError(path, "<yaml>", "settings without a value that contains itself through an alias",
+                            f"a recursive alias at line {node.start_mark.line + 1}")
+        open_nodes.add(key)
+        stack.append((node, True))
+        stack.extend((c, False) for c in _yaml_children(node) if id(c) not in size)
+    return size[id(root)]
+
+
+def safe_yaml(text: str, path: str | Path, max_values: int = MAX_YAML_VALUES):
+    """``text`` (the YAML of the settings file ``path``) parsed like :func:`yaml.safe_load`, after its size with every
+    alias expanded is checked (:data:`MAX_YAML_VALUES`; one :class:`bgfn.errors.DataError` naming the file, before any
+    value is built). Raises :class:`yaml.YAMLError` for text that is no YAML."""
+    loader = yaml.SafeLoader(text)
+    try:
+        try:
+            node = loader.get_single_node()
+        except RecursionError:
+            raise DataError(path, "<yaml>", "settings nested a few levels deep",
+                            "a nesting too deep to parse") from None
+        if node is None:
+            return None
+        values = _expanded_values(node, Path(path))
+        if values > max_values:
+            raise DataError(path, "<yaml>", f"at most {max_values:,} values once its aliases (*name) are expanded",
+                            f"{values:,} values (aliases that nest: a file that would exhaust the memory)")
+        return loader.construct_document(node)
+    finally:
+        loader.dispose()
+
+
 def _read_profile_file(path: Path) -> dict:
     size = path.stat().st_size
     if size > MAX_PROFILE_BYTES:
         raise DataError(path, "<file>", f"a profile of at most {MAX_PROFILE_BYTES:,} bytes", f"{size:,} bytes")
     try:
-        cfg = yaml.safe_load(path.read_bytes().decode("utf-8"))
+        cfg = safe_yaml(path.read_bytes().decode("utf-8"), path)
     except UnicodeDecodeError as exc:
         raise DataError(path, "<file>", "a YAML text file in UTF-8", f"a byte {exc.object[exc.start]:#04x} that is "
                         f"not UTF-8 at offset {exc.start} (a binary file?)") from None

@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 
 from bgfn.config import read_profile
-from bgfn.data.acquire import NAVEGO_TAG, fetch_all, raw_files
+from bgfn.data.acquire import NAVEGO_TAG, failed_on, fetch_all, raw_files
 from bgfn.data.names import data_fingerprint, profile_datasets
 from bgfn.errors import DataError
 from bgfn.io import atomic_write_text
@@ -48,6 +48,8 @@ def main(argv: list[str] | None = None) -> int:
                        "$BGFN_RTKLIB_MIRROR or <repo>/../shared/data/rtklib-drive0708)")
     fetch.add_argument("--no-download", action="store_true", help="do not try the pinned URL")
     fetch.add_argument("--timeout", type=float, default=30.0, help="network timeout, s")
+    fetch.add_argument("--retry", action="store_true", help="try again the downloads of optional files that failed "
+                       "before (after one failure they are skipped)")
     fetch.add_argument("-v", "--verbose", action="store_true", help="also what was tried for an absent optional file")
     fp = sub.add_parser("fingerprint", help="fingerprint of a profile's CSV drives (their files' sizes and times)")
     fp.add_argument("profile")
@@ -63,7 +65,7 @@ def main(argv: list[str] | None = None) -> int:
                         format="%(levelname)s %(name)s: %(message)s")
     try:
         resolved = fetch_all(data_dir=args.data_dir, mirror=args.mirror, rtklib_mirror=args.rtklib_mirror,
-                             download=not args.no_download, timeout_s=args.timeout)
+                             download=not args.no_download, timeout_s=args.timeout, retry=args.retry)
     except DataError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
@@ -79,7 +81,11 @@ def main(argv: list[str] | None = None) -> int:
         else:
             absent.setdefault(spec.when_missing, []).append(res.name)
     for when_missing, names in absent.items():
-        print(f"optional, absent: {', '.join(names)} -- {when_missing} (what was tried: python -m bgfn.data fetch -v)")
+        failed = sorted({day for day in (failed_on(n, args.data_dir) for n in names) if day})
+        skipped = (f"; its download failed on {', '.join(failed)} and is skipped since (to retry: python -m bgfn.data "
+                   "fetch --retry)" if failed and not args.no_download else "")
+        print(f"optional, absent: {', '.join(names)} -- {when_missing}{skipped} "
+              "(what was tried: python -m bgfn.data fetch -v)")
     return status
 
 

@@ -10,6 +10,7 @@ half-written file. The data folder (``BGFN_DATA_DIR``) and the mirrors (``BGFN_D
 
 from __future__ import annotations
 
+import datetime
 import hashlib
 import logging
 import os
@@ -195,6 +196,26 @@ def atomic_write_bytes(path: Path, data: bytes) -> Path:
     return path
 
 
+#: Beside an optional file in ``data/raw`` after its download failed: the date and the error. Every later run skips
+#: the download (a network that is down, or a file that moved, stays so: a retry each run costs a timeout and a
+#: line); ``python -m bgfn.data fetch --retry`` (or deleting it) tries again.
+FAILED_MARK = ".{file}.download-failed"
+
+
+def failed_mark(name: str, data_dir_: str | Path | None = None) -> Path:
+    """The marker of a failed download of the optional file ``name`` (:data:`FAILED_MARK`)."""
+    return raw_dir(data_dir_) / FAILED_MARK.format(file=name)
+
+
+def failed_on(name: str, data_dir_: str | Path | None = None) -> str | None:
+    """The date (``YYYY-MM-DD``, UTC) the download of ``name`` failed and was marked, or None."""
+    mark = failed_mark(name, data_dir_)
+    if not mark.is_file():
+        return None
+    first = mark.read_text(encoding="utf-8", errors="replace").split(maxsplit=1)
+    return first[0] if first else "an earlier run"
+
+
 def _download(url: str, timeout_s: float) -> bytes:
     try:
         with urllib.request.urlopen(url, timeout=timeout_s) as resp:  # noqa: S310 (pinned https URL)
@@ -229,7 +250,7 @@ class Resolved:
 
 
 def resolve(name: str, *, data_dir: str | Path | None = None, mirror: str | Path | None = None,
-            download: bool = True, timeout_s: float = 30.0) -> Resolved:
+            download: bool = True, timeout_s: float = 30.0, retry: bool = False) -> Resolved:
     """Find, verify and install one pinned file into ``<data>/raw``.
 
     Order: ``<data>/raw`` -> mirror folder -> pinned URL (``NAVEGO_URL``, ``RTKLIB_URL``). A file already in
@@ -248,6 +269,9 @@ def resolve(name: str, *, data_dir: str | Path | None = None, mirror: str | Path
         Whether to try the pinned URL as the last resort.
     timeout_s : float
         Network timeout, s.
+    retry : bool
+        Try the download of an optional file again though an earlier one failed (:data:`FAILED_MARK`; without it
+        that download is skipped, and a failed one is marked).
 
     Returns
     -------
@@ -277,15 +301,22 @@ def resolve(name: str, *, data_dir: str | Path | None = None, mirror: str | Path
         atomic_write_bytes(target, data)
         return Resolved(name, target, "mirror", checksum, str(mdir / name))
     tried.append(f"{mdir / name if mdir is not None else f'no mirror ({spec.mirror_env} unset)'} (absent)")
-    if download:
+    mark = failed_mark(name, data_dir)
+    if download and not spec.required and not retry and mark.is_file():
+        tried.append(f"download skipped: it failed on {failed_on(name, data_dir)} ({mark.name})")
+    elif download:
         url = spec.url.format(file=name)
         try:
             data = _download(url, timeout_s)
         except ConnectionError as exc:
             tried.append(str(exc))
+            if not spec.required:          # an optional file: not again each run (FAILED_MARK)
+                day = datetime.datetime.now(datetime.timezone.utc).date().isoformat()
+                atomic_write_bytes(mark, f"{day} {exc}\n".encode("utf-8"))
         else:
             checksum = verify_bytes(data, spec, url)
             atomic_write_bytes(target, data)
+            mark.unlink(missing_ok=True)
             return Resolved(name, target, "download", checksum, url)
     else:
         tried.append("download disabled")
@@ -323,7 +354,7 @@ def require(name: str, **kwargs) -> Path:
 
 def fetch_all(*, data_dir: str | Path | None = None, mirror: str | Path | None = None,
               rtklib_mirror: str | Path | None = None, download: bool = True,
-              timeout_s: float = 30.0) -> list[Resolved]:
+              timeout_s: float = 30.0, retry: bool = False) -> list[Resolved]:
     """Resolve all pinned files (see :func:`resolve`); what was tried for an absent optional file is logged at the
     debug level (its absence is the caller's one line).
 
@@ -331,6 +362,8 @@ def fetch_all(*, data_dir: str | Path | None = None, mirror: str | Path | None =
     ----------
     mirror, rtklib_mirror : str or Path, optional
         Mirror folder of the NaveGo files, of the RTKLIB drive's files (:func:`mirror_dir`).
+    retry : bool
+        Try again the downloads of optional files that failed before (:func:`resolve`).
 
     Returns
     -------
@@ -340,7 +373,7 @@ def fetch_all(*, data_dir: str | Path | None = None, mirror: str | Path | None =
     out = []
     for name, spec in raw_files().items():
         folder = rtklib_mirror if name in RTKLIB_FILES else mirror
-        res = resolve(name, data_dir=data_dir, mirror=folder, download=download, timeout_s=timeout_s)
+        res = resolve(name, data_dir=data_dir, mirror=folder, download=download, timeout_s=timeout_s, retry=retry)
         if res.path is None and not spec.required:   # the caller says so in one line (python -m bgfn.data fetch)
             log.debug("optional %s file %s is not available (%s)", spec.source, name, res.detail)
         out.append(res)

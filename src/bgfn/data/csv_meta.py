@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from bgfn.config import safe_yaml
 from bgfn.data.imu_errors import OPTIONAL_VECTOR_KEYS, PROFILES, SCALAR_KEYS, VECTOR_KEYS, error_params
 from bgfn.errors import DataError
 
@@ -51,7 +52,7 @@ def _unknown_key(path: Path, key, valid, prefix: str = "") -> DataError:
 def _load(path: Path) -> dict:
     """The parsed YAML mapping of ``path`` ({} for an empty file)."""
     try:
-        meta = yaml.safe_load(path.read_text(encoding="utf-8"))
+        meta = safe_yaml(path.read_text(encoding="utf-8"), path)        # aliases that nest: one error
     except (yaml.YAMLError, UnicodeDecodeError) as exc:
         raise DataError(path, "<yaml>", "valid YAML", str(exc).replace("\n", " ")) from None
     if meta is None:

@@ -22,7 +22,8 @@ from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, windo
 from bgfn.evaluate.networks import ensure_models
 from bgfn.io import atomic_write_bytes, atomic_write_csv
 from bgfn.nav import outages
-from bgfn.paper import METHOD_LABELS, nhc_label, test_of
+from bgfn.nav.constraints import DEFAULT_PLATFORM, platform_aids
+from bgfn.paper import METHOD_LABELS, nhc_label, ran_labels, test_of
 
 
 @dataclass
@@ -235,14 +236,16 @@ def save_table_result(out, result: TableResult, series_rate_hz: float = 10.0) ->
     """
     paths = table_paths(out, result.test)
     gnss = paths.pop("gnss")
-    atomic_write_csv(paths["table"], result.table[list(TABLE_COLUMNS)], float_format="%.4f")
+    # the +NHC rows named by the aids that ran (INS+ZUPT on a walker; the code keys them +NHC)
+    aids = platform_aids((result.constraints or {}).get("platform", DEFAULT_PLATFORM))
+    atomic_write_csv(paths["table"], ran_labels(result.table[list(TABLE_COLUMNS)], aids), float_format="%.4f")
     seeds = result.per_seed.assign(dataset=result.dataset)
     seeds["seed"] = seeds["seed"].astype("Int64")
-    atomic_write_csv(paths["seeds"], seeds, float_format="%.4f")
+    atomic_write_csv(paths["seeds"], ran_labels(seeds, aids), float_format="%.4f")
     series = error_series(result.runs, series_rate_hz)
     series.insert(0, "outage", series["start_s"].map(
         dict(zip(result.per_seed["start_s"], result.per_seed["outage"]))).astype(int))
-    atomic_write_csv(paths["series"], series, float_format="%.4f")
+    atomic_write_csv(paths["series"], ran_labels(series, aids), float_format="%.4f")
     if result.gnss_errors is not None:
         paths["gnss"] = gnss
         atomic_write_csv(gnss, result.gnss_errors, float_format="%.4f")

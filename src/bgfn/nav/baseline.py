@@ -492,13 +492,18 @@ def save_baseline(b: Baseline, out, file_id: str, lat=None) -> dict:
     """
     out = Path(out)
     d = file_id
+    # the INS+NHC rows named by the aids that ran on this drive (INS+ZUPT for a walker; the code keys them +NHC)
+    aids = cn.platform_aids((b.constraints or {}).get("platform", cn.DEFAULT_PLATFORM))
     save_states(out / f"nav_states_{d}.npz", b.states)
     atomic_write_csv(out / "tables" / f"kf_rms_{d}.csv", b.rms.reset_index(), float_format="%.6g")
-    atomic_write_csv(out / "tables" / f"kf_outage_max_errors_{d}.csv", ins_max_error_file(b.outage_table))
-    atomic_write_csv(out / "tables" / f"kf_outage_metrics_{d}.csv", b.outage_table, float_format="%.6g")
+    atomic_write_csv(out / "tables" / f"kf_outage_max_errors_{d}.csv",
+                     paper.ran_labels(ins_max_error_file(b.outage_table), aids))
+    atomic_write_csv(out / "tables" / f"kf_outage_metrics_{d}.csv", paper.ran_labels(b.outage_table, aids),
+                     float_format="%.6g")
     series = pd.concat([e.assign(outage=name)[["outage", "method", "t_rel", "east", "north", "down", "horizontal"]]
                         for name, e in b.outage_errors.items()], ignore_index=True)
-    atomic_write_csv(out / "tables" / f"kf_outage_errors_{d}.csv", series, float_format="%.6g")
+    atomic_write_csv(out / "tables" / f"kf_outage_errors_{d}.csv", paper.ran_labels(series, aids),
+                     float_format="%.6g")
     upd = b.full.updates
     return {"rms": {k: float(v) for k, v in b.rms["rms"].items()},
             "outages": b.outage_table.drop(columns=["dataset"]).to_dict(orient="records"),

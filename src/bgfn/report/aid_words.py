@@ -3,20 +3,14 @@ the rows' labels with the aids that ran (``INS+ZUPT`` for a walker, whose filter
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
-from bgfn.config import RUN_RECORDS
-from bgfn.data.names import dataset_id
-from bgfn.report.reading import read_json
+from bgfn.data.platforms import recorded_platform as _recorded_platform
 from bgfn.nav.constraints import DEFAULT_PLATFORM, PLATFORM_AIDS, PLATFORM_NOTES, ConstraintConfig, platform_aids
-from bgfn.paper import NHC_SUFFIX
+from bgfn.paper import aids_suffix, ran_label
 
 #: The aids in words (:func:`aided_ins_words`).
 AID_WORDS: dict[str, str] = {"NHC": "non-holonomic constraints", "ZUPT": "zero-velocity updates"}
-#: A label's constraint suffix where the tables write it (``INS+NHC``, ``BGFN+NHC``, ``INS+NHC+HOLD``), after a
-#: method's name (not a bare ``+NHC`` in a sentence about the rows in general).
-_SUFFIX_IN_TEXT = re.compile(r"(?<=[A-Za-z0-9])" + re.escape(NHC_SUFFIX) + r"(?![A-Za-z0-9])")
 
 
 def _platform(platform: str) -> str:
@@ -40,28 +34,19 @@ def constraint_words(config: ConstraintConfig) -> str:
 
 
 def aid_suffix(platform: str) -> str:
-    """The suffix of the rows the tables write ``+NHC`` (run with the platform's learning-free aids): ``+NHC`` on a
+    """The suffix of the rows the code keys ``+NHC`` (run with the platform's learning-free aids): ``+NHC`` on a
     car (the paper's label; its ZUPT at stops beside it, as ever), ``+ZUPT`` on a walker (no NHC ran), ``+no aid``
-    on a platform that takes neither (:data:`bgfn.nav.constraints.PLATFORM_AIDS`)."""
-    platform = _platform(platform)
-    if platform == DEFAULT_PLATFORM:
-        return NHC_SUFFIX
-    aids = platform_aids(platform)
-    return "+" + "+".join(aids) if aids else "+no aid"
+    on a platform that takes neither (:func:`bgfn.paper.aids_suffix`; the tables write the same)."""
+    return aids_suffix(platform_aids(_platform(platform)))
 
 
 def aid_label(text: str, platform: str) -> str:
     """A row's label, or every row label in a sentence, with the aids that ran on ``platform``: ``INS+NHC`` ->
     ``INS+ZUPT``, ``BGFN+NHC`` -> ``BGFN+ZUPT`` for a walker; a car's labels (and text without them) as they are."""
-    suffix = aid_suffix(platform)
-    return str(text) if suffix == NHC_SUFFIX else _SUFFIX_IN_TEXT.sub(suffix, str(text))
+    return ran_label(text, platform_aids(_platform(platform)))
 
 
 def recorded_platform(out: str | Path, dataset: str) -> str:
     """The drive's platform as notebook 02 recorded it (``kf_baseline.json`` under ``out``; ``car`` when it says
-    nothing)."""
-    record = read_json(Path(out) / RUN_RECORDS["kf_baseline"]) or {}
-    for name, facts in (record.get("datasets") or {}).items():
-        if dataset_id(name) == dataset_id(dataset):
-            return str(((facts or {}).get("constraints") or {}).get("platform", DEFAULT_PLATFORM))
-    return DEFAULT_PLATFORM
+    nothing): :func:`bgfn.data.platforms.recorded_platform`."""
+    return _recorded_platform(out, dataset)

@@ -26,12 +26,14 @@ def rel(path: str | Path) -> str:
 
 
 def read_csv(path: str | Path) -> pd.DataFrame | None:
-    """A CSV table (``#`` comment lines skipped), or ``None`` when the file does not exist."""
+    """A CSV table (``#`` comment lines skipped), or ``None`` when the file does not exist. Its rows keyed as the
+    code keys them (:func:`bgfn.paper.key_labels`: a walker's ``INS+ZUPT`` row reads as ``INS+NHC``; the page
+    names it by the aids that ran again, :mod:`bgfn.report.aid_words`)."""
     path = Path(path)
     if not path.is_file():
         return None
     try:
-        return pd.read_csv(path, comment="#")
+        return paper.key_labels(pd.read_csv(path, comment="#"))
     except pd.errors.EmptyDataError:         # a table with nothing to say (no rows, no header): empty, not missing
         return pd.DataFrame()
 

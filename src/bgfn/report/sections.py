@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import pandas as pd
+
 from bgfn import paper
 from bgfn.config import RUN_RECORDS, SHARED_TABLES
 from bgfn.data.names import dataset_id
@@ -162,6 +164,9 @@ def sweep_section(res: ProfileResults) -> list:
     st = sweep_table(res.sweep)
     if st is None:
         return [missing_note(file, "the outage sweep", "notebook 06, `evaluate.sweep`")]
+    # each drive's rows named by the aids that ran on it (INS+ZUPT on a walker)
+    st.index = pd.MultiIndex.from_tuples([(d, aid_label(m, recorded_platform(res.out, d))) for d, m in st.index],
+                                         names=st.index.names)
     sw = (res.evaluation or {}).get("evaluate", {}).get("sweep", {})
     pieces = [compact(st.style, f"Median max horizontal error (m) [95 % interval], profile {res.profile}"),
               provenance(file, (res.sweep_record or {}).get("meta"), res.current,

@@ -21,11 +21,12 @@ import pandas as pd
 
 from bgfn.config import SHARED_TABLES
 from bgfn.data.names import dataset_id
+from bgfn.data.platforms import write_ran_table
 from bgfn.data.registry import SIMULATED_IMU
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.evaluate.plots import finish_duration_axes
 from bgfn.studies.outage_sweep.sweep import profile_sweep_plan
-from bgfn.io import atomic_write_csv, save_figure
+from bgfn.io import save_figure
 from bgfn.parallel import Runner
 
 #: chi-square with 2 degrees of freedom: its median (2 ln 2) and its 95 % quantile (-2 ln 0.05).
@@ -103,7 +104,7 @@ def nees_section(out: str | Path, results: dict, sweep: pd.DataFrame | None) -> 
     (``figures/outage_nees_<id>.png``); returns the summary (in words:
     :func:`bgfn.report.ins_fidelity_words.nees_lines`)."""
     summary = nees_summary(sweep, results)
-    atomic_write_csv(Path(out) / "tables" / SHARED_TABLES["nees"], summary, float_format="%.4f")
+    write_ran_table(Path(out) / "tables" / SHARED_TABLES["nees"], summary, out, float_format="%.4f")
     for name in summary.loc[summary["window"] == "sweep", "dataset"].unique():
         fig = plot_nees(summary, name)
         save_figure(fig, Path(out) / "figures" / f"outage_nees_{dataset_id(name)}.png")

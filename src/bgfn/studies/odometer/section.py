@@ -15,11 +15,12 @@ import pandas as pd
 
 from bgfn.config import SHARED_TABLES, odometer_datasets
 from bgfn.data import dataset_id
+from bgfn.data.platforms import write_ran_table
 from bgfn.studies.odometer.errors import ERROR_COLUMNS, error_parts_table, offset_bar_mps, plot_error_parts
 from bgfn.studies.odometer.uncertainty import UNCERTAINTY_COLUMNS, uncertainty_table
 from bgfn.evaluate.plots import finish_duration_axes
 from bgfn.studies.odometer.ridge_curve import CURVE_COLUMNS, plot_curve
-from bgfn.io import atomic_write_csv, save_figure
+from bgfn.io import save_figure
 from bgfn.paper import ENSEMBLE_SUFFIX, nhc_label
 from bgfn.parallel import Runner
 
@@ -79,13 +80,13 @@ def run_odometer_section(cfg: dict, profile: str, setup, out, runner: Runner | N
                          for name, f in facts.items() if f.get("speed_series")) if len(e)]
     errors = pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(columns=list(ERROR_COLUMNS))
     tables = Path(out) / "tables"
-    atomic_write_csv(tables / SHARED_TABLES["odometer_errors"], errors, float_format="%.4f")
-    atomic_write_csv(tables / SHARED_TABLES["odometer_uncertainty"], uncertainty, float_format="%.4f")
-    atomic_write_csv(tables / SHARED_TABLES["odometer_curve"], curve, float_format="%.4f")
-    atomic_write_csv(tables / SHARED_TABLES["odometer_networks"], networks, float_format="%.4f")
-    atomic_write_csv(tables / SHARED_TABLES["odometer"], rows, float_format="%.4f")
-    atomic_write_csv(tables / SHARED_TABLES["odometer_summary"], summary, float_format="%.4f")
-    atomic_write_csv(tables / SHARED_TABLES["odometer_paper"], paper, float_format="%.4f")
+    write_ran_table(tables / SHARED_TABLES["odometer_errors"], errors, out, float_format="%.4f")
+    write_ran_table(tables / SHARED_TABLES["odometer_uncertainty"], uncertainty, out, float_format="%.4f")
+    write_ran_table(tables / SHARED_TABLES["odometer_curve"], curve, out, float_format="%.4f")
+    write_ran_table(tables / SHARED_TABLES["odometer_networks"], networks, out, float_format="%.4f")
+    write_ran_table(tables / SHARED_TABLES["odometer"], rows, out, float_format="%.4f")
+    write_ran_table(tables / SHARED_TABLES["odometer_summary"], summary, out, float_format="%.4f")
+    write_ran_table(tables / SHARED_TABLES["odometer_paper"], paper, out, float_format="%.4f")
     figures = []
     for name, f in facts.items():
         if f.get("skipped"):

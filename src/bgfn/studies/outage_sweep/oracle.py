@@ -25,12 +25,13 @@ import pandas as pd
 
 from bgfn.config import SHARED_TABLES
 from bgfn.data import dataset_id, load_drive
+from bgfn.data.platforms import write_ran_table
 from bgfn.errors import DataError
 from bgfn.evaluate.setup import COLORS
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
 from bgfn.studies.outage_sweep.increments import AntennaTruth, increment_rmse
 from bgfn.studies.outage_sweep.sweep import profile_sweep_plan
-from bgfn.io import atomic_write_csv, save_figure
+from bgfn.io import save_figure
 from bgfn.nav.outages import outage_windows
 from bgfn.paper import METHOD_LABELS, test_of
 from bgfn.parallel import Runner
@@ -544,9 +545,9 @@ def run_oracle(cfg: dict, profile: str, setup, out=None, results: dict | None = 
         result.figures = {name: plot_oracle(table, lv, be, name) for name in names}
     if out is not None:
         tables = Path(out) / "tables"
-        atomic_write_csv(tables / SHARED_TABLES["oracle"], table, float_format="%.4f")
-        atomic_write_csv(tables / SHARED_TABLES["oracle_breakeven"], be, float_format="%.4f")
-        atomic_write_csv(tables / SHARED_TABLES["oracle_runs"], runs, float_format="%.4f")
+        write_ran_table(tables / SHARED_TABLES["oracle"], table, out, float_format="%.4f")
+        write_ran_table(tables / SHARED_TABLES["oracle_breakeven"], be, out, float_format="%.4f")
+        write_ran_table(tables / SHARED_TABLES["oracle_runs"], runs, out, float_format="%.4f")
         for name, fig in result.figures.items():
             save_figure(fig, Path(out) / "figures" / FIGURE_FILE.format(dataset=dataset_id(name)))   # no path in a name
     return result

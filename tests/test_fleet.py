@@ -14,7 +14,7 @@ from bgfn.settings import defaults
 from bgfn.stats import holm_adjust
 from bgfn.studies.fleet import drives as fd
 from bgfn.studies.fleet import protocol as fp
-from bgfn.studies.fleet.coverage import outage_flags, speed_range
+from bgfn.studies.fleet.coverage import outage_flags, speed_range, turn_range, turn_rate_at
 from bgfn.studies.odometer.errors import error_parts_table
 from synthetic_fleet import fleet_drive
 
@@ -122,8 +122,33 @@ def test_a_faster_test_drive_is_flagged_out_of_range(fleet):
     moving = starts > 30.0
     assert flags["out_of_range"].to_numpy()[moving].all()
     _, w_in, t_in, s_in, tr_in = lodo_offsets(prepared, 0, [1, 2, 3])
-    inside = outage_flags("drive 1", w_in.t_end, t_in, s_in, [30.0], *speed_range(tr_in), 0.1)
-    assert not inside["out_of_range"].any()                          # the same speeds as its training drives
+    inside = outage_flags("drive 1", w_in.t_end, t_in, s_in, [30.0], *speed_range(tr_in), 0.1,
+                          turn_rate_at(prepared[0], w_in.t_end, 2.0), *turn_range(tr_in, 2.0))
+    assert not inside["out_of_range"].any()              # the same speeds and (no) turns as its training drives
+
+
+def test_a_weaving_test_drive_is_flagged_for_its_turn_rates_not_its_speeds(fleet):
+    """A drive at the training drives' speeds whose yaw rate swings +-15 deg/s, where they drove straight: its
+    outages are out of range by turn rate only; the window mean of the turn rate is the weave's, within 1 deg/s."""
+    _, prepared = fleet
+    weave = fd.prepare_fleet([fleet_drive("weaving drive", turn_dps=15.0, tilt_deg=(1.0, -2.0), seed=5)], FLEET)[0]
+    train = prepared[:4]
+    lo_w, hi_w = turn_range(train, 2.0)
+    assert max(abs(lo_w), abs(hi_w)) < 1.0                           # straight drives: vibration averages out
+    t = fp.aid_epochs(weave.label_time[0] + 2.0, weave.label_time[-1], 1.0)
+    w = turn_rate_at(weave, t, 2.0)
+    v = fd.reference_speed_at(weave.drive, t)
+    # the reference's yaw rate averaged over the same 2 s (its yaw's change over them)
+    ref = weave.drive.reference
+    yaw = np.unwrap(ref["yaw"].to_numpy(float))
+    expect = np.degrees(np.interp(t, ref["time"], yaw) - np.interp(t - 2.0, ref["time"], yaw)) / 2.0
+    np.testing.assert_allclose(w, expect, atol=1.0)
+    starts = np.arange(20.0, 200.0, 30.0)
+    flags = outage_flags("weaving drive", t, v, starts, [30.0], *speed_range(train), 0.1, w, lo_w, hi_w)
+    moving = starts > 30.0
+    assert flags["turn_out_of_range"].to_numpy()[moving].all() and flags["out_of_range"].to_numpy()[moving].all()
+    assert not flags["speed_out_of_range"].any()
+    assert (flags["turn_max_dps"].to_numpy()[moving] > 10.0).all()
 
 
 def test_protocol_splits():

@@ -14,8 +14,8 @@ from bgfn.studies.odometer.bars import HOLD, RIDGE
 from bgfn.studies.odometer.section import odometer_table
 
 #: The ``speed_range`` codes in words.
-RANGE_WORDS = {"all": "every outage", "in": "outages inside the training drives' speeds",
-               "out": "outages outside the training drives' speeds"}
+RANGE_WORDS = {"all": "every outage", "in": "outages inside the training drives' speeds and turn rates",
+               "out": "outages outside the training drives' speeds or turn rates"}
 #: The pooled rows' name in words.
 POOLED_WORDS = "all test drives (pooled)"
 
@@ -118,16 +118,19 @@ def verdict_lines(summary: pd.DataFrame, offsets: pd.DataFrame) -> list[str]:
 
 
 def coverage_lines(motion: pd.DataFrame, flags: pd.DataFrame) -> list[str]:
-    """Per test drive: its speeds and turn rates against its training drives', and the outages out of range."""
+    """Per test drive: its speeds and turn rates against its training drives', and the outages out of range (by
+    speed, by turn rate)."""
     lines = []
     for test, g in motion.groupby("test_drive", sort=False):
         t, tr = g[g["role"] == "test"].iloc[0], g[g["role"] == "training"].iloc[0]
         f = flags[(flags["dataset"] == test) & (flags["duration_s"] == flags["duration_s"].max())]
+        turn = (f"turn rate (the mean over the odometer's window) 95th percentile {t.turn_p95_dps:.1f}, max "
+                f"{t.turn_max_dps:.1f} against {tr.turn_p95_dps:.1f}, {tr.turn_max_dps:.1f} deg/s")
         lines.append(f"{test}: speed median {t.speed_p50_mps:.1f}, 95th percentile {t.speed_p95_mps:.1f}, max "
                      f"{t.speed_max_mps:.1f} m/s against the training drives' {tr.speed_p50_mps:.1f}, "
-                     f"{tr.speed_p95_mps:.1f}, {tr.speed_max_mps:.1f} m/s; turn rate 95th percentile "
-                     f"{t.turn_p95_dps:.1f} against {tr.turn_p95_dps:.1f} deg/s; {int(f['out_of_range'].sum())} of "
-                     f"{len(f)} outages of {f['duration_s'].max():g} s outside the training speeds.")
+                     f"{tr.speed_p95_mps:.1f}, {tr.speed_max_mps:.1f} m/s; {turn}; of {len(f)} outages of "
+                     f"{f['duration_s'].max():g} s, {int(f['speed_out_of_range'].sum())} outside the training speeds "
+                     f"and {int(f['turn_out_of_range'].sum())} outside their turn rates.")
     return lines
 
 

@@ -7,6 +7,7 @@ IMU is tilted, rescaled and biased differently; only the speed path is run here 
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from bgfn.errors import DataError
@@ -180,8 +181,6 @@ def test_holm_on_a_hand_example():
 def test_fleet_summary_pools_drives_and_adjusts_per_family():
     """Hand-made rows of two test drives whose starts share their times: pooled, each start stays its own drive's;
     two learned odometers form the Holm family; the out-of-range outages are summarized apart."""
-    import pandas as pd
-
     from bgfn.stats import wilcoxon_p
     from bgfn.studies.fleet.summary import fleet_summary
 
@@ -231,3 +230,55 @@ def test_a_fleet_section_that_cannot_run_is_one_error_naming_the_key(params):
         (params / f"{name}.yaml").write_text(f"profile: {name}\nbase: smoke\ndescription: x\n{body}\n")
         with pytest.raises(DataError, match=key.replace(".", r"\.")):
             load_profile(name)
+
+
+def curve_config(networks: bool) -> dict:
+    """The smoke profile's budgets with one tiny MLP odometer, and the fleet's curve with or without networks."""
+    from bgfn.profile_schema import load_profile
+
+    cfg = load_profile("smoke")
+    oc = {**cfg["evaluate"]["odometer"], "methods": ["mlp"], "network_seeds": [0], "network_datasets": None,
+          "lr_search": False, "inputs": "band_frames"}
+    return {**cfg, "evaluate": {**cfg["evaluate"], "odometer": oc},
+            "fleet": {**FLEET, "networks": networks, "curve_networks": networks}}
+
+
+def curve_test_drive(p):
+    """What the curve's speed rows read of a test drive, without its filter: windows, truth, outages of 30 s."""
+    from types import SimpleNamespace
+
+    windows = fp.drive_windows(p, fp.aid_epochs(p.label_time[0], p.label_time[-1], 1.0), 2.0, False)
+    return SimpleNamespace(name=p.name, prepared=p, windows=windows,
+                           truth=fd.reference_speed_at(p.drive, windows.t_end),
+                           outages=[(float(s), 30.0) for s in np.arange(50.0, 200.0, 30.0)])
+
+
+def test_the_learning_curve_trains_the_networks_per_training_set(fleet, monkeypatch, tmp_path):
+    """Training sets {1}, {2}, {1, 2} for test drive 3: RIDGE-ODO and MLP-ODO per set, the MLP trained per set
+    (a checkpoint folder each) except the full set, whose tracks the split already has (reused as given); the
+    minutes double with the drives; without curve_networks only the ridge, and nothing trained."""
+    from bgfn import config
+
+    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)
+    _, prepared = fleet
+    by_name = {p.name: p for p in prepared[:3]}
+    test, train = curve_test_drive(prepared[2]), [prepared[0].name, prepared[1].name]
+    cfg = curve_config(True)
+    given = fp.ridge_track(fp.fit_ridge(fp.pooled_speed_data(prepared[:2], PARAMS), 100.0, PARAMS), test.windows, PARAMS)
+    full = {("RIDGE-ODO", 0): given, ("MLP-ODO", 0): given}         # the split's own tracks, stand-ins here
+    sets = fp.curve_tracks(cfg, "p", "fleet-test3", test, by_name, train, PARAMS, None, full)
+    assert [len(c) for c, _, _ in sets] == [1, 1, 2]
+    assert all(set(learned) == {("RIDGE-ODO", 0), ("MLP-ODO", 0)} for _, _, learned in sets)
+    assert sets[2][2][("MLP-ODO", 0)] is given                        # the full set: taken as given, not retrained
+    trained = sorted(p.name for p in tmp_path.glob("p/models/*") if p.is_dir())
+    assert len(trained) == 2 and all("curve" in n for n in trained), trained
+    rows = pd.DataFrame(fp.curve_speed_rows(test, sets, 30.0, 1.0))
+    assert len(rows) == 6 and set(rows["method"]) == {"RIDGE-ODO", "MLP-ODO"}
+    one, two = rows.loc[rows["n_train"] == 1, "train_min"], rows.loc[rows["n_train"] == 2, "train_min"]
+    assert two.iloc[0] == pytest.approx(one.iloc[0] + one.iloc[2], rel=0.05)    # drives 1 and 2: their minutes add
+    assert rows["offset_rms_mps"].notna().all() and rows["speed_rmse_mps"].notna().all()
+    ridge = rows[rows["method"] == "RIDGE-ODO"]
+    assert (ridge["offset_rms_mps"] < 1.0).all()                      # the speed comes back from either drive
+    plain = fp.curve_tracks(curve_config(False), "q", "fleet-test3", test, by_name, train, PARAMS, None, full)
+    assert all(set(learned) == {("RIDGE-ODO", 0)} for _, _, learned in plain)
+    assert not (tmp_path / "q").exists()

@@ -353,6 +353,8 @@ class Fleet(Section):
                                            "outside the training drives' speeds")
     networks: bool = _f(False, "the odometer networks too (evaluate.odometer.methods; false: RIDGE-ODO only)")
     curve: bool = _f(True, "the learning curve (1 .. N-1 training drives)")
+    curve_networks: bool = _f(False, "the networks in the learning curve too, with networks (each training set "
+                                     "trains them again; false: RIDGE-ODO's curve only)")
     curve_max_combinations: Count = _f(10, "learning curve: every combination of training drives, else this many "
                                            "drawn per size")
     curve_seed: Seed = _f(0, "the draw of those combinations")

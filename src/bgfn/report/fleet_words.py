@@ -135,35 +135,44 @@ def coverage_lines(motion: pd.DataFrame, flags: pd.DataFrame) -> list[str]:
 
 
 def curve_lines(curve: pd.DataFrame) -> list[str]:
-    """The learning curve per number of training drives: the median over test drives and training sets."""
+    """The learning curve per learned odometer and number of training drives: the median over test drives, training
+    sets and seeds."""
     if curve.empty:
         return []
-    g = curve.groupby("n_train").agg(minutes=("train_min", "median"), offset=("offset_rms_mps", "median"),
+    lines = []
+    for method, c in curve.groupby("method", sort=False):
+        g = c.groupby("n_train").agg(minutes=("train_min", "median"), offset=("offset_rms_mps", "median"),
                                      rmse=("speed_rmse_mps", "median"), maxh=("median_max_h_m", "median"),
                                      sets=("offset_rms_mps", "size"))
-    return ["RIDGE-ODO against its training data (median over the test drives and training sets): "
-            + "; ".join(f"{n} drive{'s' if n > 1 else ''} ({r.minutes:.1f} min, {int(r.sets)} sets): offset per "
-                        f"outage {r.offset:.2f} m/s, speed RMSE {r.rmse:.2f} m/s, median max error {r.maxh:.1f} m"
-                        for n, r in g.iterrows()) + "."]
+        lines.append(f"{method} against its training data (median over the test drives, training sets and seeds): "
+                     + "; ".join(f"{n} drive{'s' if n > 1 else ''} ({r.minutes:.1f} min, {int(r.sets)} sets): offset "
+                                 f"per outage {r.offset:.2f} m/s, speed RMSE {r.rmse:.2f} m/s, median max error "
+                                 f"{r.maxh:.1f} m" for n, r in g.iterrows()) + ".")
+    return lines
 
 
 def plot_curve(curve: pd.DataFrame):
     """The learning curve: the offset per outage, the speed RMSE and the median max error against training minutes,
-    a dot per training set, a line per test drive through the medians per number of training drives."""
+    a dot per training set (and seed), a line per test drive and learned odometer through the medians per number of
+    training drives."""
     fig, axes = plt.subplots(1, 3, figsize=(10, 3.2))
     cols = [("offset_rms_mps", "offset per outage, RMS (m/s)"), ("speed_rmse_mps", "speed RMSE (m/s)"),
             ("median_max_h_m", "median max error (m)")]
+    methods = list(dict.fromkeys(curve["method"]))
+    styles = dict(zip(methods, ["-", "--", ":", "-."] * len(methods)))
     for ax, (c, label) in zip(axes, cols):
-        for test, g in curve.groupby("test_drive", sort=False):
+        for (test, method), g in curve.groupby(["test_drive", "method"], sort=False):
             # each training set a dot, the line through the median per number of training drives
             med = g.groupby("n_train")[["train_min", c]].median()
-            line = ax.plot(med["train_min"], med[c], "-", lw=1.2, label=test)[0]
+            name = test if len(methods) == 1 else f"{test}, {method}"
+            line = ax.plot(med["train_min"], med[c], styles[method], lw=1.2, label=name)[0]
             ax.plot(g["train_min"], g[c], "o", ms=3, alpha=0.6, color=line.get_color())
         ax.set_xlabel("training minutes")
         ax.set_ylabel(label)
         ax.set_ylim(bottom=0)
     axes[0].legend(fontsize=6)
-    fig.suptitle("RIDGE-ODO on drives it never saw, against the minutes it trained on", fontsize=9)
+    who = methods[0] if len(methods) == 1 else "The learned odometers"
+    fig.suptitle(f"{who} on drives never seen, against the minutes trained on", fontsize=9)
     fig.tight_layout()
     return fig
 

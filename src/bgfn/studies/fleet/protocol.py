@@ -236,32 +236,64 @@ def curve_combinations(train: list[str], fleet: dict) -> list[tuple[str, ...]]:
     return out
 
 
-def curve_rows(test: TestDrive, by_name: dict, train: list[str], fleet: dict, params: dict, oc: dict,
-               pseudo: dict, runner: Runner | None) -> pd.DataFrame:
-    """The ridge's learning curve on one test drive (:data:`CURVE_COLUMNS`): per training set of
-    :func:`curve_combinations`, its training minutes, the offset per outage and the speed RMSE in the test's outages
-    over their first ``curve_duration_s``, and the median max horizontal error there."""
-    d = float(fleet["curve_duration_s"])
-    runs, tracks, facts = [], {}, []
+def curve_tracks(cfg: dict, profile: str, key: str, test, by_name: dict, train: list[str], params: dict,
+                 runner: Runner | None, full: dict | None = None) -> list[tuple[tuple[str, ...], lo.SpeedData, dict]]:
+    """Per training set of :func:`curve_combinations`: its drives, its pooled data and the learned tracks over the
+    test drive's windows (``test.windows``, ``test.prepared``), ``{(label, seed): SpeedTrack}``: ``RIDGE-ODO``, and
+    with ``fleet.networks`` and ``fleet.curve_networks`` the networks (:func:`network_tracks`, checkpoints under
+    ``<key>-curve<i>``); ``full``: the tracks already trained on all of ``train`` (the split's), taken as they are
+    for that set."""
+    fleet, out = cfg["fleet"], []
+    networks = bool(fleet["networks"] and fleet["curve_networks"])
     for i, combo in enumerate(curve_combinations(train, fleet)):
         data = pooled_speed_data([by_name[n] for n in combo], params)
-        track = ridge_track(fit_ridge(data, test.prepared.rate_hz, params), test.windows, params)
-        runs.append(bars.OdometerRun(f"{test.name} curve {i} {bars.RIDGE}", test.outages,
-                                     no.Odometer(test.con, track, oc["gate_probability"]), bars.RIDGE, np.nan, 0, i))
+        if full is not None and set(combo) == set(train):
+            out.append((combo, data, {k: v for k, v in full.items() if networks or k[0] == bars.RIDGE}))
+            continue
+        learned = {(bars.RIDGE, 0): ridge_track(fit_ridge(data, test.prepared.rate_hz, params), test.windows, params)}
+        if networks:
+            learned.update(network_tracks(cfg, profile, f"{key}-curve{i + 1}", data, test, runner))
+        out.append((combo, data, learned))
+    return out
+
+
+def curve_speed_rows(test, sets: list, duration: float, aid_rate_hz: float) -> list[dict]:
+    """Per training set of :func:`curve_tracks` and learned track: the test drive, the method and seed, the training
+    drives and minutes, the offset per outage and the speed RMSE in the test's outages (``test.outages``) over
+    their first ``duration`` s (:func:`bgfn.studies.odometer.errors.error_parts_table`)."""
+    rows = []
+    for combo, data, learned in sets:
+        for (label, seed), track in learned.items():
+            series = speed_series(test.windows.t_end, test.truth, test.outages, {label: track})
+            parts = error_parts_table(test.name, series, [duration])
+            rows.append({"test_drive": test.name, "method": label, "seed": int(seed), "n_train": len(combo),
+                         "train_drives": "; ".join(combo), "train_min": training_minutes(data, aid_rate_hz),
+                         "offset_rms_mps": float(parts["offset_rms_mps"].iloc[0]) if len(parts) else np.nan,
+                         "speed_rmse_mps": float(parts["speed_rmse_mps"].iloc[0]) if len(parts) else np.nan})
+    return rows
+
+
+def curve_rows(cfg: dict, profile: str, key: str, test: TestDrive, by_name: dict, train: list[str], params: dict,
+               runner: Runner | None, full: dict | None = None) -> pd.DataFrame:
+    """The learning curve on one test drive (:data:`CURVE_COLUMNS`): per training set and learned odometer
+    (:func:`curve_tracks`), its training minutes, the offset per outage and the speed RMSE in the test's outages over
+    their first ``fleet.curve_duration_s`` (:func:`curve_speed_rows`), and the median max horizontal error there."""
+    d, oc = float(cfg["fleet"]["curve_duration_s"]), cfg["evaluate"]["odometer"]
+    sets = curve_tracks(cfg, profile, key, test, by_name, train, params, runner, full)
+    facts = curve_speed_rows(test, sets, d, params["aid_rate_hz"])
+    runs, tracks = [], {}
+    for j, (label, seed, track) in enumerate((lb, sd, tk) for _, _, learned in sets
+                                             for (lb, sd), tk in learned.items()):
+        runs.append(bars.OdometerRun(f"{test.name} curve {j} {label} seed {seed}", test.outages,
+                                     no.Odometer(test.con, track, oc["gate_probability"]), label, np.nan, int(seed), j))
         tracks[runs[-1].label] = track
-        series = speed_series(test.windows.t_end, test.truth, test.outages, {bars.RIDGE: track})
-        parts = error_parts_table(test.name, series, [d])
-        facts.append({"test_drive": test.name, "n_train": len(combo), "train_drives": "; ".join(combo),
-                      "train_min": training_minutes(data, params["aid_rate_hz"]),
-                      "offset_rms_mps": float(parts["offset_rms_mps"].iloc[0]) if len(parts) else np.nan,
-                      "speed_rmse_mps": float(parts["speed_rmse_mps"].iloc[0]) if len(parts) else np.nan})
-    rows = run_rows(test, runs, tracks, pseudo, runner, [d])
+    rows = run_rows(test, runs, tracks, cfg["evaluate"]["pseudo_gps"], runner, [d])
     med = rows.groupby("fold")["max_h_m"].median()
-    for i, f in enumerate(facts):
-        f["median_max_h_m"] = float(med.get(i, np.nan))
+    for j, f in enumerate(facts):
+        f["median_max_h_m"] = float(med.get(j, np.nan))
     return pd.DataFrame(facts, columns=list(CURVE_COLUMNS))
 
 
 #: Columns of ``tables/fleet_curve.csv`` (:func:`curve_rows`).
-CURVE_COLUMNS: tuple[str, ...] = ("test_drive", "n_train", "train_drives", "train_min", "offset_rms_mps",
-                                  "speed_rmse_mps", "median_max_h_m")
+CURVE_COLUMNS: tuple[str, ...] = ("test_drive", "method", "seed", "n_train", "train_drives", "train_min",
+                                  "offset_rms_mps", "speed_rmse_mps", "median_max_h_m")

@@ -87,7 +87,8 @@ def run_fleet(cfg: dict, profile: str, runner: Runner | None = None, drives=None
                             cv.turn_rate_at(by_name[test_name], test.windows.t_end, params["window_s"]), lo_w, hi_w)
         flags.append(f)
         if fleet["curve"]:
-            curves.append(fp.curve_rows(test, by_name, train, fleet, params, oc, ecfg["pseudo_gps"], runner))
+            curves.append(fp.curve_rows(cfg, profile, f"fleet-test{i + 1}", test, by_name, train, params, runner,
+                                        full=learned))
         longest = f[f["duration_s"] == test.dmax]
         split_rows.append({"test_drive": test_name, "train_drives": "; ".join(train),
                            "train_min": fp.training_minutes(data, params["aid_rate_hz"]),

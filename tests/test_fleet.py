@@ -282,3 +282,27 @@ def test_the_learning_curve_trains_the_networks_per_training_set(fleet, monkeypa
     plain = fp.curve_tracks(curve_config(False), "q", "fleet-test3", test, by_name, train, PARAMS, None, full)
     assert all(set(learned) == {("RIDGE-ODO", 0)} for _, _, learned in plain)
     assert not (tmp_path / "q").exists()
+
+
+def test_sigma_judged_on_epochs_and_on_outage_means():
+    """Two hundred 60 s outages at 1 Hz, every std 1 m/s. White errors of std 1: 95 % of epochs and of outage means within
+    2 sigma (the mean's sigma 1/sqrt(60)). An offset per outage of std 1: the epochs still look calibrated (95 %),
+    the means do not (|b| < 0.26 m/s: about 20 %), unless the track's correlation says the 60 epochs are one
+    (kappa 60: the mean's sigma 1 m/s, 95 % again)."""
+    from bgfn.nav.odometer import SpeedTrack
+    from bgfn.studies.fleet.summary import sigma_table
+
+    rng = np.random.default_rng(3)
+    t = np.arange(20000.0)
+    truth = np.full(t.size, 10.0)
+    outages = [(100.0 * k, 60.0) for k in range(200)]
+    offsets = np.repeat(rng.standard_normal(200), 100)
+    tracks = {"white": SpeedTrack(t, truth + rng.standard_normal(t.size), np.ones(t.size)),
+              "offset": SpeedTrack(t, truth + offsets, np.ones(t.size)),
+              "offset, kappa 60": SpeedTrack(t, truth + offsets, np.ones(t.size), 60.0)}
+    s = sigma_table("d", fp.speed_series(t, truth, outages, tracks), [60.0]).set_index("method")
+    assert s.loc["white", "epoch_within_2sigma"] == pytest.approx(0.95, abs=0.02)
+    assert s.loc["white", "mean_within_2sigma"] >= 0.85
+    assert s.loc["offset", "epoch_within_2sigma"] == pytest.approx(0.95, abs=0.04)
+    assert s.loc["offset", "mean_within_2sigma"] <= 0.35
+    assert s.loc["offset, kappa 60", "mean_within_2sigma"] >= 0.85

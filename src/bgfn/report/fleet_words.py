@@ -55,6 +55,10 @@ def _num(v, fmt: str = ".2f") -> str:
     return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, fmt)
 
 
+def _pct(v) -> str:
+    return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{100.0 * v:.0f} %"
+
+
 def preparation_lines(prep: pd.DataFrame) -> list[str]:
     """Per drive: how it was made comparable (levelling, scale, gyro bias, rate, bandwidth, label)."""
     lines = []
@@ -96,7 +100,8 @@ def fleet_markdown(summary: pd.DataFrame, speed_range: str = "all") -> str:
 
 def verdict_lines(summary: pd.DataFrame, offsets: pd.DataFrame) -> list[str]:
     """Per test drive and pooled, at the longest duration: RIDGE-ODO's median max error against INS+NHC (ratio,
-    Wilcoxon p, Holm-adjusted p) and its offset per outage against the held speed's."""
+    Wilcoxon p, Holm-adjusted p), its offset per outage against the held speed's, and its sigma judged on the epochs
+    and on the outages' means."""
     s = summary[summary["speed_range"] == "all"]
     if s.empty:
         return []
@@ -111,6 +116,11 @@ def verdict_lines(summary: pd.DataFrame, offsets: pd.DataFrame) -> list[str]:
         off = {m: o.loc[o["method"] == m, "offset_rms_mps"] for m in (RIDGE, HOLD)}
         off_text = (f"; its offset per outage {off[RIDGE].iloc[0]:.2f} m/s RMS against the held speed's "
                     f"{off[HOLD].iloc[0]:.2f} m/s" if len(off[RIDGE]) and len(off[HOLD]) else "")
+        sig = o[o["method"] == RIDGE]
+        if len(sig) and "mean_within_2sigma" in sig:
+            off_text += (f"; within its 2 sigma: {_pct(sig['epoch_within_2sigma'].iloc[0])} of the epochs' speed "
+                         f"errors, {_pct(sig['mean_within_2sigma'].iloc[0])} of the outages' mean errors (the mean's "
+                         "sigma as the filter weighs it)")
         lines.append(f"{drive_words(ds)}, {d:g} s outages ({int(r['runs'])}): {RIDGE} {r['max_h_m']:.1f} m against "
                      f"{nhc_label('INS')} {n['max_h_m']:.1f} m (median per-start ratio {r['ratio_to_nhc']:.2f}, "
                      f"Wilcoxon p {_num(r['p_vs_nhc'])}, Holm-adjusted {_num(r['p_vs_nhc_holm'])}){off_text}.")

@@ -109,15 +109,16 @@ def ridge_track(model: lo.RidgeOdometer, windows: lo.SpeedWindows, params: dict)
 
 def speed_series(t, truth, outages, tracks: dict) -> dict:
     """The honest speed series of :func:`bgfn.studies.odometer.errors.error_parts_table`: each track's speed and std
-    inside the ``outages`` ``[(start, duration), ...]``, NaN elsewhere."""
+    inside the ``outages`` ``[(start, duration), ...]``, NaN elsewhere; and ``fused_std``: the std the filter fuses
+    each speed with (:meth:`bgfn.nav.odometer.SpeedTrack.fused_std`), which the window means are judged by."""
     t, truth = np.asarray(t, dtype=float), np.asarray(truth, dtype=float)
     inside = overlaps(t, t, np.array([[s, s + d] for s, d in outages], dtype=float).reshape(-1, 2))
-    out = {}
+    out, fused = {}, {}
     for label, track in tracks.items():
         speed, std = np.full(t.size, np.nan), np.full(t.size, np.nan)
         speed[inside], std[inside] = track.at(t[inside])
-        out[label] = (speed, std)
-    return {"time": t, "truth": truth, "outages": list(outages), "tracks": out}
+        out[label], fused[label] = (speed, std), track.fused_std(std)
+    return {"time": t, "truth": truth, "outages": list(outages), "tracks": out, "fused_std": fused}
 
 
 def held_track(epochs, starts, duration: float, speed_at_start, std: float) -> no.SpeedTrack:

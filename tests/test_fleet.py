@@ -306,3 +306,58 @@ def test_sigma_judged_on_epochs_and_on_outage_means():
     assert s.loc["offset", "epoch_within_2sigma"] == pytest.approx(0.95, abs=0.04)
     assert s.loc["offset", "mean_within_2sigma"] <= 0.35
     assert s.loc["offset, kappa 60", "mean_within_2sigma"] >= 0.85
+
+
+def test_each_network_reads_its_own_inputs_with_one_budget(fleet, monkeypatch):
+    """fleet.inputs {bgfn: imu}: BGFN is trained on the raw IMU windows, its ANN twin on band frames (the default),
+    both under the same odometer budget; each test track comes back under its own network's label."""
+    from bgfn.learning import odometry as lo
+    from bgfn.studies.odometer import bars
+
+    calls = []
+
+    def fake(cfg, profile, key, ecfg, data, windows, runner=None):
+        oc = ecfg["odometer"]
+        calls.append((tuple(oc["methods"]), oc["inputs"], data[0].options["inputs"], windows.x.ndim,
+                      windows.x.shape[-1], bars.odometer_train_config(cfg["train"], ecfg)))
+        return {(bars.odometer_label(m), 0, 0): (m, {}) for m in oc["methods"]}
+
+    monkeypatch.setattr(bars, "network_odometers", fake)
+    _, prepared = fleet
+    cfg = curve_config(True)
+    cfg = {**cfg, "evaluate": {**cfg["evaluate"], "odometer": {**cfg["evaluate"]["odometer"],
+                                                                "methods": ["bgfn", "transformer"]}},
+           "fleet": {**cfg["fleet"], "inputs": {"bgfn": "imu"}}}
+    assert fp.network_inputs(cfg) == {"bgfn": "imu", "transformer": "band_frames"}
+    tracks = fp.network_tracks(cfg, "p", "k", fp.pooled_speed_data(prepared[:2], PARAMS), curve_test_drive(prepared[2]),
+                               None)
+    assert tracks == {("BGFN-ODO", 0): "bgfn", (bars.odometer_label("transformer"), 0): "transformer"}
+    (m_imu, in_imu, opt_imu, _, ch_imu, budget_imu), (m_band, in_band, opt_band, _, ch_band, budget_band) = calls
+    assert (m_imu, in_imu, opt_imu, ch_imu) == (("bgfn",), "imu", "imu", 6)                  # six raw channels
+    assert (m_band, in_band, opt_band) == (("transformer",), "band_frames", "band_frames") and ch_band != 6
+    assert budget_imu == budget_band                                                           # one budget
+
+
+def test_the_book_has_a_fleet_page_for_every_profile(tmp_path):
+    """The table of contents lists notebook 11 under "Beyond the paper"; make book copies it where it ran and
+    otherwise writes a page under the notebook's own title saying that the study did not run (and why)."""
+    import json
+
+    from bgfn.config import PROJECT_ROOT
+    from bgfn.report import book_notebooks, fleet_words
+
+    toc = (PROJECT_ROOT / "book" / "_toc.yml").read_text()
+    beyond = toc.split("caption: Beyond the paper")[1].split("caption:")[0]
+    assert "file: notebooks/11_fleet" in beyond
+    make = (PROJECT_ROOT / "Makefile").read_text()
+    assert "cp $(EXEC) book/notebooks/" in make and "--absent book/notebooks" in make
+    nb = json.loads((PROJECT_ROOT / "notebooks" / "11_fleet.ipynb").read_text())
+    assert "".join(nb["cells"][0]["source"]).splitlines()[0] == f"# {fleet_words.FLEET_PAGE_TITLE}"
+    written = book_notebooks.absent_pages(tmp_path, "quick")
+    assert written == [tmp_path / "11_fleet.md"]
+    page = written[0].read_text()
+    assert page.startswith(f"# {fleet_words.FLEET_PAGE_TITLE}\n") and "`quick`" in page and "did not run" in page
+    ran = tmp_path / "ran"
+    ran.mkdir()
+    (ran / "11_fleet.ipynb").write_text("{}")
+    assert book_notebooks.absent_pages(ran, "fleet") == [] and not (ran / "11_fleet.md").exists()

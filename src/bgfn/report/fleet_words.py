@@ -10,7 +10,7 @@ import pandas as pd
 
 from bgfn.paper import nhc_label
 from bgfn.studies.fleet.summary import POOLED
-from bgfn.studies.odometer.bars import HOLD, RIDGE
+from bgfn.studies.odometer.bars import HOLD, RIDGE, odometer_label
 from bgfn.studies.odometer.section import odometer_table
 
 #: The ``speed_range`` codes in words.
@@ -25,13 +25,18 @@ def drive_words(name: str) -> str:
     return POOLED_WORDS if name == POOLED else name
 
 
+#: What a network reads (``fleet.inputs``, ``evaluate.odometer.inputs``) in words.
+INPUT_WORDS = {"imu": "the raw IMU window", "band_frames": "band frames"}
+
+
 def fleet_title(facts: dict) -> str:
-    """What the fleet is, in one line: pieces of one drive are said to be that."""
+    """What the fleet is, in one line: pieces of one drive are said to be that; and what each network reads."""
+    reads = "".join(f" {odometer_label(m)} reads {INPUT_WORDS.get(i, i)}." for m, i in (facts.get("inputs") or {}).items())
     if facts.get("pieces"):
         return (f"A stand-in for a fleet: one drive cut into {facts['pieces']} contiguous pieces (pieces of one drive, "
                 "one mount and one day, not drives of a fleet); protocol "
-                f"{facts['protocol'].replace('_', '-')}, at {facts['rate_hz']:g} Hz.")
-    return f"A fleet of drives; protocol {facts['protocol'].replace('_', '-')}, at {facts['rate_hz']:g} Hz."
+                f"{facts['protocol'].replace('_', '-')}, at {facts['rate_hz']:g} Hz.{reads}")
+    return f"A fleet of drives; protocol {facts['protocol'].replace('_', '-')}, at {facts['rate_hz']:g} Hz.{reads}"
 
 
 #: The fleet page's title (notebook 11's first line): the book's page says it when the study did not run.

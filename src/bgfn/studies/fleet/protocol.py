@@ -204,18 +204,30 @@ def run_rows(test: TestDrive, runs: list, tracks: dict, pseudo: dict, runner: Ru
     return pd.DataFrame(rows, columns=list(bars.ODOMETER_COLUMNS))
 
 
-def network_tracks(cfg: dict, profile: str, key: str, data: lo.SpeedData, test: TestDrive,
-                   runner: Runner | None) -> dict:
+def network_inputs(cfg: dict) -> dict[str, str]:
+    """What each network of ``evaluate.odometer.methods`` reads: ``fleet.inputs``' choice, else
+    ``evaluate.odometer.inputs`` (the raw IMU window or its band frames, :func:`bgfn.learning.odometry.network_inputs`)."""
+    oc, chosen = cfg["evaluate"]["odometer"], (cfg.get("fleet") or {}).get("inputs") or {}
+    return {m: chosen.get(m, oc["inputs"]) for m in oc["methods"]}
+
+
+def network_tracks(cfg: dict, profile: str, key: str, data: lo.SpeedData, test, runner: Runner | None) -> dict:
     """The odometer networks (``evaluate.odometer.methods``, their seeds and ensembles) trained on the pooled
     ``data`` as one fold and run over the test drive's windows (:func:`bgfn.studies.odometer.bars.network_odometers`;
-    checkpoints under the model key ``key``): ``{(label, seed): SpeedTrack}``."""
-    ecfg = cfg["evaluate"]
-    oc = {**ecfg["odometer"], "network_datasets": None}
-    rate = test.prepared.rate_hz
-    nets = bars.network_odometers(cfg, profile, key, {**ecfg, "odometer": oc},
-                                  {0: lo.with_inputs(data, oc["inputs"], rate)},
-                                  lo.network_inputs(test.windows, oc["inputs"], rate), runner)
-    return {(label, seed): track for (label, _, seed), (track, _) in nets.items()}
+    checkpoints under the model key ``key``), each on its inputs (:func:`network_inputs`), all with one budget:
+    ``{(label, seed): SpeedTrack}``."""
+    ecfg, rate = cfg["evaluate"], test.prepared.rate_hz
+    groups: dict[str, list[str]] = {}
+    for m, inputs in network_inputs(cfg).items():
+        groups.setdefault(inputs, []).append(m)
+    out = {}
+    for inputs, methods in groups.items():
+        oc = {**ecfg["odometer"], "network_datasets": None, "methods": methods, "inputs": inputs}
+        nets = bars.network_odometers(cfg, profile, key, {**ecfg, "odometer": oc},
+                                      {0: lo.with_inputs(data, inputs, rate)},
+                                      lo.network_inputs(test.windows, inputs, rate), runner)
+        out.update({(label, seed): track for (label, _, seed), (track, _) in nets.items()})
+    return out
 
 
 def training_minutes(data: lo.SpeedData, aid_rate_hz: float) -> float:

@@ -108,7 +108,8 @@ def run_fleet(cfg: dict, profile: str, runner: Runner | None = None, drives=None
         motion=cv.motion_table(splits, by_name, params["window_s"]), flags=flags_all,
         curve=pd.concat(curves, ignore_index=True) if curves else pd.DataFrame(columns=list(fp.CURVE_COLUMNS)),
         facts={"wall_s": time.perf_counter() - t0, "pieces": fleet.get("pieces"), "protocol": fleet["protocol"],
-               "rate_hz": float(np.unique([p.rate_hz for p in prepared])[0]), "networks": bool(fleet["networks"])})
+               "rate_hz": float(np.unique([p.rate_hz for p in prepared])[0]), "networks": bool(fleet["networks"]),
+               "inputs": fp.network_inputs(cfg) if fleet["networks"] else {}})
 
 
 #: ``results/<profile>/tables/`` file of each table of a :class:`FleetResult`.

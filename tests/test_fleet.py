@@ -361,3 +361,24 @@ def test_the_book_has_a_fleet_page_for_every_profile(tmp_path):
     ran.mkdir()
     (ran / "11_fleet.ipynb").write_text("{}")
     assert book_notebooks.absent_pages(ran, "fleet") == [] and not (ran / "11_fleet.md").exists()
+
+
+def test_the_verdict_names_every_learned_odometer_with_its_offset_and_sigma():
+    """One test drive with RIDGE-ODO and BGFN-ODO in the table: a line each, with its own numbers."""
+    from bgfn.report.fleet_words import verdict_lines
+    from bgfn.studies.fleet.summary import FLEET_SUMMARY_COLUMNS, OFFSET_COLUMNS
+
+    base = {c: np.nan for c in FLEET_SUMMARY_COLUMNS}
+    summary = pd.DataFrame([{**base, "speed_range": "all", "dataset": "d", "method": m, "duration_s": 60.0,
+                             "runs": 6, "max_h_m": e, "ratio_to_nhc": e / 50.0, "p_vs_nhc": p, "p_vs_nhc_holm": q}
+                            for m, e, p, q in (("INS+NHC", 50.0, np.nan, np.nan), ("RIDGE-ODO", 40.0, 0.03, 0.06),
+                                               ("BGFN-ODO", 60.0, 0.5, 0.5))])
+    offsets = pd.DataFrame([{**{c: np.nan for c in OFFSET_COLUMNS}, "speed_range": "all", "dataset": "d",
+                             "method": m, "duration_s": 60.0, "offset_rms_mps": off, "epoch_within_2sigma": ep,
+                             "mean_within_2sigma": mn}
+                            for m, off, ep, mn in (("RIDGE-ODO", 0.8, 0.9, 0.5), ("BGFN-ODO", 1.6, 0.95, 1 / 3),
+                                                   ("INS+NHC+HOLD", 3.0, 0.5, 0.0))])
+    ridge, bgfn = verdict_lines(summary, offsets)
+    assert ridge.startswith("d, 60 s outages (6): RIDGE-ODO 40.0 m against INS+NHC 50.0 m")
+    assert "p 0.03, Holm-adjusted 0.06" in ridge and "0.80 m/s RMS against the held speed's 3.00" in ridge
+    assert "BGFN-ODO 60.0 m" in bgfn and "1.60 m/s RMS" in bgfn and "95 % of the epochs" in bgfn and "33 % of" in bgfn

@@ -9,6 +9,7 @@ import matplotlib.pyplot as plt
 import pandas as pd
 
 from bgfn.paper import nhc_label
+from bgfn.studies.fleet.protocol import LEARNED
 from bgfn.studies.fleet.summary import POOLED
 from bgfn.studies.odometer.bars import HOLD, RIDGE, odometer_label
 from bgfn.studies.odometer.section import odometer_table
@@ -104,31 +105,34 @@ def fleet_markdown(summary: pd.DataFrame, speed_range: str = "all") -> str:
 
 
 def verdict_lines(summary: pd.DataFrame, offsets: pd.DataFrame) -> list[str]:
-    """Per test drive and pooled, at the longest duration: RIDGE-ODO's median max error against INS+NHC (ratio,
-    Wilcoxon p, Holm-adjusted p), its offset per outage against the held speed's, and its sigma judged on the epochs
-    and on the outages' means."""
+    """Per test drive and pooled, at the longest duration, for every learned odometer of the table (RIDGE-ODO, each
+    network, each ensemble): its median max error against INS+NHC (ratio, Wilcoxon p, Holm-adjusted p), its offset
+    per outage against the held speed's, and its sigma judged on the epochs and on the outages' means."""
     s = summary[summary["speed_range"] == "all"]
     if s.empty:
         return []
     d = float(s["duration_s"].max())
     lines = []
     for ds, g in s[s["duration_s"] == d].groupby("dataset", sort=False):
-        r, n = g[g["method"] == RIDGE], g[g["method"] == nhc_label("INS")]
-        if r.empty or n.empty:
+        n = g[g["method"] == nhc_label("INS")]
+        if n.empty:
             continue
-        r, n = r.iloc[0], n.iloc[0]
+        n = n.iloc[0]
         o = offsets[(offsets["speed_range"] == "all") & (offsets["dataset"] == ds) & (offsets["duration_s"] == d)]
-        off = {m: o.loc[o["method"] == m, "offset_rms_mps"] for m in (RIDGE, HOLD)}
-        off_text = (f"; its offset per outage {off[RIDGE].iloc[0]:.2f} m/s RMS against the held speed's "
-                    f"{off[HOLD].iloc[0]:.2f} m/s" if len(off[RIDGE]) and len(off[HOLD]) else "")
-        sig = o[o["method"] == RIDGE]
-        if len(sig) and "mean_within_2sigma" in sig:
-            off_text += (f"; within its 2 sigma: {_pct(sig['epoch_within_2sigma'].iloc[0])} of the epochs' speed "
-                         f"errors, {_pct(sig['mean_within_2sigma'].iloc[0])} of the outages' mean errors (the mean's "
-                         "sigma as the filter weighs it)")
-        lines.append(f"{drive_words(ds)}, {d:g} s outages ({int(r['runs'])}): {RIDGE} {r['max_h_m']:.1f} m against "
-                     f"{nhc_label('INS')} {n['max_h_m']:.1f} m (median per-start ratio {r['ratio_to_nhc']:.2f}, "
-                     f"Wilcoxon p {_num(r['p_vs_nhc'])}, Holm-adjusted {_num(r['p_vs_nhc_holm'])}){off_text}.")
+        held = o.loc[o["method"] == HOLD, "offset_rms_mps"]
+        for method in (m for m in LEARNED if m in set(g["method"])):
+            r = g[g["method"] == method].iloc[0]
+            own = o[o["method"] == method]
+            off_text = (f"; its offset per outage {own['offset_rms_mps'].iloc[0]:.2f} m/s RMS against the held "
+                        f"speed's {held.iloc[0]:.2f} m/s" if len(own) and len(held) else "")
+            if len(own) and "mean_within_2sigma" in own:
+                off_text += (f"; within its 2 sigma: {_pct(own['epoch_within_2sigma'].iloc[0])} of the epochs' "
+                             f"speed errors, {_pct(own['mean_within_2sigma'].iloc[0])} of the outages' mean errors "
+                             "(the mean's sigma as the filter weighs it)")
+            lines.append(f"{drive_words(ds)}, {d:g} s outages ({int(r['runs'])}): {method} {r['max_h_m']:.1f} m "
+                         f"against {nhc_label('INS')} {n['max_h_m']:.1f} m (median per-start ratio "
+                         f"{r['ratio_to_nhc']:.2f}, Wilcoxon p {_num(r['p_vs_nhc'])}, Holm-adjusted "
+                         f"{_num(r['p_vs_nhc_holm'])}){off_text}.")
     return lines
 
 

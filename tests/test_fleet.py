@@ -226,7 +226,10 @@ def test_a_fleet_section_that_cannot_run_is_one_error_naming_the_key(params):
             ("two", "fleet: {drives: [a, b], pieces: 3}", "fleet.drives"),
             ("one", "fleet: {drives: [a]}", "fleet.drives"),
             ("named", "fleet: {drives: [a, b, c], protocol: named, train: [a, b]}", "fleet.test"),
-            ("long", "fleet: {drives: [a, b], curve_duration_s: 500.0}", "fleet.curve_duration_s")):
+            ("long", "fleet: {drives: [a, b], curve_duration_s: 500.0}", "fleet.curve_duration_s"),
+            ("curve", "fleet: {drives: [a, b], curve: false, curve_networks: true}", "fleet.curve_networks"),
+            ("inputs", "fleet: {drives: [a, b], curve: false, networks: true, inputs: {at_lstm: imu}}",
+             "fleet.inputs")):
         (params / f"{name}.yaml").write_text(f"profile: {name}\nbase: smoke\ndescription: x\n{body}\n")
         with pytest.raises(DataError, match=key.replace(".", r"\.")):
             load_profile(name)
@@ -264,7 +267,8 @@ def test_the_learning_curve_trains_the_networks_per_training_set(fleet, monkeypa
     by_name = {p.name: p for p in prepared[:3]}
     test, train = curve_test_drive(prepared[2]), [prepared[0].name, prepared[1].name]
     cfg = curve_config(True)
-    given = fp.ridge_track(fp.fit_ridge(fp.pooled_speed_data(prepared[:2], PARAMS), 100.0, PARAMS), test.windows, PARAMS)
+    model = fp.fit_ridge(fp.pooled_speed_data(prepared[:2], PARAMS), 100.0, PARAMS)
+    given = fp.ridge_track(model, test.windows, PARAMS)
     full = {("RIDGE-ODO", 0): given, ("MLP-ODO", 0): given}         # the split's own tracks, stand-ins here
     sets = fp.curve_tracks(cfg, "p", "fleet-test3", test, by_name, train, PARAMS, None, full)
     assert [len(c) for c, _, _ in sets] == [1, 1, 2]
@@ -285,8 +289,8 @@ def test_the_learning_curve_trains_the_networks_per_training_set(fleet, monkeypa
 
 
 def test_sigma_judged_on_epochs_and_on_outage_means():
-    """Two hundred 60 s outages at 1 Hz, every std 1 m/s. White errors of std 1: 95 % of epochs and of outage means within
-    2 sigma (the mean's sigma 1/sqrt(60)). An offset per outage of std 1: the epochs still look calibrated (95 %),
+    """Two hundred 60 s outages at 1 Hz, every std 1 m/s. White errors of std 1: 95 % of epochs and of outage means
+    within 2 sigma (the mean's sigma 1/sqrt(60)). An offset per outage of std 1: the epochs still look calibrated (95 %),
     the means do not (|b| < 0.26 m/s: about 20 %), unless the track's correlation says the 60 epochs are one
     (kappa 60: the mean's sigma 1 m/s, 95 % again)."""
     from bgfn.nav.odometer import SpeedTrack
@@ -311,7 +315,6 @@ def test_sigma_judged_on_epochs_and_on_outage_means():
 def test_each_network_reads_its_own_inputs_with_one_budget(fleet, monkeypatch):
     """fleet.inputs {bgfn: imu}: BGFN is trained on the raw IMU windows, its ANN twin on band frames (the default),
     both under the same odometer budget; each test track comes back under its own network's label."""
-    from bgfn.learning import odometry as lo
     from bgfn.studies.odometer import bars
 
     calls = []

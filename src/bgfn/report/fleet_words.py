@@ -11,7 +11,7 @@ import pandas as pd
 from bgfn.paper import nhc_label
 from bgfn.studies.fleet.protocol import LEARNED
 from bgfn.studies.fleet.summary import POOLED
-from bgfn.studies.odometer.bars import HOLD, RIDGE, odometer_label
+from bgfn.studies.odometer.bars import HOLD, odometer_label
 from bgfn.studies.odometer.section import odometer_table
 
 #: The ``speed_range`` codes in words.

@@ -206,7 +206,8 @@ def run_rows(test: TestDrive, runs: list, tracks: dict, pseudo: dict, runner: Ru
 
 def network_inputs(cfg: dict) -> dict[str, str]:
     """What each network of ``evaluate.odometer.methods`` reads: ``fleet.inputs``' choice, else
-    ``evaluate.odometer.inputs`` (the raw IMU window or its band frames, :func:`bgfn.learning.odometry.network_inputs`)."""
+    ``evaluate.odometer.inputs`` (the raw IMU window or its band frames,
+    :func:`bgfn.learning.odometry.network_inputs`)."""
     oc, chosen = cfg["evaluate"]["odometer"], (cfg.get("fleet") or {}).get("inputs") or {}
     return {m: chosen.get(m, oc["inputs"]) for m in oc["methods"]}
 

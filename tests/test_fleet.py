@@ -315,6 +315,7 @@ def test_sigma_judged_on_epochs_and_on_outage_means():
 def test_each_network_reads_its_own_inputs_with_one_budget(fleet, monkeypatch):
     """fleet.inputs {bgfn: imu}: BGFN is trained on the raw IMU windows, its ANN twin on band frames (the default),
     both under the same odometer budget; each test track comes back under its own network's label."""
+    from bgfn.nav.odometer import SpeedTrack
     from bgfn.studies.odometer import bars
 
     calls = []
@@ -323,7 +324,9 @@ def test_each_network_reads_its_own_inputs_with_one_budget(fleet, monkeypatch):
         oc = ecfg["odometer"]
         calls.append((tuple(oc["methods"]), oc["inputs"], data[0].options["inputs"], windows.x.ndim,
                       windows.x.shape[-1], bars.odometer_train_config(cfg["train"], ecfg)))
-        return {(bars.odometer_label(m), 0, 0): (m, {}) for m in oc["methods"]}
+        code = {"bgfn": 1.0, "transformer": 2.0}
+        return {(bars.odometer_label(m), 0, 0): (SpeedTrack(windows.t_end, np.full(len(windows), code[m]),
+                                                            np.ones(len(windows))), {}) for m in oc["methods"]}
 
     monkeypatch.setattr(bars, "network_odometers", fake)
     _, prepared = fleet
@@ -334,7 +337,10 @@ def test_each_network_reads_its_own_inputs_with_one_budget(fleet, monkeypatch):
     assert fp.network_inputs(cfg) == {"bgfn": "imu", "transformer": "band_frames"}
     tracks = fp.network_tracks(cfg, "p", "k", fp.pooled_speed_data(prepared[:2], PARAMS), curve_test_drive(prepared[2]),
                                None)
-    assert tracks == {("BGFN-ODO", 0): "bgfn", (bars.odometer_label("transformer"), 0): "transformer"}
+    test = curve_test_drive(prepared[2])
+    assert {k: float(np.unique(t.speed)[0]) for k, t in tracks.items()} == {
+        ("BGFN-ODO", 0): 1.0, (bars.odometer_label("transformer"), 0): 2.0}
+    assert all(np.array_equal(t.time, test.windows.t_end) for t in tracks.values())   # back on the test's clock
     (m_imu, in_imu, opt_imu, _, ch_imu, budget_imu), (m_band, in_band, opt_band, _, ch_band, budget_band) = calls
     assert (m_imu, in_imu, opt_imu, ch_imu) == (("bgfn",), "imu", "imu", 6)                  # six raw channels
     assert (m_band, in_band, opt_band) == (("transformer",), "band_frames", "band_frames") and ch_band != 6
@@ -385,3 +391,27 @@ def test_the_verdict_names_every_learned_odometer_with_its_offset_and_sigma():
     assert ridge.startswith("d, 60 s outages (6): RIDGE-ODO 40.0 m against INS+NHC 50.0 m")
     assert "p 0.03, Holm-adjusted 0.06" in ridge and "0.80 m/s RMS against the held speed's 3.00" in ridge
     assert "BGFN-ODO 60.0 m" in bgfn and "1.60 m/s RMS" in bgfn and "95 % of the epochs" in bgfn and "33 % of" in bgfn
+
+
+def test_a_network_ensemble_on_a_drive_never_seen(fleet, monkeypatch, tmp_path):
+    """Two seeds of a tiny MLP trained on drives 1-2: each member's track and their ensemble come back on test drive
+    3's clock, the ensemble's speed the members' mean, its std calibrated on the training drives' held-out windows
+    (the test drive has none) and at least each member's spread around that mean."""
+    from bgfn import config
+    from bgfn.studies.odometer import bars
+
+    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)
+    _, prepared = fleet
+    cfg = curve_config(True)
+    cfg = {**cfg, "evaluate": {**cfg["evaluate"], "odometer": {**cfg["evaluate"]["odometer"], "network_seeds": [0, 1],
+                                                                "ensemble": True}}}
+    test = curve_test_drive(prepared[2])
+    tracks = fp.network_tracks(cfg, "p", "k", fp.pooled_speed_data(prepared[:2], PARAMS), test, None)
+    mlp, ens = bars.odometer_label("mlp"), bars.ensemble_label(bars.odometer_label("mlp"))
+    assert set(tracks) == {(mlp, 0), (mlp, 1), (ens, 0)}
+    for track in tracks.values():
+        np.testing.assert_array_equal(track.time, test.windows.t_end)
+        assert np.isfinite(track.speed).all() and (track.std > 0).all()
+    members = np.stack([tracks[(mlp, s)].speed for s in (0, 1)])
+    np.testing.assert_allclose(tracks[(ens, 0)].speed, members.mean(axis=0), rtol=1e-6)
+    assert (tracks[(ens, 0)].std >= np.abs(members - members.mean(axis=0)).max(axis=0) - 1e-9).all()

@@ -212,22 +212,38 @@ def network_inputs(cfg: dict) -> dict[str, str]:
     return {m: chosen.get(m, oc["inputs"]) for m in oc["methods"]}
 
 
+def with_calibration_windows(test_windows: lo.SpeedWindows, data: lo.SpeedData) -> lo.SpeedWindows:
+    """The test drive's windows, their times shifted back by :data:`DRIVE_TIME_SHIFT_S` (before every training
+    drive's clock), followed by the training data's calibration windows: one track over both lets an ensemble
+    calibrate on those (:func:`bgfn.studies.odometer.bars.ensemble_tracks`), as it does within a drive, whose track
+    covers its validation blocks."""
+    cal = data.calibration_windows
+    cal = cal.subset(np.argsort(cal.t_end, kind="stable"))
+    return lo.SpeedWindows(np.concatenate([test_windows.x, cal.x]), np.concatenate([test_windows.speed, cal.speed]),
+                           np.concatenate([test_windows.t_end - DRIVE_TIME_SHIFT_S, cal.t_end]),
+                           np.concatenate([test_windows.t_start - DRIVE_TIME_SHIFT_S, cal.t_start]))
+
+
 def network_tracks(cfg: dict, profile: str, key: str, data: lo.SpeedData, test, runner: Runner | None) -> dict:
     """The odometer networks (``evaluate.odometer.methods``, their seeds and ensembles) trained on the pooled
     ``data`` as one fold and run over the test drive's windows (:func:`bgfn.studies.odometer.bars.network_odometers`;
-    checkpoints under the model key ``key``), each on its inputs (:func:`network_inputs`), all with one budget:
-    ``{(label, seed): SpeedTrack}``."""
+    checkpoints under the model key ``key``; the ensembles calibrated on the training data's calibration windows,
+    :func:`with_calibration_windows`), each on its inputs (:func:`network_inputs`), all with one budget:
+    ``{(label, seed): SpeedTrack}`` on the test drive's clock."""
     ecfg, rate = cfg["evaluate"], test.prepared.rate_hz
     groups: dict[str, list[str]] = {}
     for m, inputs in network_inputs(cfg).items():
         groups.setdefault(inputs, []).append(m)
+    both, n = with_calibration_windows(test.windows, data), len(test.windows)
     out = {}
     for inputs, methods in groups.items():
         oc = {**ecfg["odometer"], "network_datasets": None, "methods": methods, "inputs": inputs}
         nets = bars.network_odometers(cfg, profile, key, {**ecfg, "odometer": oc},
-                                      {0: lo.with_inputs(data, inputs, rate)},
-                                      lo.network_inputs(test.windows, inputs, rate), runner)
-        out.update({(label, seed): track for (label, _, seed), (track, _) in nets.items()})
+                                      {0: lo.with_inputs(data, inputs, rate)}, lo.network_inputs(both, inputs, rate),
+                                      runner)
+        out.update({(label, seed): no.SpeedTrack(test.windows.t_end, track.speed[:n], track.std[:n],
+                                                 track.correlation)
+                    for (label, _, seed), (track, _) in nets.items()})
     return out
 
 

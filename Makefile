@@ -332,8 +332,9 @@ NOTEBOOK_SLOTS ?= 2
 define build_book
 	@echo "==> book from $(RES)/notebooks"
 	@rm -rf book/notebooks book/_generated book/api && mkdir -p book/notebooks book/_generated
-	@cp $(filter-out $(FLEET_EXEC),$(EXEC)) book/notebooks/   # the book's pages: 01-10 (11 stays in results/)
-	@$(PY) -m bgfn.report.book_notebooks --profile $(PROFILE) book/notebooks/*.ipynb   # one parameters cell: the run's values
+	@cp $(EXEC) book/notebooks/   # the book's pages: 01-10, and 11 for a profile with a fleet
+	@# one parameters cell: the run's values; 11 without a fleet: a page saying the study did not run
+	@$(PY) -m bgfn.report.book_notebooks --profile $(PROFILE) --absent book/notebooks book/notebooks/*.ipynb
 	@for d in tables figures; do if [ -d "$(RES)/$$d" ]; then cp -r "$(RES)/$$d" book/_generated/; fi; done
 	@find book/notebooks book/_generated -name '.*' -type f -delete   # never a temporary or hidden file
 	@if [ -f "$(RES)/findings.md" ]; then cp "$(RES)/findings.md" book/_generated/; else \

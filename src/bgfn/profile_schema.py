@@ -227,8 +227,15 @@ def _check_fleet(cfg: dict) -> None:
     if fl.get("curve") and fl.get("curve_duration_s", 0.0) > longest:
         raise ProfileError("fleet.curve_duration_s", f"at most evaluate.sweep.durations_s's longest {longest:g} s",
                            fmt(fl.get("curve_duration_s")))
-    if fl.get("networks") and not (cfg.get("evaluate") or {}).get("odometer", {}).get("methods"):
+    methods = (cfg.get("evaluate") or {}).get("odometer", {}).get("methods") or []
+    if fl.get("networks") and not methods:
         raise ProfileError("fleet.networks", "evaluate.odometer.methods naming the networks to train", "none")
+    if fl.get("curve_networks") and not (fl.get("networks") and fl.get("curve")):
+        raise ProfileError("fleet.curve_networks", "fleet.networks and fleet.curve on (the curve's networks are "
+                           "the fleet's)", "networks or curve off")
+    if fl.get("inputs") and not (fl.get("networks") and set(fl["inputs"]) <= set(methods)):
+        raise ProfileError("fleet.inputs", f"networks the fleet trains (fleet.networks on; evaluate.odometer.methods: "
+                           f"{fmt(methods)})", fmt(sorted(fl["inputs"])))
 
 
 def _check_variants(cfg: dict) -> None:

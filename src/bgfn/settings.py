@@ -352,7 +352,11 @@ class Fleet(Section):
     out_of_range_share: Fraction = _f(0.1, "an outage is out of range when more of its epochs than this share lie "
                                            "outside the training drives' speeds")
     networks: bool = _f(False, "the odometer networks too (evaluate.odometer.methods; false: RIDGE-ODO only)")
+    inputs: dict[Method, Literal["imu", "band_frames"]] = _f({}, "per network, what it reads where not "
+                                                                 "evaluate.odometer.inputs, e.g. {bgfn: imu}")
     curve: bool = _f(True, "the learning curve (1 .. N-1 training drives)")
+    curve_networks: bool = _f(False, "the networks in the learning curve too, with networks (each training set "
+                                     "trains them again; false: RIDGE-ODO's curve only)")
     curve_max_combinations: Count = _f(10, "learning curve: every combination of training drives, else this many "
                                            "drawn per size")
     curve_seed: Seed = _f(0, "the draw of those combinations")

@@ -5,9 +5,11 @@ would show both. :func:`one_parameters_cell` writes the run's values into the no
 kept) and drops the copy; ``make book`` applies it to the copies under ``book/notebooks/``. The same step refuses a
 notebook that printed a warning (:func:`warnings_in`): a ``RuntimeWarning`` or ``UserWarning`` there is a defect of
 ours the reader would otherwise see. No machine path reaches a page (:func:`without_machine_paths`): the
-repository's folder is cut from the outputs, and an own log's folder becomes its dataset id.
-``python -m bgfn.report.book_notebooks [--profile P] FILE.ipynb ...`` rewrites each file in place, then exits 1
-naming every warning found.
+repository's folder is cut from the outputs, and an own log's folder becomes its dataset id. A page of the table of
+contents whose notebook runs only for some profiles (:data:`OPTIONAL_PAGES`) is, where it did not run, a page that
+says so (:func:`absent_pages`).
+``python -m bgfn.report.book_notebooks [--profile P] [--absent DIR] FILE.ipynb ...`` rewrites each file in place,
+writes those pages into ``DIR``, then exits 1 naming every warning found.
 """
 
 from __future__ import annotations
@@ -22,6 +24,11 @@ from bgfn.config import PROJECT_ROOT, read_profile
 from bgfn.data.names import dataset_folder, dataset_id
 from bgfn.errors import DataError
 from bgfn.io import atomic_write_text
+from bgfn.report import fleet_words
+
+#: The book's pages whose notebook runs only for a profile with its section (notebook 11: ``fleet:``), each with the
+#: Markdown page shown in its place where it did not run (``profile -> text``).
+OPTIONAL_PAGES = {"11_fleet": fleet_words.absent_page}
 
 #: The tags papermill reads and writes.
 PARAMETERS_TAG, INJECTED_TAG = "parameters", "injected-parameters"
@@ -131,12 +138,27 @@ def rewrite(path: str | Path, paths: dict[str, str] | None = None) -> None:
     atomic_write_text(path, json.dumps(nb, indent=1, ensure_ascii=False) + "\n")
 
 
+def absent_pages(folder: str | Path, profile: str) -> list[Path]:
+    """For each of :data:`OPTIONAL_PAGES` without its executed notebook in ``folder``, ``<folder>/<name>.md`` saying
+    that it did not run for ``profile``; the pages written."""
+    folder, out = Path(folder), []
+    for name, page in OPTIONAL_PAGES.items():
+        if not (folder / f"{name}.ipynb").exists():
+            out.append(folder / f"{name}.md")
+            atomic_write_text(out[-1], page(profile))
+    return out
+
+
 def main(paths) -> int:
-    """Rewrite each notebook (:func:`rewrite`); 1 when any printed a warning (each named), else 0."""
+    """Rewrite each notebook (:func:`rewrite`) and write the pages of :func:`absent_pages` (``--absent DIR``); 1 when
+    any notebook printed a warning (each named), else 0."""
     paths = list(paths)
-    profile = None
-    if paths[:1] == ["--profile"] and len(paths) >= 2:
-        profile, paths = paths[1], paths[2:]
+    options = {"--profile": None, "--absent": None}
+    while paths[:1] and paths[0] in options and len(paths) >= 2:
+        options[paths[0]], paths = paths[1], paths[2:]
+    profile = options["--profile"]
+    if options["--absent"] is not None:
+        absent_pages(options["--absent"], profile or "")
     shown = machine_paths(profile)
     found = []
     for name in paths:

@@ -9,13 +9,14 @@ import matplotlib.pyplot as plt
 import pandas as pd
 
 from bgfn.paper import nhc_label
+from bgfn.studies.fleet.protocol import LEARNED
 from bgfn.studies.fleet.summary import POOLED
-from bgfn.studies.odometer.bars import HOLD, RIDGE
+from bgfn.studies.odometer.bars import HOLD, odometer_label
 from bgfn.studies.odometer.section import odometer_table
 
 #: The ``speed_range`` codes in words.
-RANGE_WORDS = {"all": "every outage", "in": "outages inside the training drives' speeds",
-               "out": "outages outside the training drives' speeds"}
+RANGE_WORDS = {"all": "every outage", "in": "outages inside the training drives' speeds and turn rates",
+               "out": "outages outside the training drives' speeds or turn rates"}
 #: The pooled rows' name in words.
 POOLED_WORDS = "all test drives (pooled)"
 
@@ -25,17 +26,43 @@ def drive_words(name: str) -> str:
     return POOLED_WORDS if name == POOLED else name
 
 
+#: What a network reads (``fleet.inputs``, ``evaluate.odometer.inputs``) in words.
+INPUT_WORDS = {"imu": "the raw IMU window", "band_frames": "band frames"}
+
+
 def fleet_title(facts: dict) -> str:
-    """What the fleet is, in one line: pieces of one drive are said to be that."""
+    """What the fleet is, in one line: pieces of one drive are said to be that; and what each network reads."""
+    reads = "".join(f" {odometer_label(m)} reads {INPUT_WORDS.get(i, i)}." for m, i in (facts.get("inputs") or {}).items())
     if facts.get("pieces"):
         return (f"A stand-in for a fleet: one drive cut into {facts['pieces']} contiguous pieces (pieces of one drive, "
                 "one mount and one day, not drives of a fleet); protocol "
-                f"{facts['protocol'].replace('_', '-')}, at {facts['rate_hz']:g} Hz.")
-    return f"A fleet of drives; protocol {facts['protocol'].replace('_', '-')}, at {facts['rate_hz']:g} Hz."
+                f"{facts['protocol'].replace('_', '-')}, at {facts['rate_hz']:g} Hz.{reads}")
+    return f"A fleet of drives; protocol {facts['protocol'].replace('_', '-')}, at {facts['rate_hz']:g} Hz.{reads}"
+
+
+#: The fleet page's title (notebook 11's first line): the book's page says it when the study did not run.
+FLEET_PAGE_TITLE = "11 Beyond the paper: a fleet of drives"
+
+
+def no_fleet_line(profile: str) -> str:
+    """What notebook 11 says for a profile that names no fleet."""
+    return (f"Profile `{profile}` names no fleet (its `fleet.drives` is empty): the fleet study did not run. "
+            "`make reproduce PROFILE=fleet` runs it on the shipped real drive cut into three pieces; a fleet of "
+            "one's own drives is a profile's `fleet: {drives: [...]}` (README, *Your own log*).")
+
+
+def absent_page(profile: str) -> str:
+    """The book's fleet page (Markdown) for a profile whose chain has no ``fleet:`` section (notebook 11 did not
+    run)."""
+    return f"# {FLEET_PAGE_TITLE}\n\n{no_fleet_line(profile)}\n"
 
 
 def _num(v, fmt: str = ".2f") -> str:
     return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, fmt)
+
+
+def _pct(v) -> str:
+    return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{100.0 * v:.0f} %"
 
 
 def preparation_lines(prep: pd.DataFrame) -> list[str]:
@@ -78,72 +105,93 @@ def fleet_markdown(summary: pd.DataFrame, speed_range: str = "all") -> str:
 
 
 def verdict_lines(summary: pd.DataFrame, offsets: pd.DataFrame) -> list[str]:
-    """Per test drive and pooled, at the longest duration: RIDGE-ODO's median max error against INS+NHC (ratio,
-    Wilcoxon p, Holm-adjusted p) and its offset per outage against the held speed's."""
+    """Per test drive and pooled, at the longest duration, for every learned odometer of the table (RIDGE-ODO, each
+    network, each ensemble): its median max error against INS+NHC (ratio, Wilcoxon p, Holm-adjusted p), its offset
+    per outage against the held speed's, and its sigma judged on the epochs and on the outages' means."""
     s = summary[summary["speed_range"] == "all"]
     if s.empty:
         return []
     d = float(s["duration_s"].max())
     lines = []
     for ds, g in s[s["duration_s"] == d].groupby("dataset", sort=False):
-        r, n = g[g["method"] == RIDGE], g[g["method"] == nhc_label("INS")]
-        if r.empty or n.empty:
+        n = g[g["method"] == nhc_label("INS")]
+        if n.empty:
             continue
-        r, n = r.iloc[0], n.iloc[0]
+        n = n.iloc[0]
         o = offsets[(offsets["speed_range"] == "all") & (offsets["dataset"] == ds) & (offsets["duration_s"] == d)]
-        off = {m: o.loc[o["method"] == m, "offset_rms_mps"] for m in (RIDGE, HOLD)}
-        off_text = (f"; its offset per outage {off[RIDGE].iloc[0]:.2f} m/s RMS against the held speed's "
-                    f"{off[HOLD].iloc[0]:.2f} m/s" if len(off[RIDGE]) and len(off[HOLD]) else "")
-        lines.append(f"{drive_words(ds)}, {d:g} s outages ({int(r['runs'])}): {RIDGE} {r['max_h_m']:.1f} m against "
-                     f"{nhc_label('INS')} {n['max_h_m']:.1f} m (median per-start ratio {r['ratio_to_nhc']:.2f}, "
-                     f"Wilcoxon p {_num(r['p_vs_nhc'])}, Holm-adjusted {_num(r['p_vs_nhc_holm'])}){off_text}.")
+        held = o.loc[o["method"] == HOLD, "offset_rms_mps"]
+        for method in (m for m in LEARNED if m in set(g["method"])):
+            r = g[g["method"] == method].iloc[0]
+            own = o[o["method"] == method]
+            off_text = (f"; its offset per outage {own['offset_rms_mps'].iloc[0]:.2f} m/s RMS against the held "
+                        f"speed's {held.iloc[0]:.2f} m/s" if len(own) and len(held) else "")
+            if len(own) and "mean_within_2sigma" in own:
+                off_text += (f"; within its 2 sigma: {_pct(own['epoch_within_2sigma'].iloc[0])} of the epochs' "
+                             f"speed errors, {_pct(own['mean_within_2sigma'].iloc[0])} of the outages' mean errors "
+                             "(the mean's sigma as the filter weighs it)")
+            lines.append(f"{drive_words(ds)}, {d:g} s outages ({int(r['runs'])}): {method} {r['max_h_m']:.1f} m "
+                         f"against {nhc_label('INS')} {n['max_h_m']:.1f} m (median per-start ratio "
+                         f"{r['ratio_to_nhc']:.2f}, Wilcoxon p {_num(r['p_vs_nhc'])}, Holm-adjusted "
+                         f"{_num(r['p_vs_nhc_holm'])}){off_text}.")
     return lines
 
 
 def coverage_lines(motion: pd.DataFrame, flags: pd.DataFrame) -> list[str]:
-    """Per test drive: its speeds and turn rates against its training drives', and the outages out of range."""
+    """Per test drive: its speeds and turn rates against its training drives', and the outages out of range (by
+    speed, by turn rate)."""
     lines = []
     for test, g in motion.groupby("test_drive", sort=False):
         t, tr = g[g["role"] == "test"].iloc[0], g[g["role"] == "training"].iloc[0]
         f = flags[(flags["dataset"] == test) & (flags["duration_s"] == flags["duration_s"].max())]
+        turn = (f"turn rate (the mean over the odometer's window) 95th percentile {t.turn_p95_dps:.1f}, max "
+                f"{t.turn_max_dps:.1f} against {tr.turn_p95_dps:.1f}, {tr.turn_max_dps:.1f} deg/s")
         lines.append(f"{test}: speed median {t.speed_p50_mps:.1f}, 95th percentile {t.speed_p95_mps:.1f}, max "
                      f"{t.speed_max_mps:.1f} m/s against the training drives' {tr.speed_p50_mps:.1f}, "
-                     f"{tr.speed_p95_mps:.1f}, {tr.speed_max_mps:.1f} m/s; turn rate 95th percentile "
-                     f"{t.turn_p95_dps:.1f} against {tr.turn_p95_dps:.1f} deg/s; {int(f['out_of_range'].sum())} of "
-                     f"{len(f)} outages of {f['duration_s'].max():g} s outside the training speeds.")
+                     f"{tr.speed_p95_mps:.1f}, {tr.speed_max_mps:.1f} m/s; {turn}; of {len(f)} outages of "
+                     f"{f['duration_s'].max():g} s, {int(f['speed_out_of_range'].sum())} outside the training speeds "
+                     f"and {int(f['turn_out_of_range'].sum())} outside their turn rates.")
     return lines
 
 
 def curve_lines(curve: pd.DataFrame) -> list[str]:
-    """The learning curve per number of training drives: the median over test drives and training sets."""
+    """The learning curve per learned odometer and number of training drives: the median over test drives, training
+    sets and seeds."""
     if curve.empty:
         return []
-    g = curve.groupby("n_train").agg(minutes=("train_min", "median"), offset=("offset_rms_mps", "median"),
+    lines = []
+    for method, c in curve.groupby("method", sort=False):
+        g = c.groupby("n_train").agg(minutes=("train_min", "median"), offset=("offset_rms_mps", "median"),
                                      rmse=("speed_rmse_mps", "median"), maxh=("median_max_h_m", "median"),
                                      sets=("offset_rms_mps", "size"))
-    return ["RIDGE-ODO against its training data (median over the test drives and training sets): "
-            + "; ".join(f"{n} drive{'s' if n > 1 else ''} ({r.minutes:.1f} min, {int(r.sets)} sets): offset per "
-                        f"outage {r.offset:.2f} m/s, speed RMSE {r.rmse:.2f} m/s, median max error {r.maxh:.1f} m"
-                        for n, r in g.iterrows()) + "."]
+        lines.append(f"{method} against its training data (median over the test drives, training sets and seeds): "
+                     + "; ".join(f"{n} drive{'s' if n > 1 else ''} ({r.minutes:.1f} min, {int(r.sets)} sets): offset "
+                                 f"per outage {r.offset:.2f} m/s, speed RMSE {r.rmse:.2f} m/s, median max error "
+                                 f"{r.maxh:.1f} m" for n, r in g.iterrows()) + ".")
+    return lines
 
 
 def plot_curve(curve: pd.DataFrame):
     """The learning curve: the offset per outage, the speed RMSE and the median max error against training minutes,
-    a dot per training set, a line per test drive through the medians per number of training drives."""
+    a dot per training set (and seed), a line per test drive and learned odometer through the medians per number of
+    training drives."""
     fig, axes = plt.subplots(1, 3, figsize=(10, 3.2))
     cols = [("offset_rms_mps", "offset per outage, RMS (m/s)"), ("speed_rmse_mps", "speed RMSE (m/s)"),
             ("median_max_h_m", "median max error (m)")]
+    methods = list(dict.fromkeys(curve["method"]))
+    styles = dict(zip(methods, ["-", "--", ":", "-."] * len(methods)))
     for ax, (c, label) in zip(axes, cols):
-        for test, g in curve.groupby("test_drive", sort=False):
+        for (test, method), g in curve.groupby(["test_drive", "method"], sort=False):
             # each training set a dot, the line through the median per number of training drives
             med = g.groupby("n_train")[["train_min", c]].median()
-            line = ax.plot(med["train_min"], med[c], "-", lw=1.2, label=test)[0]
+            name = test if len(methods) == 1 else f"{test}, {method}"
+            line = ax.plot(med["train_min"], med[c], styles[method], lw=1.2, label=name)[0]
             ax.plot(g["train_min"], g[c], "o", ms=3, alpha=0.6, color=line.get_color())
         ax.set_xlabel("training minutes")
         ax.set_ylabel(label)
         ax.set_ylim(bottom=0)
     axes[0].legend(fontsize=6)
-    fig.suptitle("RIDGE-ODO on drives it never saw, against the minutes it trained on", fontsize=9)
+    who = methods[0] if len(methods) == 1 else "The learned odometers"
+    fig.suptitle(f"{who} on drives never seen, against the minutes trained on", fontsize=9)
     fig.tight_layout()
     return fig
 

@@ -109,15 +109,16 @@ def ridge_track(model: lo.RidgeOdometer, windows: lo.SpeedWindows, params: dict)
 
 def speed_series(t, truth, outages, tracks: dict) -> dict:
     """The honest speed series of :func:`bgfn.studies.odometer.errors.error_parts_table`: each track's speed and std
-    inside the ``outages`` ``[(start, duration), ...]``, NaN elsewhere."""
+    inside the ``outages`` ``[(start, duration), ...]``, NaN elsewhere; and ``fused_std``: the std the filter fuses
+    each speed with (:meth:`bgfn.nav.odometer.SpeedTrack.fused_std`), which the window means are judged by."""
     t, truth = np.asarray(t, dtype=float), np.asarray(truth, dtype=float)
     inside = overlaps(t, t, np.array([[s, s + d] for s, d in outages], dtype=float).reshape(-1, 2))
-    out = {}
+    out, fused = {}, {}
     for label, track in tracks.items():
         speed, std = np.full(t.size, np.nan), np.full(t.size, np.nan)
         speed[inside], std[inside] = track.at(t[inside])
-        out[label] = (speed, std)
-    return {"time": t, "truth": truth, "outages": list(outages), "tracks": out}
+        out[label], fused[label] = (speed, std), track.fused_std(std)
+    return {"time": t, "truth": truth, "outages": list(outages), "tracks": out, "fused_std": fused}
 
 
 def held_track(epochs, starts, duration: float, speed_at_start, std: float) -> no.SpeedTrack:
@@ -203,18 +204,47 @@ def run_rows(test: TestDrive, runs: list, tracks: dict, pseudo: dict, runner: Ru
     return pd.DataFrame(rows, columns=list(bars.ODOMETER_COLUMNS))
 
 
-def network_tracks(cfg: dict, profile: str, key: str, data: lo.SpeedData, test: TestDrive,
-                   runner: Runner | None) -> dict:
+def network_inputs(cfg: dict) -> dict[str, str]:
+    """What each network of ``evaluate.odometer.methods`` reads: ``fleet.inputs``' choice, else
+    ``evaluate.odometer.inputs`` (the raw IMU window or its band frames,
+    :func:`bgfn.learning.odometry.network_inputs`)."""
+    oc, chosen = cfg["evaluate"]["odometer"], (cfg.get("fleet") or {}).get("inputs") or {}
+    return {m: chosen.get(m, oc["inputs"]) for m in oc["methods"]}
+
+
+def with_calibration_windows(test_windows: lo.SpeedWindows, data: lo.SpeedData) -> lo.SpeedWindows:
+    """The test drive's windows, their times shifted back by :data:`DRIVE_TIME_SHIFT_S` (before every training
+    drive's clock), followed by the training data's calibration windows: one track over both lets an ensemble
+    calibrate on those (:func:`bgfn.studies.odometer.bars.ensemble_tracks`), as it does within a drive, whose track
+    covers its validation blocks."""
+    cal = data.calibration_windows
+    cal = cal.subset(np.argsort(cal.t_end, kind="stable"))
+    return lo.SpeedWindows(np.concatenate([test_windows.x, cal.x]), np.concatenate([test_windows.speed, cal.speed]),
+                           np.concatenate([test_windows.t_end - DRIVE_TIME_SHIFT_S, cal.t_end]),
+                           np.concatenate([test_windows.t_start - DRIVE_TIME_SHIFT_S, cal.t_start]))
+
+
+def network_tracks(cfg: dict, profile: str, key: str, data: lo.SpeedData, test, runner: Runner | None) -> dict:
     """The odometer networks (``evaluate.odometer.methods``, their seeds and ensembles) trained on the pooled
     ``data`` as one fold and run over the test drive's windows (:func:`bgfn.studies.odometer.bars.network_odometers`;
-    checkpoints under the model key ``key``): ``{(label, seed): SpeedTrack}``."""
-    ecfg = cfg["evaluate"]
-    oc = {**ecfg["odometer"], "network_datasets": None}
-    rate = test.prepared.rate_hz
-    nets = bars.network_odometers(cfg, profile, key, {**ecfg, "odometer": oc},
-                                  {0: lo.with_inputs(data, oc["inputs"], rate)},
-                                  lo.network_inputs(test.windows, oc["inputs"], rate), runner)
-    return {(label, seed): track for (label, _, seed), (track, _) in nets.items()}
+    checkpoints under the model key ``key``; the ensembles calibrated on the training data's calibration windows,
+    :func:`with_calibration_windows`), each on its inputs (:func:`network_inputs`), all with one budget:
+    ``{(label, seed): SpeedTrack}`` on the test drive's clock."""
+    ecfg, rate = cfg["evaluate"], test.prepared.rate_hz
+    groups: dict[str, list[str]] = {}
+    for m, inputs in network_inputs(cfg).items():
+        groups.setdefault(inputs, []).append(m)
+    both, n = with_calibration_windows(test.windows, data), len(test.windows)
+    out = {}
+    for inputs, methods in groups.items():
+        oc = {**ecfg["odometer"], "network_datasets": None, "methods": methods, "inputs": inputs}
+        nets = bars.network_odometers(cfg, profile, key, {**ecfg, "odometer": oc},
+                                      {0: lo.with_inputs(data, inputs, rate)}, lo.network_inputs(both, inputs, rate),
+                                      runner)
+        out.update({(label, seed): no.SpeedTrack(test.windows.t_end, track.speed[:n], track.std[:n],
+                                                 track.correlation)
+                    for (label, _, seed), (track, _) in nets.items()})
+    return out
 
 
 def training_minutes(data: lo.SpeedData, aid_rate_hz: float) -> float:
@@ -236,32 +266,64 @@ def curve_combinations(train: list[str], fleet: dict) -> list[tuple[str, ...]]:
     return out
 
 
-def curve_rows(test: TestDrive, by_name: dict, train: list[str], fleet: dict, params: dict, oc: dict,
-               pseudo: dict, runner: Runner | None) -> pd.DataFrame:
-    """The ridge's learning curve on one test drive (:data:`CURVE_COLUMNS`): per training set of
-    :func:`curve_combinations`, its training minutes, the offset per outage and the speed RMSE in the test's outages
-    over their first ``curve_duration_s``, and the median max horizontal error there."""
-    d = float(fleet["curve_duration_s"])
-    runs, tracks, facts = [], {}, []
+def curve_tracks(cfg: dict, profile: str, key: str, test, by_name: dict, train: list[str], params: dict,
+                 runner: Runner | None, full: dict | None = None) -> list[tuple[tuple[str, ...], lo.SpeedData, dict]]:
+    """Per training set of :func:`curve_combinations`: its drives, its pooled data and the learned tracks over the
+    test drive's windows (``test.windows``, ``test.prepared``), ``{(label, seed): SpeedTrack}``: ``RIDGE-ODO``, and
+    with ``fleet.networks`` and ``fleet.curve_networks`` the networks (:func:`network_tracks`, checkpoints under
+    ``<key>-curve<i>``); ``full``: the tracks already trained on all of ``train`` (the split's), taken as they are
+    for that set."""
+    fleet, out = cfg["fleet"], []
+    networks = bool(fleet["networks"] and fleet["curve_networks"])
     for i, combo in enumerate(curve_combinations(train, fleet)):
         data = pooled_speed_data([by_name[n] for n in combo], params)
-        track = ridge_track(fit_ridge(data, test.prepared.rate_hz, params), test.windows, params)
-        runs.append(bars.OdometerRun(f"{test.name} curve {i} {bars.RIDGE}", test.outages,
-                                     no.Odometer(test.con, track, oc["gate_probability"]), bars.RIDGE, np.nan, 0, i))
+        if full is not None and set(combo) == set(train):
+            out.append((combo, data, {k: v for k, v in full.items() if networks or k[0] == bars.RIDGE}))
+            continue
+        learned = {(bars.RIDGE, 0): ridge_track(fit_ridge(data, test.prepared.rate_hz, params), test.windows, params)}
+        if networks:
+            learned.update(network_tracks(cfg, profile, f"{key}-curve{i + 1}", data, test, runner))
+        out.append((combo, data, learned))
+    return out
+
+
+def curve_speed_rows(test, sets: list, duration: float, aid_rate_hz: float) -> list[dict]:
+    """Per training set of :func:`curve_tracks` and learned track: the test drive, the method and seed, the training
+    drives and minutes, the offset per outage and the speed RMSE in the test's outages (``test.outages``) over
+    their first ``duration`` s (:func:`bgfn.studies.odometer.errors.error_parts_table`)."""
+    rows = []
+    for combo, data, learned in sets:
+        for (label, seed), track in learned.items():
+            series = speed_series(test.windows.t_end, test.truth, test.outages, {label: track})
+            parts = error_parts_table(test.name, series, [duration])
+            rows.append({"test_drive": test.name, "method": label, "seed": int(seed), "n_train": len(combo),
+                         "train_drives": "; ".join(combo), "train_min": training_minutes(data, aid_rate_hz),
+                         "offset_rms_mps": float(parts["offset_rms_mps"].iloc[0]) if len(parts) else np.nan,
+                         "speed_rmse_mps": float(parts["speed_rmse_mps"].iloc[0]) if len(parts) else np.nan})
+    return rows
+
+
+def curve_rows(cfg: dict, profile: str, key: str, test: TestDrive, by_name: dict, train: list[str], params: dict,
+               runner: Runner | None, full: dict | None = None) -> pd.DataFrame:
+    """The learning curve on one test drive (:data:`CURVE_COLUMNS`): per training set and learned odometer
+    (:func:`curve_tracks`), its training minutes, the offset per outage and the speed RMSE in the test's outages over
+    their first ``fleet.curve_duration_s`` (:func:`curve_speed_rows`), and the median max horizontal error there."""
+    d, oc = float(cfg["fleet"]["curve_duration_s"]), cfg["evaluate"]["odometer"]
+    sets = curve_tracks(cfg, profile, key, test, by_name, train, params, runner, full)
+    facts = curve_speed_rows(test, sets, d, params["aid_rate_hz"])
+    runs, tracks = [], {}
+    for j, (label, seed, track) in enumerate((lb, sd, tk) for _, _, learned in sets
+                                             for (lb, sd), tk in learned.items()):
+        runs.append(bars.OdometerRun(f"{test.name} curve {j} {label} seed {seed}", test.outages,
+                                     no.Odometer(test.con, track, oc["gate_probability"]), label, np.nan, int(seed), j))
         tracks[runs[-1].label] = track
-        series = speed_series(test.windows.t_end, test.truth, test.outages, {bars.RIDGE: track})
-        parts = error_parts_table(test.name, series, [d])
-        facts.append({"test_drive": test.name, "n_train": len(combo), "train_drives": "; ".join(combo),
-                      "train_min": training_minutes(data, params["aid_rate_hz"]),
-                      "offset_rms_mps": float(parts["offset_rms_mps"].iloc[0]) if len(parts) else np.nan,
-                      "speed_rmse_mps": float(parts["speed_rmse_mps"].iloc[0]) if len(parts) else np.nan})
-    rows = run_rows(test, runs, tracks, pseudo, runner, [d])
+    rows = run_rows(test, runs, tracks, cfg["evaluate"]["pseudo_gps"], runner, [d])
     med = rows.groupby("fold")["max_h_m"].median()
-    for i, f in enumerate(facts):
-        f["median_max_h_m"] = float(med.get(i, np.nan))
+    for j, f in enumerate(facts):
+        f["median_max_h_m"] = float(med.get(j, np.nan))
     return pd.DataFrame(facts, columns=list(CURVE_COLUMNS))
 
 
 #: Columns of ``tables/fleet_curve.csv`` (:func:`curve_rows`).
-CURVE_COLUMNS: tuple[str, ...] = ("test_drive", "n_train", "train_drives", "train_min", "offset_rms_mps",
-                                  "speed_rmse_mps", "median_max_h_m")
+CURVE_COLUMNS: tuple[str, ...] = ("test_drive", "method", "seed", "n_train", "train_drives", "train_min",
+                                  "offset_rms_mps", "speed_rmse_mps", "median_max_h_m")

@@ -81,11 +81,14 @@ def run_fleet(cfg: dict, profile: str, runner: Runner | None = None, drives=None
         series[test_name] = fp.speed_series(test.windows.t_end, test.truth, test.outages,
                                             {**first, bars.HOLD: held})
         lo_v, hi_v = cv.speed_range([by_name[n] for n in train])
+        lo_w, hi_w = cv.turn_range([by_name[n] for n in train], params["window_s"])
         f = cv.outage_flags(test_name, test.windows.t_end, test.truth, test.starts, test.durations, lo_v, hi_v,
-                            float(fleet["out_of_range_share"]))
+                            float(fleet["out_of_range_share"]),
+                            cv.turn_rate_at(by_name[test_name], test.windows.t_end, params["window_s"]), lo_w, hi_w)
         flags.append(f)
         if fleet["curve"]:
-            curves.append(fp.curve_rows(test, by_name, train, fleet, params, oc, ecfg["pseudo_gps"], runner))
+            curves.append(fp.curve_rows(cfg, profile, f"fleet-test{i + 1}", test, by_name, train, params, runner,
+                                        full=learned))
         longest = f[f["duration_s"] == test.dmax]
         split_rows.append({"test_drive": test_name, "train_drives": "; ".join(train),
                            "train_min": fp.training_minutes(data, params["aid_rate_hz"]),
@@ -102,10 +105,11 @@ def run_fleet(cfg: dict, profile: str, runner: Runner | None = None, drives=None
         splits=pd.DataFrame(split_rows, columns=list(SPLIT_COLUMNS)),
         rows=rows_all, summary=fleet_summary(rows_all, flags_all),
         offsets=offset_table(series, durations, flags_all, params["max_lag_s"]),
-        motion=cv.motion_table(splits, by_name), flags=flags_all,
+        motion=cv.motion_table(splits, by_name, params["window_s"]), flags=flags_all,
         curve=pd.concat(curves, ignore_index=True) if curves else pd.DataFrame(columns=list(fp.CURVE_COLUMNS)),
         facts={"wall_s": time.perf_counter() - t0, "pieces": fleet.get("pieces"), "protocol": fleet["protocol"],
-               "rate_hz": float(np.unique([p.rate_hz for p in prepared])[0]), "networks": bool(fleet["networks"])})
+               "rate_hz": float(np.unique([p.rate_hz for p in prepared])[0]), "networks": bool(fleet["networks"]),
+               "inputs": fp.network_inputs(cfg) if fleet["networks"] else {}})
 
 
 #: ``results/<profile>/tables/`` file of each table of a :class:`FleetResult`.

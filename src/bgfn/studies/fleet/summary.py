@@ -1,8 +1,9 @@
 """The fleet's tables per test drive and pooled over them, for all outages and for those in and out of the training
 drives' speed range: the odometer table's summary (:func:`bgfn.studies.odometer.bars.odometer_summary`, Wilcoxon
 paired by start against INS+NHC) with the learned odometers' p Holm-adjusted per drive, duration and range
-(:func:`bgfn.stats.holm_adjust`), and the offset per outage (:func:`bgfn.studies.odometer.errors.error_parts_table`).
-Pooled, a start is one drive's start: the pairs stay within a drive."""
+(:func:`bgfn.stats.holm_adjust`), and the offset per outage (:func:`bgfn.studies.odometer.errors.error_parts_table`)
+with each odometer's sigma judged on the epochs and on the outages' means (:func:`sigma_table`). Pooled, a start is
+one drive's start: the pairs stay within a drive."""
 
 from __future__ import annotations
 
@@ -21,7 +22,9 @@ SPEED_RANGES: tuple[str, ...] = ("all", "in", "out")
 #: Columns of ``tables/fleet_summary.csv`` (:func:`fleet_summary`).
 FLEET_SUMMARY_COLUMNS: tuple[str, ...] = ("speed_range", *(c for c in SUMMARY_COLUMNS if c != "p_vs_nhc_holm"), "p_vs_nhc_holm")
 #: Columns of ``tables/fleet_offsets.csv`` (:func:`offset_table`).
-OFFSET_COLUMNS: tuple[str, ...] = ("speed_range", *ERROR_COLUMNS)
+OFFSET_COLUMNS: tuple[str, ...] = ("speed_range", *ERROR_COLUMNS, "epoch_within_2sigma", "mean_within_2sigma")
+#: The columns of :func:`sigma_table`.
+SIGMA_COLUMNS: tuple[str, ...] = ("dataset", "method", "duration_s", "epoch_within_2sigma", "mean_within_2sigma")
 
 
 def pooled_rows(rows: pd.DataFrame) -> pd.DataFrame:
@@ -78,10 +81,42 @@ def pooled_series(series: dict) -> dict:
         n = len(s["time"])
         return s["tracks"].get(k, (np.full(n, np.nan), np.full(n, np.nan)))
 
+    def fused(s, k):
+        return s.get("fused_std", {}).get(k, track(s, k)[1])
+
     return {"time": np.concatenate([s["time"] + d for s, d in zip(items, shift)]),
             "truth": np.concatenate([s["truth"] for s in items]),
             "outages": [(a + d, b) for s, d in zip(items, shift) for a, b in s["outages"]],
-            "tracks": {k: tuple(np.concatenate([track(s, k)[j] for s in items]) for j in (0, 1)) for k in labels}}
+            "tracks": {k: tuple(np.concatenate([track(s, k)[j] for s in items]) for j in (0, 1)) for k in labels},
+            "fused_std": {k: np.concatenate([fused(s, k) for s in items]) for k in labels}}
+
+
+def sigma_table(dataset: str, series: dict, durations) -> pd.DataFrame:
+    """Each odometer's sigma judged twice over the first ``d`` s of the outages of ``series``
+    (:func:`bgfn.studies.fleet.protocol.speed_series`): ``epoch_within_2sigma``, the share of epochs whose speed
+    error lies within 2 std (white errors: 95 %); ``mean_within_2sigma``, the share of outages whose mean speed error
+    lies within 2 std of the mean as the filter weighs it: the speeds fused with ``fused_std`` each as independent,
+    the mean's std is ``sqrt(mean(fused_std^2) / N)`` over the outage's ``N`` epochs. An offset the std does not
+    allow for shows in the second share, not in the first (:data:`SIGMA_COLUMNS`)."""
+    t, truth = np.asarray(series["time"], dtype=float), np.asarray(series["truth"], dtype=float)
+    rows = []
+    for label, (speed, std) in series["tracks"].items():
+        err, std = np.asarray(speed, dtype=float) - truth, np.asarray(std, dtype=float)
+        fused = np.asarray(series.get("fused_std", {}).get(label, std), dtype=float)
+        for d in durations:
+            epochs, means = [], []
+            for start, length in series["outages"]:
+                m = ((t > start) & (t <= start + min(float(d), float(length)) + 1e-6) & np.isfinite(err)
+                     & np.isfinite(std) & (std > 0))
+                if m.sum() < 2:
+                    continue
+                epochs.append(np.abs(err[m]) <= 2.0 * std[m])
+                means.append(abs(err[m].mean()) <= 2.0 * np.sqrt(np.mean(fused[m] ** 2) / m.sum()))
+            if means:
+                rows.append({"dataset": dataset, "method": label, "duration_s": float(d),
+                             "epoch_within_2sigma": float(np.concatenate(epochs).mean()),
+                             "mean_within_2sigma": float(np.mean(means))})
+    return pd.DataFrame(rows, columns=list(SIGMA_COLUMNS))
 
 
 def offset_table(series: dict, durations, flags: pd.DataFrame, max_lag_s: float) -> pd.DataFrame:
@@ -99,7 +134,9 @@ def offset_table(series: dict, durations, flags: pd.DataFrame, max_lag_s: float)
                     chosen[name] = {**s, "outages": keep}
             for name, s in [*chosen.items(), (POOLED, pooled_series(chosen))]:
                 if s:
-                    parts.append(error_parts_table(name, s, [d], max_lag_s).assign(speed_range=which))
+                    parts.append(error_parts_table(name, s, [d], max_lag_s)
+                                 .merge(sigma_table(name, s, [d]), on=["dataset", "method", "duration_s"], how="left")
+                                 .assign(speed_range=which))
     if not parts:
         return pd.DataFrame(columns=list(OFFSET_COLUMNS))
     return pd.concat(parts, ignore_index=True).reindex(columns=list(OFFSET_COLUMNS))

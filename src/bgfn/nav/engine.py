@@ -37,6 +37,8 @@ def propagate_steps(i0, i1, dt, gyro, accel, pos, v, c, ba, bg, P, q_g, q_a, q_b
     F = np.empty((n, n))
     Q = np.empty((n, n))
     phi = np.empty((n, n))
+    phi_p = np.empty((n, n))        # phi P, and phi P phi^T: P's update written into these
+    phi_p_phi = np.empty((n, n))
     wb = np.empty(3)
     fb = np.empty(3)
     for k in range(i0, i1):
@@ -51,7 +53,13 @@ def propagate_steps(i0, i1, dt, gyro, accel, pos, v, c, ba, bg, P, q_g, q_a, q_b
             for s in range(n):
                 phi[r, s] = F[r, s] * h
             phi[r, r] += 1.0
-        P[:, :] = phi @ P @ phi.T + Q
+        # P = phi P phi^T + Q_d: the same two BLAS products as ``phi @ P @ phi.T`` (bit for bit), into buffers
+        # allocated once per call rather than three arrays per IMU step
+        np.dot(phi, P, phi_p)
+        np.dot(phi_p, phi.T, phi_p_phi)
+        for r in range(n):
+            for s in range(n):
+                P[r, s] = phi_p_phi[r, s] + Q[r, s]
         step_inplace(pos, v, c, wb, fb, h)
         # Gauss-Markov bias estimates decay with their model (decay = 0: random walk, or held as NaveGo does).
         for a in range(3):

@@ -92,10 +92,7 @@ def system_matrix_nb(pos, v, c_bn, f_b, inv_tau_a, inv_tau_g, out):
     dwie_dl = np.array([-OMEGA_IE * sl, 0.0, -OMEGA_IE * cl])
     dwen_dl = np.array([0.0, 0.0, -ve / (rn_h * cl * cl)])
     dwen_dh = np.array([-ve / rn_h ** 2, vn / rm_h ** 2, ve * tl / rn_h ** 2])
-    phi = np.array([PHI_N, PHI_E, PHI_D])
-    dv = np.array([DV_N, DV_E, DV_D])
-    ba = np.array([BA_X, BA_Y, BA_Z])
-    bg = np.array([BG_X, BG_Y, BG_Z])
+    phi, dv, ba, bg = PHI_NED, DV_NED, BA, BG      # module constants: numba bakes them in, no array per step
     # Eq. (eq9): attitude error.
     _put(out, phi, phi, -skew_nb(w_ie + w_en))
     _put(out, phi, dv, dwen_dv)
@@ -151,8 +148,7 @@ def process_noise_nb(c_bn, q_g, q_a, q_bg, q_ba, dt, out):
     out : ndarray, shape (15, 15)
     """
     out[:, :] = 0.0
-    phi = np.array([PHI_N, PHI_E, PHI_D])
-    dv = np.array([DV_N, DV_E, DV_D])
+    phi, dv = PHI_NED, DV_NED
     qg = (c_bn * q_g) @ c_bn.T * dt
     qa = (c_bn * q_a) @ c_bn.T * dt
     _put(out, phi, phi, qg)

@@ -287,7 +287,7 @@ class Oracle(Section):
 
 
 class NeesScan(Section):
-    """Beyond the paper, notebook 08: the INS NEES against the filter's gyro bias instability (bgfn.studies.ins_fidelity)."""
+    """Beyond the paper, notebook 08: the INS NEES against the filter's gyro bias instability (studies.ins_fidelity)."""
 
     gyro_bias_dps: Annotated[list[Pos], Field(min_length=2)] = _f(
         [0.005, 0.01, 0.02, 0.03, 0.05, 0.1, 0.2, 0.3], "instabilities scanned on a recorded drive, deg/s")

@@ -3,6 +3,8 @@ instability from their changes, the trajectory twin, and the effective instabili
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -97,3 +99,43 @@ def test_the_implied_setting_takes_the_unmodelled_terms_in_quadrature_and_the_li
     assert "ratio 2.67" in lines[0] and "does not hold" in lines[1] and "smoother" in lines[1]
     table.loc[0, "effective_dps"] = 0.033
     assert "holds" in words.twin_lines(table)[1] and "not" not in words.twin_lines(table)[1]
+
+
+def test_a_twin_scan_that_brackets_the_crossing_gives_the_whole_grids_value_and_one_that_does_not_is_rescanned(
+        monkeypatch):
+    """evaluate.nees_scan.twin_gyro_bias_dps: a shorter twin grid that brackets the NEES crossing gives the effective
+    instability of the whole grid (the same two points are interpolated); where it does not, the whole grid runs."""
+    whole = [0.005, 0.01, 0.02, 0.03, 0.05, 0.1, 0.2, 0.3]
+    short = [0.02, 0.03, 0.05, 0.1, 0.2]
+
+    def nees(values, level):              # NEES falls as the square of the told instability: 1.39 at `level`
+        return [T.CHI2_MEDIAN * (level / v) ** 2 for v in values]
+
+    full_value = T.effective_instability(_scan("d", whole, nees(whole, 0.07), 0.1))["effective_dps"].iloc[0]
+    short_scan = _scan("d", short, nees(short, 0.07), 0.1)
+    assert T.brackets_crossing(short_scan)
+    assert T.effective_instability(short_scan)["effective_dps"].iloc[0] == pytest.approx(full_value, rel=1e-12)
+    assert full_value == pytest.approx(0.07, rel=1e-9)            # a power law: the log-log line is exact
+    assert not T.brackets_crossing(_scan("d", short, nees(short, 0.01), 0.1))     # consistent at its first point
+    assert not T.brackets_crossing(_scan("d", short, nees(short, 0.5), 0.1))      # never consistent
+
+    grids = []
+
+    def fake_scan(cfg, drives, durations=None, values_dps=None, report=None, runner=None):
+        values = list(values_dps or cfg["evaluate"]["nees_scan"]["gyro_bias_dps"])
+        grids.append(values)
+        return pd.concat([_scan("road", values, nees(values, d.level), 0.1) for d in drives], ignore_index=True)
+
+    monkeypatch.setattr(T, "consistency_scan", fake_scan)
+    monkeypatch.setattr(T, "trajectory_twin", lambda recorded, errors, seed: SimpleNamespace(level=0.02 + 0.01 * seed))
+    recorded, stand_in = SimpleNamespace(name="road"), SimpleNamespace(name="sim", meta={"imu_errors": {}})
+    cfg = {"evaluate": {"nees_scan": {"gyro_bias_dps": whole, "twin_gyro_bias_dps": short, "twin_seeds": [1, 2]}}}
+    scan = _scan("road", whole, nees(whole, 0.08), 0.1)
+    table = T.twin_check(cfg, recorded, stand_in, scan=scan)
+    assert grids == [short]                                             # 0.03 and 0.04: inside the bracket
+    assert table.loc[table["imu"] != "recorded", "effective_dps"].tolist() == pytest.approx([0.03, 0.04])
+    grids.clear()
+    monkeypatch.setattr(T, "trajectory_twin", lambda recorded, errors, seed: SimpleNamespace(level=0.01 * seed))
+    table = T.twin_check(cfg, recorded, stand_in, scan=scan)
+    assert grids == [short, whole]                                       # 0.01 is below the short grid: rescanned
+    assert table.loc[table["imu"] != "recorded", "effective_dps"].tolist() == pytest.approx([0.01, 0.02])

@@ -91,6 +91,27 @@ def test_a_changed_input_is_computed_again(drive, tmp_path, monkeypatch):
     _same(moved, baseline.run_baseline(Drive(drive.name, drive.reference, drive.imu, gnss, drive.meta), cfg, WINDOWS))
 
 
+def test_the_noise_scale_search_is_kept_once_per_drive_and_settings(drive, tmp_path, monkeypatch):
+    """nav.noise_scale auto: its search (several GPS-aided runs) is read back for the next context of the same drive
+    and settings, the same factor bit for bit; a drive with other IMU errors searches again."""
+    from bgfn.nav import tuning
+
+    cfg = baseline.nav_config({**NAV, "noise_scale": {"default": "auto"}})
+    fresh = baseline.prepare_filter(drive, cfg)                   # no cache folder: searched
+    searches = []
+    real = baseline.search_noise_scale
+    monkeypatch.setattr(baseline, "search_noise_scale", lambda *a, **k: searches.append(1) or real(*a, **k))
+    monkeypatch.setenv(CACHE_DIR_ENV, str(tmp_path))
+    first, again = baseline.prepare_filter(drive, cfg), baseline.prepare_filter(drive, cfg)
+    assert len(searches) == 1 and len(list((tmp_path / "noise_scale").glob("*.pkl"))) == 1
+    assert isinstance(again.tuning, tuning.NoiseTuning) and fresh.tuning.runs
+    _same(fresh, first)
+    _same(fresh, again)
+    errors = {**drive.meta["imu_errors"], "gyro_bias_instability": [1e-3, 1e-3, 1e-3]}
+    baseline.prepare_filter(dataclasses.replace(drive, meta={**drive.meta, "imu_errors": errors}), cfg)
+    assert len(searches) == 2
+
+
 def test_a_damaged_entry_is_computed_again_and_replaced(tmp_path, monkeypatch):
     monkeypatch.setenv(CACHE_DIR_ENV, str(tmp_path))
     calls = []

@@ -51,7 +51,7 @@ NOTEBOOK_SECTIONS: dict[str, tuple[str, ...]] = {
     "06_outage_sweep": (*_DRIVES, *_EVALUATE, "evaluate.sweep", "evaluate.oracle", "variants", "variant_runs",
                         "description"),
     "07_learned_odometer": (*_DRIVES, *_EVALUATE, "evaluate.sweep", "evaluate.odometer", "energy", "description"),
-    "08_ins_fidelity": (*_DRIVES, *_EVALUATE, "evaluate.sweep"),
+    "08_ins_fidelity": (*_DRIVES, *_EVALUATE, "evaluate.sweep", "evaluate.nees_scan"),
     "09_own_logs": _DRIVES,
     "10_results": ("*",),
     "11_fleet": (*_DRIVES, *_EVALUATE, "evaluate.sweep", "evaluate.odometer", "fleet", "description"),

@@ -286,6 +286,16 @@ class Oracle(Section):
     durations_s: list[Pos] = _f([30.0, 60.0], "sweep durations it runs (at most the sweep's longest), s")
 
 
+class NeesScan(Section):
+    """Beyond the paper, notebook 08: the INS NEES against the filter's gyro bias instability (studies.ins_fidelity)."""
+
+    gyro_bias_dps: Annotated[list[Pos], Field(min_length=2)] = _f(
+        [0.005, 0.01, 0.02, 0.03, 0.05, 0.1, 0.2, 0.3], "instabilities scanned on a recorded drive, deg/s")
+    twin_gyro_bias_dps: Annotated[list[Pos], Field(min_length=2)] | None = _f(
+        None, "those its trajectory twins scan (null: gyro_bias_dps), deg/s")
+    twin_seeds: Seeds = _f([1, 2, 3], "seeds of the twins' simulated IMU")
+
+
 class Odometer(Section):
     """Beyond the paper: the bars a learned odometer (speed + std, fused with the NHC rows) must clear."""
 
@@ -329,6 +339,7 @@ class Evaluate(Section):
     sweep: Sweep = _f({}, "the outage sweep")
     oracle: Oracle = _f({}, "the oracle pseudo-GPS")
     odometer: Odometer = _f({}, "the learned odometer's bars")
+    nees_scan: NeesScan = _f({}, "notebook 08's NEES scan and its trajectory twins")
 
 
 class Fleet(Section):

@@ -283,7 +283,9 @@ def prepare_filter(drive, cfg: dict) -> FilterSetup:
             raise DataError(drive.name, "gnss", "GNSS fixes to set nav.noise_scale: auto from", "none fused")
         return s["mean_nis"], s["dof"]
 
-    tuning = search_noise_scale(mean_nis, cfg["noise_search"])
+    # the search's filter runs are three quarters of a navigation context of such a drive, built again by every
+    # study on it: kept once per drive and settings (the same factor, bit for bit)
+    tuning = cached("noise_scale", lambda: run_key(drive, cfg), lambda: search_noise_scale(mean_nis, cfg["noise_search"]))
     return FilterSetup(initial, _noise(drive, cfg, tuning.scale), tuning.scale, alignment, tuning, attitude)
 
 

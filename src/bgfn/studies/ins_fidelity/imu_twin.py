@@ -20,13 +20,11 @@ import pandas as pd
 
 from bgfn.config import SHARED_TABLES
 from bgfn.studies.ins_fidelity.imu_roughness import trajectory_twin
-from bgfn.studies.ins_fidelity.nees import CHI2_MEDIAN, consistency_scan
+from bgfn.studies.ins_fidelity.nees import CHI2_MEDIAN, consistency_scan, scan_options
 from bgfn.io import atomic_write_csv
 from bgfn.paper import test_of
 from bgfn.parallel import Runner
 
-#: Seeds of the twin's simulated IMU.
-TWIN_SEEDS: tuple[int, ...] = (1, 2, 3)
 #: Columns of ``tables/kf_imu_twin.csv``.
 TWIN_COLUMNS: tuple[str, ...] = ("dataset", "imu", "seed", "duration_s", "effective_dps", "model_dps",
                                  "median_max_h_m")
@@ -59,6 +57,17 @@ def effective_instability(scan: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=["dataset", "duration_s", "effective_dps"])
 
 
+def brackets_crossing(scan: pd.DataFrame) -> bool:
+    """Whether the scan of one drive has, at every duration, its median NEES above :data:`CHI2_MEDIAN` at its smallest
+    gyro bias instability and at or below it at some larger one: :func:`effective_instability` then interpolates
+    inside the scan's grid, and a wider grid that adds no crossing below it gives the same value."""
+    for _, g in scan.groupby("duration_s", sort=False):
+        y = g.sort_values("gyro_bias_instability_dps", kind="stable")["median_nees"].to_numpy(float)
+        if not (y[0] > CHI2_MEDIAN and np.any(y <= CHI2_MEDIAN)):
+            return False
+    return len(scan) > 0
+
+
 def _rows(scan: pd.DataFrame, imu: str, seed) -> list[dict]:
     eff = effective_instability(scan)
     own = scan[scan["profile"]]
@@ -71,7 +80,7 @@ def _rows(scan: pd.DataFrame, imu: str, seed) -> list[dict]:
     return out
 
 
-def twin_check(cfg: dict, recorded, stand_in, seeds=TWIN_SEEDS, scan: pd.DataFrame | None = None,
+def twin_check(cfg: dict, recorded, stand_in, seeds=None, scan: pd.DataFrame | None = None,
                gyro_dps: float | None = None, report: Callable[[str], None] | None = None,
                runner: Runner | None = None) -> pd.DataFrame:
     """The effective gyro bias instability of the recorded drive and of its trajectory twins (module docstring).
@@ -82,8 +91,8 @@ def twin_check(cfg: dict, recorded, stand_in, seeds=TWIN_SEEDS, scan: pd.DataFra
         The profile (``nav:`` runs the filter, ``evaluate.sweep`` places the starts).
     recorded, stand_in : bgfn.data.Drive
         The recorded drive, and the simulated stand-in whose ``meta["imu_errors"]`` the twin simulates.
-    seeds : sequence of int
-        Seeds of the twin's IMU errors.
+    seeds : sequence of int, optional
+        Seeds of the twin's IMU errors (default ``evaluate.nees_scan.twin_seeds``).
     scan : DataFrame, optional
         The recorded drive's :func:`bgfn.studies.ins_fidelity.nees.consistency_scan` (notebook 08 has run it; default: run here).
     gyro_dps : float, optional
@@ -99,6 +108,8 @@ def twin_check(cfg: dict, recorded, stand_in, seeds=TWIN_SEEDS, scan: pd.DataFra
         :data:`TWIN_COLUMNS`: ``imu`` ``recorded`` or ``<stand-in> model``; ``model_dps`` the filter's own setting
         and ``median_max_h_m`` the INS drift with it (the twin's: the stand-in's model, exact).
     """
+    options = scan_options(cfg)
+    seeds = options["twin_seeds"] if seeds is None else seeds
     scan = (consistency_scan(cfg, [recorded], runner=runner) if scan is None
             else scan[scan["dataset"] == recorded.name])
     rows = _rows(scan, "recorded", None)
@@ -109,8 +120,16 @@ def twin_check(cfg: dict, recorded, stand_in, seeds=TWIN_SEEDS, scan: pd.DataFra
     # every twin's scan in one map: its points spread over the runner's jobs together
     # (the twins carry the recorded drive's name, so its settings apply: their rows come back twin by twin, each
     # twin the same number of them)
-    twin_scan = consistency_scan(cfg, twins, runner=runner)
+    # a twin's scan only has to bracket where its NEES falls to 1.39 (effective_instability): a profile may give it
+    # fewer points than the recorded drive's (evaluate.nees_scan.twin_gyro_bias_dps); where they do not bracket it
+    # (already consistent at the first point, or never), the twins are scanned again on the recorded drive's grid
+    short = options["twin_gyro_bias_dps"]
+    twin_scan = consistency_scan(cfg, twins, values_dps=short, runner=runner)
     per_twin = len(twin_scan) // max(len(twins), 1)
+    if short is not None and not all(brackets_crossing(twin_scan.iloc[k * per_twin:(k + 1) * per_twin])
+                                     for k in range(len(twins))):
+        twin_scan = consistency_scan(cfg, twins, runner=runner)
+        per_twin = len(twin_scan) // max(len(twins), 1)
     for k, seed in enumerate(seeds):
         rows += _rows(twin_scan.iloc[k * per_twin:(k + 1) * per_twin], f"{stand_in.name} model", int(seed))
     out = pd.DataFrame(rows, columns=list(TWIN_COLUMNS))
@@ -143,7 +162,7 @@ def implied_setting(table: pd.DataFrame) -> float:
     return float(np.sqrt(max(rec ** 2 - extra2, 0.0)))
 
 
-def settle_setting(cfg: dict, recorded, stand_in, start_dps: float, seeds=TWIN_SEEDS, rtol: float = 0.1,
+def settle_setting(cfg: dict, recorded, stand_in, start_dps: float, seeds=None, rtol: float = 0.1,
                    max_steps: int = 5, report: Callable[[str], None] | None = None) -> tuple[float, pd.DataFrame]:
     """Repeat :func:`implied_setting` from ``start_dps`` until a step changes it by less than ``rtol``.
 

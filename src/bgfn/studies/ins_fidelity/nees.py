@@ -19,6 +19,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from bgfn import settings
 from bgfn.config import SHARED_TABLES
 from bgfn.data.names import dataset_id
 from bgfn.data.platforms import write_ran_table
@@ -112,14 +113,18 @@ def nees_section(out: str | Path, results: dict, sweep: pd.DataFrame | None) -> 
     return summary
 
 
-#: Gyro bias instabilities the scan tries, deg/s (half the MPU-6000 profile's 0.01 deg/s up to 0.3 deg/s; dense where the
-#: recorded drive and its trajectory twin turn consistent, :mod:`bgfn.studies.ins_fidelity.imu_twin`).
-SCAN_GYRO_BIAS_DPS: tuple[float, ...] = (0.005, 0.01, 0.02, 0.03, 0.05, 0.1, 0.2, 0.3)
 #: Outage durations of the scan, s, where the sweep's starts leave room for them (:func:`scan_durations`).
 SCAN_DURATIONS_S: tuple[float, ...] = (30.0, 60.0)
 #: Columns of ``tables/kf_nees_scan.csv``.
 SCAN_COLUMNS: tuple[str, ...] = ("dataset", "gyro_bias_instability_dps", "profile", "duration_s", "runs",
                                  "median_nees", "inside_95", "median_max_h_m", "verdict")
+
+
+def scan_options(cfg: dict) -> dict:
+    """``evaluate.nees_scan`` with its defaults (:class:`bgfn.settings.NeesScan`: the gyro bias instabilities scanned on
+    a recorded drive, half the MPU-6000 profile's 0.01 deg/s up to 0.3 deg/s and dense where the recorded drive and
+    its trajectory twin turn consistent; those of the twins, null: the same; the twins' seeds)."""
+    return {**settings.defaults("evaluate.nees_scan"), **((cfg.get("evaluate") or {}).get("nees_scan") or {})}
 
 
 def scan_point(cfg: dict, drive, value_dps: float, own: bool, starts: list[float], durations) -> list[dict]:
@@ -145,16 +150,17 @@ def scan_durations(sweep: dict) -> list[float]:
     return [d for d in SCAN_DURATIONS_S if d <= longest] or [longest]
 
 
-def consistency_scan(cfg: dict, drives, durations=None, values_dps=SCAN_GYRO_BIAS_DPS,
+def consistency_scan(cfg: dict, drives, durations=None, values_dps=None,
                      report: Callable[[str], None] | None = None, runner: Runner | None = None) -> pd.DataFrame:
     """The INS NEES of every recorded drive among ``drives`` from the sweep's starts (``evaluate.sweep``) with the
     filter's gyro bias instability set to each of ``values_dps`` (deg/s, every axis) and to the profile's own
     (``profile`` True): median NEES, share inside the 95 % bound, median max horizontal error, per duration
-    (default :func:`scan_durations`).
+    (default :func:`scan_durations`). ``values_dps`` defaults to ``evaluate.nees_scan.gyro_bias_dps``.
 
     The points are independent runs (:func:`scan_point`), spread over ``runner`` (default: one after the other);
     the rows come back in the grid's order whatever the number of jobs."""
     tasks, labels = [], []
+    values_dps = scan_options(cfg)["gyro_bias_dps"] if values_dps is None else values_dps
     durations = scan_durations(cfg["evaluate"]["sweep"]) if durations is None else durations
     for drive in drives:
         if drive.name in SIMULATED_IMU:

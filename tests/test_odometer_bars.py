@@ -268,3 +268,14 @@ def test_the_ensemble_of_two_oppositely_biased_seeds_is_unbiased_with_the_mixtur
     track, facts = O.ensemble_tracks(tracks, data, recalibrate=True)[("NET-ODO-ENS", 0, 0)]
     assert facts["calibration"] == pytest.approx(0.3 / np.sqrt(1.04))
     assert track.std == pytest.approx(np.full(t.size, 0.3))
+
+
+def test_a_drive_without_odometer_bars_is_said_on_the_page_with_its_platform():
+    import pandas as pd
+
+    from bgfn.report.odometer_words import odometer_markdown
+    from bgfn.studies.odometer.section import OdometerSection
+    section = OdometerSection(pd.DataFrame(), pd.DataFrame(), {"my-walk": {"skipped": "walker"}, "car": {}})
+    text = odometer_markdown(section)
+    assert "my-walk: no odometer bars (platform walker" in text
+    assert "car:" not in text

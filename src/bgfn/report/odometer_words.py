@@ -16,11 +16,19 @@ from bgfn.studies.odometer.section import OdometerSection, odometer_table
 from bgfn.studies.odometer.uncertainty import ranks_errors
 
 
+def skipped_lines(facts: dict) -> list[str]:
+    """One line per drive without odometer bars (``facts[name]["skipped"]``: its platform)."""
+    return [f"{name}: no odometer bars (platform {f['skipped']}: the learned odometer is a car's forward speed, "
+            "fused with the non-holonomic constraints)" for name, f in facts.items() if f.get("skipped")]
+
+
 def odometer_markdown(section: OdometerSection) -> str:
     """Notebook 07's odometer bars (:class:`~bgfn.studies.odometer.section.OdometerSection`): the summary at the
     sweep's durations as a Markdown table (:func:`~bgfn.studies.odometer.section.odometer_table`), then the lines."""
+    skipped = skipped_lines(section.facts)
     if section.summary.empty:
-        return "No odometer bars (``evaluate.odometer.datasets`` is empty or the sweep has no dataset)."
+        return "\n".join(skipped or ["No odometer bars (``evaluate.odometer.datasets`` is empty or the sweep has no "
+                                      "dataset)."])
     wide = odometer_table(section.summary)
     head = "| dataset | method | " + " | ".join(wide.columns) + " |"
     body = [f"| {ds} | {m} | " + " | ".join(f"{v:.1f}" for v in r) + " |" for (ds, m), r in wide.iterrows()]
@@ -32,7 +40,8 @@ def odometer_markdown(section: OdometerSection) -> str:
                                             else [])]
                       + [f"- {s}" for s in error_parts_lines(section.errors)]
                       + [f"- {s}" for s in curve_lines(section.curve if section.curve is not None
-                                                       else pd.DataFrame(columns=list(CURVE_COLUMNS)))])
+                                                       else pd.DataFrame(columns=list(CURVE_COLUMNS)))]
+                      + [f"- {s}" for s in skipped])
     if section.paper is None or section.paper.empty:
         return text
     p = section.paper[section.paper["sigma_mps"].isna()]       # the oracle's grid: tables/outage_odometer_paper.csv

@@ -322,7 +322,8 @@ def load_drive(name: str | Path = DEFAULT_DATASET, *, profile: str | None = None
     ----------
     name : str or Path
         A key of ``DATASETS`` (default ``"turin-sim-ekinox"``) or a folder in the CSV schema, absolute or
-        relative to the repository root, else to the current directory (:func:`bgfn.data.names.dataset_folder`).
+        relative to the repository root, else to the current directory (:func:`bgfn.data.names.dataset_folder`);
+        with ``profile``, also the id of a folder the profile names (as a loaded profile lists it).
     profile : str, optional
         Take the parameters from the ``data:`` section of ``params/<profile>.yaml``
         (:func:`profile_overrides`); explicit ``overrides`` win.
@@ -354,7 +355,7 @@ def load_drive(name: str | Path = DEFAULT_DATASET, *, profile: str | None = None
         file cannot be had (for the real IMU files: says that the simulated datasets stand in);
         :class:`bgfn.errors.ChecksumError` on a checksum mismatch.
     """
-    folder = dataset_folder(name)
+    folder = dataset_folder(name, profile)          # a folder's path, or (with the profile) its id
     if folder is not None:
         return _load_folder(folder, profile, overrides)
     if name not in DATASETS:

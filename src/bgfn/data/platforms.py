@@ -48,6 +48,12 @@ def _own_platform(dataset: str, out: str | Path) -> str:
     return str(read_meta(folder / META_FILE).get("platform", DEFAULT_PLATFORM))
 
 
+def drive_platform(out: str | Path, dataset: str) -> str:
+    """The platform of ``dataset``: as notebook 02 recorded it under ``out`` (``results/<profile>``), else as its
+    folder's ``meta.yaml`` names it; ``car`` when neither says."""
+    return recorded_platforms(out).get(dataset_id(dataset)) or _own_platform(dataset, out)
+
+
 def platform_aid_names(platform: str) -> tuple[str, ...]:
     """The aids ``platform`` takes (a platform not known reads as the default's)."""
     return platform_aids(platform if platform in PLATFORM_AIDS else DEFAULT_PLATFORM)
@@ -65,4 +71,4 @@ def write_ran_table(path: str | Path, frame: pd.DataFrame, out: str | Path, **kw
     return atomic_write_csv(path, table, **kwargs)
 
 
-__all__ = ["platform_aid_names", "recorded_platform", "recorded_platforms", "write_ran_table"]
+__all__ = ["drive_platform", "platform_aid_names", "recorded_platform", "recorded_platforms", "write_ran_table"]

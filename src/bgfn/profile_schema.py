@@ -283,8 +283,9 @@ def load_profile(profile: str, overrides: dict[str, Any] | None = None,
     Raises
     ------
     bgfn.errors.DataError
-        As :func:`bgfn.config.read_profile`; two drives of one id (naming the profile's file); a value that breaks the schema or a cross-field fact: the message
-        names the YAML file that set the key (the profile's own or a base), the key path and the value.
+        As :func:`bgfn.config.read_profile`; two drives of one id (naming the profile's file); a value that breaks
+        the schema or a cross-field fact: the message names the YAML file that set the key (the profile's own or a
+        base), the key path and the value.
     """
     cfg = with_dataset_ids(read_profile(profile), profile_chain(profile)[0])   # own logs by id from here on
     try:

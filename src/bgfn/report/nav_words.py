@@ -85,8 +85,9 @@ def baseline_aid_lines(baseline: Baseline) -> list[str]:
         return []
     platform = c.get("platform", cn.DEFAULT_PLATFORM)
     what = constraint_words(cn.ConstraintConfig(platform=platform))
-    return [f"{baseline.drive_name}: the {aid_label('INS+NHC', platform)} rows' aids -- {what}; {c['aid_epochs']} aid epochs over the drive, "
-            f"{c['zupt_epochs']} of them ZUPT (still {100 * c['still_fraction']:.0f} % of the IMU rows)"]
+    return [f"{baseline.drive_name}: the {aid_label('INS+NHC', platform)} rows' aids -- {what}; {c['aid_epochs']} "
+            f"aid epochs over the drive, {c['zupt_epochs']} of them ZUPT "
+            f"(still {100 * c['still_fraction']:.0f} % of the IMU rows)"]
 
 
 def baseline_lines(baseline: Baseline) -> list[str]:

@@ -326,6 +326,11 @@ def test_a_loaded_profile_names_its_folders_by_id_and_refuses_two_of_one_id(tmp_
     assert dataset_folder("Drive-1", "two") == a.resolve()
     quick = config.read_profile("quick")
     assert with_dataset_ids(quick) == quick                       # the shipped drives keep their keys
+    (params / "gone.yaml").write_text(f"base: quick\ndatasets: ['{tmp_path / 'absent' / 'run 9'}']\n")
+    assert load_profile("gone")["data"]["datasets"] == ["run-9"]
+    with pytest.raises(DataError) as err:                         # the missing folder named as the file names it
+        load_drive("run-9", profile="gone")
+    assert err.value.field == "folder" and str(tmp_path / "absent" / "run 9") in str(err.value)
 
 
 def test_attitude_all_three_or_none(tmp_path, monkeypatch, truth):

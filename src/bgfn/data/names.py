@@ -40,16 +40,26 @@ def dataset_folder(name: str | Path, profile: str | None = None) -> Path | None:
     """
     if registered(name) or not str(name).strip():
         return None
-    if profile is not None:
-        for entry in profile_datasets(read_profile(profile)):     # as the file names them (paths)
-            if entry != str(name) and not registered(entry) and dataset_id(entry) == str(name):
-                return dataset_folder(entry)
+    entry = profile_entry(name, profile) if profile is not None else None
+    if entry is not None:
+        return dataset_folder(entry)
     path = Path(str(name)).expanduser()
     if path.is_absolute():
         return path if path.is_dir() else None
     for base in (PROJECT_ROOT, Path.cwd()):
         if (base / path).is_dir():
             return (base / path).resolve()
+    return None
+
+
+def profile_entry(name: str | Path, profile: str) -> str | None:
+    """The entry of ``profile``'s file (a folder's path, as written) whose id (:func:`dataset_id`) is ``name``, when
+    ``name`` is not that entry itself; None otherwise."""
+    if registered(name):
+        return None
+    for entry in profile_datasets(read_profile(profile)):          # as the file names them (paths)
+        if entry != str(name) and not registered(entry) and dataset_id(entry) == str(name):
+            return entry
     return None
 
 

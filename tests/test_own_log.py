@@ -324,6 +324,8 @@ def test_a_loaded_profile_names_its_folders_by_id_and_refuses_two_of_one_id(tmp_
     assert ow["Drive-1"] == [[1.0, 2.0]] and ow["default"] == [[3.0, 4.0]] and not any("/" in k for k in ow)
     assert dataset_folder("second", "two") == b.resolve() and dataset_folder("second") is None
     assert dataset_folder("Drive-1", "two") == a.resolve()
+    from bgfn.profile_schema import _typed
+    assert _typed("two", "outage_windows.Drive-1") and not _typed("two", "outage_windows.second")   # kept as typed
     quick = config.read_profile("quick")
     assert with_dataset_ids(quick) == quick                       # the shipped drives keep their keys
     (params / "gone.yaml").write_text(f"base: quick\ndatasets: ['{tmp_path / 'absent' / 'run 9'}']\n")

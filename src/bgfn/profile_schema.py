@@ -368,8 +368,9 @@ def check_keys(profile: str) -> list[str]:
 
 
 def _typed(profile: str, key: str) -> bool:
-    """Whether the profile's own file (not a base) sets the dotted ``key``."""
-    node = own_settings(profile)
+    """Whether the profile's own file (not a base) sets the dotted ``key`` (a drive by its id, as the loaded profile
+    names it: :func:`bgfn.data.names.with_dataset_ids`)."""
+    node = with_dataset_ids(own_settings(profile))
     for k in key.split("."):
         if not isinstance(node, dict) or k not in node:
             return False

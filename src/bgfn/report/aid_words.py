@@ -114,7 +114,7 @@ def ran_lines(lines: Iterable[str], platforms: Mapping[str, str]) -> list[str]:
     whole = next(iter(shared)) if len(shared) == 1 else DEFAULT_PLATFORM
     names = sorted(platforms, key=len, reverse=True)          # the longest name first: "walk-2" before "walk"
 
-    def platform_of(line: str) -> str:
+    def line_platform(line: str) -> str:
         d = next((d for d in names if line.startswith(d) and line[len(d):len(d) + 1] in (",", " ", ":")), None)
         return platforms[d] if d is not None else whole
-    return [aid_label(line, platform_of(line)) for line in lines]
+    return [aid_label(line, line_platform(line)) for line in lines]

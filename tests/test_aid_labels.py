@@ -120,3 +120,47 @@ def test_a_walk_that_notebook_02_did_not_run_is_named_by_its_own_meta(tmp_path):
     frame = _rows([str(folder)] * 4)
     path = write_ran_table(out / "tables" / "walk.csv", frame, out)
     assert list(pd.read_csv(path)["method"]) == ["INS", "INS+ZUPT", "BGFN+ZUPT", "INS+ZUPT+HOLD"]
+
+
+# --------------------------------------------------------------------- what the notebooks display and print
+def test_a_walkers_displayed_frames_and_sentences_name_the_aids_that_ran(walk_baseline):
+    from bgfn.report.aid_words import ran_frame, ran_lines
+    from bgfn.report.nav_words import baseline_aid_lines
+
+    platforms = {"walk": "walker", "car": "car"}
+    frame = pd.concat([_rows(["walk"] * 4), _rows(["car"] * 4)], ignore_index=True)
+    shown = ran_frame(frame, platforms)                                 # rows by their dataset column
+    assert list(shown["method"]) == ["INS", "INS+ZUPT", "BGFN+ZUPT", "INS+ZUPT+HOLD",
+                                     "INS", "INS+NHC", "BGFN+NHC", "INS+NHC+HOLD"]
+    wide = frame.set_index(["dataset", "method"])                       # rows by their index level
+    assert list(ran_frame(wide, platforms).index) == [(d, m) for d, m in zip(shown["dataset"], shown["method"])]
+    layout = baseline.ins_layout(walk_baseline.outage_table, "walk")   # notebook 02's layout: +NHC in the columns
+    assert any("+NHC" in str(c) for c in layout.columns.to_flat_index())
+    shown = ran_frame(layout, "walker")
+    assert not any("+NHC" in str(c) for c in shown.columns.to_flat_index())
+    assert any("INS+ZUPT" in str(c) for c in shown.columns.to_flat_index())
+    assert shown.to_numpy().tobytes() == layout.to_numpy().tobytes()   # the numbers as they were
+    for car in (frame, layout):
+        assert ran_frame(car, "car") is car and ran_frame(car, {"car": "car"}) is car   # a car's display untouched
+    lines = ["walk, 10 s: INS+NHC 4.5 m, BGFN+NHC 3.1 m", "walk-2 (real test): INS+NHC 1 m", "car, BGFN+NHC 2 m",
+             "every drive: INS+NHC"]
+    assert ran_lines(lines, {**platforms, "walk-2": "car"}) == [
+        "walk, 10 s: INS+ZUPT 4.5 m, BGFN+ZUPT 3.1 m", "walk-2 (real test): INS+NHC 1 m", "car, BGFN+NHC 2 m",
+        "every drive: INS+NHC"]                                          # a line of no one drive: mixed, as it is
+    assert ran_lines(["every drive: INS+NHC"], {"walk": "walker"}) == ["every drive: INS+ZUPT"]
+    (aids,) = baseline_aid_lines(walk_baseline)                        # notebooks 02 and 09 print it
+    assert "INS+ZUPT rows' aids" in aids and "+NHC" not in aids
+
+
+def test_the_sweep_setup_line_names_the_rows_of_the_drives_platforms():
+    from bgfn.report.sweep_words import describe_sweep_setup
+
+    cfg = load_profile("smoke")
+    ecfg = {**cfg["evaluate"], "methods": ["bgfn"], "nhc_rows": True}
+    car = describe_sweep_setup(cfg["train"], ecfg, ["rtklib-drive0708"])
+    assert car == describe_sweep_setup(cfg["train"], ecfg, ["rtklib-drive0708"], {"rtklib-drive0708": "car"})
+    assert car[-1].endswith("rows INS+NHC, BGFN+NHC")                 # a car's line as before
+    walk = describe_sweep_setup(cfg["train"], ecfg, ["walk"], {"walk": "walker"})
+    assert walk[1:-1] == car[1:-1] and "+NHC" not in walk[-1] and walk[-1].endswith("rows INS+ZUPT, BGFN+ZUPT")
+    both = describe_sweep_setup(cfg["train"], ecfg, ["walk", "car"], {"walk": "walker", "car": "car"})
+    assert both[-2:] == [car[-1], walk[-1]]

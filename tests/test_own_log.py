@@ -20,7 +20,8 @@ from bgfn import config
 from bgfn.data import load_drive, write_csv_drive
 from bgfn.data import imu_errors as ie
 from bgfn.data.csv_meta import DEFAULT_IMU_PROFILE, META_KEYS, read_meta
-from bgfn.data.names import data_fingerprint, dataset_folder, dataset_id, profile_datasets, unique_ids
+from bgfn.data.names import (data_fingerprint, dataset_folder, dataset_id, profile_datasets, unique_ids,
+                             with_dataset_ids)
 from bgfn.data.regrid import GAP_SAMPLES, interpolate_reference
 from bgfn.errors import DataError
 from bgfn.nav import earth, sim
@@ -92,12 +93,12 @@ def test_a_csv_log_named_by_its_path_runs_notebooks_01_to_04(tmp_path, monkeypat
     cfg = load_profile("mine")
     assert cfg["profile"] == "mine"                               # the file's name
     assert cfg["description"] == "profile 'mine': 'quick' with its own settings"     # none written
-    assert any(line.startswith(f"{log}: {T0:.2f}..") for line in check_with_drives("mine"))    # make's check step, with the data
-    name = str(log)
+    did = dataset_id(str(log))
+    assert did == "my-car"                                        # meta.yaml's name
+    assert any(line.startswith(f"{did}: {T0:.2f}..") for line in check_with_drives("mine"))    # make's check step
+    name = did                                                    # the loaded profile names the folder by its id
     assert [cfg[s]["datasets"] for s in ("data", "nav", "train", "evaluate")] == [[name]] * 4
     assert cfg["evaluate"]["sweep"]["datasets"] == []             # the file's own section wins
-    did = dataset_id(name)
-    assert did == "my-car"                                        # meta.yaml's name
     out = config.results_dir("mine")
 
     # notebook 01
@@ -142,6 +143,13 @@ def test_a_csv_log_named_by_its_path_runs_notebooks_01_to_04(tmp_path, monkeypat
     assert f"kf_rms_{did}.csv" in files and "outage_my-car.csv" in files and "bgfn_seed0.pt" in files
     assert (out / "models" / did / "mlp_seed0.pt").is_file()
     assert not any("logs" in p or " " in p for p in written if p.startswith("results/"))
+    # no machine path in a table, a record or a file name: the folder's path (and its name) appear nowhere
+    texts = {p: p.read_text(encoding="utf-8") for p in results.rglob("*") if p.suffix in (".csv", ".json")}
+    assert len([p for p in texts if p.suffix == ".csv"]) >= 3 and any(p.suffix == ".json" for p in texts)
+    assert [p for p, text in texts.items() if str(log) in text or str(tmp_path) in text or log.name in text] == []
+    assert [p for p in results.rglob("*") if log.name in p.name or "/" in p.name] == []
+    assert all(did in set(pd.read_csv(p)["dataset"]) for p in texts if p.suffix == ".csv"
+               and "dataset" in pd.read_csv(p, nrows=0).columns)
 
 
 # ------------------------------------------------------------------------------------ regrid and reference
@@ -296,6 +304,37 @@ def test_dataset_ids_are_safe_and_keep_the_shipped_names(tmp_path, monkeypatch):
     assert unique_ids(["turin-sim-ekinox", str(a)]) == {"turin-sim-ekinox": "turin-sim-ekinox", str(a): "rainy"}
 
 
+def test_a_loaded_profile_names_its_folders_by_id_and_refuses_two_of_one_id(tmp_path, monkeypatch):
+    params = tmp_path / "params"
+    params.mkdir()
+    shutil.copy(config.PARAMS_DIR / "quick.yaml", params / "quick.yaml")
+    monkeypatch.setattr(config, "PARAMS_DIR", params)
+    a, b = tmp_path / "logs" / "Drive 1", tmp_path / "other" / "Drive 1"    # two folders of one name
+    for folder in (a, b):
+        folder.mkdir(parents=True)
+    (params / "two.yaml").write_text(f"base: quick\ndatasets: ['{a}', '{b}']\n"
+                                     f"outage_windows: {{'{a}': [[1.0, 2.0]], default: [[3.0, 4.0]]}}\n")
+    with pytest.raises(DataError, match="both have the id 'Drive-1'") as err:
+        load_profile("two")                                       # before any drive is loaded
+    assert err.value.source == str(params / "two.yaml")
+    (b / "meta.yaml").write_text("name: second\n")              # meta.yaml's name tells them apart
+    cfg = load_profile("two")
+    assert [cfg[s]["datasets"] for s in ("data", "nav", "train", "evaluate")] == [["Drive-1", "second"]] * 4
+    ow = cfg["outage_windows"]
+    assert ow["Drive-1"] == [[1.0, 2.0]] and ow["default"] == [[3.0, 4.0]] and not any("/" in k for k in ow)
+    assert dataset_folder("second", "two") == b.resolve() and dataset_folder("second") is None
+    assert dataset_folder("Drive-1", "two") == a.resolve()
+    from bgfn.profile_schema import _typed
+    assert _typed("two", "outage_windows.Drive-1") and not _typed("two", "outage_windows.second")   # kept as typed
+    quick = config.read_profile("quick")
+    assert with_dataset_ids(quick) == quick                       # the shipped drives keep their keys
+    (params / "gone.yaml").write_text(f"base: quick\ndatasets: ['{tmp_path / 'absent' / 'run 9'}']\n")
+    assert load_profile("gone")["data"]["datasets"] == ["run-9"]
+    with pytest.raises(DataError) as err:                         # the missing folder named as the file names it
+        load_drive("run-9", profile="gone")
+    assert err.value.field == "folder" and str(tmp_path / "absent" / "run 9") in str(err.value)
+
+
 def test_attitude_all_three_or_none(tmp_path, monkeypatch, truth):
     log = _write_log(tmp_path / "d", truth)
     pd.read_csv(log / "reference.csv").drop(columns=["yaw"]).to_csv(log / "reference.csv", index=False)
@@ -341,10 +380,10 @@ def test_top_level_datasets_reach_every_notebook_and_a_section_still_wins(tmp_pa
     (params / "bad.yaml").write_text("base: quick\ndescription: d\ndatasets: []\n")
     mine, again = load_profile("mine"), load_profile("again")
     quick = load_profile("quick")
-    for section in ("data", "nav", "train", "evaluate"):
-        assert mine[section]["datasets"] == ["a/b"]
-    assert mine["evaluate"]["sweep"]["datasets"] == ["a/b"] and mine["profile"] == "mine"
-    assert again["nav"]["datasets"] == ["c"] and again["train"]["datasets"] == ["a/b"]
+    for section in ("data", "nav", "train", "evaluate"):                  # a folder by its id (dataset_id)
+        assert mine[section]["datasets"] == ["b"]
+    assert mine["evaluate"]["sweep"]["datasets"] == ["b"] and mine["profile"] == "mine"
+    assert again["nav"]["datasets"] == ["c"] and again["train"]["datasets"] == ["b"]
     assert {k: v for k, v in mine["train"].items() if k != "datasets"} == {
         k: v for k, v in quick["train"].items() if k != "datasets"}
     with pytest.raises(DataError) as err:

@@ -22,7 +22,7 @@ from typing import Any
 from bgfn.config import (DEFAULT_DATASET_KEY, MAIN_VARIANT, VARIANT_NAME, VARIANT_RUN_KEYS, file_setting,
                          odometer_datasets, own_settings, profile_chain, read_profile, set_keys, variant_config)
 from bgfn.data import load_drive
-from bgfn.data.names import profile_datasets, unique_ids
+from bgfn.data.names import profile_datasets, unique_ids, with_dataset_ids
 from bgfn.data.imu_errors import EKINOX_D, MPU6000, error_params
 from bgfn.data.registry import DATASETS
 from bgfn.errors import DataError
@@ -284,15 +284,17 @@ def load_profile(profile: str, overrides: dict[str, Any] | None = None,
     Returns
     -------
     dict
-        As :func:`bgfn.config.read_profile`: a fresh copy on every call.
+        As :func:`bgfn.config.read_profile` (a fresh copy on every call), each CSV folder named by its dataset id
+        (:func:`bgfn.data.names.with_dataset_ids`): no machine path reaches a table, record or file name.
 
     Raises
     ------
     bgfn.errors.DataError
-        As :func:`bgfn.config.read_profile`, and a value that breaks the schema or a cross-field fact: the message
-        names the YAML file that set the key (the profile's own or a base), the key path and the value.
+        As :func:`bgfn.config.read_profile`; two drives of one id (naming the profile's file); a value that breaks
+        the schema or a cross-field fact: the message names the YAML file that set the key (the profile's own or a
+        base), the key path and the value.
     """
-    cfg = read_profile(profile)
+    cfg = with_dataset_ids(read_profile(profile), profile_chain(profile)[0])   # own logs by id from here on
     try:
         cross_check(cfg)
     except ProfileError as exc:
@@ -373,8 +375,9 @@ def check_keys(profile: str) -> list[str]:
 
 
 def _typed(profile: str, key: str) -> bool:
-    """Whether the profile's own file (not a base) sets the dotted ``key``."""
-    node = own_settings(profile)
+    """Whether the profile's own file (not a base) sets the dotted ``key`` (a drive by its id, as the loaded profile
+    names it: :func:`bgfn.data.names.with_dataset_ids`)."""
+    node = with_dataset_ids(own_settings(profile))
     for k in key.split("."):
         if not isinstance(node, dict) or k not in node:
             return False

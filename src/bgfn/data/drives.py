@@ -29,7 +29,7 @@ from bgfn.data.csv_drive import CSV_FILES, TABLE_OF, load_csv_drive
 from bgfn.data.drive import Drive, load_cached, prune_stale, save_drive
 from bgfn.data.gnss import decimate, degrade_fixes, fix_errors, imu_position, simulate_fixes
 from bgfn.data.imu_errors import MPU6000, apply_imu_errors, error_params
-from bgfn.data.names import dataset_folder
+from bgfn.data.names import dataset_folder, profile_entry
 from bgfn.data.navego import read_gnss, read_imu, read_reference, resample_imu
 from bgfn.data.registry import COMMON_PARAMS, DATASETS, DEFAULT_DATASET
 from bgfn.data.rtklib import LEVER_ARM_M as RTKLIB_LEVER_ARM_M, Q_FIX, quality_spans, read_imu_csv, read_pos, read_tag
@@ -322,7 +322,8 @@ def load_drive(name: str | Path = DEFAULT_DATASET, *, profile: str | None = None
     ----------
     name : str or Path
         A key of ``DATASETS`` (default ``"turin-sim-ekinox"``) or a folder in the CSV schema, absolute or
-        relative to the repository root, else to the current directory (:func:`bgfn.data.names.dataset_folder`).
+        relative to the repository root, else to the current directory (:func:`bgfn.data.names.dataset_folder`);
+        with ``profile``, also the id of a folder the profile names (as a loaded profile lists it).
     profile : str, optional
         Take the parameters from the ``data:`` section of ``params/<profile>.yaml``
         (:func:`profile_overrides`); explicit ``overrides`` win.
@@ -354,6 +355,8 @@ def load_drive(name: str | Path = DEFAULT_DATASET, *, profile: str | None = None
         file cannot be had (for the real IMU files: says that the simulated datasets stand in);
         :class:`bgfn.errors.ChecksumError` on a checksum mismatch.
     """
+    entry = profile_entry(name, profile) if profile is not None else None    # an id: the folder the profile names
+    name = entry if entry is not None else name
     folder = dataset_folder(name)
     if folder is not None:
         return _load_folder(folder, profile, overrides)

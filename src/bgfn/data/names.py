@@ -5,6 +5,8 @@ A profile names a drive by a registered dataset (:data:`bgfn.data.DATASETS`) or 
 files are named by :func:`dataset_id`, never by the path, so outputs stay under ``results/<profile>/`` and no file
 name holds a folder path: a registered dataset keeps its name, a CSV folder takes its ``meta.yaml`` ``name`` or its
 own name made safe. :func:`dataset_id` is idempotent, so a name read back from a result file gives the same file.
+:func:`with_dataset_ids` maps a loaded profile's drive entries to their ids once, so that every table, record and
+file downstream names an own log by its id; :func:`dataset_folder` with the profile finds the folder of an id again.
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ import hashlib
 import re
 from pathlib import Path
 
-from bgfn.config import PROJECT_ROOT
+from bgfn.config import DATASET_KEYS, PROJECT_ROOT, read_profile
 from bgfn.data.csv_meta import ID_PATTERN, META_FILE, read_meta_name
 from bgfn.data.registry import DATASETS
 from bgfn.errors import DataError
@@ -29,20 +31,35 @@ def registered(name) -> bool:
     return isinstance(name, str) and name in DATASETS
 
 
-def dataset_folder(name: str | Path) -> Path | None:
+def dataset_folder(name: str | Path, profile: str | None = None) -> Path | None:
     """The CSV folder a dataset name denotes, or None (a registered dataset, or no such folder).
 
     An absolute path is taken as is; a relative one relative to the repository root
-    (:data:`bgfn.config.PROJECT_ROOT`, where ``make`` runs the notebooks), else to the current directory.
+    (:data:`bgfn.config.PROJECT_ROOT`, where ``make`` runs the notebooks), else to the current directory. With
+    ``profile``, an id (:func:`dataset_id`) of a folder the profile's file names is that folder first.
     """
     if registered(name) or not str(name).strip():
         return None
+    entry = profile_entry(name, profile) if profile is not None else None
+    if entry is not None:
+        return dataset_folder(entry)
     path = Path(str(name)).expanduser()
     if path.is_absolute():
         return path if path.is_dir() else None
     for base in (PROJECT_ROOT, Path.cwd()):
         if (base / path).is_dir():
             return (base / path).resolve()
+    return None
+
+
+def profile_entry(name: str | Path, profile: str) -> str | None:
+    """The entry of ``profile``'s file (a folder's path, as written) whose id (:func:`dataset_id`) is ``name``, when
+    ``name`` is not that entry itself; None otherwise."""
+    if registered(name):
+        return None
+    for entry in profile_datasets(read_profile(profile)):          # as the file names them (paths)
+        if entry != str(name) and not registered(entry) and dataset_id(entry) == str(name):
+            return entry
     return None
 
 
@@ -96,6 +113,49 @@ def unique_ids(names, source: str | Path = "profile") -> dict[str, str]:
         seen[i] = name
         ids[name] = i
     return ids
+
+
+#: Mappings keyed by dataset (with a ``default``) whose keys name drives as the datasets' lists do.
+KEYED_BY_DATASET: tuple[str, ...] = ("outage_windows", "nav.noise_scale", "evaluate.odometer.network_seeds")
+
+
+def with_dataset_ids(cfg: dict, source: str | Path = "profile") -> dict:
+    """``cfg`` (a profile as read) with every drive entry an id (:func:`dataset_id`): the lists of
+    :data:`bgfn.config.DATASET_KEYS`, ``energy.dataset`` and the keys of :data:`KEYED_BY_DATASET`; a registered
+    dataset keeps its name, so a profile of the shipped drives comes back equal. The one place where a CSV folder's
+    path becomes its id: everything read from the profile after it (tables, records, file names) names the drive by
+    its id (:func:`dataset_folder` with the profile finds the folder again).
+
+    Raises
+    ------
+    DataError
+        Two entries share one id (naming ``source``), or a folder's ``meta.yaml`` is unreadable.
+    """
+    unique_ids(profile_datasets(cfg) + [str(n) for n in [(cfg.get("energy") or {}).get("dataset")] if n], source)
+    out = dict(cfg)
+
+    def node_at(path: str):
+        *parents, key = path.split(".")
+        node = out
+        for k in parents:                          # copy the sections on the way, so that cfg is not changed
+            if not isinstance(node.get(k), dict):
+                return None, key
+            node[k] = dict(node[k])
+            node = node[k]
+        return node, key
+
+    for path in ("datasets", *DATASET_KEYS):
+        node, key = node_at(path)
+        if node is not None and isinstance(node.get(key), list):
+            node[key] = [dataset_id(d) if isinstance(d, (str, Path)) else d for d in node[key]]
+    node, key = node_at("energy.dataset")
+    if node is not None and isinstance(node.get(key), str):
+        node[key] = dataset_id(node[key])
+    for path in KEYED_BY_DATASET:
+        node, key = node_at(path)
+        if node is not None and isinstance(node.get(key), dict):
+            node[key] = {dataset_id(k) if isinstance(k, str) else k: v for k, v in node[key].items()}
+    return out
 
 
 def profile_datasets(cfg: dict) -> list[str]:

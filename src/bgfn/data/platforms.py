@@ -16,6 +16,7 @@ import pandas as pd
 from bgfn.config import RUN_RECORDS
 from bgfn.data.csv_meta import META_FILE, read_meta
 from bgfn.data.names import dataset_folder, dataset_id
+from bgfn.errors import DataError
 from bgfn.io import atomic_write_csv
 from bgfn.nav.constraints import DEFAULT_PLATFORM, PLATFORM_AIDS, platform_aids
 from bgfn.paper import ran_labels
@@ -35,12 +36,22 @@ def recorded_platform(out: str | Path, dataset: str) -> str:
     return recorded_platforms(out).get(dataset_id(dataset), DEFAULT_PLATFORM)
 
 
-def _own_platform(dataset: str) -> str:
-    """The platform a CSV folder's ``meta.yaml`` names (``car`` for a registered dataset or none said)."""
-    folder = dataset_folder(dataset)
+def _own_platform(dataset: str, out: str | Path) -> str:
+    """The platform a CSV folder's ``meta.yaml`` names (``car`` for a registered dataset or none said); ``dataset``
+    a folder, or its id in the profile whose results ``out`` holds (``results/<profile>``)."""
+    try:
+        folder = dataset_folder(dataset, Path(out).name)
+    except DataError:                               # ``out`` is no profile's results: the name as it is
+        folder = dataset_folder(dataset)
     if folder is None or not (folder / META_FILE).is_file():
         return DEFAULT_PLATFORM
     return str(read_meta(folder / META_FILE).get("platform", DEFAULT_PLATFORM))
+
+
+def drive_platform(out: str | Path, dataset: str) -> str:
+    """The platform of ``dataset``: as notebook 02 recorded it under ``out`` (``results/<profile>``), else as its
+    folder's ``meta.yaml`` names it; ``car`` when neither says."""
+    return recorded_platforms(out).get(dataset_id(dataset)) or _own_platform(dataset, out)
 
 
 def platform_aid_names(platform: str) -> tuple[str, ...]:
@@ -53,11 +64,11 @@ def write_ran_table(path: str | Path, frame: pd.DataFrame, out: str | Path, **kw
     named by the aids that ran on its drive (:func:`recorded_platforms` of ``out``; a drive notebook 02 did not run:
     its folder's ``meta.yaml``); a car's table byte for byte as before."""
     platforms = recorded_platforms(out)
-    aids = {d: platform_aid_names(platforms.get(dataset_id(d)) or _own_platform(d))
+    aids = {d: platform_aid_names(platforms.get(dataset_id(d)) or _own_platform(d, out))
             for d in (frame["dataset"].unique() if "dataset" in frame.columns else ()) if isinstance(d, str)}
     default = platform_aid_names(DEFAULT_PLATFORM)          # a row of no drive (none so far) as a car's
     table = ran_labels(frame, lambda d: aids.get(d, default)) if aids else frame
     return atomic_write_csv(path, table, **kwargs)
 
 
-__all__ = ["platform_aid_names", "recorded_platform", "recorded_platforms", "write_ran_table"]
+__all__ = ["drive_platform", "platform_aid_names", "recorded_platform", "recorded_platforms", "write_ran_table"]

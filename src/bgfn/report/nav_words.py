@@ -12,7 +12,7 @@ from bgfn.nav.consistency import nis_summary
 from bgfn.nav.outage_rules import PickedOutages
 from bgfn.nav.outages import outage_windows, picked_outages
 from bgfn.nav.tuning import NoiseTuning
-from bgfn.report.aid_words import constraint_words
+from bgfn.report.aid_words import aid_label, constraint_words
 
 
 def picked_outage_lines(picked: PickedOutages) -> list[str]:
@@ -78,13 +78,16 @@ def nis_line(name: str, summary: dict) -> str:
 
 
 def baseline_aid_lines(baseline: Baseline) -> list[str]:
-    """Which aids the ``INS+NHC`` rows ran, and why (the drive's platform), with their epoch counts."""
+    """Which aids the ``INS+NHC`` rows ran (named by them: ``INS+ZUPT`` on a walker), and why (the drive's
+    platform), with their epoch counts."""
     c = baseline.constraints
     if not c:
         return []
-    what = constraint_words(cn.ConstraintConfig(platform=c.get("platform", cn.DEFAULT_PLATFORM)))
-    return [f"{baseline.drive_name}: the INS+NHC rows' aids -- {what}; {c['aid_epochs']} aid epochs over the drive, "
-            f"{c['zupt_epochs']} of them ZUPT (still {100 * c['still_fraction']:.0f} % of the IMU rows)"]
+    platform = c.get("platform", cn.DEFAULT_PLATFORM)
+    what = constraint_words(cn.ConstraintConfig(platform=platform))
+    return [f"{baseline.drive_name}: the {aid_label('INS+NHC', platform)} rows' aids -- {what}; {c['aid_epochs']} "
+            f"aid epochs over the drive, {c['zupt_epochs']} of them ZUPT "
+            f"(still {100 * c['still_fraction']:.0f} % of the IMU rows)"]
 
 
 def baseline_lines(baseline: Baseline) -> list[str]:

@@ -14,6 +14,7 @@ import pandas as pd
 
 from bgfn import paper
 from bgfn.config import PROJECT_ROOT, RUN_RECORDS, SHARED_TABLES, read_profile, results_dir, run_metadata
+from bgfn.data.names import with_dataset_ids
 
 
 def rel(path: str | Path) -> str:
@@ -110,7 +111,7 @@ def read_results(profile: str, out: str | Path | None = None) -> ProfileResults:
         ``params/<profile>.yaml`` is missing or invalid (the page needs the profile; a missing *result* is
         ``None``).
     """
-    cfg = read_profile(profile)
+    cfg = with_dataset_ids(read_profile(profile), profile)   # an own log by its id, as the notebooks named it
     out = Path(out) if out is not None else results_dir(profile)
     tables = out / "tables"
     return ProfileResults(

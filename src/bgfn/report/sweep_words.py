@@ -7,15 +7,18 @@ import numpy as np
 import pandas as pd
 
 from bgfn.evaluate.setup import TABLE_METHODS
+from bgfn.nav.constraints import DEFAULT_PLATFORM
 from bgfn.paper import label, nhc_label
+from bgfn.report.aid_words import aid_label, aided_ins_words
 from bgfn.studies.outage_sweep.oracle import (BEYOND_GRID, CROSSED, NEVER_BELOW, SWEEP_OUTAGE, NoSweepStarts,
                                              OracleResult)
 from bgfn.studies.outage_sweep.sweep import sweep_train_config
 
 
-def describe_sweep_setup(train_section: dict, ecfg: dict, datasets) -> list[str]:
+def describe_sweep_setup(train_section: dict, ecfg: dict, datasets, platforms: dict | None = None) -> list[str]:
     """Lines saying what the sweep runs: its sizes, and the fold networks' window, size block, optimizer budget
-    and per-method sizes (the ``train:`` section with the ``sweep.train`` overrides, :func:`sweep_train_config`).
+    and per-method sizes (the ``train:`` section with the ``sweep.train`` overrides, :func:`sweep_train_config`);
+    the aided rows by the aids that ran on the drives (``platforms``, ``{dataset: platform}``; none: a car's).
     """
     sw = ecfg["sweep"]
     tc = sweep_train_config(train_section, sw)
@@ -26,8 +29,14 @@ def describe_sweep_setup(train_section: dict, ecfg: dict, datasets) -> list[str]
              f"fold networks: window {tc.get('window')} samples, size block {tc.get('size')!r}, optimizer {budget}"]
     lines += [f"  {label(m):>12}: {tc['sizes'][m][tc['size']]}" for m in ecfg["methods"]]
     if ecfg["nhc_rows"]:
-        lines.append("INS and every network also with the vehicle constraints (NHC, ZUPT when still): rows "
-                     + ", ".join(nhc_label(m) for m in ["INS"] + list(ecfg["methods"])))
+        rows = [nhc_label(m) for m in ["INS"] + list(ecfg["methods"])]
+        ran = {(platforms or {}).get(d, DEFAULT_PLATFORM) for d in datasets} or {DEFAULT_PLATFORM}
+        kinds = sorted(ran - {DEFAULT_PLATFORM}, key=str)
+        if DEFAULT_PLATFORM in ran:                                  # a car among the drives
+            lines.append("INS and every network also with the vehicle constraints (NHC, ZUPT when still): rows "
+                         + ", ".join(rows))
+        lines += [f"INS and every network also with the aids of the {p}'s drives -- {aided_ins_words(p)}: rows "
+                  + ", ".join(aid_label(r, p) for r in rows) for p in kinds]
     return lines
 
 

@@ -37,7 +37,7 @@ class GalleryRun:
     """One log's run: its profile text, ``meta.yaml``, its rows (:data:`GALLERY_COLUMNS`), the loaded drive with its
     outages (for the figures), and what the loader and the filter decided (the drive's ``meta``, the KF baseline
     run, what the profile's rule picked, None for a list; :func:`bgfn.report.gallery_words.gallery_decisions`
-    words them). ``entry`` is the drive's name in the profile (its folder)."""
+    words them). ``entry`` is the drive's name in the profile (its id)."""
 
     log: GalleryLog
     profile_text: str
@@ -55,7 +55,7 @@ def run_log(log: GalleryLog, folder: Path, cfg: dict) -> GalleryRun:
     profile the log's :meth:`~bgfn.studies.gallery.logs.GalleryLog.profile_text` describes)."""
     folder = Path(folder).resolve()
     drive = load_drive(folder)
-    windows = outage_windows(cfg, drive, str(folder))
+    windows = outage_windows(cfg, drive, drive.name)      # the profile names an own log by its id (its drive's name)
     b = run_baseline(drive, nav_config(cfg["nav"]), windows, keep=False)   # a gallery log: read once
     base = {"log": drive.name, "kind": log.kind, "platform": drive.meta.get("platform", DEFAULT_PLATFORM),
             "duration_s": float(drive.imu["time"].iloc[-1] - drive.imu["time"].iloc[0]), "imu_rows": len(drive.imu),
@@ -70,7 +70,7 @@ def run_log(log: GalleryLog, folder: Path, cfg: dict) -> GalleryRun:
                          "method": "INS" if r["method"] == "INS" else aided, "max_h_m": float(r["max_horizontal"])})
     meta_text = (folder / "meta.yaml").read_text(encoding="utf-8")
     return GalleryRun(log, log.profile_text(folder), meta_text, pd.DataFrame(rows, columns=list(GALLERY_COLUMNS)),
-                      drive, list(windows), b, picked_outages(cfg, drive, str(folder)), str(folder))
+                      drive, list(windows), b, picked_outages(cfg, drive, drive.name), drive.name)
 
 
 def own_logs(cfg: dict) -> list[tuple[GalleryLog, Path]]:
@@ -78,7 +78,7 @@ def own_logs(cfg: dict) -> list[tuple[GalleryLog, Path]]:
     09 shows them rather than the built-in gallery; [] for a profile of the shipped drives."""
     out = []
     for name in cfg["data"]["datasets"]:
-        folder = dataset_folder(name)
+        folder = dataset_folder(name, cfg["profile"])      # a loaded profile names its folders by id
         if folder is None:
             continue
         meta = read_meta(folder / META_FILE)

@@ -279,3 +279,40 @@ def test_a_drive_without_odometer_bars_is_said_on_the_page_with_its_platform():
     text = odometer_markdown(section)
     assert "my-walk: no odometer bars (platform walker" in text
     assert "car:" not in text
+
+
+def test_each_odometer_network_reads_its_own_inputs_with_a_default_for_the_others():
+    from bgfn.config import odometer_inputs
+    from bgfn.profile_schema import load_profile
+    from bgfn.settings_check import ProfileError, complete
+
+    oc = {"inputs": {"default": "band_frames", "bgfn": "imu"}, "methods": ["bgfn", "transformer"]}
+    assert [odometer_inputs(oc, m) for m in oc["methods"]] == ["imu", "band_frames"]
+    assert odometer_inputs({"inputs": "imu"}, "mlp") == "imu"
+    cfg = load_profile("smoke")
+    cfg["evaluate"]["odometer"]["inputs"] = {"bgfn": "imu"}
+    with pytest.raises(ProfileError, match="default"):
+        complete(cfg)
+    cfg["evaluate"]["odometer"]["inputs"] = {"default": "imu", "lstm": "imu"}
+    with pytest.raises(ProfileError, match="inputs.lstm"):
+        complete(cfg)
+
+
+def test_two_networks_on_two_front_ends_train_side_by_side(monkeypatch, tmp_path):
+    from bgfn import config
+
+    monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)
+    seen = []
+    with_inputs = O.lo.with_inputs
+    monkeypatch.setattr(O.lo, "with_inputs", lambda d, inputs, rate: seen.append(inputs) or with_inputs(d, inputs, rate))
+    drive = demo_drive("synthetic", 150.0, 5.0, 3)
+    cfg = load_profile("smoke")
+    cfg = {**cfg, "nav": NAV, "train": {**cfg["train"], "window": 50, "margin_s": 5.0}}
+    ecfg = ev.evaluate_config({"sweep": {"n_starts": 2, "folds": 2, "durations_s": [10.0], "warmup_s": 30.0},
+                               "odometer": {**PLAIN, "sigmas_mps": [0.5], "seeds": [0], "methods": ["mlp", "at_lstm"],
+                                            "inputs": {"default": "band_frames", "mlp": "imu"}}}, cfg["train"])
+    rows, facts = O.odometer_rows(cfg, "t", "synthetic", ecfg, drive=drive)
+    assert seen == ["imu", "imu", "band_frames", "band_frames"]          # per front end, each fold once
+    assert sorted(facts["networks"]) == ["AT-LSTM-ODO fold 0 seed 0", "AT-LSTM-ODO fold 1 seed 0",
+                                         "MLP-ODO fold 0 seed 0", "MLP-ODO fold 1 seed 0"]
+    assert rows.loc[rows["method"].isin(["MLP-ODO", "AT-LSTM-ODO"]), "speed_rmse_mps"].notna().all()

@@ -169,7 +169,7 @@ def test_the_settings_choices_are_the_modules_choices():
 
     assert choices(settings.Nhc, "mounting") == set(cn.MOUNTINGS)
     assert choices(settings.Nhc, "mounting_weight") == set(cn.MOUNTING_WEIGHTS)
-    assert choices(settings.Odometer, "inputs") == set(ODOMETER_INPUTS)
+    assert set(get_args(settings.OdometerInput)) == set(ODOMETER_INPUTS)
     assert choices(settings.Nav, "ins_tuning") == set(navego_setup.INS_TUNINGS)
     assert choices(settings.Parallel, "backend") == set(BACKENDS)
     assert set(get_args(settings.Method)) == set(METHOD_LABELS) == set(settings.METHODS)

@@ -114,7 +114,7 @@ def odometer_datasets(odometer: dict | None, sweep_datasets) -> list[str]:
 
 
 #: The entry of a per-dataset setting that holds for every dataset it does not name (``outage_windows``,
-#: ``nav.noise_scale``, ``evaluate.odometer.network_seeds``).
+#: ``nav.noise_scale``, ``evaluate.odometer.network_seeds``; per network: ``evaluate.odometer.inputs``).
 DEFAULT_DATASET_KEY = "default"
 
 
@@ -129,6 +129,13 @@ def odometer_network_seeds(odometer: dict | None, dataset: str) -> list[int]:
         raise DataError("evaluate.odometer", "network_seeds", f"seeds for {dataset} (or a 'default' list)",
                         repr(odometer["network_seeds"]))
     return [int(s) for s in seeds]
+
+
+def odometer_inputs(odometer: dict, method: str) -> str:
+    """What the odometer network ``method`` reads: ``evaluate.odometer.inputs``, one choice for every network or per
+    network with a ``default`` for those not named (``{default: band_frames, bgfn: imu}``)."""
+    inputs = odometer["inputs"]
+    return str(inputs.get(method, inputs.get(DEFAULT_DATASET_KEY)) if isinstance(inputs, dict) else inputs)
 
 
 #: Keys of earlier versions that now live elsewhere: ``section.key`` -> the key to set instead.

@@ -296,6 +296,10 @@ class NeesScan(Section):
     twin_seeds: Seeds = _f([1, 2, 3], "seeds of the twins' simulated IMU")
 
 
+#: What an odometer network reads (bgfn.learning.odometry.ODOMETER_INPUTS).
+OdometerInput = Literal["imu", "band_frames"]
+
+
 class Odometer(Section):
     """Beyond the paper: the bars a learned odometer (speed + std, fused with the NHC rows) must clear."""
 
@@ -312,7 +316,8 @@ class Odometer(Section):
     ridge_alpha: Pos = _f(1.0, "ridge penalty on the standardized band energies")
     gate_probability: Fraction | None = _f(0.999, "chi-square gate of the speed row, 1 dof (null: none)")
     lr_search: bool = _f(False, "each network's rate per fold from train.lr_search (false: train.lr)")
-    inputs: Literal["imu", "band_frames"] = _f("band_frames", "networks read band frames | the raw IMU samples")
+    inputs: OdometerInput | dict[str, OdometerInput] = _f(
+        "band_frames", "networks read band frames | the raw IMU samples; or per network with a default")
     val_blocks: Count = _f(4, "validation blocks spread over the drive")
     curve_folds: list[Count] = _f([2, 4, 10, 20], "RIDGE-ODO refitted in each of these numbers of folds")
     ensemble: bool = _f(True, "each network's seeds also as one equal-weight ensemble (<METHOD>-ODO-ENS)")

@@ -141,6 +141,16 @@ def _check_free(cfg: dict) -> None:
             raise ProfileError("evaluate.odometer.network_seeds" + (f".{key}" if key else ""),
                                "a list of non-negative integers of at least 1 item (or per drive, with a 'default')",
                                fmt(value))
+    inputs = cfg["evaluate"]["odometer"]["inputs"]
+    if isinstance(inputs, dict):
+        if DEFAULT_DATASET_KEY not in inputs:
+            raise ProfileError("evaluate.odometer.inputs", f"a '{DEFAULT_DATASET_KEY}' choice beside the per-network "
+                               "ones", fmt(inputs))
+        unknown = sorted(set(inputs) - {DEFAULT_DATASET_KEY, *cfg["evaluate"]["odometer"]["methods"]})
+        if unknown:
+            raise ProfileError("evaluate.odometer.inputs." + unknown[0], "a network of evaluate.odometer.methods "
+                               f"({', '.join(cfg['evaluate']['odometer']['methods'])}) or '{DEFAULT_DATASET_KEY}'",
+                               fmt(unknown[0]))
     std = cfg["evaluate"]["pseudo_gps"]["std_m"]
     if std is not None and not (_number(std) and std > 0):
         raise ProfileError("evaluate.pseudo_gps.std_m", "a positive number, m, or null", fmt(std))

@@ -18,6 +18,7 @@ import itertools
 import numpy as np
 import pandas as pd
 
+from bgfn.config import odometer_inputs
 from bgfn.errors import DataError
 from bgfn.evaluate.hybrid import navigation_context, window_metrics
 from bgfn.learning import odometry as lo
@@ -209,7 +210,7 @@ def network_inputs(cfg: dict) -> dict[str, str]:
     ``evaluate.odometer.inputs`` (the raw IMU window or its band frames,
     :func:`bgfn.learning.odometry.network_inputs`)."""
     oc, chosen = cfg["evaluate"]["odometer"], (cfg.get("fleet") or {}).get("inputs") or {}
-    return {m: chosen.get(m, oc["inputs"]) for m in oc["methods"]}
+    return {m: chosen.get(m, odometer_inputs(oc, m)) for m in oc["methods"]}
 
 
 def with_calibration_windows(test_windows: lo.SpeedWindows, data: lo.SpeedData) -> lo.SpeedWindows:

@@ -21,7 +21,7 @@ from typing import Callable
 import numpy as np
 import pandas as pd
 
-from bgfn.config import odometer_network_seeds
+from bgfn.config import odometer_inputs, odometer_network_seeds
 from bgfn.errors import DataError
 from bgfn.data import load_drive
 from bgfn.evaluate.hybrid import navigation_context, run_outages, window_metrics
@@ -140,10 +140,9 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
     if paper:
         folds[PAPER_FOLD] = paper
     # one honest split per fold: the ridge and the networks learn from the same windows, the networks through
-    # their front end (evaluate.odometer.inputs)
+    # their front ends (evaluate.odometer.inputs, per network)
     data = {k: lo.build_speed_data(ws, fw, margin, val_fraction, int(oc["val_blocks"]), bool(oc["calibration_blocks"]))
             for k, fw in folds.items()}
-    net_data = {k: lo.with_inputs(d, oc["inputs"], imu_rate) for k, d in data.items()}
     runs, tracks = [], {}
     facts = {"ridge_std_mps": {}, "ridge_correlation": {}, "epochs": int(len(all_windows)),
              "paper_windows": folds.get(PAPER_FOLD, [])}
@@ -181,8 +180,13 @@ def odometer_rows(cfg: dict, profile: str, dataset: str, ecfg: dict, runner: Run
             runs.append(OdometerRun(f"{dataset} fold {k} {method} {sigma:g} m/s seed {seed}", fw,
                                     no.Odometer(con, track, gate), method, float(sigma), int(seed), int(k)))
             tracks[runs[-1].label] = track
-    nets = network_odometers(cfg, profile, dataset, ecfg, net_data,
-                             lo.network_inputs(all_windows, oc["inputs"], imu_rate), runner)
+    inputs_of = {m: odometer_inputs(oc, m) for m in oc["methods"]}
+    nets = {}
+    for inputs in dict.fromkeys(inputs_of.values()):        # one front end at a time, the networks in their order
+        group = {**ecfg, "odometer": {**oc, "methods": [m for m, i in inputs_of.items() if i == inputs]}}
+        nets.update(network_odometers(cfg, profile, dataset, group,
+                                      {k: lo.with_inputs(d, inputs, imu_rate) for k, d in data.items()},
+                                      lo.network_inputs(all_windows, inputs, imu_rate), runner))
     facts["networks"] = {}
     for (label, k, seed), (track, fact) in nets.items():
         runs.append(OdometerRun(f"{dataset} fold {k} {label} seed {seed}", folds[k], no.Odometer(con, track, gate),

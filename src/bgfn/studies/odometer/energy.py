@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from bgfn.config import odometer_datasets, odometer_network_seeds
+from bgfn.config import odometer_datasets, odometer_inputs, odometer_network_seeds
 from bgfn.data import load_drive
 from bgfn.data.registry import recorded_first
 from bgfn.energy.checkpoint import MEASURED, SPIKING, check_trained, improved
@@ -138,8 +138,9 @@ def odometer_energy(profile: str, cfg: dict, e_mac: float, e_ac: float, batch_si
     window, rate = lo.window_samples(drive.imu, oc["window_s"])
     t = drive.imu["time"].to_numpy(float)
     n = int((cfg.get("energy") or {}).get("max_windows") or 128)
-    ws = lo.network_inputs(lo.speed_windows(drive.imu, np.linspace(t[window], t[-1], n), window), oc["inputs"], rate)
-    counts = {m: layer_counts(tm.model.eval(), tm.norm.x(ws.x).astype(np.float32), batch_size)
+    ws = lo.speed_windows(drive.imu, np.linspace(t[window], t[-1], n), window)
+    fed = {m: lo.network_inputs(ws, odometer_inputs(oc, m), rate) for m in trained}     # each network's front end
+    counts = {m: layer_counts(tm.model.eval(), tm.norm.x(fed[m].x).astype(np.float32), batch_size)
               for m, tm in trained.items()}
     tables = {m: table_from_counts(c, odometer_label(m), e_mac, e_ac) for m, c in counts.items()}
     return OdometerEnergy(dataset, seed, paths, tables, mean_rate(counts["bgfn"]), len(ws),

@@ -50,7 +50,8 @@ def write_run_facts(profile: str, cfg: dict, t0: float, jobs: str) -> Path:
     where set: a copy of the tree on another machine may carry no git, or another one's)."""
     tc = (cfg["evaluate"]["odometer"].get("train") or {}).get("optimizer") or {}
     facts = {"profile": profile, "size": (cfg["evaluate"]["sweep"].get("train") or {}).get("size"),
-             "inputs": cfg["evaluate"]["odometer"].get("inputs"),
+             "inputs": inputs if isinstance(inputs := cfg["evaluate"]["odometer"].get("inputs"), str | None)
+             else ", ".join(f"{m}: {i}" for m, i in inputs.items()),          # per network: one cell of the table
              "correlation": bool(cfg["evaluate"]["odometer"]["correlation"]),
              "epochs_max": tc.get("epochs"), "batch_size": tc.get("batch_size"), "device": device_name(),
              "wall_s": round(time.perf_counter() - t0, 1), "jobs": jobs, "torch": torch.__version__,

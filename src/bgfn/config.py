@@ -115,7 +115,7 @@ def odometer_datasets(odometer: dict | None, sweep_datasets) -> list[str]:
 
 #: The entry of a per-dataset setting that holds for every dataset it does not name (``outage_windows``,
 #: ``nav.noise_scale``, ``evaluate.odometer.network_seeds``; per network: ``evaluate.odometer.inputs``).
-DEFAULT_DATASET_KEY = "default"
+DEFAULT_DATASET_KEY = settings.DEFAULT_DATASET_KEY
 
 
 def odometer_network_seeds(odometer: dict | None, dataset: str) -> list[int]:

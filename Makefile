@@ -44,7 +44,9 @@ override DASK_SCHEDULER := $(value DASK_SCHEDULER)
 # expands it. A path (VENV, PYTHON; PY and RES, which tests point elsewhere) is one word of a path's characters;
 # options (PIP_FLAGS, PAPERMILL_FLAGS, PYTEST_ARGS) words of an option's (no quote, `$`, `;`, `|`, `&`, `<`, `>`,
 # parenthesis, backquote or line break); NOTEBOOK_SLOTS a count; CI a word. A command-line variable that is none of
-# these settings is refused (the data step's command, DATA_FETCH, included): nothing else reaches a shell from outside.
+# these settings is refused (the data step's command, DATA_FETCH, included): nothing else reaches a recipe's shell from
+# outside. (What make itself evaluates while it reads its command line, `X!=cmd` or `X:=$(shell cmd)`, it runs before
+# any Makefile line: no Makefile can refuse it; the user typed that command.)
 comma := ,
 space := $(subst ,, )
 PATH_CHARS := $(NAME_CHARS) / + ~
@@ -65,6 +67,11 @@ $(foreach v,$(PATH_SETTINGS),$(if $(call from_outside,$(v)),$(if $(call is_path,
 $(foreach v,$(OPTION_SETTINGS),$(if $(call from_outside,$(v)),$(if $(call is_options,$(value $(v))),,$(error \
   $(v) "$(value $(v))" is not a list of options: expected words of letters, digits and . _ - / + ~ = : $(comma) @ % [ ] \
   (no quote, $$, ;, |, &, <, >, parenthesis, backquote or line break)))))
+# JOBS and DASK_SCHEDULER: their values are the profile check's to judge (bgfn.profile_schema), their characters
+# make's, here (a notebook target made directly runs no profile check first)
+$(foreach v,JOBS DASK_SCHEDULER,$(if $(value $(v)),$(if $(call is_options,$(value $(v))),,$(error \
+  $(v) "$(value $(v))" is not a value of options' characters: expected letters, digits and . _ - / + ~ = : $(comma) @ % \
+  [ ] (no quote, $$, ;, |, &, <, >, parenthesis, backquote or line break)))))
 ifneq ($(call from_outside,NOTEBOOK_SLOTS),)
 ifeq ($(call is_count,$(value NOTEBOOK_SLOTS)),)
 $(error NOTEBOOK_SLOTS "$(value NOTEBOOK_SLOTS)" is not a count: expected a whole number from 1 to 99 (notebooks at a time))
@@ -239,7 +246,7 @@ $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(STAMP) | data $(KERNEL_CONFIG) cle
 	started="$(RES)/logs/.started-$*"; touch "$$started"; written="$(RES)/logs/$*.written"; : > "$$written"; \
 	run() { BGFN_PROGRESS_LOG="$(CURDIR)/$$log" BGFN_OUTPUT_LOG="$(CURDIR)/$$written" \
 	  $(VENV_ABS)/bin/papermill "$<" "$$tmp" -p profile $(PROFILE) --cwd "$(CURDIR)" -k python3 "$$@" $(PAPERMILL_FLAGS); }; \
-	if [[ "$(MAKEFLAGS)" =~ (^|[[:space:]])-j([^1]|1[0-9]) ]]; then prefix="[$*] "; else prefix=""; fi; \
+	if [[ " $(filter -j%,$(MAKEFLAGS)) " =~ [[:space:]]-j([^1]|1[0-9]) ]]; then prefix="[$*] "; else prefix=""; fi; \
 	tail --pid=$$$$ -s 0.5 -n +1 -f "$$log" 2>/dev/null | sed -u "s/^/    $$prefix/; 1s/^/\n/" & \
 	if if [ -z "$$prefix" ]; then run --progress-bar; else run --no-progress-bar 2>&1 | sed -u "s/^/$$prefix/"; fi; then \
 	  mv -f "$$tmp" "$@"; rm -f "$$started"; \

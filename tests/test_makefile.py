@@ -172,7 +172,12 @@ def test_the_settings_take_their_documented_values_and_nothing_else_is_a_setting
 def test_jobs_and_the_scheduler_reach_python_as_text_never_as_make_code(tmp_path):
     repo = _checkout(tmp_path)
     res = _make("-n", "help", "JOBS=$(shell touch pwned)", "DASK_SCHEDULER=$(shell touch pwned)", cwd=repo)
-    assert res.returncode == 0 and not (repo / "pwned").exists()
+    assert res.returncode != 0 and not (repo / "pwned").exists()
+    assert 'JOBS "$(shell touch pwned)" is not a value of options\' characters' in res.stderr
+    # a backquote would reach the notebook recipe's shell through MAKEFLAGS: refused by make itself, nothing run
+    res = _make("-n", "help", "DASK_SCHEDULER=`touch pwned`", cwd=repo)
+    assert res.returncode != 0 and "DASK_SCHEDULER" in res.stderr and not (repo / "pwned").exists()
+    assert _make("-n", "help", "JOBS=2", "DASK_SCHEDULER=tcp://10.0.0.5:8786", cwd=repo).returncode == 0
 
 
 

@@ -124,3 +124,21 @@ def test_the_scan_runs_only_durations_the_sweep_ran():
     assert N.scan_durations({"durations_s": [10.0, 30.0, 60.0, 120.0]}) == [30.0, 60.0]
     assert N.scan_durations({"durations_s": [10.0, 30.0]}) == [30.0]
     assert N.scan_durations({"durations_s": [10.0, 20.0]}) == [20.0]
+
+
+def test_a_profile_grid_that_misses_the_crossing_is_scanned_again_widened():
+    """quick scans a narrow grid around the crossing; a drive whose scan (the profile's own value included) never
+    gets consistent on it (this synthetic drive crosses between 5 and 10 deg/s) is scanned again on the grid widened
+    by the default one, so its effective instability is not clipped at the grid's edge; a grid that brackets the
+    crossing is kept as it is."""
+    drive = demo_drive("synthetic", 150.0, 5.0, 3)
+    cfg = load_profile("smoke")
+    sweep = {**cfg["evaluate"]["sweep"], "n_starts": 2, "warmup_s": 30.0, "durations_s": [10.0]}
+
+    def grid(values):
+        c = {**cfg, "nav": NAV, "evaluate": {**cfg["evaluate"], "nees_scan": {"gyro_bias_dps": values}, "sweep": sweep}}
+        scan = N.consistency_scan(c, [drive], durations=(10.0,))
+        return set(scan.loc[~scan["profile"], "gyro_bias_instability_dps"])
+
+    assert grid([5.0, 10.0]) == {5.0, 10.0}                                    # brackets: kept
+    assert grid([0.001, 0.002]) == {0.001, 0.002, 0.005, 0.01, 0.02, 0.03, 0.05, 0.1, 0.2, 0.3}   # widened

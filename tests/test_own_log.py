@@ -335,6 +335,32 @@ def test_a_loaded_profile_names_its_folders_by_id_and_refuses_two_of_one_id(tmp_
     assert err.value.field == "folder" and str(tmp_path / "absent" / "run 9") in str(err.value)
 
 
+def test_an_id_that_would_load_another_drive_or_merge_two_keys_is_refused(tmp_path, monkeypatch):
+    params = tmp_path / "params"
+    params.mkdir()
+    shutil.copy(config.PARAMS_DIR / "quick.yaml", params / "quick.yaml")
+    monkeypatch.setattr(config, "PARAMS_DIR", params)
+    copy, odo = tmp_path / "copy", tmp_path / "odo run"
+    for folder in (copy, odo):
+        folder.mkdir()
+    (copy / "meta.yaml").write_text("name: rtklib-drive0708\n")   # a copy of the shipped drive, its name kept
+    (params / "copy.yaml").write_text(f"base: quick\ndatasets: ['{copy}']\n")
+    with pytest.raises(DataError, match="has the id 'rtklib-drive0708'"):
+        load_profile("copy")                                      # it would have loaded the built-in drive
+    (copy / "meta.yaml").write_text("name: default\n")
+    with pytest.raises(DataError, match="has the id 'default'"):
+        load_profile("copy")                                      # it would read as every drive's default
+    # a folder named only in the odometer's list is found again by its id
+    (params / "odo.yaml").write_text(f"base: quick\nevaluate: {{odometer: {{datasets: ['{odo}']}}}}\n")
+    assert load_profile("odo")["evaluate"]["odometer"]["datasets"] == ["odo-run"]
+    assert dataset_folder("odo-run", "odo") == odo.resolve()
+    # two keys of one drive (its path and its id) in a per-drive mapping: refused, not one silently dropped
+    (params / "twice.yaml").write_text(f"base: quick\ndatasets: ['{odo}']\n"
+                                       f"outage_windows: {{'{odo}': [[1.0, 2.0]], odo-run: [[3.0, 4.0]]}}\n")
+    with pytest.raises(DataError, match="two keys with the id 'odo-run'"):
+        load_profile("twice")
+
+
 def test_attitude_all_three_or_none(tmp_path, monkeypatch, truth):
     log = _write_log(tmp_path / "d", truth)
     pd.read_csv(log / "reference.csv").drop(columns=["yaw"]).to_csv(log / "reference.csv", index=False)

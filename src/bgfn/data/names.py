@@ -15,7 +15,7 @@ import hashlib
 import re
 from pathlib import Path
 
-from bgfn.config import DATASET_KEYS, PROJECT_ROOT, read_profile
+from bgfn.config import DATASET_KEYS, DEFAULT_DATASET_KEY, PROJECT_ROOT, read_profile
 from bgfn.data.csv_meta import ID_PATTERN, META_FILE, read_meta_name
 from bgfn.data.registry import DATASETS
 from bgfn.errors import DataError
@@ -57,7 +57,7 @@ def profile_entry(name: str | Path, profile: str) -> str | None:
     ``name`` is not that entry itself; None otherwise."""
     if registered(name):
         return None
-    for entry in profile_datasets(read_profile(profile)):          # as the file names them (paths)
+    for entry in profile_entries(read_profile(profile)):           # as the file names them (paths)
         if entry != str(name) and not registered(entry) and dataset_id(entry) == str(name):
             return entry
     return None
@@ -107,10 +107,15 @@ def unique_ids(names, source: str | Path = "profile") -> dict[str, str]:
     seen: dict[str, str] = {}
     for name in dict.fromkeys(str(n) for n in names):
         i = dataset_id(name)
-        if i in seen and seen[i] != name:
+        if (registered(i) and not registered(name)) or i == DEFAULT_DATASET_KEY:
+            # the id would load the built-in drive (or read as the per-dataset settings' default), not this folder
+            raise DataError(source, "datasets", "a CSV folder whose id (its meta.yaml 'name', else its folder name) "
+                            f"is neither a built-in dataset nor '{DEFAULT_DATASET_KEY}'", f"{name!r} has the id {i!r}")
+        if i in seen and seen[i] != name and i not in (name, seen[i]):      # an id beside its folder: one drive
             raise DataError(source, "datasets", "datasets with distinct ids (a CSV folder's id is its meta.yaml "
                             "'name', else its folder name)", f"{seen[i]!r} and {name!r} both have the id {i!r}")
-        seen[i] = name
+        if i != name or i not in seen:
+            seen[i] = name
         ids[name] = i
     return ids
 
@@ -131,7 +136,7 @@ def with_dataset_ids(cfg: dict, source: str | Path = "profile") -> dict:
     DataError
         Two entries share one id (naming ``source``), or a folder's ``meta.yaml`` is unreadable.
     """
-    unique_ids(profile_datasets(cfg) + [str(n) for n in [(cfg.get("energy") or {}).get("dataset")] if n], source)
+    unique_ids(profile_entries(cfg), source)
     out = dict(cfg)
 
     def node_at(path: str):
@@ -154,8 +159,29 @@ def with_dataset_ids(cfg: dict, source: str | Path = "profile") -> dict:
     for path in KEYED_BY_DATASET:
         node, key = node_at(path)
         if node is not None and isinstance(node.get(key), dict):
-            node[key] = {dataset_id(k) if isinstance(k, str) else k: v for k, v in node[key].items()}
+            ids = [dataset_id(k) if isinstance(k, str) and k != DEFAULT_DATASET_KEY else k for k in node[key]]
+            repeated = sorted({str(i) for i in ids if ids.count(i) > 1})
+            if repeated:                                   # two keys of one drive: one would silently win
+                raise DataError(source, path, "each drive once", f"two keys with the id {repeated[0]!r}")
+            node[key] = dict(zip(ids, node[key].values()))
     return out
+
+
+def profile_entries(cfg: dict) -> list[str]:
+    """Every drive entry of a profile as written, each once: the lists of ``datasets`` and
+    :data:`bgfn.config.DATASET_KEYS`, ``energy.dataset`` and the keys of :data:`KEYED_BY_DATASET` (but
+    ``default``), the set :func:`with_dataset_ids` names by id."""
+    def at(path: str):
+        node = cfg
+        for k in path.split("."):
+            node = node.get(k) if isinstance(node, dict) else None
+        return node
+
+    found = [d for path in ("datasets", *DATASET_KEYS) if isinstance(at(path), list) for d in at(path)]
+    found += [at("energy.dataset")] if isinstance(at("energy.dataset"), str) else []
+    found += [k for path in KEYED_BY_DATASET if isinstance(at(path), dict) for k in at(path)
+              if k != DEFAULT_DATASET_KEY]
+    return list(dict.fromkeys(str(d) for d in found if isinstance(d, (str, Path))))
 
 
 def profile_datasets(cfg: dict) -> list[str]:

@@ -108,8 +108,8 @@ def ran_frame(frame: pd.DataFrame, platform: str | Mapping[str, str]) -> pd.Data
 
 def ran_lines(lines: Iterable[str], platforms: Mapping[str, str]) -> list[str]:
     """Sentences with their row labels named by the aids that ran (:func:`aid_label`): a line that leads with a
-    drive of ``platforms`` (its name, then a comma, an opening parenthesis or a colon) by that drive's platform;
-    any other line by the drives' one platform when they share one, else as it is."""
+    drive of ``platforms`` (its name, then a comma, a space and an opening parenthesis, or a colon) by that
+    drive's platform; any other line by the drives' one platform when they share one, else as it is."""
     shared = set(platforms.values())
     whole = next(iter(shared)) if len(shared) == 1 else DEFAULT_PLATFORM
     names = sorted(platforms, key=len, reverse=True)          # the longest name first: "walk-2" before "walk"

@@ -20,7 +20,7 @@ import pandas as pd
 
 from bgfn.config import SHARED_TABLES
 from bgfn.studies.ins_fidelity.imu_roughness import trajectory_twin
-from bgfn.studies.ins_fidelity.nees import CHI2_MEDIAN, consistency_scan, scan_options
+from bgfn.studies.ins_fidelity.nees import CHI2_MEDIAN, brackets_crossing, consistency_scan, scan_options
 from bgfn.io import atomic_write_csv
 from bgfn.paper import test_of
 from bgfn.parallel import Runner
@@ -55,17 +55,6 @@ def effective_instability(scan: pd.DataFrame) -> pd.DataFrame:
             value = float(np.exp(np.log(x[k - 1]) + w * (np.log(x[k]) - np.log(x[k - 1]))))
         rows.append((ds, float(du), value))
     return pd.DataFrame(rows, columns=["dataset", "duration_s", "effective_dps"])
-
-
-def brackets_crossing(scan: pd.DataFrame) -> bool:
-    """Whether the scan of one drive has, at every duration, its median NEES above :data:`CHI2_MEDIAN` at its smallest
-    gyro bias instability and at or below it at some larger one: :func:`effective_instability` then interpolates
-    inside the scan's grid, and a wider grid that adds no crossing below it gives the same value."""
-    for _, g in scan.groupby("duration_s", sort=False):
-        y = g.sort_values("gyro_bias_instability_dps", kind="stable")["median_nees"].to_numpy(float)
-        if not (y[0] > CHI2_MEDIAN and np.any(y <= CHI2_MEDIAN)):
-            return False
-    return len(scan) > 0
 
 
 def _rows(scan: pd.DataFrame, imu: str, seed) -> list[dict]:

@@ -150,15 +150,29 @@ def scan_durations(sweep: dict) -> list[float]:
     return [d for d in SCAN_DURATIONS_S if d <= longest] or [longest]
 
 
+def brackets_crossing(scan: pd.DataFrame) -> bool:
+    """Whether the scan of one drive has, at every duration, its median NEES above :data:`CHI2_MEDIAN` at its smallest
+    gyro bias instability and at or below it at some larger one: :func:`effective_instability` then interpolates
+    inside the scan's grid, and a wider grid that adds no crossing below it gives the same value."""
+    for _, g in scan.groupby("duration_s", sort=False):
+        y = g.sort_values("gyro_bias_instability_dps", kind="stable")["median_nees"].to_numpy(float)
+        if not (y[0] > CHI2_MEDIAN and np.any(y <= CHI2_MEDIAN)):
+            return False
+    return len(scan) > 0
+
+
 def consistency_scan(cfg: dict, drives, durations=None, values_dps=None,
                      report: Callable[[str], None] | None = None, runner: Runner | None = None) -> pd.DataFrame:
     """The INS NEES of every recorded drive among ``drives`` from the sweep's starts (``evaluate.sweep``) with the
     filter's gyro bias instability set to each of ``values_dps`` (deg/s, every axis) and to the profile's own
     (``profile`` True): median NEES, share inside the 95 % bound, median max horizontal error, per duration
-    (default :func:`scan_durations`). ``values_dps`` defaults to ``evaluate.nees_scan.gyro_bias_dps``.
+    (default :func:`scan_durations`). ``values_dps`` defaults to ``evaluate.nees_scan.gyro_bias_dps``; a drive whose
+    scan on that grid does not bracket its crossing (:func:`brackets_crossing`: a profile's grid may be a narrow one)
+    is scanned again on it widened by the default grid.
 
     The points are independent runs (:func:`scan_point`), spread over ``runner`` (default: one after the other);
     the rows come back in the grid's order whatever the number of jobs."""
+    widen = values_dps is None
     tasks, labels = [], []
     values_dps = scan_options(cfg)["gyro_bias_dps"] if values_dps is None else values_dps
     durations = scan_durations(cfg["evaluate"]["sweep"]) if durations is None else durations
@@ -177,4 +191,15 @@ def consistency_scan(cfg: dict, drives, durations=None, values_dps=None,
 
     done = (runner or Runner()).map(scan_point, tasks, labels=labels, summary=line, desc="NEES scan",
                                     echo=report if report is not None else (lambda _line: None), bar=False)
-    return pd.DataFrame([row for rows in done for row in rows], columns=list(SCAN_COLUMNS))
+    scan = pd.DataFrame([row for rows in done for row in rows], columns=list(SCAN_COLUMNS))
+    if not widen:
+        return scan
+    wide = sorted({*map(float, values_dps), *map(float, settings.defaults("evaluate.nees_scan")["gyro_bias_dps"])})
+    narrow = [d for d in drives if d.name not in SIMULATED_IMU
+              and not brackets_crossing(scan[scan["dataset"] == d.name])]
+    if narrow and wide != sorted(map(float, values_dps)):
+        again = consistency_scan(cfg, narrow, durations, wide, report, runner)
+        names = {d.name for d in narrow}
+        scan = pd.concat([(again if d.name in names else scan).query("dataset == @d.name")
+                          for d in drives if d.name not in SIMULATED_IMU], ignore_index=True)
+    return scan

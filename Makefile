@@ -232,7 +232,9 @@ data: $(STAMP)
 # older copies. Its networks stay: they are checkpoints a rerun resumes from; so do the complete cache entries.
 # The notebook's runner (bgfn.parallel) writes one
 # line per finished run to $(RES)/logs/<notebook>.log (BGFN_PROGRESS_LOG); `tail` shows them here as they come
-# (the first on a line of its own, below papermill's cell bar)
+# (the first on a line of its own, below papermill's cell bar). Where /usr/bin/time exists, the notebook's wall, user
+# and system seconds (papermill, its kernel and the kernel's pool workers) go to $(RES)/logs/<notebook>.cpu, for the
+# book's "Reproduce it" page (bgfn.report.walltimes)
 # and stops after this recipe's shell ($$$$) has ended, having shown the last ones.
 # Each notebook also depends on the profile sections it reads and the modules it imports ($(RES)/.deps.mk,
 # below), not on the whole profile and every src/bgfn file. Notebooks run side by side (-j, NOTEBOOK_SLOTS): each
@@ -244,8 +246,9 @@ $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(STAMP) | data $(KERNEL_CONFIG) cle
 	@echo "==> [$(PROFILE)] papermill $<"
 	@tmp="$(@D)/.$*.running-$$$$.ipynb"; log="$(RES)/logs/$*.log"; : > "$$log"; \
 	started="$(RES)/logs/.started-$*"; touch "$$started"; written="$(RES)/logs/$*.written"; : > "$$written"; \
+	cpu="$(RES)/logs/$*.cpu"; rm -f "$$cpu"; timer=""; if [ -x /usr/bin/time ]; then timer="/usr/bin/time -q -f %e_%U_%S -o $$cpu"; fi; \
 	run() { BGFN_PROGRESS_LOG="$(CURDIR)/$$log" BGFN_OUTPUT_LOG="$(CURDIR)/$$written" \
-	  $(VENV_ABS)/bin/papermill "$<" "$$tmp" -p profile $(PROFILE) --cwd "$(CURDIR)" -k python3 "$$@" $(PAPERMILL_FLAGS); }; \
+	  $$timer $(VENV_ABS)/bin/papermill "$<" "$$tmp" -p profile $(PROFILE) --cwd "$(CURDIR)" -k python3 "$$@" $(PAPERMILL_FLAGS); }; \
 	if [[ " $(filter -j%,$(MAKEFLAGS)) " =~ [[:space:]]-j([^1]|1[0-9]) ]]; then prefix="[$*] "; else prefix=""; fi; \
 	tail --pid=$$$$ -s 0.5 -n +1 -f "$$log" 2>/dev/null | sed -u "s/^/    $$prefix/; 1s/^/\n/" & \
 	if if [ -z "$$prefix" ]; then run --progress-bar; else run --no-progress-bar 2>&1 | sed -u "s/^/$$prefix/"; fi; then \

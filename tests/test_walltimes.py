@@ -36,6 +36,14 @@ def test_notebook_wall_times_come_from_papermill_metadata(tmp_path, monkeypatch)
     times = W.notebook_wall_times("p")
     assert times["notebook"].tolist() == ["01_data_prep", "03_bgfn_training"]
     assert times["wall_s"].tolist() == [5.0, 300.0]
+    assert times["cpu_s"].isna().all()                                  # no /usr/bin/time record: unknown
+    (tmp_path / "p" / "logs").mkdir()
+    (tmp_path / "p" / "logs" / "03_bgfn_training.cpu").write_text("300.5_520.25_19.75\n")   # wall_user_sys
+    times = W.notebook_wall_times("p")
+    assert times["cpu_s"].iloc[1] == pytest.approx(540.0)
+    page = W.wall_time_markdown("p", pd.DataFrame(columns=list(W.MEASURED_COLUMNS)))
+    assert "| 03_bgfn_training | 5.0 min (300 s) | 9.0 min (540 s) | 180 % |" in page
+    assert "| 01_data_prep | 0.1 min (5 s) | - | - |" in page
     (tmp_path / "p" / "notebooks" / "02_kf_baseline.ipynb").write_text(json.dumps({"cells": [], "metadata": {}}))
     with pytest.raises(DataError, match="02_kf_baseline.ipynb.*papermill"):
         W.notebook_wall_times("p")

@@ -36,8 +36,19 @@ def notebook_wall_times(profile: str) -> pd.DataFrame:
             raise DataError(str(path), "metadata.papermill", "an executed notebook (papermill's metadata)",
                             type(exc).__name__) from None
         rows.append({"notebook": path.stem, "wall_s": float(meta.get("duration") or float("nan")),
-                     "end": meta.get("end_time")})
-    return pd.DataFrame(rows, columns=["notebook", "wall_s", "end"])
+                     "end": meta.get("end_time"), "cpu_s": notebook_cpu_seconds(profile, path.stem)})
+    return pd.DataFrame(rows, columns=["notebook", "wall_s", "end", "cpu_s"])
+
+
+def notebook_cpu_seconds(profile: str, notebook: str) -> float:
+    """User + system seconds of ``notebook``'s last run (papermill, its kernel and the kernel's pool workers), from
+    ``logs/<notebook>.cpu`` (``wall_user_sys``, written by the Makefile's ``/usr/bin/time``); NaN when absent."""
+    path = results_dir(profile, create=False) / "logs" / f"{notebook}.cpu"
+    try:
+        _, user, system = (float(v) for v in path.read_text(encoding="utf-8").strip().split("_"))
+    except (OSError, ValueError):
+        return float("nan")
+    return user + system
 
 
 def read_measured(path: str | Path = MEASURED_FILE) -> pd.DataFrame:
@@ -106,9 +117,12 @@ def wall_time_markdown(profile: str, measured: pd.DataFrame | None = None) -> st
     if times.empty:
         lines.append("No executed notebook of this profile yet.")
     else:
-        lines += ["| notebook | wall time |", "|---|---|"]
-        lines += [f"| {r.notebook} | {_minutes(r.wall_s)} |" for r in times.itertuples()]
-        lines.append(f"| all notebooks | {_minutes(times['wall_s'].sum())} |")
+        # CPU share: CPU seconds over wall seconds; 2 cores busy read 200 %, a neighbour notebook's share not counted
+        lines += ["| notebook | wall time | CPU time | CPU share |", "|---|---|---|---|"]
+        lines += [f"| {r.notebook} | {_minutes(r.wall_s)} | {_minutes(r.cpu_s)} | {_share(r.cpu_s, r.wall_s)} |"
+                  for r in times.itertuples()]
+        cpu_all = times["cpu_s"].sum(min_count=len(times))
+        lines.append(f"| all notebooks | {_minutes(times['wall_s'].sum())} | {_minutes(cpu_all)} | |")
     lines += ["", f"### With 1 and 2 jobs (`{profile}`, measured from a fresh clone)", ""]
     table = scaling_table(measured, profile)
     if table.empty:
@@ -129,6 +143,11 @@ def wall_time_markdown(profile: str, measured: pd.DataFrame | None = None) -> st
               "equal length as jobs and nothing else shared (memory bandwidth, disk, a GPU), so it is an upper "
               "bound on the speed-up: with fewer runs than jobs the longest run sets the time."]
     return "\n".join(lines) + "\n"
+
+
+def _share(cpu_s: float, wall_s: float) -> str:
+    """``163 %``: CPU over wall seconds (``-`` when either is unknown)."""
+    return "-" if cpu_s != cpu_s or not wall_s == wall_s or wall_s <= 0 else f"{100 * cpu_s / wall_s:.0f} %"
 
 
 def _minutes(seconds: float) -> str:

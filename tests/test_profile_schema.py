@@ -251,8 +251,8 @@ def test_odometer_network_seeds_per_drive_need_a_default(params):
     with pytest.raises(DataError) as err:
         load_profile("mine")
     assert err.value.field == "evaluate.odometer.network_seeds" and "'default'" in str(err.value)
-    # quick: three seeds on the real drive, one on every other; a list holds for every drive
-    oc = load_profile("quick")["evaluate"]["odometer"]
+    # per drive: the drive's own list, else the default's; a list holds for every drive
+    oc = {"network_seeds": {"default": [0], "rtklib-drive0708": [0, 1, 2]}}
     assert odometer_network_seeds(oc, "rtklib-drive0708") == [0, 1, 2]
     assert odometer_network_seeds(oc, "turin-sim-ekinox") == [0]
     assert odometer_network_seeds({"network_seeds": [3, 4]}, "any drive") == [3, 4]

@@ -26,7 +26,7 @@ import sys
 from pathlib import Path
 
 from bgfn.config import profile_chain, read_profile
-from bgfn.data.names import data_fingerprint, profile_datasets
+from bgfn.data.names import data_fingerprint, profile_entries
 from bgfn.errors import DataError
 
 #: Sections whose subsections (the mappings among their keys) get files of their own: a study's knobs
@@ -210,7 +210,7 @@ def write_profile_deps(profile: str, results: Path, notebooks_dir: Path = Path("
         if stale.stem not in values:
             stale.unlink()
             changed.append(stale.stem)
-    write_if_changed(results / ".data-fingerprint", data_fingerprint(profile_datasets(cfg)) + "\n")
+    write_if_changed(results / ".data-fingerprint", data_fingerprint(profile_entries(cfg)) + "\n")
 
     lines = [f"# Written by tools/notebook_deps.py for profile {profile}: what each executed notebook depends on."]
     for path in sorted(notebooks_dir.glob("[0-9][0-9]_*.ipynb")):

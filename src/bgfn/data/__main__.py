@@ -19,14 +19,14 @@ from pathlib import Path
 
 from bgfn.config import read_profile
 from bgfn.data.acquire import NAVEGO_TAG, failed_on, fetch_all, raw_files
-from bgfn.data.names import data_fingerprint, profile_datasets
+from bgfn.data.names import data_fingerprint, profile_entries
 from bgfn.errors import DataError
 from bgfn.io import atomic_write_text
 
 
 def fingerprint(profile: str, write: str | None) -> int:
     """Print the fingerprint of ``profile``'s CSV drives; with ``write``, store it there when it differs."""
-    value = data_fingerprint(profile_datasets(read_profile(profile)))
+    value = data_fingerprint(profile_entries(read_profile(profile)))
     if write:
         path = Path(write)
         if not path.is_file() or path.read_text().strip() != value:

@@ -8,7 +8,7 @@ import json
 import pandas as pd
 import pytest
 
-from bgfn import paper
+from bgfn import row_labels
 from bgfn.config import RUN_RECORDS
 from bgfn.data import load_drive
 from bgfn.data.platforms import recorded_platforms, write_ran_table
@@ -23,17 +23,17 @@ WALKER, CAR, OTHER = ("ZUPT",), ("NHC", "ZUPT"), ()
 
 
 def test_a_label_names_the_aids_that_ran_and_reads_back_as_the_codes_key():
-    assert paper.ran_label("INS+NHC", WALKER) == "INS+ZUPT" and paper.ran_label("BGFN+NHC", WALKER) == "BGFN+ZUPT"
-    assert paper.ran_label("INS+NHC+HOLD", WALKER) == "INS+ZUPT+HOLD"
-    assert paper.ran_label("INS+NHC_east_m", WALKER) == "INS+ZUPT_east_m"        # a column of the paper layout
-    assert paper.ran_label("INS+NHC", OTHER) == "INS+no aid" and paper.ran_label("INS", WALKER) == "INS"
-    assert paper.ran_label("INS+NHC", CAR) == "INS+NHC"                            # NHC ran: the project's label
+    assert row_labels.ran_label("INS+NHC", WALKER) == "INS+ZUPT" and row_labels.ran_label("BGFN+NHC", WALKER) == "BGFN+ZUPT"
+    assert row_labels.ran_label("INS+NHC+HOLD", WALKER) == "INS+ZUPT+HOLD"
+    assert row_labels.ran_label("INS+NHC_east_m", WALKER) == "INS+ZUPT_east_m"        # a column of the paper layout
+    assert row_labels.ran_label("INS+NHC", OTHER) == "INS+no aid" and row_labels.ran_label("INS", WALKER) == "INS"
+    assert row_labels.ran_label("INS+NHC", CAR) == "INS+NHC"                            # NHC ran: the project's label
     for label in ("INS+NHC", "BGFN+NHC", "AT-LSTM+NHC", "Transformer+NHC", "INS+NHC+HOLD", "MLP+NHC_north_m"):
         for aids in (WALKER, OTHER, CAR):
-            assert paper.key_label(paper.ran_label(label, aids)) == label
+            assert row_labels.key_label(row_labels.ran_label(label, aids)) == label
     # text that is no written row label stays as it is
     for text in ("NHC+ZUPT", "ORACLE-SPEED+WALK", "the +ZUPT rows", "RIDGE-ODO", "BGFN-ODO-ENS"):
-        assert paper.key_label(text) == text
+        assert row_labels.key_label(text) == text
 
 
 def _rows(datasets) -> pd.DataFrame:
@@ -47,7 +47,7 @@ def test_a_cars_table_is_written_byte_for_byte_as_before(tmp_path):
     (out / RUN_RECORDS["kf_baseline"]).write_text(json.dumps(
         {"datasets": {"rtklib-drive0708": {"constraints": {"platform": "car"}}}}))
     frame = _rows(["rtklib-drive0708"] * 4)
-    assert paper.ran_labels(frame, CAR) is frame           # nothing copied or touched
+    assert row_labels.ran_labels(frame, CAR) is frame           # nothing copied or touched
     write_ran_table(out / "tables" / "ran.csv", frame, out, float_format="%.4f")
     atomic_write_csv(out / "tables" / "plain.csv", frame, float_format="%.4f")
     assert (out / "tables" / "ran.csv").read_bytes() == (out / "tables" / "plain.csv").read_bytes()

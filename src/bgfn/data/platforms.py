@@ -1,9 +1,9 @@
 """What moved each drive, as the run recorded it, and the tables written with the aids that ran on it.
 
 Notebook 02 records each drive's platform with its constraints (``kf_baseline.json``); a table of the ``+NHC``
-rows is written with the label of the aids that ran there (:func:`bgfn.paper.ran_labels`: ``INS+ZUPT`` for a
+rows is written with the label of the aids that ran there (:func:`bgfn.row_labels.ran_labels`: ``INS+ZUPT`` for a
 walker), while the code keys the rows ``+NHC`` throughout and reads the tables back so
-(:func:`bgfn.paper.key_labels`).
+(:func:`bgfn.row_labels.key_labels`).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from bgfn.data.names import dataset_folder, dataset_id
 from bgfn.errors import DataError
 from bgfn.io import atomic_write_csv
 from bgfn.nav.constraints import DEFAULT_PLATFORM, PLATFORM_AIDS, platform_aids
-from bgfn.paper import ran_labels
+from bgfn.row_labels import ran_labels
 
 
 def recorded_platforms(out: str | Path) -> dict[str, str]:

@@ -23,7 +23,8 @@ from bgfn.evaluate.networks import ensure_models
 from bgfn.io import atomic_write_bytes, atomic_write_csv
 from bgfn.nav import outages
 from bgfn.nav.constraints import DEFAULT_PLATFORM, platform_aids
-from bgfn.paper import METHOD_LABELS, nhc_label, ran_labels, test_of
+from bgfn.paper import METHOD_LABELS, nhc_label, test_of
+from bgfn.row_labels import ran_labels
 
 
 @dataclass

@@ -18,7 +18,7 @@ import numba
 import numpy as np
 import pandas as pd
 
-from .. import paper, settings
+from .. import paper, row_labels, settings
 from ..config import DEFAULT_DATASET_KEY
 from ..errors import DataError
 from ..io import atomic_write_csv, cached, content_hash, sources_hash
@@ -499,12 +499,12 @@ def save_baseline(b: Baseline, out, file_id: str, lat=None) -> dict:
     save_states(out / f"nav_states_{d}.npz", b.states)
     atomic_write_csv(out / "tables" / f"kf_rms_{d}.csv", b.rms.reset_index(), float_format="%.6g")
     atomic_write_csv(out / "tables" / f"kf_outage_max_errors_{d}.csv",
-                     paper.ran_labels(ins_max_error_file(b.outage_table), aids))
-    atomic_write_csv(out / "tables" / f"kf_outage_metrics_{d}.csv", paper.ran_labels(b.outage_table, aids),
+                     row_labels.ran_labels(ins_max_error_file(b.outage_table), aids))
+    atomic_write_csv(out / "tables" / f"kf_outage_metrics_{d}.csv", row_labels.ran_labels(b.outage_table, aids),
                      float_format="%.6g")
     series = pd.concat([e.assign(outage=name)[["outage", "method", "t_rel", "east", "north", "down", "horizontal"]]
                         for name, e in b.outage_errors.items()], ignore_index=True)
-    atomic_write_csv(out / "tables" / f"kf_outage_errors_{d}.csv", paper.ran_labels(series, aids),
+    atomic_write_csv(out / "tables" / f"kf_outage_errors_{d}.csv", row_labels.ran_labels(series, aids),
                      float_format="%.6g")
     upd = b.full.updates
     return {"rms": {k: float(v) for k, v in b.rms["rms"].items()},

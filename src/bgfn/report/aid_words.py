@@ -12,7 +12,8 @@ import pandas as pd
 from bgfn.data.platforms import drive_platform
 from bgfn.data.platforms import recorded_platform as _recorded_platform
 from bgfn.nav.constraints import DEFAULT_PLATFORM, PLATFORM_AIDS, PLATFORM_NOTES, ConstraintConfig, platform_aids
-from bgfn.paper import NHC_SUFFIX, aids_suffix, ran_label
+from bgfn.paper import NHC_SUFFIX
+from bgfn.row_labels import aids_suffix, ran_label
 
 #: The aids in words (:func:`aided_ins_words`).
 AID_WORDS: dict[str, str] = {"NHC": "non-holonomic constraints", "ZUPT": "zero-velocity updates"}
@@ -41,7 +42,7 @@ def constraint_words(config: ConstraintConfig) -> str:
 def aid_suffix(platform: str) -> str:
     """The suffix of the rows the code keys ``+NHC`` (run with the platform's learning-free aids): ``+NHC`` on a
     car (the paper's label; its ZUPT at stops beside it, as ever), ``+ZUPT`` on a walker (no NHC ran), ``+no aid``
-    on a platform that takes neither (:func:`bgfn.paper.aids_suffix`; the tables write the same)."""
+    on a platform that takes neither (:func:`bgfn.row_labels.aids_suffix`; the tables write the same)."""
     return aids_suffix(platform_aids(_platform(platform)))
 
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from bgfn import paper
+from bgfn import paper, row_labels
 from bgfn.config import PROJECT_ROOT, RUN_RECORDS, SHARED_TABLES, read_profile, results_dir, run_metadata
 from bgfn.data.names import with_dataset_ids
 
@@ -28,13 +28,13 @@ def rel(path: str | Path) -> str:
 
 def read_csv(path: str | Path) -> pd.DataFrame | None:
     """A CSV table (``#`` comment lines skipped), or ``None`` when the file does not exist. Its rows keyed as the
-    code keys them (:func:`bgfn.paper.key_labels`: a walker's ``INS+ZUPT`` row reads as ``INS+NHC``; the page
+    code keys them (:func:`bgfn.row_labels.key_labels`: a walker's ``INS+ZUPT`` row reads as ``INS+NHC``; the page
     names it by the aids that ran again, :mod:`bgfn.report.aid_words`)."""
     path = Path(path)
     if not path.is_file():
         return None
     try:
-        return paper.key_labels(pd.read_csv(path, comment="#"))
+        return row_labels.key_labels(pd.read_csv(path, comment="#"))
     except pd.errors.EmptyDataError:         # a table with nothing to say (no rows, no header): empty, not missing
         return pd.DataFrame()
 

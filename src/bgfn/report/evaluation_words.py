@@ -13,7 +13,7 @@ from bgfn.evaluate.setup import METRIC_COLUMNS, REAL_IMU_DATASETS, EvaluationSet
 from bgfn.evaluate.tables import error_reduction
 from bgfn.paper import nhc_label
 from bgfn.report.run_words import runner_words
-from bgfn.report.sample_words import sample_clause
+from bgfn.report.sample_words import sample_note
 
 
 def real_imu_words(choice: RealImuChoice) -> str:
@@ -64,13 +64,6 @@ def _network_seeds(result, outage, methods) -> int:
     return int(sel.groupby("method")["seed"].nunique().max()) if len(sel) else 0
 
 
-def _sample_note(n_seeds: int, n_windows: int) -> str:
-    """:func:`bgfn.report.sample_words.sample_clause` in parentheses with a space before it; empty when the sample
-    is large enough or its seeds unknown (the runs were not kept)."""
-    clause = sample_clause(n_seeds, n_windows) if n_seeds > 0 else ""
-    return f" ({clause})" if clause else ""
-
-
 def describe_tables(results) -> list[str]:
     """Plain-language lines on the outage tables (what beats what), computed from the numbers; a line on networks
     says how many training seeds and windows (the table's outages) it rests on when too few for statistics
@@ -84,7 +77,7 @@ def describe_tables(results) -> list[str]:
             score = (g["max_east_m"] + g["max_north_m"]) / 2.0
             learned = [m for m in ("MLP", "AT-LSTM", "BGFN", "Transformer") if m in g.index]
             best = min(learned, key=lambda m: score[m]) if learned else None
-            sample = _sample_note(_network_seeds(r, o, learned), n_windows) if learned else ""
+            sample = sample_note(_network_seeds(r, o, learned), n_windows) if learned else ""
             txt = (f"{r.dataset} ({r.test} test), outage {o}{sample}: max east/north error INS "
                    f"{g.loc['INS', 'max_east_m']:.1f}/{g.loc['INS', 'max_north_m']:.1f} m, GPS "
                    f"{g.loc['GPS', 'max_east_m']:.1f}/{g.loc['GPS', 'max_north_m']:.1f} m")
@@ -154,7 +147,7 @@ def claim_lines(reductions: Mapping[str, pd.DataFrame]) -> list[str]:
             got = (f"ours {row['east_%'].item():.1f} % east / {row['north_%'].item():.1f} % north"
                    if row is not None and len(row) else "not evaluated")
             if row is not None and len(row) and {"n_seeds", "n_windows"} <= set(row.columns):
-                got += _sample_note(int(row["n_seeds"].item()), int(row["n_windows"].item()))
+                got += sample_note(int(row["n_seeds"].item()), int(row["n_windows"].item()))
             lines.append(f"BGFN vs INS, {spec['title']}, outage {outage}: paper quotes {stated['east']} % east / "
                          f"{stated['north']} % north; {got}")
     return lines

@@ -13,6 +13,7 @@ from bgfn.studies.fleet.protocol import LEARNED
 from bgfn.studies.fleet.summary import POOLED
 from bgfn.studies.odometer.bars import HOLD, odometer_label
 from bgfn.studies.odometer.section import odometer_table
+from bgfn.report.sample_words import INPUT_WORDS
 
 #: The ``speed_range`` codes in words.
 RANGE_WORDS = {"all": "every outage", "in": "outages inside the training drives' speeds and turn rates",
@@ -27,7 +28,6 @@ def drive_words(name: str) -> str:
 
 
 #: What a network reads (``fleet.inputs``, ``evaluate.odometer.inputs``) in words.
-INPUT_WORDS = {"imu": "the raw IMU window", "band_frames": "band frames"}
 
 
 def fleet_title(facts: dict) -> str:

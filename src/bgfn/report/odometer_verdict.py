@@ -22,6 +22,7 @@ from bgfn.data.names import dataset_id
 from bgfn.studies.odometer.sizes import read_measured
 from bgfn.studies.odometer.errors import offset_bar_mps
 from bgfn.report.odometer_words import uncertainty_sentence
+from bgfn.report.sample_words import INPUT_WORDS
 from bgfn.studies.odometer.bars import HOLD, LEARNED_ODOMETERS, ORACLE, RIDGE, holm_vs_nhc
 from bgfn.paper import METHOD_LABELS, ensemble_label, nhc_label, odometer_label
 from bgfn.stats import wilcoxon_p
@@ -42,7 +43,6 @@ ORACLE_ODO_ROW = f"oracle speed at {SUBJECT_ODO}'s speed error"
 #: What an odometer reads (the verdict table's ``inputs``).
 ODOMETER_INPUTS = "body-frame IMU"
 #: The odometer networks' inputs (``evaluate.odometer.inputs``) in words.
-INPUT_WORDS = {"band_frames": "band frames", "imu": "the raw IMU samples"}
 #: The coverage of +-2 sigma that a calibrated Gaussian std gives, and the band the issue calls calibrated.
 CALIBRATED_COVERAGE = (0.90, 0.98)
 #: Wilcoxon p below which a difference is called one (the Holm-adjusted p where the page names the best of several).

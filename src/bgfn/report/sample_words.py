@@ -19,3 +19,14 @@ def sample_clause(n_seeds: int, n_windows: int) -> str:
     if n_windows < MIN_WINDOWS:
         return f"{_count(n_seeds, 'seed')}, {_count(n_windows, 'window')}: no statistics"
     return f"{_count(n_seeds, 'seed')}, {_count(n_windows, 'window')}: no spread between training seeds"
+
+
+def sample_note(n_seeds: int, n_windows: int, lead: str = " (") -> str:
+    """:func:`sample_clause` in parentheses (``lead`` opens it: ``" ("``, or ``" (BGFN: "``); empty when the sample
+    is large enough or either count is unknown (0: the runs were not kept)."""
+    clause = sample_clause(n_seeds, n_windows) if n_seeds > 0 and n_windows > 0 else ""
+    return f"{lead}{clause})" if clause else ""
+
+
+#: What an odometer network reads (``evaluate.odometer.inputs``, ``fleet.inputs``), in words.
+INPUT_WORDS = {"imu": "the raw IMU window", "band_frames": "band frames"}

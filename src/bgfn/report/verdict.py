@@ -26,7 +26,7 @@ from bgfn.report.aid_words import aid_label, aid_suffix, aided_ins_words, record
 from bgfn.report.odometer_verdict import (OdometerInputs, answer_odometer, odometer_headline, odometer_rows,
                                           read_odometer_inputs, same_dataset)
 from bgfn.report.reading import read_csv
-from bgfn.report.sample_words import sample_clause
+from bgfn.report.sample_words import sample_note
 
 #: Rows of the verdict table, in order: (label, method label in the tables). The oracle row is built apart.
 METHOD_ROWS: tuple[tuple[str, str], ...] = (
@@ -236,13 +236,6 @@ def _sweep_sample(summary: pd.DataFrame | None, method: str, duration: float) ->
     return int(round(int(sel["n"].iloc[0]) / starts)), starts
 
 
-def _sample_note(seeds_windows: tuple[int, int], lead: str = " (") -> str:
-    """:func:`bgfn.report.sample_words.sample_clause` in parentheses (``lead`` opens it), empty when the sample
-    is large enough or unknown."""
-    clause = sample_clause(*seeds_windows) if seeds_windows[1] > 0 else ""
-    return f"{lead}{clause})" if clause else ""
-
-
 def _mean_outages(row: pd.Series | None) -> float:
     """Mean of a row's max errors over the outages it has (a user's drive may have one), NaN without any."""
     if row is None:
@@ -294,7 +287,7 @@ def answer_free_aids(table: pd.DataFrame, drift: pd.DataFrame | None = None, pla
         text = (f"In the paper's two outages (mean of their max errors) INS reaches {_m(_mean_outages(ins))}, INS+NHC "
                 f"{_m(_mean_outages(nhc))}" + drift_clause(drift, _mean_outages(ins), _mean_outages(nhc))
                 + f"; BGFN {_m(_mean_outages(bgfn))} and BGFN+NHC {_m(_mean_outages(both))}"
-                + _sample_note(_outage_sample(bgfn)) + ".")
+                + sample_note(*_outage_sample(bgfn)) + ".")
     a, b = (both[col], nhc[col]) if col else (_mean_outages(both), _mean_outages(nhc))
     add = ("BGFN adds to the free aid" if np.isfinite(a) and np.isfinite(b) and a < b
            else f"BGFN does not add to the free aid: fused with {aid} it is worse than {aid} alone")
@@ -408,7 +401,7 @@ def answer_protocol(table: pd.DataFrame, claims: dict | None = None) -> str:
     return ("Was the paper's protocol leaky? Mean max error in the paper's two outages, trained with the test outages "
             "and a margin left out (honest) and on the whole drive, the test outages included (leaky): "
             + "; ".join(lines) + f" (INS {_m(ins)}"
-            + _sample_note((min(n for n, _ in samples), max(w for _, w in samples)), "; each from ")[:-1] + ")."
+            + sample_note(min(n for n, _ in samples), max(w for _, w in samples), "; each from ")[:-1] + ")."
             + stated)
 
 
@@ -482,11 +475,11 @@ def _headline(inp: VerdictInputs, table: pd.DataFrame) -> str:
     if col:
         vals = (b[col], i[col], n[col] if n is not None else np.nan)
         where = ("median max error over the 30 s sweep"
-                 + _sample_note(_sweep_sample(inp.sweep_summary, SUBJECT, 30.0), " (BGFN: "))
+                 + sample_note(*_sweep_sample(inp.sweep_summary, SUBJECT, 30.0), " (BGFN: "))
     else:
         vals = (_mean_outages(b), _mean_outages(i), _mean_outages(n))
         where = ("mean max error in the paper's two outages" if paper.has_own_values(inp.test)
-                 else "mean max error in the profile's outages") + _sample_note(_outage_sample(b), " (BGFN: ")
+                 else "mean max error in the profile's outages") + sample_note(*_outage_sample(b), " (BGFN: ")
     word = "below" if vals[0] < vals[1] else "above"
     odo = odometer_headline(inp.odometer, SWEEP_DURATIONS) if inp.odometer is not None else ""
     return (f"{title} ({inp.dataset}): " + (f"{odo[0].upper()}{odo[1:]}. " if odo else "")

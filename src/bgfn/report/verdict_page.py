@@ -21,7 +21,8 @@ from bgfn.report.glance import run_header
 from bgfn.report.odometer_verdict import OdometerInputs, odometer_headline
 from bgfn.report.reading import read_csv
 from bgfn.report.verdict import (SUBJECT, SWEEP_DURATIONS, Verdict, VerdictInputs, _mean_outages, _outage_sample,
-                                 _row, _sample_note, _variant_rows, format_table, headline)
+                                 _row, _variant_rows, format_table, headline)
+from bgfn.report.sample_words import sample_note
 from bgfn.studies.ins_fidelity.ins_setups import gap_explained
 
 #: The rows and columns of the short table (the full one, with the variants and the NEES, is further down).
@@ -74,7 +75,7 @@ def short_free_aids(table: pd.DataFrame) -> str:
         return float("nan") if r is None else float(r["sweep 30 s"]) if sweep else _mean_outages(r)
     ins, nhc, bgfn, both = (value(k) for k in rows)
     p = rows[f"{SUBJECT}+NHC"]["p 30 s"] if sweep and rows[f"{SUBJECT}+NHC"] is not None else float("nan")
-    where = "30 s sweep" if sweep else "paper's two outages" + _sample_note(_outage_sample(rows[SUBJECT]))
+    where = "30 s sweep" if sweep else "paper's two outages" + sample_note(*_outage_sample(rows[SUBJECT]))
     return (f"{'yes' if np.isfinite(both) and both < nhc else 'no'}: in the {where} INS+NHC (no learning) reaches "
             f"{_m(nhc)}, BGFN {_m(bgfn)}, BGFN+NHC {_m(both)}" + (f" (p {p:.2g})" if np.isfinite(p) else "")
             + f"; INS {_m(ins)}.")

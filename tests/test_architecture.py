@@ -17,7 +17,10 @@ ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "src" / "bgfn"
 LINT = Path(sys.executable).with_name("lint-imports")
 #: Imports inside functions that are genuinely optional or heavy (each with a comment saying why at its place).
-ALLOWED_FUNCTION_IMPORTS = {("bgfn.nav.pyins_bridge", "pyins"), ("bgfn.train.speed", "torch.profiler")}
+ALLOWED_FUNCTION_IMPORTS = {("bgfn.nav.pyins_bridge", "pyins"), ("bgfn.train.speed", "torch.profiler"),
+                            # scipy.stats (and scipy.signal, which imports it) cost about a second in every process
+                            ("bgfn.stats", "scipy.stats"), ("bgfn.data.imu_errors", "scipy"),
+                            ("bgfn.data.imu_levels", "scipy")}
 
 
 def _lint(src: Path, tmp: Path) -> subprocess.CompletedProcess:

@@ -9,6 +9,7 @@
   :data:`MIN_WINDOWS` outage windows (a page then says so instead of implying a result).
 - :func:`holm_adjust`: Holm's step-down adjusted p-values of a family of tests, for a page that names the best of
   several candidates (the smallest of k raw p-values is small by chance alone).
+- :func:`chi2_quantile`: the chi-square quantile of the filter's gates and consistency checks.
 
 Every random draw takes a seed (``numpy.random.default_rng(seed)``).
 """
@@ -18,7 +19,7 @@ from __future__ import annotations
 from typing import Callable
 
 import numpy as np
-from scipy.stats import wilcoxon
+from scipy import special
 
 from bgfn.errors import DataError
 
@@ -90,7 +91,17 @@ def wilcoxon_p(diff) -> float:
     d = d[d != 0.0]
     if len(d) == 0:
         return float("nan")
+    # imported here: scipy.stats takes about a second to import, in every process that runs a filter
+    from scipy.stats import wilcoxon
+
     return float(wilcoxon(d, zero_method="wilcox", alternative="two-sided").pvalue)
+
+
+def chi2_quantile(p, dof):
+    """The chi-square distribution's ``p`` quantile with ``dof`` degrees of freedom (arrays broadcast):
+    ``2 P^-1(dof / 2, p)``, ``P`` the regularized lower incomplete gamma function -- what
+    ``scipy.stats.chi2.ppf`` computes, without importing ``scipy.stats`` into every filter process."""
+    return 2.0 * special.gammaincinv(np.asarray(dof, dtype=float) / 2.0, p)
 
 
 def paired_comparison(a, b) -> dict:
@@ -163,4 +174,4 @@ def holm_adjust(p_values) -> np.ndarray:
     return out
 
 
-__all__ = ["MIN_WINDOWS", "bootstrap_ci", "holm_adjust", "too_few_for_statistics", "paired_comparison", "wilcoxon_p"]
+__all__ = ["MIN_WINDOWS", "bootstrap_ci", "holm_adjust", "too_few_for_statistics", "paired_comparison", "wilcoxon_p", "chi2_quantile"]

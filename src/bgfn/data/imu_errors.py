@@ -18,7 +18,6 @@ import copy
 
 import numpy as np
 import pandas as pd
-from scipy import signal
 
 from bgfn.errors import DataError
 
@@ -180,6 +179,8 @@ def gauss_markov(n: int, dt: float, sigma, tau, rng: np.random.Generator) -> np.
         ``x[k] = a x[k-1] + sigma sqrt(1 - a^2) w[k]``, ``a = exp(-dt/tau)``, ``x[0] ~ N(0, sigma^2)``;
         autocorrelation ``sigma^2 exp(-|lag| / tau)``.
     """
+    # imported here: scipy.signal imports scipy.stats, about a second in every process that loads a drive
+    from scipy import signal
     sigma = np.atleast_1d(np.asarray(sigma, dtype=float))
     tau = np.atleast_1d(np.asarray(tau, dtype=float))
     w = rng.standard_normal((n, sigma.size))  # [n, m]
@@ -213,6 +214,8 @@ def band_limited_noise(n: int, rate_hz: float, f_center: float, bandwidth: float
     ndarray, shape (n, m)
         Stationary std 1 (normalized by the filter's exact noise gain, not by the sample std).
     """
+    # imported here: scipy.signal imports scipy.stats, about a second in every process that loads a drive
+    from scipy import signal
     lo, hi = f_center - bandwidth / 2.0, f_center + bandwidth / 2.0
     if not 0.0 < lo < hi < rate_hz / 2.0:
         raise DataError("imu_errors", "vibration_freq_hz/vibration_bandwidth_hz",

@@ -14,7 +14,6 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
-from scipy import signal
 
 from bgfn.errors import DataError
 from bgfn.nav.constraints import DEFAULT_PLATFORM
@@ -98,6 +97,8 @@ def rest_biases(drive, still_mps: float = STILL_MPS) -> pd.DataFrame:
 
 def highpass(x: np.ndarray, rate_hz: float, corner_hz: float = HIGHPASS_HZ) -> np.ndarray:
     """Zero-phase 2nd-order Butterworth high pass of the columns of ``x``."""
+    # imported here: scipy.signal imports scipy.stats, about a second in every process that loads a drive
+    from scipy import signal
     if not 0.0 < corner_hz < rate_hz / 2:
         raise DataError("imu_levels", "highpass_hz", f"a corner in (0, {rate_hz / 2}) Hz", str(corner_hz))
     b, a = signal.butter(2, corner_hz, "highpass", fs=rate_hz)
@@ -106,6 +107,8 @@ def highpass(x: np.ndarray, rate_hz: float, corner_hz: float = HIGHPASS_HZ) -> n
 
 def noise_band_hz(rate_hz: float, corner_hz: float = HIGHPASS_HZ) -> float:
     """Noise bandwidth ``B`` of :func:`highpass` for white noise of density ``N``: level^2 = ``N^2 B`` (Hz)."""
+    # imported here: scipy.signal imports scipy.stats, about a second in every process that loads a drive
+    from scipy import signal
     b, a = signal.butter(2, corner_hz, "highpass", fs=rate_hz)
     f, h = signal.freqz(b, a, worN=8192, fs=rate_hz)
     return float(2.0 * np.trapezoid(np.abs(h) ** 4, f))
@@ -249,6 +252,8 @@ def imu_psd(drive, state: str = "driving", nperseg: int = 512, still_mps: float 
     DataFrame
         ``freq_hz`` and one column per IMU channel (unit^2/Hz).
     """
+    # imported here: scipy.signal imports scipy.stats, about a second in every process that loads a drive
+    from scipy import signal
     imu = drive.imu
     sel = (motion_states(drive, still_mps, driving_mps) == state).to_numpy()
     if sel.sum() < nperseg:

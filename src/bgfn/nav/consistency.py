@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
-from scipy.stats import chi2
+from bgfn.stats import chi2_quantile
 
 #: A mean NIS within a factor NIS_BAND of its degrees of freedom reads as consistent. The bound is deliberately
 #: loose: real GNSS errors are time-correlated and no 15-state filter models them, so a mean of 4-5 for 3 axes is
@@ -49,7 +49,7 @@ def nis_summary(updates: pd.DataFrame, kind: str = "gnss") -> dict:
                 "above_chi2_95": float("nan"), "verdict": verdict(float("nan"), float("nan"))}
     nis, dof = u["nis"].to_numpy(float), u["dof"].to_numpy(float)
     used = dof > 0
-    above = float(np.mean(nis[used] > chi2.ppf(0.95, dof[used]))) if used.any() else float("nan")
+    above = float(np.mean(nis[used] > chi2_quantile(0.95, dof[used]))) if used.any() else float("nan")
     mean, mean_dof = float(np.mean(nis)), float(np.mean(dof))
     return {"fixes": int(len(u)), "dof": mean_dof, "mean_nis": mean, "median_nis": float(np.median(nis)),
             "above_chi2_95": above, "verdict": verdict(mean, mean_dof)}

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 import pandas as pd
-from scipy.stats import chi2
+from bgfn.stats import chi2_quantile
 
 from ..errors import DataError
 from ..schema import GNSS_FIX_COLUMNS
@@ -71,7 +71,7 @@ def gate_thresholds(probability: float | None, source: str = "nav") -> np.ndarra
         p = float("nan")
     if not 0.0 < p < 1.0:
         raise DataError(source, "innovation_gate", "a probability in (0, 1), or null for no gate", repr(probability))
-    return np.array([0.0] + [float(chi2.ppf(p, k)) for k in (1, 2, 3)])
+    return np.array([0.0] + [float(chi2_quantile(p, k)) for k in (1, 2, 3)])
 
 
 def check_gnss(gnss: pd.DataFrame, source: str) -> None:

@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.stats import chi2
+from bgfn.stats import chi2_quantile
 
 from ..errors import DataError
 from . import error_model as em
@@ -143,7 +143,7 @@ class Odometer:
         p = self.gate_probability
         if p is not None and not 0.0 < p < 1.0:
             raise DataError(source, "gate_probability", "a probability in (0, 1), or None for no gate", repr(p))
-        return OdometerSchedule(vehicle.rows, vehicle, speed, std, float(chi2.ppf(p, 1)) if p else 0.0)
+        return OdometerSchedule(vehicle.rows, vehicle, speed, std, float(chi2_quantile(p, 1)) if p else 0.0)
 
     def summary(self) -> dict:
         """The vehicle constraints' summary and how many epochs have a speed."""

@@ -108,3 +108,17 @@ def test_a_walker_in_a_fleet_is_refused_before_any_preparation(walk):
         fd.fleet_drives({"drives": [str(walk)], "pieces": 3}, loader=lambda n, profile=None: pytest.fail("loaded"))
     assert fd.platform_refusal({"a": "car", "b": None}) is None      # a platform not known yet: the loader's to say
     assert fd.platform_refusal({"o": "other"}) is not None            # no motion model: no NHC either
+
+
+def test_the_gallery_check_is_said_as_one_drive_and_a_walk_not_a_fleet(check):
+    from bgfn.report.fleet_words import gallery_lines, gallery_tables
+
+    lines = gallery_lines(check)
+    prep = check.preparation.set_index("role")
+    d_pitch = prep.loc["car_whole", "tilt_pitch_deg"] - prep.loc["phone", "tilt_pitch_deg"]
+    assert "one drive and a walk, not a fleet" in lines[0] and "a fleet refuses it (fleet.drives" in lines[0]
+    assert "undoes a phone's mounting and clock" in lines[1] and "(0, 0, -90) deg" in lines[0]
+    assert f"{d_pitch:+.2f} deg in pitch" in lines[2]
+    numbers, agreement = gallery_tables(check)
+    assert list(numbers.columns) == ["car log, over the phone's span", "phone log", "car log, whole drive"]
+    assert len(agreement) == 7 and numbers.loc["mounting_yaw_deg", "phone log"] == G.PHONE_MOUNTING_DEG[2]

@@ -72,9 +72,10 @@ def write_car_and_phone(recorded: Drive, root: Path) -> tuple[Path, Path]:
 
 
 def _channels(p: PreparedDrive, t: np.ndarray) -> pd.DataFrame:
-    """The prepared channels of ``p`` at its rows whose times are ``t`` (to 1 us), with the speed label."""
+    """The prepared channels of ``p`` at its rows whose times are ``t`` (to 1 us; NaN where it has none), with the
+    speed label."""
     imu = p.imu.set_index(np.round(p.imu["time"].to_numpy(float) * 1e6).astype(np.int64))
-    out = imu.loc[np.round(t * 1e6).astype(np.int64), list(ACCEL_COLUMNS + GYRO_COLUMNS)].reset_index(drop=True)
+    out = imu.reindex(np.round(t * 1e6).astype(np.int64))[list(ACCEL_COLUMNS + GYRO_COLUMNS)].reset_index(drop=True)
     return out.assign(speed=p.label_at(t))
 
 

@@ -22,7 +22,7 @@ from typing import Any
 from bgfn.config import (DEFAULT_DATASET_KEY, MAIN_VARIANT, VARIANT_NAME, VARIANT_RUN_KEYS, file_setting,
                          odometer_datasets, own_settings, profile_chain, read_profile, set_keys, variant_config)
 from bgfn.data import load_drive
-from bgfn.data.names import profile_datasets, unique_ids, with_dataset_ids
+from bgfn.data.names import dataset_id, profile_datasets, unique_ids, with_dataset_ids
 from bgfn.data.imu_errors import EKINOX_D, MPU6000, error_params
 from bgfn.data.registry import DATASETS
 from bgfn.errors import DataError
@@ -31,6 +31,7 @@ from bgfn.report.run_plan import plan_lines
 from bgfn.report.run_words import runner_words
 from bgfn.evaluate import evaluate_config
 from bgfn.studies.outage_sweep.sweep import sweep_plan
+from bgfn.studies.fleet.drives import DRIVES_KEY, folder_platform, platform_refusal
 from bgfn.learning import learning_options
 from bgfn.nav.baseline import filter_start
 from bgfn.nav.outages import check_windows, is_rule, outage_entry, picked_outages, snap_windows
@@ -217,6 +218,9 @@ def _check_fleet(cfg: dict) -> None:
         raise ProfileError("fleet.drives", "one drive to cut into fleet.pieces", fmt(drives))
     if not fl.get("pieces") and len(drives) < 2:
         raise ProfileError("fleet.drives", "at least 2 drives (or one with fleet.pieces)", fmt(drives))
+    refused = platform_refusal({dataset_id(d): folder_platform(d) for d in drives})   # meta.yaml's platform
+    if refused is not None:
+        raise ProfileError(DRIVES_KEY, *refused)
     if fl.get("protocol") == "named":
         for key in ("train", "test"):
             if not fl.get(key):

@@ -196,5 +196,71 @@ def plot_curve(curve: pd.DataFrame):
     return fig
 
 
+#: The rows of the gallery's check (:data:`bgfn.studies.fleet.gallery.ROLES`) in words.
+ROLE_WORDS = {"car_span": "car log, over the phone's span", "phone": "phone log", "car_whole": "car log, whole drive"}
+#: The gallery check's agreement columns (:data:`bgfn.studies.fleet.gallery.AGREEMENT_COLUMNS`) as the table heads them.
+AGREEMENT_HEADS = {"channel": "prepared channel", "unit": "unit", "rms": "RMS over the phone's span",
+                   "same_span_max_diff": "max |car - phone|, same span prepared",
+                   "whole_log_max_diff": "max |car - phone|, whole car log prepared",
+                   "whole_log_rest_max_diff": "the same, levellings taken out"}
+
+
+def gallery_tables(check) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The gallery check's preparation (a column per log, its rows the numbers) and agreement tables, headed in
+    words."""
+    prep = check.preparation.assign(role=check.preparation["role"].map(ROLE_WORDS)).set_index("role")
+    keep = [c for c in prep.columns if c.startswith(("mounting_", "tilt_", "gyro_bias_"))
+            or c in ("duration_s", "standstill_s", "accel_scale", "rate_hz", "cutoff_hz", "label_checked")]
+    agree = check.agreement.rename(columns=AGREEMENT_HEADS).set_index(AGREEMENT_HEADS["channel"])
+    return prep[keep].T.rename_axis(None, axis=1), agree
+
+
+def no_gallery_line() -> str:
+    """What notebook 11 says when the profile does not load the drive the gallery's logs are made of."""
+    return ("The gallery's car and phone logs are made of the shipped real drive (rtklib-drive0708), which this "
+            "profile does not load: their check is not shown.")
+
+
+def _agree(diff: float, unit: str) -> str:
+    """How closely two prepared numbers agree: exactly, or to their largest difference."""
+    return "exactly" if diff == 0 else f"to {diff:.1g}{' ' + unit if unit else ''}"
+
+
+def gallery_lines(check) -> list[str]:
+    """What the gallery's logs show through the fleet's preparation (:func:`bgfn.studies.fleet.gallery.gallery_check`):
+    what they are (one drive and a walk, not a fleet), the phone's mounting and clock undone, and the whole car log's
+    own levelling."""
+    f, prep = check.facts, check.preparation.set_index("role")
+    agree = check.agreement.set_index("channel")
+    imu = agree.drop(index="speed")
+    accel, gyro = imu[imu["unit"] == "m/s^2"], imu[imu["unit"] == "rad/s"]
+    car, phone, whole = prep.loc["car_span"], prep.loc["phone"], prep.loc["car_whole"]
+    keys = ["tilt_roll_deg", "tilt_pitch_deg", "accel_scale", *(f"gyro_bias_{a}_dps" for a in "xyz")]
+    worst = max(abs(float(phone[k]) - float(car[k])) for k in keys)
+    mount = ", ".join(f"{v:g}" for v in f["phone_mounting_deg"])
+    return [
+        "The gallery's logs are one drive and a walk, not a fleet: the phone log is the car drive's first "
+        f"{f['span_s']:.0f} s, its IMU turned by ({mount}) deg and its clock {f['phone_imu_offset_s']:g} s early, both "
+        "stated in its meta.yaml; the walker is a pedestrian, and a fleet refuses it (fleet.drives: a fleet is drives "
+        "of a vehicle with the non-holonomic constraint, which a walker's sideways steps break).",
+        "What they show is that the preparation undoes a phone's mounting and clock: prepared with the fleet's "
+        f"settings over the same span, the phone's and the car's {f['rows']} rows lie on the same times "
+        f"({_agree(f['max_time_diff_s'], 's')}), their accelerometer channels agree "
+        f"({_agree(accel['same_span_max_diff'].max(), 'm/s^2')}) and so do their gyro channels "
+        f"({_agree(gyro['same_span_max_diff'].max(), 'rad/s')}), their tilt, accelerometer scale and gyro bias "
+        f"({_agree(worst, '')}) and their speed labels ({_agree(agree.loc['speed', 'same_span_max_diff'], 'm/s')}; "
+        "the car's checked against its GNSS speed, the phone's unchecked: its fixes carry no velocity).",
+        f"As a fleet holds them, the whole car log is levelled from its {whole['standstill_s']:.0f} s standing, the "
+        f"phone log from the {phone['standstill_s']:.0f} s of its span: their tilts differ by "
+        f"{whole['tilt_roll_deg'] - phone['tilt_roll_deg']:+.2f} deg in roll and "
+        f"{whole['tilt_pitch_deg'] - phone['tilt_pitch_deg']:+.2f} deg in pitch (the road's slope where each stood, "
+        "which levelling from standstills cannot tell from a mount's tilt), so their channels differ by up to "
+        f"{accel['whole_log_max_diff'].max():.2f} m/s^2 and {gyro['whole_log_max_diff'].max():.4f} rad/s; with the two "
+        f"levellings, scales and gyro biases taken out, {max(imu['whole_log_rest_max_diff'].max(), 0.0):.1g} is left "
+        f"(more than {f['edge_s']:g} s from the phone's ends).",
+    ]
+
+
 __all__ = ["RANGE_WORDS", "POOLED_WORDS", "drive_words", "fleet_title", "preparation_lines", "fleet_markdown",
-           "verdict_lines", "coverage_lines", "curve_lines", "plot_curve"]
+           "verdict_lines", "coverage_lines", "curve_lines", "plot_curve", "ROLE_WORDS", "AGREEMENT_HEADS", "gallery_tables",
+           "no_gallery_line", "gallery_lines"]

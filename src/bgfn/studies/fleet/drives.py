@@ -12,6 +12,10 @@ Each step returns its numbers per drive (:data:`PREPARATION_COLUMNS`):
 - one sample rate (``rate_hz``, null: the lowest of the fleet; :func:`scipy.signal.resample_poly`, whose
   anti-alias filter cuts at the new Nyquist frequency) and one bandwidth: every drive, the slowest too, low-passed
   at ``bandwidth_fraction`` of that Nyquist frequency (zero-phase Butterworth);
+- the platform: a fleet is one vehicle's drives, run with the car's non-holonomic constraint (INS+NHC is the row the
+  learned odometer is judged against); a drive whose ``meta.yaml`` names a platform without it (``walker``,
+  ``other``: :data:`bgfn.nav.constraints.PLATFORM_AIDS`) is refused, at the profile check when its folder is there,
+  else when the drives are loaded, before any preparation;
 - the speed label: the reference's horizontal speed, checked against the GNSS speed; a stretch of at least
   ``label_min_s`` where they differ by more than ``label_max_diff_mps`` is left out (``drop``) or labelled from
   the GNSS speed (``gnss``); a drive without GNSS velocities is labelled unchecked.
@@ -26,8 +30,12 @@ import numpy as np
 import pandas as pd
 from scipy.signal import butter, resample_poly, sosfiltfilt
 
-from bgfn.data import Drive, load_drive
+from bgfn.config import file_setting
+from bgfn.data import Drive, dataset_id, load_drive
+from bgfn.data.csv_meta import META_FILE, read_meta
+from bgfn.data.names import dataset_folder, registered
 from bgfn.errors import DataError
+from bgfn.nav.constraints import DEFAULT_PLATFORM, PLATFORM_AIDS
 from bgfn.nav.transform import dcm_from_euler
 from bgfn.schema import ACCEL_COLUMNS, GYRO_COLUMNS
 
@@ -78,17 +86,68 @@ class PreparedDrive:
         return out
 
 
+#: The key of a profile that names the fleet's drives (the errors name it).
+DRIVES_KEY = "fleet.drives"
+
+
+def nhc_platform(platform: str) -> bool:
+    """Whether ``platform`` takes the car's non-holonomic constraint (:data:`bgfn.nav.constraints.PLATFORM_AIDS`)."""
+    return bool(PLATFORM_AIDS.get(str(platform), (False, False))[0])
+
+
+def folder_platform(entry: str, profile: str | None = None) -> str | None:
+    """The platform a fleet entry names before it is loaded: its folder's ``meta.yaml`` ``platform`` (the default,
+    a car, when it says none or for a built-in dataset); None when the folder is not there (the loader names it)."""
+    if registered(entry):                               # every shipped drive is a car's
+        return DEFAULT_PLATFORM
+    folder = dataset_folder(entry, profile)
+    if folder is None:
+        return None
+    return str(read_meta(folder / META_FILE).get("platform") or DEFAULT_PLATFORM)
+
+
+def platform_refusal(platforms: dict[str, str | None]) -> tuple[str, str] | None:
+    """``(expected, found)`` when a drive of ``platforms`` (``{drive id: platform}``, None: not known yet) is no
+    vehicle with the non-holonomic constraint; None when every known one is."""
+    bad = {d: p for d, p in platforms.items() if p is not None and not nhc_platform(p)}
+    if not bad:
+        return None
+    takes = ", ".join(p for p in PLATFORM_AIDS if nhc_platform(p))
+    return (f"drives of one vehicle with the non-holonomic constraint (platform: {takes} in meta.yaml): the fleet's "
+            "filter runs INS+NHC and its odometer learns a vehicle's forward speed",
+            "; ".join(f"drive {d!r} with platform: {p}" for d, p in bad.items()))
+
+
+def check_platforms(drives: list[Drive], source: str = "fleet") -> None:
+    """One DataError (naming ``source`` and :data:`DRIVES_KEY`) when a loaded drive's platform is no vehicle with the
+    non-holonomic constraint (:func:`platform_refusal`)."""
+    refused = platform_refusal({d.meta.get("piece_of", d.name): str(d.meta.get("platform") or DEFAULT_PLATFORM)
+                                for d in drives})
+    if refused is not None:
+        raise DataError(source, DRIVES_KEY, *refused)
+
+
 def fleet_drives(fleet: dict, profile: str | None = None, loader=load_drive) -> list[Drive]:
     """The drives a profile's ``fleet:`` section names, loaded (``loader(name, profile=...)``); with ``pieces`` its
-    one drive cut into that many contiguous pieces of equal time (:data:`PIECE_FORMAT`)."""
+    one drive cut into that many contiguous pieces of equal time (:data:`PIECE_FORMAT`). A drive of no vehicle with
+    the non-holonomic constraint is refused before any is loaded when its ``meta.yaml`` says so
+    (:func:`folder_platform`), else once loaded (:func:`check_platforms`)."""
     names = list(fleet["drives"])
+    source = file_setting(profile, DRIVES_KEY) if profile else "fleet"
+    refused = platform_refusal({dataset_id(n): folder_platform(n, profile) for n in names})
+    if refused is not None:
+        raise DataError(source, DRIVES_KEY, *refused)
     if fleet.get("pieces"):
         if len(names) != 1:
             raise DataError("fleet", "pieces", "one drive in fleet.drives to cut into pieces", f"{len(names)} drives")
-        return drive_pieces(loader(names[0], profile=profile), int(fleet["pieces"]))
+        drive = loader(names[0], profile=profile)
+        check_platforms([drive], source)
+        return drive_pieces(drive, int(fleet["pieces"]))
     if len(names) < 2:
         raise DataError("fleet", "drives", "at least 2 drives (or one with fleet.pieces)", f"{len(names)}")
-    return [loader(n, profile=profile) for n in names]
+    drives = [loader(n, profile=profile) for n in names]
+    check_platforms(drives, source)
+    return drives
 
 
 def drive_pieces(drive: Drive, n: int) -> list[Drive]:
@@ -220,7 +279,9 @@ def speed_label(drive: Drive, max_diff: float, action: str, min_s: float) -> tup
 
 
 def prepare_fleet(drives: list[Drive], fleet: dict) -> list[PreparedDrive]:
-    """Every drive made comparable (module docstring), in order; names must be distinct."""
+    """Every drive made comparable (module docstring), in order; names must be distinct, platforms vehicles with
+    the non-holonomic constraint (:func:`check_platforms`)."""
+    check_platforms(drives)
     names = [d.name for d in drives]
     if len(set(names)) != len(names):
         raise DataError("fleet", "drives", "distinct drive names", ", ".join(names))

@@ -322,13 +322,15 @@ $(RES)/notebooks/09_own_logs.ipynb: $(RES)/notebooks/01_data_prep.ipynb
 # (quick: 03 started at 349 s instead of 91 s). After 02 they are ready with 03, which make starts first (it comes
 # first in 10's list); 08 also finds 02's GPS-aided runs in the cache then.
 $(RES)/notebooks/08_ins_fidelity.ipynb $(RES)/notebooks/09_own_logs.ipynb: | $(RES)/notebooks/02_kf_baseline.ipynb
-# With two slots (the default), one slot is the paper's chain's and the other the studies', run one after the other
-# (07, 08, 09; order-only): a study queued for a slot took the slot 03 freed before 04 could (quick: 09 went first and
-# 04, on the longest path, waited 23 s). Chained, a study is not queued before its lane's slot is free. With more
-# slots they run side by side.
+# With two slots (the default), one slot is the longest path's (01 02 03 04 06 10) and the other a lane of the rest,
+# one after the other (order-only): 07 beside 02 and 03; then 08 and 09 once 03 is done, beside 04 and 06, whose
+# serial stretches leave a core free (quick: 06 alone used 154 % of the 2 cores), while 03 has the cores to itself;
+# then 05. Chained, a notebook is not queued before its lane's slot is free: queued early, 09 took the slot 03 freed
+# and 04 waited (23 s). With more slots they run side by side.
 ifeq ($(or $(NOTEBOOK_SLOTS),2),2)   # NOTEBOOK_SLOTS ?= 2 comes below
-$(RES)/notebooks/08_ins_fidelity.ipynb: | $(RES)/notebooks/07_learned_odometer.ipynb
+$(RES)/notebooks/08_ins_fidelity.ipynb: | $(RES)/notebooks/07_learned_odometer.ipynb $(RES)/notebooks/03_bgfn_training.ipynb
 $(RES)/notebooks/09_own_logs.ipynb: | $(RES)/notebooks/08_ins_fidelity.ipynb
+$(RES)/notebooks/05_energy_estimate.ipynb: | $(RES)/notebooks/09_own_logs.ipynb
 endif
 $(RES)/notebooks/11_fleet.ipynb: $(RES)/notebooks/01_data_prep.ipynb
 # 10 (the results page) reads every earlier output, the paper's published values and the odometers' run at the

@@ -149,3 +149,31 @@ def test_cached_windows_are_the_windows_built_again(tmp_path, monkeypatch):
     _same(fresh, again)
     other = L.build_learning_data(imu, att, gnss, [(1100.0, 20.0)], keep=True, **{**options, "window": 40})
     assert other.train.x.shape[1] == 40 and len(list((tmp_path / "learning_data").glob("*.pkl"))) == 2
+
+
+def _slow_entry(args):
+    """In a process of its own: ask for one cache entry whose computation takes a while and leaves a mark."""
+    root, marks = args
+    import os
+    import time
+
+    os.environ[CACHE_DIR_ENV] = root
+
+    def compute():
+        with open(marks, "a") as f:
+            f.write("computed\n")
+        time.sleep(1.0)
+        return {"value": 42}
+
+    return cached("slow", {"k": 1}, compute)
+
+
+def test_two_processes_asking_for_one_entry_at_once_compute_it_once(tmp_path):
+    # notebooks side by side under make -j: the second waits for the first's result instead of computing it again
+    import multiprocessing
+
+    marks = tmp_path / "marks.txt"
+    with multiprocessing.get_context("spawn").Pool(2) as pool:
+        got = pool.map(_slow_entry, [(str(tmp_path / "cache"), str(marks))] * 2)
+    assert got == [{"value": 42}, {"value": 42}]
+    assert marks.read_text().splitlines() == ["computed"]

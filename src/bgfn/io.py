@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import fcntl
 import hashlib
 import json
 import os
@@ -219,17 +220,33 @@ def cached(kind: str, key: Any | Callable[[], Any], compute: Callable[[], T]) ->
         return compute()
     digest = content_hash({"kind": kind, "key": key})
     path = Path(root) / kind / f"{digest[:32]}.pkl"
-    if path.is_file():
+    found = _read_entry(path, digest)
+    if found is not None:
+        return found[0]
+    # Two notebooks side by side (make -j) may ask for the same entry at once: the second waits for the first's
+    # result instead of computing it again (an exclusive lock per entry, released when its holder ends, even killed;
+    # a computation never asks for its own entry, so no two wait for each other).
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path.with_suffix(".lock"), "a+b") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        found = _read_entry(path, digest)
+        if found is not None:
+            return found[0]
+        value = compute()
         try:
-            stored_digest, value = pickle.loads(path.read_bytes())
-            if stored_digest == digest:
-                return value
-        except Exception:   # a truncated or foreign file: computed again and replaced
-            pass
-    value = compute()
-    try:
-        blob = pickle.dumps((digest, value), protocol=pickle.HIGHEST_PROTOCOL)
-    except Exception:       # a result that cannot be pickled is simply not kept
-        return value
-    atomic_write_bytes(path, blob)
+            blob = pickle.dumps((digest, value), protocol=pickle.HIGHEST_PROTOCOL)
+        except Exception:       # a result that cannot be pickled is simply not kept
+            return value
+        atomic_write_bytes(path, blob)
     return value
+
+
+def _read_entry(path: Path, digest: str) -> tuple[Any] | None:
+    """``(value,)`` of the cache entry at ``path`` when it holds ``digest``'s; None when absent or not readable."""
+    if not path.is_file():
+        return None
+    try:
+        stored_digest, value = pickle.loads(path.read_bytes())
+    except Exception:   # a truncated or foreign file: computed again and replaced
+        return None
+    return (value,) if stored_digest == digest else None

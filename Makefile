@@ -234,7 +234,7 @@ data: $(STAMP)
 # line per finished run to $(RES)/logs/<notebook>.log (BGFN_PROGRESS_LOG); `tail` shows them here as they come
 # (the first on a line of its own, below papermill's cell bar). Where /usr/bin/time exists, the notebook's wall, user
 # and system seconds (papermill, its kernel and the kernel's pool workers) go to $(RES)/logs/<notebook>.cpu, for the
-# book's "Reproduce it" page (bgfn.report.walltimes)
+# book's "Reproduce it" page (bgfn.report.walltimes); a pool worker counts once reaped (a Dask cluster's do not)
 # and stops after this recipe's shell ($$$$) has ended, having shown the last ones.
 # Each notebook also depends on the profile sections it reads and the modules it imports ($(RES)/.deps.mk,
 # below), not on the whole profile and every src/bgfn file. Notebooks run side by side (-j, NOTEBOOK_SLOTS): each
@@ -246,14 +246,15 @@ $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(STAMP) | data $(KERNEL_CONFIG) cle
 	@echo "==> [$(PROFILE)] papermill $<"
 	@tmp="$(@D)/.$*.running-$$$$.ipynb"; log="$(RES)/logs/$*.log"; : > "$$log"; \
 	started="$(RES)/logs/.started-$*"; touch "$$started"; written="$(RES)/logs/$*.written"; : > "$$written"; \
-	cpu="$(RES)/logs/$*.cpu"; rm -f "$$cpu"; timer=""; if [ -x /usr/bin/time ]; then timer="/usr/bin/time -q -f %e_%U_%S -o $$cpu"; fi; \
+	cpu="$(RES)/logs/$*.cpu"; rm -f "$$cpu"; timer=""; \
+	if /usr/bin/time -q -f %e -o /dev/null true 2>/dev/null; then timer="/usr/bin/time -q -f %e_%U_%S -o $$cpu"; fi; \
 	run() { BGFN_PROGRESS_LOG="$(CURDIR)/$$log" BGFN_OUTPUT_LOG="$(CURDIR)/$$written" \
 	  $$timer $(VENV_ABS)/bin/papermill "$<" "$$tmp" -p profile $(PROFILE) --cwd "$(CURDIR)" -k python3 "$$@" $(PAPERMILL_FLAGS); }; \
 	if [[ " $(filter -j%,$(MAKEFLAGS)) " =~ [[:space:]]-j([^1]|1[0-9]) ]]; then prefix="[$*] "; else prefix=""; fi; \
 	tail --pid=$$$$ -s 0.5 -n +1 -f "$$log" 2>/dev/null | sed -u "s/^/    $$prefix/; 1s/^/\n/" & \
 	if if [ -z "$$prefix" ]; then run --progress-bar; else run --no-progress-bar 2>&1 | sed -u "s/^/$$prefix/"; fi; then \
 	  mv -f "$$tmp" "$@"; rm -f "$$started"; \
-	else rm -f "$$tmp"; \
+	else rm -f "$$tmp" "$$cpu"; \
 	  others=$$(find "$(RES)/logs" -name '.started-*' -not -name ".started-$*" | head -1); \
 	  { sort -u "$$written"; if [ -z "$$others" ]; then find "$(CURDIR)/$(RES)" -type f -newer "$$started"; fi; } | \
 	    grep -e "^$(CURDIR)/$(RES)/" | grep -v -e "^$(CURDIR)/$(RES)/models/" -e "^$(CURDIR)/$(RES)/logs/" -e "^$(CURDIR)/$(RES)/cache/" \
@@ -286,7 +287,7 @@ $(RES)/notebooks/01_data_prep.ipynb: $(RES)/.data-fingerprint
 # What each notebook reads of the profile and which modules it imports: $(RES)/.deps.mk, remade by
 # tools/notebook_deps.py on every run of the notebooks (an included makefile: make remakes it first, even under
 # -n). The script writes each resolved profile section to $(RES)/.sections/<section>.json and the fingerprint of
-# the profile's own CSV drives (a folder in `datasets:`: their files' sizes and times) to $(RES)/.data-fingerprint,
+# the profile's own CSV drives (every folder it names, a fleet's too: their files' sizes and times) to $(RES)/.data-fingerprint,
 # each only when it changed: an edited setting reruns the notebooks that read it, an edited or touched drive
 # every notebook (through 01), and nothing else does.
 DEPS_MK := $(RES)/.deps.mk
@@ -302,6 +303,12 @@ $(DEPS_MK): FORCE $(if $(DRY),,| $(STAMP))
 	elif [ ! -f $@ ]; then echo "# no venv yet ($(PY)): make venv" > $@; fi
 $(RES)/.data-fingerprint: $(DEPS_MK)
 FORCE:
+
+# Notebooks at a time under `make reproduce` / `make notebooks` (1: one after the other, papermill's progress bar
+# shown). Each notebook's runner keeps every core (JOBS, else the profile's parallel.jobs, else the cores): the
+# chain 02-06 is the longest path, and when the studies beside it are done it must have all of them again; while
+# two notebooks run, the system shares the cores between their processes. No table depends on either number.
+NOTEBOOK_SLOTS ?= 2
 
 # The notebooks whose outputs a notebook reads. Notebook 01 builds the drives' caches every other one loads.
 $(RES)/notebooks/02_kf_baseline.ipynb: $(RES)/notebooks/01_data_prep.ipynb
@@ -326,11 +333,14 @@ $(RES)/notebooks/08_ins_fidelity.ipynb $(RES)/notebooks/09_own_logs.ipynb: | $(R
 # one after the other (order-only): 07 beside 02 and 03; then 08 and 09 once 03 is done, beside 04 and 06, whose
 # serial stretches leave a core free (quick: 06 alone used 154 % of the 2 cores), while 03 has the cores to itself;
 # then 05. Chained, a notebook is not queued before its lane's slot is free: queued early, 09 took the slot 03 freed
-# and 04 waited (23 s). With more slots they run side by side.
-ifeq ($(or $(NOTEBOOK_SLOTS),2),2)   # NOTEBOOK_SLOTS ?= 2 comes below
+# and 04 waited (23 s). With more slots they run side by side. Only in a whole run (a notebook made alone builds
+# no other lane's notebook).
+ifeq ($(NOTEBOOK_SLOTS),2)
+ifneq ($(filter _reproduce _notebooks,$(MAKECMDGOALS)),)
 $(RES)/notebooks/08_ins_fidelity.ipynb: | $(RES)/notebooks/07_learned_odometer.ipynb $(RES)/notebooks/03_bgfn_training.ipynb
 $(RES)/notebooks/09_own_logs.ipynb: | $(RES)/notebooks/08_ins_fidelity.ipynb
 $(RES)/notebooks/05_energy_estimate.ipynb: | $(RES)/notebooks/09_own_logs.ipynb
+endif
 endif
 $(RES)/notebooks/11_fleet.ipynb: $(RES)/notebooks/01_data_prep.ipynb
 # 10 (the results page) reads every earlier output, the paper's published values and the odometers' run at the
@@ -344,11 +354,6 @@ $(RES)/notebooks/10_results.ipynb: $(wildcard $(filter-out $(RES)/%,$(VARIANTS:%
 
 _notebooks: $(EXEC)
 
-# Notebooks at a time under `make reproduce` / `make notebooks` (1: one after the other, papermill's progress bar
-# shown). Each notebook's runner keeps every core (JOBS, else the profile's parallel.jobs, else the cores): the
-# chain 02-06 is the longest path, and when the studies beside it are done it must have all of them again; while
-# two notebooks run, the system shares the cores between their processes. No table depends on either number.
-NOTEBOOK_SLOTS ?= 2
 
 # ---------------------------------------------------------------- book
 # The book shows the executed notebooks of $(PROFILE) (copied to the gitignored book/notebooks/) and the

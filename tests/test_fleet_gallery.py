@@ -48,6 +48,7 @@ def test_the_phone_prepared_is_the_car_prepared_over_the_same_span(check):
                 "gyro_bias_z_dps", "speed_max_mps", "rate_hz", "cutoff_hz"):
         assert phone[key] == pytest.approx(car[key], rel=1e-9, abs=1e-12), key
     assert check.facts["rows"] == check.facts["car_rows"] and check.facts["max_time_diff_s"] < 1e-6
+    assert check.facts["same_span_agrees"]                  # what the page's sentence says rests on this
     assert check.facts["span_s"] == pytest.approx(G.PHONE_DURATION_S, abs=0.02)
     for r in check.agreement.itertuples():
         assert r.same_span_max_diff <= 1e-9 * max(1.0, r.rms), r.channel

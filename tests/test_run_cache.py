@@ -152,12 +152,20 @@ def test_cached_windows_are_the_windows_built_again(tmp_path, monkeypatch):
 
 
 def _slow_entry(args):
-    """In a process of its own: ask for one cache entry whose computation takes a while and leaves a mark."""
-    root, marks = args
+    """In a process of its own: wait until both processes are there (a file each), then ask for one cache entry whose
+    computation takes a while and leaves a mark; returns the entry and this process's id."""
+    root, marks, me = args
     import os
     import time
+    from pathlib import Path
 
     os.environ[CACHE_DIR_ENV] = root
+    Path(root, f"ready-{me}").parent.mkdir(parents=True, exist_ok=True)
+    Path(root, f"ready-{me}").touch()
+    deadline = time.monotonic() + 60.0
+    while len(list(Path(root).glob("ready-*"))) < 2:        # both processes ask at once, not one after the other
+        assert time.monotonic() < deadline, "the other process never came"
+        time.sleep(0.01)
 
     def compute():
         with open(marks, "a") as f:
@@ -165,7 +173,7 @@ def _slow_entry(args):
         time.sleep(1.0)
         return {"value": 42}
 
-    return cached("slow", {"k": 1}, compute)
+    return cached("slow", {"k": 1}, compute), os.getpid()
 
 
 def test_two_processes_asking_for_one_entry_at_once_compute_it_once(tmp_path):
@@ -174,6 +182,6 @@ def test_two_processes_asking_for_one_entry_at_once_compute_it_once(tmp_path):
 
     marks = tmp_path / "marks.txt"
     with multiprocessing.get_context("spawn").Pool(2) as pool:
-        got = pool.map(_slow_entry, [(str(tmp_path / "cache"), str(marks))] * 2)
-    assert got == [{"value": 42}, {"value": 42}]
+        got = pool.map(_slow_entry, [(str(tmp_path / "cache"), str(marks), i) for i in range(2)], chunksize=1)
+    assert [v for v, _ in got] == [{"value": 42}, {"value": 42}] and got[0][1] != got[1][1]   # two processes
     assert marks.read_text().splitlines() == ["computed"]

@@ -228,7 +228,10 @@ def cached(kind: str, key: Any | Callable[[], Any], compute: Callable[[], T]) ->
     # a computation never asks for its own entry, so no two wait for each other).
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(path.with_suffix(".lock"), "a+b") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+        except OSError:     # a file system without locks (some network mounts): computed here, as without a lock
+            pass
         found = _read_entry(path, digest)
         if found is not None:
             return found[0]

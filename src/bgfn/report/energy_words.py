@@ -6,7 +6,7 @@ from __future__ import annotations
 from bgfn.energy.checkpoint import EvaluationWindows, MeasuredModels
 from bgfn.energy.crosscheck import Crosscheck
 from bgfn.energy.tables import SPEED_KEYS, EnergyTotals
-from bgfn.report.sample_words import sample_clause
+from bgfn.report.sample_words import sample_clause, sample_note
 
 
 def measured_lines(measured: MeasuredModels) -> list[str]:
@@ -28,9 +28,8 @@ def windows_line(windows: EvaluationWindows, dataset: str, time_steps: int) -> s
 
 def _sample(n_windows: int, n_seeds: int = 1) -> str:
     """The energy is measured on one trained network (one seed) over ``n_windows`` validation windows:
-    :func:`bgfn.report.sample_words.sample_clause` in parentheses, a space before it."""
-    clause = sample_clause(n_seeds, n_windows)
-    return f" ({clause})" if clause else ""
+    :func:`bgfn.report.sample_words.sample_note`."""
+    return sample_note(n_seeds, n_windows)
 
 
 def totals_lines(totals: EnergyTotals, n_windows: int, n_seeds: int = 1) -> list[str]:

@@ -222,7 +222,9 @@ def no_gallery_line() -> str:
 
 
 def _agree(diff: float, unit: str) -> str:
-    """How closely two prepared numbers agree: exactly, or to their largest difference."""
+    """How closely two prepared numbers agree: exactly, or to their largest difference (unknown: rows differ)."""
+    if diff != diff:
+        return "not row for row: their rows differ"
     return "exactly" if diff == 0 else f"to {diff:.1g}{' ' + unit if unit else ''}"
 
 
@@ -243,9 +245,12 @@ def gallery_lines(check) -> list[str]:
         f"{f['span_s']:.0f} s, its IMU turned by ({mount}) deg and its clock {f['phone_imu_offset_s']:g} s early, both "
         "stated in its meta.yaml; the walker is a pedestrian, and a fleet refuses it (fleet.drives: a fleet is drives "
         "of a vehicle with the non-holonomic constraint, which a walker's sideways steps break).",
-        "What they show is that the preparation undoes a phone's mounting and clock: prepared with the fleet's "
-        f"settings over the same span, the phone's and the car's {f['rows']} rows lie on the same times "
-        f"({_agree(f['max_time_diff_s'], 's')}), their accelerometer channels agree "
+        ("What they show is that the preparation undoes a phone's mounting and clock: prepared with the fleet's "
+         if f.get("same_span_agrees") else
+         "They show that the preparation did NOT undo the phone's mounting or clock (more than float rounding "
+         "apart): prepared with the fleet's ")
+        + f"settings over the same span, the phone's {f['rows']} and the car's {f['car_rows']} rows lie on the same "
+        f"times ({_agree(f['max_time_diff_s'], 's')}), their accelerometer channels agree "
         f"({_agree(accel['same_span_max_diff'].max(), 'm/s^2')}) and so do their gyro channels "
         f"({_agree(gyro['same_span_max_diff'].max(), 'rad/s')}), their tilt, accelerometer scale and gyro bias "
         f"({_agree(worst, '')}) and their speed labels ({_agree(agree.loc['speed', 'same_span_max_diff'], 'm/s')}; "
@@ -256,8 +261,9 @@ def gallery_lines(check) -> list[str]:
         f"{whole['tilt_pitch_deg'] - phone['tilt_pitch_deg']:+.2f} deg in pitch (the road's slope where each stood, "
         "which levelling from standstills cannot tell from a mount's tilt), so their channels differ by up to "
         f"{accel['whole_log_max_diff'].max():.2f} m/s^2 and {gyro['whole_log_max_diff'].max():.4f} rad/s; with the two "
-        f"levellings, scales and gyro biases taken out, {max(imu['whole_log_rest_max_diff'].max(), 0.0):.1g} is left "
-        f"(more than {f['edge_s']:g} s from the phone's ends).",
+        f"levellings, scales and gyro biases taken out, {max(accel['whole_log_rest_max_diff'].max(), 0.0):.1g} m/s^2 "
+        f"and {max(gyro['whole_log_rest_max_diff'].max(), 0.0):.1g} rad/s are left (more than {f['edge_s']:g} s from "
+        "the phone's ends).",
     ]
 
 

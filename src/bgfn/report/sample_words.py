@@ -29,4 +29,4 @@ def sample_note(n_seeds: int, n_windows: int, lead: str = " (") -> str:
 
 
 #: What an odometer network reads (``evaluate.odometer.inputs``, ``fleet.inputs``), in words.
-INPUT_WORDS = {"imu": "the raw IMU window", "band_frames": "band frames"}
+INPUT_WORDS = {"imu": "the raw IMU samples", "band_frames": "band frames"}

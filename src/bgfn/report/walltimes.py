@@ -27,7 +27,8 @@ PROJECTED_JOBS = (4, 8, 16)
 
 
 def notebook_wall_times(profile: str) -> pd.DataFrame:
-    """``notebook, wall_s, end`` of every executed notebook of ``profile`` (papermill's metadata), in order."""
+    """``notebook, wall_s, end, cpu_s`` of every executed notebook of ``profile`` (papermill's metadata; the CPU
+    seconds from :func:`notebook_cpu_seconds`), in order."""
     rows = []
     for path in sorted((results_dir(profile, create=False) / "notebooks").glob("[0-9]*.ipynb")):
         try:
@@ -41,7 +42,7 @@ def notebook_wall_times(profile: str) -> pd.DataFrame:
 
 
 def notebook_cpu_seconds(profile: str, notebook: str) -> float:
-    """User + system seconds of ``notebook``'s last run (papermill, its kernel and the kernel's pool workers), from
+    """User + system seconds of ``notebook``'s last run (papermill, its kernel and the pool workers it reaped), from
     ``logs/<notebook>.cpu`` (``wall_user_sys``, written by the Makefile's ``/usr/bin/time``); NaN when absent."""
     path = results_dir(profile, create=False) / "logs" / f"{notebook}.cpu"
     try:

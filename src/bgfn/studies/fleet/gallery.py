@@ -39,6 +39,9 @@ RECORDED = "rtklib-drive0708"
 #: The phone's ends left out of the whole-log comparison, s: the zero-phase Butterworth's transient at a drive's end
 #: (order 4, cut at 0.8 of Nyquist: its impulse response has died out within a few tens of samples).
 EDGE_S = 1.0
+#: Same span, same samples: the phone and the car agree when every prepared channel's largest difference is at most
+#: this share of the channel's size (RMS, at least 1), and the rows' times within TIME_TOL_S: float rounding only.
+SAME_SPAN_RTOL, TIME_TOL_S = 1e-9, 1e-6
 #: Columns of :attr:`GalleryCheck.agreement`: per prepared channel (and the speed label, ``speed``), its RMS over
 #: the phone's span, the largest difference car-phone there with the same span prepared, with the whole car log
 #: prepared, and what is left of that once the two levellings are taken out.
@@ -120,6 +123,8 @@ def compare_car_and_phone(car: Drive, phone: Drive, fleet: dict) -> GalleryCheck
              "phone_imu_offset_s": float((phone.meta.get("time_shifts_s") or {}).get("imu_time_offset_s") or 0.0),
              "span_s": t1 - t0, "edge_s": EDGE_S, "rows": int(t.size), "car_rows": int(span_t.size),
              "max_time_diff_s": float(np.abs(span_t - t).max()) if span_t.size == t.size else float("nan")}
+    facts["same_span_agrees"] = bool(facts["max_time_diff_s"] <= TIME_TOL_S and all(
+        r["same_span_max_diff"] <= SAME_SPAN_RTOL * max(1.0, r["rms"]) for r in rows))
     return GalleryCheck(prep, pd.DataFrame(rows, columns=list(AGREEMENT_COLUMNS)), facts)
 
 

@@ -240,6 +240,9 @@ data: $(STAMP)
 # below), not on the whole profile and every src/bgfn file. Notebooks run side by side (-j, NOTEBOOK_SLOTS): each
 # line a notebook prints then starts with its number, and its outputs (bgfn.io logs each file it writes to
 # $(RES)/logs/<notebook>.written, BGFN_OUTPUT_LOG) are told apart from its neighbours' when it fails.
+# A notebook's OpenMP threads (torch's, numba's) sleep while they wait (OMP_WAIT_POLICY=PASSIVE, unless the
+# environment sets it): spinning, they took the cores a notebook beside them needed. Quick's 04 beside 08 took
+# 121 CPU s (44 alone), and 33 s with PASSIVE; 08 80 s instead of 102 (benchmarks/MEASUREMENTS.md).
 # Debris of an interrupted run is removed once, before the first notebook (clean-debris, order-only).
 $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(STAMP) | data $(KERNEL_CONFIG) clean-debris $(RES)/.profile-checked
 	@mkdir -p $(@D) $(RES)/logs
@@ -249,6 +252,7 @@ $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(STAMP) | data $(KERNEL_CONFIG) cle
 	cpu="$(RES)/logs/$*.cpu"; rm -f "$$cpu"; timer=""; \
 	if /usr/bin/time -q -f %e -o /dev/null true 2>/dev/null; then timer="/usr/bin/time -q -f %e_%U_%S -o $$cpu"; fi; \
 	run() { BGFN_PROGRESS_LOG="$(CURDIR)/$$log" BGFN_OUTPUT_LOG="$(CURDIR)/$$written" \
+	  OMP_WAIT_POLICY="$${OMP_WAIT_POLICY:-PASSIVE}" \
 	  $$timer $(VENV_ABS)/bin/papermill "$<" "$$tmp" -p profile $(PROFILE) --cwd "$(CURDIR)" -k python3 "$$@" $(PAPERMILL_FLAGS); }; \
 	if [[ " $(filter -j%,$(MAKEFLAGS)) " =~ [[:space:]]-j([^1]|1[0-9]) ]]; then prefix="[$*] "; else prefix=""; fi; \
 	tail --pid=$$$$ -s 0.5 -n +1 -f "$$log" 2>/dev/null | sed -u "s/^/    $$prefix/; 1s/^/\n/" & \
@@ -374,7 +378,8 @@ define build_book
 	@printf '%s\n' "Built from the executed notebooks of profile \`$(PROFILE)\` (\`params/$(PROFILE).yaml\`)," \
 	  "commit \`$$(git rev-parse --short HEAD 2>/dev/null || echo unknown)\`." > book/_generated/build_info.md
 	@rm -f book/_build/.built-*
-	$(VENV_ABS)/bin/jupyter-book build book --all -W -n --keep-going
+	@# jupyter-book build book --all -W -n --keep-going, with Sphinx on every core (quick's book: 90 -> 51 s)
+	$(PY) tools/build_book.py book --all -W -n --keep-going
 	@# the code pages show module constants' values, some of them paths in this checkout: relative, as the notebooks'
 	@{ grep -rlF --include='*.html' '$(CURDIR)' book/_build/html 2>/dev/null || true; } | xargs -r sed -i 's|$(CURDIR)/||g; s|$(CURDIR)|.|g'
 	@touch $(BOOK_STAMP)

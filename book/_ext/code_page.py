@@ -101,4 +101,12 @@ def setup(app):
     # around napoleon (priority 500), which turns numpydoc sections into reStructuredText
     app.connect("autodoc-process-docstring", _no_inline_type, priority=400)
     app.connect("autodoc-process-docstring", _plain, priority=900)
+    # Two extensions declare nothing, so Sphinx would read and write the pages one at a time (tools/build_book.py
+    # gives it the cores): sphinx-mathjax-offline only copies MathJax once the build has finished, and
+    # sphinx_multitoc_numbering (loaded by sphinx_external_toc) numbers sections in the main process after reading,
+    # and the book numbers none (html.use_multitoc_numbering: false).
+    for name in ("sphinx-mathjax-offline", "sphinx_multitoc_numbering"):
+        if name in app.extensions:
+            app.extensions[name].parallel_read_safe = True
+            app.extensions[name].parallel_write_safe = True
     return {"parallel_read_safe": True, "parallel_write_safe": True}

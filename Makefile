@@ -290,10 +290,11 @@ $(RES)/notebooks/01_data_prep.ipynb: $(RES)/.data-fingerprint
 
 # What each notebook reads of the profile and which modules it imports: $(RES)/.deps.mk, remade by
 # tools/notebook_deps.py on every run of the notebooks (an included makefile: make remakes it first, even under
-# -n). The script writes each resolved profile section to $(RES)/.sections/<section>.json and the fingerprint of
-# the profile's own CSV drives (every folder it names, a fleet's too: their files' sizes and times) to $(RES)/.data-fingerprint,
-# each only when it changed: an edited setting reruns the notebooks that read it, an edited or touched drive
-# every notebook (through 01), and nothing else does.
+# -n). The script writes each resolved profile section to $(RES)/.sections/<section>.json, the fingerprint of the
+# profile's own CSV drives (every folder it names: their files' sizes and times) to $(RES)/.data-fingerprint and
+# that of its fleet's drives to $(RES)/.fleet-fingerprint, each only when it changed: an edited setting reruns the
+# notebooks that read it, an edited or touched drive every notebook (through 01), a fleet's drive notebook 11 only,
+# and nothing else does.
 DEPS_MK := $(RES)/.deps.mk
 # a dry run (make -n): its flags' first word holds an n
 DRY = $(findstring n,$(filter-out --% %=%,$(firstword $(MAKEFLAGS))))
@@ -305,7 +306,7 @@ endif
 $(DEPS_MK): FORCE $(if $(DRY),,| $(STAMP))
 	@mkdir -p $(@D); if [ -x "$(PY)" ]; then $(PY) tools/notebook_deps.py $(PROFILE) --results $(RES); \
 	elif [ ! -f $@ ]; then echo "# no venv yet ($(PY)): make venv" > $@; fi
-$(RES)/.data-fingerprint: $(DEPS_MK)
+$(RES)/.data-fingerprint $(RES)/.fleet-fingerprint: $(DEPS_MK)
 FORCE:
 
 # Notebooks at a time under `make reproduce` / `make notebooks` (1: one after the other, papermill's progress bar
@@ -346,7 +347,7 @@ $(RES)/notebooks/09_own_logs.ipynb: | $(RES)/notebooks/08_ins_fidelity.ipynb
 $(RES)/notebooks/05_energy_estimate.ipynb: | $(RES)/notebooks/09_own_logs.ipynb
 endif
 endif
-$(RES)/notebooks/11_fleet.ipynb: $(RES)/notebooks/01_data_prep.ipynb
+$(RES)/notebooks/11_fleet.ipynb: $(RES)/notebooks/01_data_prep.ipynb $(RES)/.fleet-fingerprint
 # 10 (the results page) reads every earlier output, the paper's published values and the odometers' run at the
 # paper's size recorded from a GPU (python -m bgfn odometers --record).
 $(RES)/notebooks/10_results.ipynb: $(filter-out $(RES)/notebooks/10_results.ipynb $(FLEET_EXEC),$(EXEC)) \

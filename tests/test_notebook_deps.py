@@ -112,6 +112,22 @@ def test_one_edited_key_reruns_only_the_notebooks_that_read_it(tmp_path):
     assert _would_run(repo) == ALL                          # the drives: every notebook (through 01)
 
 
+def test_an_edited_fleet_drive_reruns_only_the_fleet_study(tmp_path):
+    repo = _checkout(tmp_path)
+    drive = tmp_path / "fleet drive"                      # only its files' names, sizes and times are read
+    drive.mkdir()
+    (drive / "imu.csv").write_text("time\n0.0\n", encoding="utf-8")
+    _edit(repo, f"fleet:\n  drives: ['{drive}']\n")
+    assert _would_run(repo) == ALL | {"11"}               # nothing executed yet (the fingerprints written)
+    _all_run_long_ago(repo)
+    assert _would_run(repo) == set()
+    os.utime(drive / "imu.csv")                           # `touch imu.csv`: the fleet's drive, in no other list
+    assert _would_run(repo) == {"11"}
+    _all_run_long_ago(repo)
+    _edit(repo, "data:\n  t_end: 139250.0\n")
+    assert _would_run(repo) == ALL | {"11"}               # the profile's own drives: every notebook
+
+
 def test_every_notebook_declares_sections_the_profile_has():
     tool = _tool()
     assert sorted(tool.NOTEBOOK_SECTIONS) == NOTEBOOKS

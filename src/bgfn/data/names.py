@@ -167,17 +167,19 @@ def with_dataset_ids(cfg: dict, source: str | Path = "profile") -> dict:
     return out
 
 
-def profile_entries(cfg: dict) -> list[str]:
+def profile_entries(cfg: dict, fleet: bool = True) -> list[str]:
     """Every drive entry of a profile as written, each once: the lists of ``datasets`` and
     :data:`bgfn.config.DATASET_KEYS`, ``energy.dataset`` and the keys of :data:`KEYED_BY_DATASET` (but
-    ``default``), the set :func:`with_dataset_ids` names by id, and ``fleet.drives`` (loaded as written)."""
+    ``default``), the set :func:`with_dataset_ids` names by id, and, with ``fleet``, ``fleet.drives`` (loaded as
+    written; only the fleet study reads them)."""
     def at(path: str):
         node = cfg
         for k in path.split("."):
             node = node.get(k) if isinstance(node, dict) else None
         return node
 
-    found = [d for path in ("datasets", *DATASET_KEYS, "fleet.drives") if isinstance(at(path), list) for d in at(path)]
+    lists = ("datasets", *DATASET_KEYS) + (("fleet.drives",) if fleet else ())
+    found = [d for path in lists if isinstance(at(path), list) for d in at(path)]
     found += [at("energy.dataset")] if isinstance(at("energy.dataset"), str) else []
     found += [k for path in KEYED_BY_DATASET if isinstance(at(path), dict) for k in at(path)
               if k != DEFAULT_DATASET_KEY]

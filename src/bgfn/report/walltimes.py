@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import datetime
 import json
+import math
 from pathlib import Path
 
 import pandas as pd
@@ -148,9 +149,9 @@ def wall_time_markdown(profile: str, measured: pd.DataFrame | None = None) -> st
 
 def _share(cpu_s: float, wall_s: float) -> str:
     """``163 %``: CPU over wall seconds (``-`` when either is unknown)."""
-    return "-" if cpu_s != cpu_s or not wall_s == wall_s or wall_s <= 0 else f"{100 * cpu_s / wall_s:.0f} %"
+    return "-" if math.isnan(cpu_s) or math.isnan(wall_s) or wall_s <= 0 else f"{100 * cpu_s / wall_s:.0f} %"
 
 
 def _minutes(seconds: float) -> str:
     """``12.3 min`` from seconds (``-`` when unknown)."""
-    return "-" if seconds != seconds else f"{seconds / 60:.1f} min ({seconds:.0f} s)"
+    return "-" if math.isnan(seconds) else f"{seconds / 60:.1f} min ({seconds:.0f} s)"

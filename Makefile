@@ -242,7 +242,7 @@ data: $(STAMP)
 # $(RES)/logs/<notebook>.written, BGFN_OUTPUT_LOG) are told apart from its neighbours' when it fails.
 # A notebook's OpenMP threads (torch's, numba's) sleep while they wait (OMP_WAIT_POLICY=PASSIVE, unless the
 # environment sets it): spinning, they took the cores a notebook beside them needed. Quick's 04 beside 08 took
-# 122 CPU s (about 50 alone), 35 with PASSIVE; 08 80 s instead of 102 (benchmarks/MEASUREMENTS.md).
+# 122 CPU s (about 50 alone), 35 with PASSIVE, and 08 finished in 80 s instead of 102 (benchmarks/MEASUREMENTS.md).
 # Debris of an interrupted run is removed once, before the first notebook (clean-debris, order-only).
 $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(STAMP) | data $(KERNEL_CONFIG) clean-debris $(RES)/.profile-checked
 	@mkdir -p $(@D) $(RES)/logs

@@ -6,6 +6,7 @@ import fcntl
 import os
 import shutil
 import subprocess
+import sys
 
 import pytest
 
@@ -198,7 +199,6 @@ def _fake_run(tmp_path, papermill="exec sleep 300", keys="exit 0"):
 case "$*" in
   *"profile_schema --keys"*) {keys};;
   *"bgfn kernels"*) echo $$ > {marks}/kernels.pid; exec sleep 300;;
-  *fingerprint*) : > "${{@: -1}}";;
   *build_book*) mkdir -p book/_build && echo $$ > {marks}/book.pid;;
 esac
 exit 0
@@ -329,6 +329,34 @@ def test_the_advice_for_a_corrupt_checkpoint_reruns_the_notebook_that_trains_it_
     out = _make(*args, cwd=repo).stdout
     reruns = [nb for nb in sorted(p.stem for p in (repo / "notebooks").glob("*.ipynb")) if f"notebooks/{nb}.ipynb\"" in out]
     assert reruns[0] == "03_bgfn_training" and "04_outage_evaluation" in reruns and not path.exists()
+
+
+def test_a_notebook_runs_with_sleeping_openmp_threads_unless_the_environment_says_otherwise(tmp_path):
+    marks = tmp_path / "marks"
+    repo, _ = _fake_run(tmp_path, papermill=f'echo "${{OMP_WAIT_POLICY:-unset}}" >> {marks}/omp; exit 1')
+    for value, expected in ((None, "PASSIVE"), ("ACTIVE", "ACTIVE")):
+        env = {k: v for k, v in os.environ.items() if k != "OMP_WAIT_POLICY"}
+        env |= {"OMP_WAIT_POLICY": value} if value else {}
+        res = subprocess.run(["make", "--no-print-directory", "reproduce", "PROFILE=smoke"], cwd=repo, env=env,
+                             capture_output=True, text=True, timeout=120)
+        assert res.returncode != 0                          # papermill's stand-in failed, after saying what it saw
+        assert (marks / "omp").read_text().split()[-1] == expected
+
+
+def test_the_book_is_built_on_every_core_and_a_failed_build_fails(tmp_path, monkeypatch):
+    import runpy
+
+    import jupyter_book.sphinx
+
+    for name in ("_config.yml", "_toc.yml"):
+        (tmp_path / "book").mkdir(exist_ok=True)
+        shutil.copy(PROJECT_ROOT / "book" / name, tmp_path / "book" / name)
+    jobs = []
+    monkeypatch.setattr(jupyter_book.sphinx, "build_sphinx", lambda *a, **kw: jobs.append(kw.get("jobs")) or 1)
+    monkeypatch.setattr(sys, "argv", ["build_book.py", str(tmp_path / "book"), "--all", "-W", "-n", "--keep-going"])
+    with pytest.raises(SystemExit) as ended:
+        runpy.run_path(str(PROJECT_ROOT / "tools" / "build_book.py"), run_name="__main__")
+    assert ended.value.code == 1 and jobs == [len(os.sched_getaffinity(0))]
 
 
 def test_two_book_builds_at_once_take_turns(tmp_path):

@@ -20,8 +20,8 @@ from bgfn import config
 from bgfn.data import load_drive, write_csv_drive
 from bgfn.data import imu_errors as ie
 from bgfn.data.csv_meta import DEFAULT_IMU_PROFILE, META_KEYS, read_meta
-from bgfn.data.names import (data_fingerprint, dataset_folder, dataset_id, profile_datasets, profile_entries,
-                             unique_ids, with_dataset_ids)
+from bgfn.data.names import (data_fingerprint, dataset_folder, dataset_id, drive_fingerprints, profile_datasets,
+                             profile_entries, unique_ids, with_dataset_ids)
 from bgfn.data.regrid import GAP_SAMPLES, interpolate_reference
 from bgfn.errors import DataError
 from bgfn.nav import earth, sim
@@ -427,15 +427,33 @@ def test_the_data_fingerprint_changes_when_a_drive_file_is_touched_and_only_then
     st = (log / "imu.csv").stat()
     os.utime(log / "imu.csv", ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000_000))   # `touch imu.csv`
     assert data_fingerprint(profile_datasets(cfg)) != first
-    # a folder named only in the odometer's lists or in a fleet is fingerprinted too (every entry of the profile)
+    # a folder named only in the odometer's lists is fingerprinted too (every entry of the profile); one named only
+    # in a fleet is the fleet's fingerprint's (notebook 11 alone reads it), unless another list names it by its id
     other = _write_log(tmp_path / "fleet drive", truth)
-    for only_there in ({"evaluate": {"odometer": {"datasets": [str(other)]}}}, {"fleet": {"drives": [str(other)]}}):
-        entries = profile_entries({**cfg, **only_there})
-        assert str(other) in entries and str(other) not in profile_datasets({**cfg, **only_there})
-        before = data_fingerprint(entries)
+    meta = other / "meta.yaml"                                   # another drive: another id
+    meta.write_text(meta.read_text(encoding="utf-8").replace("my-car", "fleet-car"), encoding="utf-8")
+    assert dataset_id(other) == "fleet-car"
+
+    def touch_other():
         st = (other / "gnss.csv").stat()
         os.utime(other / "gnss.csv", ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000_000))
-        assert data_fingerprint(entries) != before
+
+    odometer = {**cfg, "evaluate": {"odometer": {"datasets": [str(other)]}}}
+    assert str(other) in profile_entries(odometer) and str(other) not in profile_datasets(odometer)
+    before = drive_fingerprints(odometer)
+    touch_other()
+    assert drive_fingerprints(odometer)[0] != before[0]
+    fleet = {**cfg, "fleet": {"drives": [str(other)]}}
+    assert str(other) in profile_entries(fleet) and str(other) not in profile_entries(fleet, fleet=False)
+    before = drive_fingerprints(fleet)
+    touch_other()
+    after = drive_fingerprints(fleet)
+    assert after[0] == before[0] and after[1] != before[1]
+    by_id = {"data": {"datasets": [dataset_id(other)]}, "fleet": {"drives": [str(other)]}}   # one drive
+    before = drive_fingerprints(by_id)
+    touch_other()
+    after = drive_fingerprints(by_id)
+    assert after[0] != before[0] and after[1] != before[1]
 
 
 # ------------------------------------------------------------------------ meta.yaml: platform, mounting, clocks

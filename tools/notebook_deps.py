@@ -6,9 +6,9 @@
   of each top-level key of the profile, ``evaluate``'s subsections in files of their own
   (``evaluate.odometer.json``, ...), each rewritten only when its content changed, so that its time changes only
   with a real change of the setting;
-- ``.data-fingerprint``: the fingerprint of the profile's CSV drives (:func:`bgfn.data.names.data_fingerprint`),
-  and ``.fleet-fingerprint`` that of its fleet's (``fleet.drives``, read by notebook 11 only), each rewritten only
-  when it changed;
+- ``.data-fingerprint``: the fingerprint of the profile's CSV drives, and ``.fleet-fingerprint`` that of its
+  fleet's (read by notebook 11 only; :func:`bgfn.data.names.drive_fingerprints`), each rewritten only when it
+  changed;
 - ``.deps.mk``: one make rule per notebook naming the section files it reads (:data:`NOTEBOOK_SECTIONS`), the
   profile files it reads besides its own (:data:`OTHER_PROFILES`) and the package's modules it imports, followed
   transitively through ``src/bgfn`` (its own ``import`` statements, at any depth, and the module names it hands
@@ -27,7 +27,7 @@ import sys
 from pathlib import Path
 
 from bgfn.config import profile_chain, read_profile
-from bgfn.data.names import data_fingerprint, profile_entries
+from bgfn.data.names import drive_fingerprints
 from bgfn.errors import DataError
 
 #: Sections whose subsections (the mappings among their keys) get files of their own: a study's knobs
@@ -211,10 +211,9 @@ def write_profile_deps(profile: str, results: Path, notebooks_dir: Path = Path("
         if stale.stem not in values:
             stale.unlink()
             changed.append(stale.stem)
-    # the drives every notebook reads (through 01), and the fleet's, which only notebook 11 reads
-    write_if_changed(results / ".data-fingerprint", data_fingerprint(profile_entries(cfg, fleet=False)) + "\n")
-    fleet_drives = (cfg.get("fleet") or {}).get("drives") or []
-    write_if_changed(results / ".fleet-fingerprint", data_fingerprint([str(d) for d in fleet_drives]) + "\n")
+    drives, fleet = drive_fingerprints(cfg)       # what notebooks 01-10 read; what only notebook 11 reads
+    write_if_changed(results / ".data-fingerprint", drives + "\n")
+    write_if_changed(results / ".fleet-fingerprint", fleet + "\n")
 
     lines = [f"# Written by tools/notebook_deps.py for profile {profile}: what each executed notebook depends on."]
     for path in sorted(notebooks_dir.glob("[0-9][0-9]_*.ipynb")):

@@ -3,10 +3,6 @@
 Prints, per file, where it was resolved from (``raw``, ``mirror``, ``download``) or why it is missing.
 Exit status 0 when the required files (``ref.mat``, ``ekinox_gnss.mat``) are in ``data/raw``, 1 when one
 of them cannot be had, 2 on a checksum mismatch or bad usage.
-
-``python -m bgfn.data fingerprint PROFILE --write FILE``: the fingerprint of the profile's CSV drives
-(:func:`bgfn.data.names.data_fingerprint`) written to FILE only when it changed, so that ``make`` reruns the
-notebooks of a profile whose drive was edited, and only then.
 """
 
 from __future__ import annotations
@@ -15,24 +11,8 @@ import argparse
 import logging
 import sys
 
-from pathlib import Path
-
-from bgfn.config import read_profile
 from bgfn.data.acquire import NAVEGO_TAG, failed_on, fetch_all, raw_files
-from bgfn.data.names import data_fingerprint, profile_entries
 from bgfn.errors import DataError
-from bgfn.io import atomic_write_text
-
-
-def fingerprint(profile: str, write: str | None) -> int:
-    """Print the fingerprint of ``profile``'s CSV drives; with ``write``, store it there when it differs."""
-    value = data_fingerprint(profile_entries(read_profile(profile)))
-    if write:
-        path = Path(write)
-        if not path.is_file() or path.read_text().strip() != value:
-            atomic_write_text(path, value + "\n")
-    print(value)
-    return 0
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -51,16 +31,7 @@ def main(argv: list[str] | None = None) -> int:
     fetch.add_argument("--retry", action="store_true", help="try again the downloads of optional files that failed "
                        "before (after one failure they are skipped)")
     fetch.add_argument("-v", "--verbose", action="store_true", help="also what was tried for an absent optional file")
-    fp = sub.add_parser("fingerprint", help="fingerprint of a profile's CSV drives (their files' sizes and times)")
-    fp.add_argument("profile")
-    fp.add_argument("--write", default=None, help="store it in this file when it changed (make's stamp)")
     args = parser.parse_args(argv)
-    if args.command == "fingerprint":
-        try:
-            return fingerprint(args.profile, args.write)
-        except DataError as exc:
-            print(f"error: {exc}", file=sys.stderr)
-            return 2
     logging.basicConfig(level=logging.DEBUG if args.verbose else logging.INFO,
                         format="%(levelname)s %(name)s: %(message)s")
     try:

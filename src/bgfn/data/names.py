@@ -209,3 +209,21 @@ def data_fingerprint(names) -> str:
             st = f.stat()
             h.update(f"{f.name}\0{st.st_size}\0{st.st_mtime_ns}\n".encode())
     return h.hexdigest()[:16]
+
+
+def drive_fingerprints(cfg: dict) -> tuple[str, str]:
+    """``(drives, fleet)``: :func:`data_fingerprint` of the CSV drives notebooks 01-10 read, and of the fleet's
+    (``fleet.drives``, read by notebook 11 only). A fleet drive that another list names by its id (a drive's id
+    beside its folder is one drive) is among the former too, and so is one whose id cannot be read."""
+    own = profile_entries(cfg, fleet=False)
+    fleet = [str(d) for d in (cfg.get("fleet") or {}).get("drives") or []]
+
+    def id_of(name):
+        try:
+            return dataset_id(name)
+        except DataError:
+            return None
+
+    ids = {id_of(e) for e in own}
+    shared = [d for d in fleet if id_of(d) in ids or id_of(d) is None]
+    return data_fingerprint(own + shared), data_fingerprint(fleet)

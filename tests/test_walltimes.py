@@ -72,6 +72,10 @@ def test_a_recorded_run_replaces_only_its_own_rows_and_the_page_projects(tmp_pat
     assert W.scaling_table(table, "other").empty
     page = W.wall_time_markdown("p", table)
     assert "| 03_bgfn_training | 5.5 min (330 s) |" in page and "Amdahl" in page and "fresh clone" in page
+    assert "not this build's" not in page                               # the same notebooks
+    (tmp_path / "p" / "notebooks" / "04_outage_evaluation.ipynb").rename(tmp_path / "p" / "notebooks" / "04_x.ipynb")
+    page = W.wall_time_markdown("p", table)                             # renamed since the runs were measured
+    assert "not this build's: 04_outage_evaluation is not among this build's notebooks" in page
 
 
 def test_a_measured_file_without_its_columns_is_refused(tmp_path):

@@ -140,11 +140,24 @@ def wall_time_markdown(profile: str, measured: pd.DataFrame | None = None) -> st
     lines += ["", "Measured: " + "; ".join(f"{r.jobs} job{'s' if r.jobs > 1 else ''} on {r.date} at commit "
                                            f"`{r.commit}`" + (f" ({r.note})" if isinstance(r.note, str) and r.note
                                                              else "") for r in runs.itertuples()) + ".",
+              *_other_notebooks(table, times),
               "", "The projection is Amdahl's law per notebook: the share that did not get faster from 1 to 2 jobs "
               "stays serial, the rest divides evenly over the jobs. That assumes at least as many runs of about "
               "equal length as jobs and nothing else shared (memory bandwidth, disk, a GPU), so it is an upper "
               "bound on the speed-up: with fewer runs than jobs the longest run sets the time."]
     return "\n".join(lines) + "\n"
+
+
+def _other_notebooks(table: pd.DataFrame, times: pd.DataFrame) -> list[str]:
+    """A paragraph when the measured runs' notebooks are not this build's (renamed, split or merged since)."""
+    measured = [n for n in table.index if n != "total"]
+    absent = [n for n in measured if n not in set(times["notebook"])]
+    if times.empty or not absent:
+        return []
+    return ["", f"The measured runs' notebooks are those of their commits, not this build's: "
+                f"{', '.join(absent)} {'is' if len(absent) == 1 else 'are'} not among this build's notebooks. "
+                "The table shows how the runs of a notebook scale with the jobs, not how long this build's "
+                "notebooks take."]
 
 
 def _share(cpu_s: float, wall_s: float) -> str:

@@ -359,7 +359,6 @@ $(RES)/notebooks/10_results.ipynb: $(wildcard $(filter-out $(RES)/%,$(VARIANTS:%
 
 _notebooks: $(EXEC)
 
-
 # ---------------------------------------------------------------- book
 # The book shows the executed notebooks of $(PROFILE) (copied to the gitignored book/notebooks/) and the
 # profile's tables/figures (copied to book/_generated/, for pages that include them). book/_config.yml has

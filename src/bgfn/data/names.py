@@ -224,6 +224,6 @@ def drive_fingerprints(cfg: dict) -> tuple[str, str]:
         except DataError:
             return None
 
-    ids = {id_of(e) for e in own}
-    shared = [d for d in fleet if id_of(d) in ids or id_of(d) is None]
+    ids = {id_of(e) for e in own} | {None}
+    shared = [d for d in fleet if id_of(d) in ids]
     return data_fingerprint(own + shared), data_fingerprint(fleet)

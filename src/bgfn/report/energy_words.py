@@ -26,17 +26,11 @@ def windows_line(windows: EvaluationWindows, dataset: str, time_steps: int) -> s
             f"week); T_s = {time_steps}")
 
 
-def _sample(n_windows: int, n_seeds: int = 1) -> str:
-    """The energy is measured on one trained network (one seed) over ``n_windows`` validation windows:
-    :func:`bgfn.report.sample_words.sample_note`."""
-    return sample_note(n_seeds, n_windows)
-
-
 def totals_lines(totals: EnergyTotals, n_windows: int, n_seeds: int = 1) -> list[str]:
     """Where BGFN's energy goes, and how much of the gap the attention products make
     (:class:`~bgfn.energy.tables.EnergyTotals`), each line saying that it rests on ``n_seeds`` trained networks
     (one: the checkpoint measured) and ``n_windows`` windows when too few for statistics."""
-    sample = _sample(n_windows, n_seeds)
+    sample = sample_note(n_seeds, n_windows)
     return [f"BGFN: {totals.macs:,.0f} MACs + {totals.sops:,.0f} SOPs; "
             f"the MAC layers (encoder, readout) take {100 * totals.mac_share:.1f} % of its energy{sample}",
             f"attention products: {100 * totals.attention_uj['transformer'] / totals.twin_uj:.1f} % of the twin's "

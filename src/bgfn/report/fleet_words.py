@@ -223,7 +223,7 @@ def no_gallery_line() -> str:
 
 def _agree(diff: float, unit: str) -> str:
     """How closely two prepared numbers agree: exactly, or to their largest difference (unknown: rows differ)."""
-    if diff != diff:
+    if math.isnan(diff):
         return "not row for row: their rows differ"
     return "exactly" if diff == 0 else f"to {diff:.1g}{' ' + unit if unit else ''}"
 

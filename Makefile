@@ -243,6 +243,9 @@ data: $(STAMP)
 # A notebook's OpenMP threads (torch's, numba's) sleep while they wait (OMP_WAIT_POLICY=PASSIVE, unless the
 # environment sets it): spinning, they took the cores a notebook beside them needed. Quick's 04 beside 08 took
 # 122 CPU s (about 50 alone), 35 with PASSIVE, and 08 finished in 80 s instead of 102 (benchmarks/MEASUREMENTS.md).
+# A kernel that dies before it runs a cell is started once more: two kernels started at the same moment can be
+# handed the same free port by the system (jupyter_client picks the ports, the kernel binds them a second later;
+# seen once in CI as "Address already in use" then "Kernel died before replying to kernel_info").
 # Debris of an interrupted run is removed once, before the first notebook (clean-debris, order-only).
 $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(STAMP) | data $(KERNEL_CONFIG) clean-debris $(RES)/.profile-checked
 	@mkdir -p $(@D) $(RES)/logs
@@ -256,7 +259,10 @@ $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(STAMP) | data $(KERNEL_CONFIG) cle
 	  $$timer $(VENV_ABS)/bin/papermill "$<" "$$tmp" -p profile $(PROFILE) --cwd "$(CURDIR)" -k python3 "$$@" $(PAPERMILL_FLAGS); }; \
 	if [[ " $(filter -j%,$(MAKEFLAGS)) " =~ [[:space:]]-j([^1]|1[0-9]) ]]; then prefix="[$*] "; else prefix=""; fi; \
 	tail --pid=$$$$ -s 0.5 -n +1 -f "$$log" 2>/dev/null | sed -u "s/^/    $$prefix/; 1s/^/\n/" & \
-	if if [ -z "$$prefix" ]; then run --progress-bar; else run --no-progress-bar 2>&1 | sed -u "s/^/$$prefix/"; fi; then \
+	attempt() { if [ -z "$$prefix" ]; then run --progress-bar; else run --no-progress-bar 2>&1 | sed -u "s/^/$$prefix/"; fi; }; \
+	unstarted() { [ -f "$$tmp" ] && $(PY) -c 'import json, sys; sys.exit(any(c.get("execution_count") for c in json.load(open(sys.argv[1]))["cells"]))' "$$tmp"; }; \
+	if attempt || { unstarted && echo "    $${prefix}$< ran no cell: its kernel did not start; starting it once more" && \
+	                attempt; }; then \
 	  mv -f "$$tmp" "$@"; rm -f "$$started"; \
 	else rm -f "$$tmp" "$$cpu"; \
 	  others=$$(find "$(RES)/logs" -name '.started-*' -not -name ".started-$*" | head -1); \

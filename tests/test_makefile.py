@@ -200,6 +200,7 @@ case "$*" in
   *"profile_schema --keys"*) {keys};;
   *"bgfn kernels"*) echo $$ > {marks}/kernels.pid; exec sleep 300;;
   *build_book*) mkdir -p book/_build && echo $$ > {marks}/book.pid;;
+  *execution_count*) exec {sys.executable} "$@";;
 esac
 exit 0
 """)
@@ -341,6 +342,19 @@ def test_a_notebook_runs_with_sleeping_openmp_threads_unless_the_environment_say
                              capture_output=True, text=True, timeout=120)
         assert res.returncode != 0                          # papermill's stand-in failed, after saying what it saw
         assert (marks / "omp").read_text().split()[-1] == expected
+
+
+@pytest.mark.parametrize("ran_a_cell", [False, True])
+def test_a_kernel_that_never_started_is_started_once_more(tmp_path, ran_a_cell):
+    marks = tmp_path / "marks"
+    count = 1 if ran_a_cell else "null"
+    repo, _ = _fake_run(tmp_path, papermill=f"""echo x >> {marks}/tries
+echo '{{"cells": [{{"cell_type": "code", "execution_count": {count}}}]}}' > "$2"; exit 1""")
+    res = subprocess.run(["make", "--no-print-directory", "reproduce", "PROFILE=smoke"], cwd=repo,
+                         capture_output=True, text=True, timeout=120)
+    tries = len((marks / "tries").read_text().split())
+    assert res.returncode != 0 and tries == (1 if ran_a_cell else 2)      # once more only when no cell ran
+    assert ("its kernel did not start" in res.stdout) == (not ran_a_cell)
 
 
 def test_the_book_is_built_on_every_core_and_a_failed_build_fails(tmp_path, monkeypatch):

@@ -138,6 +138,7 @@ SRC := $(shell find src/bgfn -name '*.py' -not -path '*/__pycache__/*' | sort)
 BOOK_SRC := $(shell find book \( -path book/_build -o -path book/notebooks -o -path book/_generated -o -path book/api \) -prune \
               -o -type f -print | sort)
 BOOK_STAMP := book/_build/.built-$(PROFILE)
+KERNELS_STARTED := $(RES)/logs/.kernels-started
 BOOK_HTML := book/_build/html/index.html
 
 # Every recipe sees the venv first on PATH and the venv's kernelspec first on JUPYTER_PATH, so papermill's
@@ -247,7 +248,7 @@ data: $(STAMP)
 # handed the same free port by the system (jupyter_client picks the ports, the kernel binds them a second later;
 # seen once in CI as "Address already in use" then "Kernel died before replying to kernel_info").
 # Debris of an interrupted run is removed once, before the first notebook (clean-debris, order-only).
-$(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(STAMP) | data $(KERNEL_CONFIG) clean-debris $(RES)/.profile-checked
+$(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(STAMP) | $(KERNELS_STARTED) data $(KERNEL_CONFIG) clean-debris $(RES)/.profile-checked
 	@mkdir -p $(@D) $(RES)/logs
 	@echo "==> [$(PROFILE)] papermill $<"
 	@tmp="$(@D)/.$*.running-$$$$.ipynb"; log="$(RES)/logs/$*.log"; : > "$$log"; \
@@ -278,17 +279,22 @@ $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(STAMP) | data $(KERNEL_CONFIG) cle
 # The profile is checked before the first notebook runs: its schema (every notebook's load_profile checks that
 # too) and the facts that need the data (outages inside the drives, window, outage sweep). A bad profile fails
 # here, naming its file and key, before hours of training.
-# Beside it the navigation's numba kernels are compiled into numba's cache, in the background while notebook 01 runs
-# (python -m bgfn kernels, bgfn.evaluate.kernels): on a fresh clone notebook 02 would otherwise compile them for
-# about 40 s on one core. Its output goes to $(RES)/logs/kernels.log; it changes no result, and what it has not
-# cached yet when a notebook needs it is compiled there as before. (A changed src/bgfn file reruns this rule, and
-# numba recompiles the kernels of a changed file.)
-# The kernels start once the check has passed (a refused profile leaves no log behind); they run in the run's
-# process group, without its lock, and end with it (reproduce's recipe).
 $(RES)/.profile-checked: $(PARAMS) $(SRC) $(STAMP) | data
 	@mkdir -p $(@D) $(RES)/logs
 	@echo "==> [$(PROFILE)] check params/$(PROFILE).yaml with its drives"
 	@$(PY) -m bgfn.profile_schema $(PROFILE)
+	@touch $@
+
+# Beside the data step and the check above, the navigation's numba kernels are compiled into numba's cache, in the
+# background (python -m bgfn kernels, bgfn.evaluate.kernels): on a fresh clone notebook 02 would otherwise compile
+# them for about 40 s on one core. Started with the data step rather than after the check, they use the core the
+# one-core steps leave idle instead of one that notebooks 02 and 07 share. Their output goes to
+# $(RES)/logs/kernels.log; they change no result, and what they have not cached yet when a notebook needs it is
+# compiled there as before. (A changed src/bgfn file reruns this rule, and numba recompiles the kernels of a
+# changed file.) They start after the key check (a profile refused there leaves no log behind), in the run's process
+# group, without its lock, and end with it (reproduce's recipe): a profile the check with the drives refuses ends them.
+$(KERNELS_STARTED): $(PARAMS) $(SRC) $(STAMP)
+	@mkdir -p $(@D)
 	@echo "==> [$(PROFILE)] numba kernels into the cache, in the background ($(RES)/logs/kernels.log)"
 	@$(PY) -m bgfn kernels --profile $(PROFILE) > $(RES)/logs/kernels.log 2>&1 < /dev/null 9>&- &
 	@touch $@
@@ -380,7 +386,7 @@ define build_book
 	@find book/notebooks book/_generated -name '.*' -type f -delete   # never a temporary or hidden file
 	@if [ -f "$(RES)/findings.md" ]; then cp "$(RES)/findings.md" book/_generated/; else \
 	  echo "No findings yet: notebook 10 of profile \`$(PROFILE)\` has not written them." > book/_generated/findings.md; fi
-	@$(PY) -m bgfn walltimes --profile $(PROFILE) --markdown book/_generated/wall_times.md
+	@$(PY) -m bgfn.report.walltimes --profile $(PROFILE) --markdown book/_generated/wall_times.md   # imports pandas, not torch
 	@printf '%s\n' "Built from the executed notebooks of profile \`$(PROFILE)\` (\`params/$(PROFILE).yaml\`)," \
 	  "commit \`$$(git rev-parse --short HEAD 2>/dev/null || echo unknown)\`." > book/_generated/build_info.md
 	@rm -f book/_build/.built-*

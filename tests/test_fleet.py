@@ -353,7 +353,7 @@ def test_the_book_has_a_fleet_page_for_every_profile(tmp_path):
     import json
 
     from bgfn.config import PROJECT_ROOT
-    from bgfn.report import book_notebooks, fleet_words
+    from bgfn.report import book_notebooks, fleet_page
 
     toc = (PROJECT_ROOT / "book" / "_toc.yml").read_text()
     beyond = toc.split("caption: Beyond the paper")[1].split("caption:")[0]
@@ -361,11 +361,11 @@ def test_the_book_has_a_fleet_page_for_every_profile(tmp_path):
     make = (PROJECT_ROOT / "Makefile").read_text()
     assert "cp $(EXEC) book/notebooks/" in make and "--absent book/notebooks" in make
     nb = json.loads((PROJECT_ROOT / "notebooks" / "11_fleet.ipynb").read_text())
-    assert "".join(nb["cells"][0]["source"]).splitlines()[0] == f"# {fleet_words.FLEET_PAGE_TITLE}"
+    assert "".join(nb["cells"][0]["source"]).splitlines()[0] == f"# {fleet_page.FLEET_PAGE_TITLE}"
     written = book_notebooks.absent_pages(tmp_path, "quick")
     assert written == [tmp_path / "11_fleet.md"]
     page = written[0].read_text()
-    assert page.startswith(f"# {fleet_words.FLEET_PAGE_TITLE}\n") and "`quick`" in page and "did not run" in page
+    assert page.startswith(f"# {fleet_page.FLEET_PAGE_TITLE}\n") and "`quick`" in page and "did not run" in page
     ran = tmp_path / "ran"
     ran.mkdir()
     (ran / "11_fleet.ipynb").write_text("{}")

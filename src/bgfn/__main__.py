@@ -5,7 +5,8 @@
 - ``python -m bgfn kernels``: the navigation's numba kernels compiled into numba's cache (:mod:`bgfn.evaluate.kernels`);
 - ``python -m bgfn odometers``: the odometer bars alone (:func:`bgfn.studies.odometer.section.run_odometer_section`);
   ``--record`` keeps their summary in ``data/measured/`` (:mod:`bgfn.studies.odometer.sizes`: a run on a GPU);
-- ``python -m bgfn walltimes``: the wall times of the book's "Reproduce it" page (:mod:`bgfn.report.walltimes`).
+- ``python -m bgfn walltimes``: the wall times of the book's "Reproduce it" page (:func:`bgfn.report.walltimes.main`,
+  which the book's build runs as ``python -m bgfn.report.walltimes``: it imports none of the rest of the package).
 
 Example::
 
@@ -25,37 +26,12 @@ from bgfn.evaluate import evaluation_setup
 from bgfn.studies.odometer import sizes as odometer_sizes
 from bgfn.studies.odometer.section import run_odometer_section
 from bgfn.evaluate.kernels import compile_kernels
-from bgfn.io import atomic_write_text
 from bgfn.parallel import Runner
 from bgfn.profile_schema import load_profile, with_overrides
 from bgfn.report import walltimes as walltimes_module
 from bgfn.report.odometer_words import odometer_markdown
 from bgfn.report.run_words import runner_words
 from bgfn.train.runs import train_profile
-
-
-def walltimes(argv) -> int:
-    """``walltimes --profile P [--markdown FILE] [--record JOBS [--total-s S] [--note TEXT]]``."""
-    p = argparse.ArgumentParser(prog="python -m bgfn walltimes", description="Wall times of a profile's notebooks.")
-    p.add_argument("--profile", default="quick")
-    p.add_argument("--markdown", help="write the book's wall-time section here (default: print it)")
-    p.add_argument("--record", type=int, metavar="JOBS", help="add the last run, made with JOBS jobs, to "
-                   "data/measured/reproduce_wall_times.csv")
-    p.add_argument("--total-s", type=float, help="the whole make reproduce's wall time, s (with --record)")
-    p.add_argument("--note", default="", help="how it was measured (with --record)")
-    a = p.parse_args(argv)
-    try:
-        if a.record is not None:
-            walltimes_module.record_run(a.profile, a.record, a.total_s, a.note)
-        text = walltimes_module.wall_time_markdown(a.profile)
-    except DataError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    if a.markdown:
-        atomic_write_text(a.markdown, text)
-    else:
-        print(text)
-    return 0
 
 
 def kernels(argv) -> int:
@@ -65,7 +41,9 @@ def kernels(argv) -> int:
     p.add_argument("--profile", default="quick")
     a = p.parse_args(argv)
     try:
-        cfg = load_profile(a.profile)
+        # without the run plan: make starts this beside the check that writes it, and the kernels' types do not
+        # depend on what the plan scales
+        cfg = load_profile(a.profile, planned=False)
     except DataError as exc:
         print(f"error: profile {a.profile!r}: {exc}", file=sys.stderr)
         return 2
@@ -135,7 +113,7 @@ def main(argv=None) -> int:
     ``--variants``; train and print one line per finished run (:class:`bgfn.parallel.RunProgress`)."""
     argv = sys.argv[1:] if argv is None else list(argv)
     if argv[:1] == ["walltimes"]:
-        return walltimes(argv[1:])
+        return walltimes_module.main(argv[1:])
     if argv[:1] == ["kernels"]:
         return kernels(argv[1:])
     if argv[:1] == ["odometers"]:

@@ -24,11 +24,11 @@ from bgfn.config import PROJECT_ROOT, read_profile
 from bgfn.data.names import dataset_folder, dataset_id
 from bgfn.errors import DataError
 from bgfn.io import atomic_write_text
-from bgfn.report import fleet_words
+from bgfn.report import fleet_page
 
 #: The book's pages whose notebook runs only for a profile with its section (notebook 11: ``fleet:``), each with the
 #: Markdown page shown in its place where it did not run (``profile -> text``).
-OPTIONAL_PAGES = {"11_fleet": fleet_words.absent_page}
+OPTIONAL_PAGES = {"11_fleet": fleet_page.absent_page}
 
 #: The tags papermill reads and writes.
 PARAMETERS_TAG, INJECTED_TAG = "parameters", "injected-parameters"

@@ -9,16 +9,18 @@ law per notebook: the share that did not get faster with 2 jobs is taken as seri
 
 from __future__ import annotations
 
+import argparse
 import datetime
 import json
 import math
+import sys
 from pathlib import Path
 
 import pandas as pd
 
 from bgfn.config import PROJECT_ROOT, git_commit, results_dir
 from bgfn.errors import DataError
-from bgfn.io import atomic_write_csv
+from bgfn.io import atomic_write_csv, atomic_write_text
 
 #: The measured runs (one row per profile, jobs and notebook; ``notebook`` ``total`` = the whole make run).
 MEASURED_FILE = PROJECT_ROOT / "data" / "measured" / "reproduce_wall_times.csv"
@@ -168,3 +170,31 @@ def _share(cpu_s: float, wall_s: float) -> str:
 def _minutes(seconds: float) -> str:
     """``12.3 min`` from seconds (``-`` when unknown)."""
     return "-" if math.isnan(seconds) else f"{seconds / 60:.1f} min ({seconds:.0f} s)"
+
+
+def main(argv=None) -> int:
+    """``walltimes --profile P [--markdown FILE] [--record JOBS [--total-s S] [--note TEXT]]``."""
+    p = argparse.ArgumentParser(prog="python -m bgfn walltimes", description="Wall times of a profile's notebooks.")
+    p.add_argument("--profile", default="quick")
+    p.add_argument("--markdown", help="write the book's wall-time section here (default: print it)")
+    p.add_argument("--record", type=int, metavar="JOBS", help="add the last run, made with JOBS jobs, to "
+                   "data/measured/reproduce_wall_times.csv")
+    p.add_argument("--total-s", type=float, help="the whole make reproduce's wall time, s (with --record)")
+    p.add_argument("--note", default="", help="how it was measured (with --record)")
+    a = p.parse_args(sys.argv[1:] if argv is None else argv)
+    try:
+        if a.record is not None:
+            record_run(a.profile, a.record, a.total_s, a.note)
+        text = wall_time_markdown(a.profile)
+    except DataError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    if a.markdown:
+        atomic_write_text(a.markdown, text)
+    else:
+        print(text)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -291,13 +291,16 @@ $(RES)/.profile-checked: $(PARAMS) $(SRC) $(STAMP) | data
 # one-core steps leave idle instead of one that notebooks 02 and 07 share. Their output goes to
 # $(RES)/logs/kernels.log; they change no result, and what they have not cached yet when a notebook needs it is
 # compiled there as before. (A changed src/bgfn file reruns this rule, and numba recompiles the kernels of a
-# changed file.) They start after the key check (a profile refused there leaves no log behind), in the run's process
-# group, without its lock, and end with it (reproduce's recipe): a profile the check with the drives refuses ends them.
+# changed file.) Under reproduce and notebooks they start after the key check (CHECK_KEYS, below: a profile refused
+# there leaves no log behind), in the run's process group, without its lock, and end with it (reproduce's recipe).
+# The stamp is written when they have finished: a run that ends first (a failed data step, a profile the check with
+# the drives refuses) starts them again next time.
 $(KERNELS_STARTED): $(PARAMS) $(SRC) $(STAMP)
-	@mkdir -p $(@D)
+	@mkdir -p $(@D); rm -f $@
 	@echo "==> [$(PROFILE)] numba kernels into the cache, in the background ($(RES)/logs/kernels.log)"
-	@$(PY) -m bgfn kernels --profile $(PROFILE) > $(RES)/logs/kernels.log 2>&1 < /dev/null 9>&- &
-	@touch $@
+	@{ $(PY) -m bgfn kernels --profile $(PROFILE) && touch $@; } > $(RES)/logs/kernels.log 2>&1 < /dev/null 9>&- &
+
+# Notebook 01 builds the drives' caches: an edited or touched drive reruns it (and so every notebook after it).
 $(RES)/notebooks/01_data_prep.ipynb: $(RES)/.data-fingerprint
 
 # What each notebook reads of the profile and which modules it imports: $(RES)/.deps.mk, remade by

@@ -183,9 +183,10 @@ def test_jobs_and_the_scheduler_reach_python_as_text_never_as_make_code(tmp_path
 
 
 
-def _fake_run(tmp_path, papermill="exec sleep 300", keys="exit 0"):
-    """A checkout whose venv is a stand-in: its python passes every step (``keys``: the profile's key check), starts
-    the kernels job as a long sleep and papermill runs ``papermill``; each writes its PID under ``marks/``."""
+def _fake_run(tmp_path, papermill="exec sleep 300", keys="exit 0", kernels="exec sleep 300"):
+    """A checkout whose venv is a stand-in: its python passes every step (``keys``: the profile's key check), runs
+    ``kernels`` as the kernels job (a long sleep) and papermill runs ``papermill``; each writes its PID under
+    ``marks/``."""
     import hashlib
 
     repo = _checkout(tmp_path)
@@ -198,7 +199,7 @@ def _fake_run(tmp_path, papermill="exec sleep 300", keys="exit 0"):
     (bin_ / "python").write_text(f"""#!/bin/bash
 case "$*" in
   *"profile_schema --keys"*) {keys};;
-  *"bgfn kernels"*) echo $$ > {marks}/kernels.pid; exec sleep 300;;
+  *"bgfn kernels"*) echo $$ > {marks}/kernels.pid; {kernels};;
   *build_book*) mkdir -p book/_build && echo $$ > {marks}/book.pid;;
   *execution_count*) exec {sys.executable} "$@";;
 esac
@@ -342,6 +343,20 @@ def test_a_notebook_runs_with_sleeping_openmp_threads_unless_the_environment_say
                              capture_output=True, text=True, timeout=120)
         assert res.returncode != 0                          # papermill's stand-in failed, after saying what it saw
         assert (marks / "omp").read_text().split()[-1] == expected
+
+
+@pytest.mark.parametrize("finished", [True, False])
+def test_the_kernels_are_started_again_unless_they_finished(tmp_path, finished):
+    import time
+
+    repo, marks = _fake_run(tmp_path, papermill="exit 1", kernels="exit 0" if finished else "exec sleep 300")
+    stamp = repo / "results" / "smoke" / "logs" / ".kernels-started"
+    res = _make("reproduce", "PROFILE=smoke", cwd=repo)             # papermill's stand-in fails: the run ends
+    _gone(_wait_for(marks / "kernels.pid"))
+    time.sleep(0.5)
+    assert res.returncode != 0 and stamp.exists() == finished
+    dry = _make("-n", "_notebooks", "PROFILE=smoke", cwd=repo).stdout
+    assert ("bgfn kernels" in dry) == (not finished)         # a run that ended before they did starts them again
 
 
 @pytest.mark.parametrize("ran_a_cell", [False, True])

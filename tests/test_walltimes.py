@@ -85,7 +85,7 @@ def test_a_measured_file_without_its_columns_is_refused(tmp_path):
         W.read_measured(bad)
 
 
-def test_the_book_builds_steps_import_no_torch_and_no_study(tmp_path, monkeypatch):
+def test_the_book_build_steps_import_no_torch_and_no_study(tmp_path, monkeypatch):
     """The book's build runs ``python -m bgfn.report.walltimes`` and ``python -m bgfn.report.book_notebooks`` one
     after the other while both cores wait: each must start in a second or two, not the 8 s of torch and the studies."""
     import subprocess
@@ -95,6 +95,8 @@ def test_the_book_builds_steps_import_no_torch_and_no_study(tmp_path, monkeypatc
             "sys.exit(' '.join(m for m in sys.modules if m == 'torch' or m.startswith('bgfn.studies')) or None)")
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert res.returncode == 0 and res.stderr == "", res.stderr
+    make = (config.PROJECT_ROOT / "Makefile").read_text()
+    assert "-m bgfn.report.walltimes --profile" in make and "-m bgfn.report.book_notebooks --profile" in make
     monkeypatch.setattr(config, "RESULTS_ROOT", tmp_path)
     out = tmp_path / "wall_times.md"
     assert W.main(["--profile", "smoke", "--markdown", str(out)]) == 0

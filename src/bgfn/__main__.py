@@ -6,7 +6,8 @@
 - ``python -m bgfn odometers``: the odometer bars alone (:func:`bgfn.studies.odometer.section.run_odometer_section`);
   ``--record`` keeps their summary in ``data/measured/`` (:mod:`bgfn.studies.odometer.sizes`: a run on a GPU);
 - ``python -m bgfn walltimes``: the wall times of the book's "Reproduce it" page (:func:`bgfn.report.walltimes.main`,
-  which the book's build runs as ``python -m bgfn.report.walltimes``: it imports none of the rest of the package).
+  which the book's build runs as ``python -m bgfn.report.walltimes``: it imports pandas and bgfn's core modules, no
+  torch and no study).
 
 Example::
 
@@ -113,7 +114,7 @@ def main(argv=None) -> int:
     ``--variants``; train and print one line per finished run (:class:`bgfn.parallel.RunProgress`)."""
     argv = sys.argv[1:] if argv is None else list(argv)
     if argv[:1] == ["walltimes"]:
-        return walltimes_module.main(argv[1:])
+        return walltimes_module.main(argv[1:], prog="python -m bgfn walltimes")
     if argv[:1] == ["kernels"]:
         return kernels(argv[1:])
     if argv[:1] == ["odometers"]:

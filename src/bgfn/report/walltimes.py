@@ -4,7 +4,8 @@ The executed notebooks' wall times (papermill's ``metadata.papermill.duration``,
 measured runs of ``make reproduce`` with ``JOBS=1`` and ``JOBS=2`` (:data:`MEASURED_FILE`; ``python -m bgfn
 walltimes --record`` adds a finished run) side by side (:func:`scaling_table`), with more jobs projected by Amdahl's
 law per notebook: the share that did not get faster with 2 jobs is taken as serial. The page names its assumption
-(the rest divides evenly over the jobs); it is an upper bound on the speed-up.
+(the rest divides evenly over the jobs); it is an upper bound on the speed-up. The book's build writes the page's
+section with ``python -m bgfn.report.walltimes`` (:func:`main`), which imports no torch and no study.
 """
 
 from __future__ import annotations
@@ -172,9 +173,9 @@ def _minutes(seconds: float) -> str:
     return "-" if math.isnan(seconds) else f"{seconds / 60:.1f} min ({seconds:.0f} s)"
 
 
-def main(argv=None) -> int:
+def main(argv=None, prog: str = "python -m bgfn.report.walltimes") -> int:
     """``walltimes --profile P [--markdown FILE] [--record JOBS [--total-s S] [--note TEXT]]``."""
-    p = argparse.ArgumentParser(prog="python -m bgfn walltimes", description="Wall times of a profile's notebooks.")
+    p = argparse.ArgumentParser(prog=prog, description="Wall times of a profile's notebooks.")
     p.add_argument("--profile", default="quick")
     p.add_argument("--markdown", help="write the book's wall-time section here (default: print it)")
     p.add_argument("--record", type=int, metavar="JOBS", help="add the last run, made with JOBS jobs, to "

@@ -5,8 +5,8 @@ loaded by every later process in a fraction of a second. :func:`compile_kernels`
 once on a short synthetic drive (the GPS-aided filter with the vehicle constraints, the standalone INS, INS+NHC and
 an odometer in one outage), and :func:`compile_lif_kernels` one forward and backward pass of the LIF layers on one
 thread and on two, so that the same functions are compiled for the same argument types. ``make reproduce`` runs it
-in the background (``python -m bgfn kernels``) from the data step on, beside the profile check and notebook 01. Nothing here changes a result:
-a kernel missing from the cache is compiled where it is first called.
+in the background (``python -m bgfn kernels``) from the data step on, beside the profile check and notebook 01.
+Nothing here changes a result: a kernel missing from the cache is compiled where it is first called.
 """
 
 from __future__ import annotations

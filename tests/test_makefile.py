@@ -241,8 +241,11 @@ def test_a_stopped_run_ends_every_process_it_started_and_releases_its_lock(tmp_p
     import time
 
     repo, marks = _fake_run(tmp_path)
+    # Ctrl-C as a terminal sends it: a make started from a shell's background job (`make test &`, nohup) would
+    # inherit SIGINT ignored, and neither make nor bash can catch a signal ignored when they start
     make = subprocess.Popen(["make", "--no-print-directory", "reproduce", "PROFILE=smoke"], cwd=repo,
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         pids = [_wait_for(marks / "papermill.pid"), _wait_for(marks / "kernels.pid")]
         lock = repo / "results" / "smoke" / ".lock"

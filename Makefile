@@ -292,7 +292,8 @@ $(RES)/.profile-checked: $(PARAMS) $(SRC) $(STAMP) | data
 # $(RES)/logs/kernels.log; they change no result, and what they have not cached yet when a notebook needs it is
 # compiled there as before. (A changed src/bgfn file reruns this rule, and numba recompiles the kernels of a
 # changed file.) Under reproduce and notebooks they start after the key check (CHECK_KEYS, below: a profile refused
-# there leaves no log behind), in the run's process group, without its lock, and end with it (reproduce's recipe).
+# there leaves no log behind), in the run's process group, without its lock, and end with it (reproduce's recipe,
+# whose tools/run_group.py reaps them: their CPU time counts with the run's).
 # The stamp is written when they have finished: a run that ends first (a failed data step, a profile the check with
 # the drives refuses) starts them again next time.
 $(KERNELS_STARTED): $(PARAMS) $(SRC) $(STAMP)
@@ -424,9 +425,11 @@ _book-build:
 # (and JOBS, DASK_SCHEDULER) are checked first, before the lock, the install's updates and the data (with no
 # venv yet: right after making it). The lock is an open file descriptor, held by the run's processes only: a run
 # that ends for any reason releases it, and no dead PID ever blocks (a PID left in the file by a killed run is
-# taken over, said once). The run is a process group of its own (setsid): SIGINT, SIGTERM or SIGHUP of this make,
-# or its end, sends SIGTERM to every process of it (a background job ignores SIGINT), background jobs included (a
-# notebook's kernel ends with papermill, and its pool workers with the kernel: bgfn.parallel.watch_owner).
+# taken over, said once). The run is a process group of its own (tools/run_group.py: setsid, and a subreaper that
+# reaps every process of the run, so a background job's CPU time is counted with the run's by /usr/bin/time): SIGINT,
+# SIGTERM or SIGHUP of this make, or its end, sends SIGTERM to every process of it (a background job ignores SIGINT),
+# background jobs included (a notebook's kernel ends with papermill, and its pool workers with the kernel:
+# bgfn.parallel.watch_owner).
 LOCK := $(RES)/.lock
 CHECK_KEYS = echo "==> [$(PROFILE)] check params/$(PROFILE).yaml (every key; JOBS, DASK_SCHEDULER)" && \
   $(if $(DRY),echo )$(PY) -m bgfn.profile_schema --keys $(PROFILE)
@@ -445,7 +448,7 @@ reproduce notebooks:
 	trap '[ $$run = 0 ] || kill -TERM -- -$$run 2>/dev/null || true; : > "$(LOCK)"; exec 9>&- 8>>"$(LOCK)"; \
 	  flock -w 10 8 || true' EXIT; \
 	if [ ! -x "$(PY)" ]; then $(MAKE) venv; $(CHECK_KEYS); fi; \
-	setsid $(MAKE) -j$(NOTEBOOK_SLOTS) _$@ & run=$$!; \
+	$(PY) tools/run_group.py $(MAKE) -j$(NOTEBOOK_SLOTS) _$@ & run=$$!; \
 	rc=0; wait $$run || rc=$$?; while kill -0 $$run 2>/dev/null; do wait $$run || rc=$$?; done; exit $$rc
 
 _reproduce: $(BOOK_STAMP)

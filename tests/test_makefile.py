@@ -198,6 +198,7 @@ def _fake_run(tmp_path, papermill="exec sleep 300", keys="exit 0", kernels="exec
     bin_.mkdir(parents=True)
     (bin_ / "python").write_text(f"""#!/bin/bash
 case "$*" in
+  *run_group.py*) exec {sys.executable} "$@";;
   *"profile_schema --keys"*) {keys};;
   *"bgfn kernels"*) echo $$ > {marks}/kernels.pid; {kernels};;
   *build_book*) mkdir -p book/_build && echo $$ > {marks}/book.pid;;

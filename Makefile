@@ -327,7 +327,7 @@ FORCE:
 
 # Notebooks at a time under `make reproduce` / `make notebooks` (1: one after the other, papermill's progress bar
 # shown). Each notebook's runner keeps every core (JOBS, else the profile's parallel.jobs, else the cores): the
-# chain 02-06 is the longest path, and when the studies beside it are done it must have all of them again; while
+# chain 01-02-03-06 is the longest path, and when the studies beside it are done it must have all of them again; while
 # two notebooks run, the system shares the cores between their processes. No table depends on either number.
 NOTEBOOK_SLOTS ?= 2
 
@@ -336,29 +336,31 @@ $(RES)/notebooks/02_kf_baseline.ipynb: $(RES)/notebooks/01_data_prep.ipynb
 $(RES)/notebooks/03_bgfn_training.ipynb: $(RES)/notebooks/02_kf_baseline.ipynb
 $(RES)/notebooks/04_outage_evaluation.ipynb: $(RES)/notebooks/03_bgfn_training.ipynb
 $(RES)/notebooks/05_energy_estimate.ipynb: $(RES)/notebooks/04_outage_evaluation.ipynb
-# The studies beyond the paper: 06 reads notebook 04's runs (evaluation/) and notebook 03's learning rates
-# (tables/lr_search.csv); 07 trains its own odometers, 08 reruns the GPS-aided filter and compares our INS with
-# NaveGo's measured run, 09 (the gallery of own logs) needs only the data and the navigation: they read no other
-# notebook's outputs, so they run beside notebooks 02-06 under -j.
-$(RES)/notebooks/06_outage_sweep.ipynb: $(RES)/notebooks/04_outage_evaluation.ipynb
+# The studies beyond the paper: 06 builds on notebook 03's networks and learning rates (tables/lr_search.csv) and on
+# notebook 04's runs, which it reads from the run cache or computes there itself (bgfn.evaluate.outage_result: the
+# two, side by side, compute them once), so it starts beside 04 rather than after it; 07 trains its own odometers,
+# 08 reruns the GPS-aided filter and compares our INS with NaveGo's measured run, 09 (the gallery of own logs) needs
+# only the data and the navigation: they read no other notebook's outputs, so they run beside notebooks 02-06 under
+# -j.
+$(RES)/notebooks/06_outage_sweep.ipynb: $(RES)/notebooks/03_bgfn_training.ipynb
 $(RES)/notebooks/07_learned_odometer.ipynb: $(RES)/notebooks/01_data_prep.ipynb
 $(RES)/notebooks/08_ins_fidelity.ipynb: $(RES)/notebooks/01_data_prep.ipynb $(wildcard data/measured/navego_check.csv)
 $(RES)/notebooks/09_own_logs.ipynb: $(RES)/notebooks/01_data_prep.ipynb
 # ... yet 08 and 09 start only after 02 (order-only: 02 never makes them rerun). A study ready while both slots are
 # busy waits in make's queue and takes the next free slot before anything that became ready later: ready after 01,
-# 08 took the slot 02 freed and 03, the head of the longest path (03-04-06-10), waited until 08 and 09 were done
+# 08 took the slot 02 freed and 03, the head of the longest path (then 03-04-06-10), waited until 08 and 09 were done
 # (quick: 03 started at 349 s instead of 91 s). After 02 they are ready with 03, which make starts first (it comes
 # first in 10's list); 08 also finds 02's GPS-aided runs in the cache then.
 $(RES)/notebooks/08_ins_fidelity.ipynb $(RES)/notebooks/09_own_logs.ipynb: | $(RES)/notebooks/02_kf_baseline.ipynb
-# With two slots (the default), one slot is the longest path's (01 02 03 04 06 10) and the other a lane of the rest,
-# one after the other (order-only): 07 beside 02 and 03; then 08 and 09 once 03 is done, beside 04 and 06, whose
+# With two slots (the default), one slot is the longest path's (01 02 03 06 10) and the other a lane of the rest,
+# one after the other (order-only): 07 beside 02 and 03; then 04, 08 and 09 once 03 is done, beside 06, whose
 # serial stretches leave a core free (quick: 06 alone used 154 % of the 2 cores), while 03 has the cores to itself;
 # then 05. Chained, a notebook is not queued before its lane's slot is free: queued early, 09 took the slot 03 freed
 # and 04 waited (23 s). With more slots they run side by side. Only in a whole run (a notebook made alone builds
 # no other lane's notebook).
 ifeq ($(NOTEBOOK_SLOTS),2)
 ifneq ($(filter _reproduce _notebooks,$(MAKECMDGOALS)),)
-$(RES)/notebooks/08_ins_fidelity.ipynb: | $(RES)/notebooks/07_learned_odometer.ipynb $(RES)/notebooks/03_bgfn_training.ipynb
+$(RES)/notebooks/08_ins_fidelity.ipynb: | $(RES)/notebooks/07_learned_odometer.ipynb $(RES)/notebooks/04_outage_evaluation.ipynb
 $(RES)/notebooks/09_own_logs.ipynb: | $(RES)/notebooks/08_ins_fidelity.ipynb
 $(RES)/notebooks/05_energy_estimate.ipynb: | $(RES)/notebooks/09_own_logs.ipynb
 endif

@@ -675,7 +675,7 @@ def test_run_tables_evaluates_writes_and_times_every_dataset(monkeypatch, tmp_pa
 
     seen = []
 
-    def fake_evaluate(cfg, profile, name, ecfg=None, **kw):
+    def fake_evaluate(cfg, profile, name, ecfg):
         seen.append(name)
         res = _table_result(name)
         res.per_seed = res.table.assign(start_s=100.0 * res.table["outage"], seed=None)
@@ -684,7 +684,7 @@ def test_run_tables_evaluates_writes_and_times_every_dataset(monkeypatch, tmp_pa
                                                       "horizontal": 0.0}))]
         return res
 
-    monkeypatch.setattr(tables, "evaluate_dataset", fake_evaluate)
+    monkeypatch.setattr(tables, "outage_result", fake_evaluate)
     lines = []
     results, timings = ev.run_tables({}, "none", ["turin-sim-ekinox", "turin-sim-mpu6000"],
                                      {"series_rate_hz": 10.0}, tmp_path, report=lines.append)

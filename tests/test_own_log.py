@@ -120,9 +120,24 @@ def test_a_csv_log_named_by_its_path_runs_notebooks_01_to_04(tmp_path, monkeypat
     prepared = train.prepare_datasets(plan)
     cards = [c for n, d in prepared.items() for c in train.train_dataset(plan, n, d.data)]
     assert {c["method"] for c in cards} == {"bgfn", "mlp"}
-    # notebook 04
+    # notebook 04, with make's run cache
+    monkeypatch.setenv("BGFN_CACHE_DIR", str(out / "cache"))
     setup = ev.evaluation_setup(cfg)
     res, _ = ev.run_tables(cfg, "mine", setup.datasets, setup.config, out)
+    # notebook 06 builds on the same runs: read back, bit for bit, not computed again; a retrained network's are
+    from bgfn.evaluate import tables
+    from bgfn.train.checkpoints import card_path, checkpoint_path
+
+    evaluate, computed = tables._evaluate, []
+    monkeypatch.setattr(tables, "_evaluate", lambda dataset, *a: computed.append(dataset) or evaluate(dataset, *a))
+    again = ev.outage_results(cfg, "mine", setup.datasets, setup.config)
+    assert computed == [] and list(again) == [name]
+    pd.testing.assert_frame_equal(again[name].per_seed, res[name].per_seed, check_exact=True)
+    assert again[name].drive.name == name and set(again[name].models) == set(res[name].models)
+    card = card_path(checkpoint_path("mine", name, "mlp", 0))
+    card.write_text(card.read_text(encoding="utf-8") + "\n", encoding="utf-8")
+    ev.outage_results(cfg, "mine", setup.datasets, setup.config)
+    assert computed == [name]
     table = res[name].table
     assert set(table["method"]) == {"INS", "GPS", "BGFN", "MLP", "INS+NHC", "BGFN+NHC", "MLP+NHC"}
     assert np.isfinite(table[list(ev.METRIC_COLUMNS)].to_numpy(float)).all()

@@ -211,8 +211,8 @@ def cached(kind: str, key: Any | Callable[[], Any], compute: Callable[[], T]) ->
     object, bit for bit) when asked for again with the same ``key``. ``key`` must hold every input of the result
     (its data's :func:`content_hash`, its settings, the version of the code: :func:`sources_hash`); None, or no
     ``BGFN_CACHE_DIR``: computed every time. ``key`` may be a function returning it: then called only when there is
-    a cache. A cache entry is only ever written by this code (results/<profile>/cache/), as
-    :func:`bgfn.evaluate.kept_results` reads notebook 04's runs."""
+    a cache. A cache entry is only ever written by this code (results/<profile>/cache/): it is unpickled, so it is
+    never a user's file."""
     root = os.environ.get(CACHE_DIR_ENV)
     if root and callable(key):
         key = key()

@@ -21,8 +21,8 @@ from bgfn.evaluate.pseudo_std import (SENSITIVITY_COLUMNS, Sensitivity, pseudo_s
 from bgfn.evaluate.plots import outage_figures, plot_gps_row, plot_outage, plot_sweep_boxes
 from bgfn.evaluate.record import RECORD_FILE, evaluation_record, write_evaluation_record
 from bgfn.evaluate.tables import (TableResult, aggregate_seeds, error_reduction, error_series,
-                                  evaluate_dataset, fix_error_table, keep_results, kept_results, KEPT_RESULTS,
-                                  representative_seeds, run_tables, save_table_result, table_file, table_paths)
+                                  evaluate_dataset, fix_error_table, OUTAGE_RUNS_CACHE, outage_result,
+                                  outage_results, representative_seeds, run_tables, save_table_result, table_file, table_paths)
 
 __all__ = [
     "REDUCTION_COLUMNS", "ours_above_paper", "reduction_table", "COLORS",
@@ -34,5 +34,5 @@ __all__ = [
     "plot_sweep_boxes", "RECORD_FILE", "evaluation_record", "write_evaluation_record", "TableResult",
     "aggregate_seeds", "error_reduction", "error_series", "evaluate_dataset", "fix_error_table",
     "SENSITIVITY_COLUMNS", "Sensitivity", "pseudo_std_sensitivity", "save_sensitivity", "sensitivity_table",
-    "KEPT_RESULTS", "keep_results", "kept_results", "representative_seeds", "run_tables", "save_table_result", "table_file", "table_paths",
+    "OUTAGE_RUNS_CACHE", "outage_result", "outage_results", "representative_seeds", "run_tables", "save_table_result", "table_file", "table_paths",
 ]

@@ -23,10 +23,11 @@ def load_model(path: str | Path):
     return model
 
 
-def ensure_models(cfg: dict, profile: str, dataset: str, ctx: NavContext, methods, seeds, windows,
+def ensure_models(cfg: dict, profile: str, dataset: str, ctx: NavContext | None, methods, seeds, windows,
                   train_missing: bool = True, progress: bool = False) -> dict:
     """Load notebook 03's networks of ``dataset``; train the missing ones with the same code and settings
-    (training excludes the evaluation outages ``windows``).
+    (training excludes the evaluation outages ``windows``; ``ctx``, the drive's navigation context, is read only
+    then).
 
     Returns
     -------

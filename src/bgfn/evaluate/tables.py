@@ -5,7 +5,6 @@ ours are :mod:`bgfn.evaluate.claims`."""
 from __future__ import annotations
 
 import dataclasses
-import pickle
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -13,6 +12,7 @@ from typing import Any, Callable
 
 import numpy as np
 import pandas as pd
+import torch
 
 from bgfn.data import load_drive
 from bgfn.data.gnss import fix_errors
@@ -20,11 +20,13 @@ from bgfn.data.names import dataset_id
 from bgfn.evaluate.setup import METRIC_COLUMNS, TABLE_COLUMNS, TABLE_FILES, TABLE_METHODS, evaluate_config
 from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
 from bgfn.evaluate.networks import ensure_models
-from bgfn.io import atomic_write_bytes, atomic_write_csv
+from bgfn.io import atomic_write_csv, cached, sources_hash
 from bgfn.nav import outages
+from bgfn.nav.baseline import run_key
 from bgfn.nav.constraints import DEFAULT_PLATFORM, platform_aids
 from bgfn.paper import METHOD_LABELS, nhc_label, test_of
 from bgfn.row_labels import ran_labels
+from bgfn.train.checkpoints import card_path, checkpoint_path
 
 
 @dataclass
@@ -126,7 +128,13 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
     if models is None:
         models = ensure_models(cfg, profile, dataset, ctx, ecfg["methods"], ecfg["seeds"], windows,
                                ecfg["train_missing"], progress)
-    aids = ctx.constraints if (ecfg["nhc_rows"] if nhc_rows is None else nhc_rows) else None
+    return _evaluate(dataset, ctx, windows, models, ecfg, ecfg["nhc_rows"] if nhc_rows is None else nhc_rows)
+
+
+def _evaluate(dataset: str, ctx, windows, models: dict, ecfg: dict, nhc_rows: bool) -> TableResult:
+    """:func:`evaluate_dataset` once its drive's navigation context, outages and networks are at hand."""
+    drive = ctx.drive
+    aids = ctx.constraints if nhc_rows else None
     runs = run_outages(ctx, windows, None, "INS", None, ecfg["pseudo_gps"])
     if aids is not None:
         runs += run_outages(ctx, windows, None, nhc_label("INS"), None, ecfg["pseudo_gps"], aids=[aids])
@@ -145,6 +153,67 @@ def evaluate_dataset(cfg: dict, profile: str, dataset: str, drive=None, ecfg: di
                        aggregate_seeds(per_seed, ecfg["seed_aggregate"]), runs, models, fixes,
                        fix_error_table(fixes, windows), drive, list(windows),
                        aids.summary() if aids is not None else None)
+
+
+#: :func:`bgfn.io.cached`'s kind of the runs of the paper's outages (:func:`outage_result`).
+OUTAGE_RUNS_CACHE = "outage_runs"
+#: What of :func:`evaluate_config` the runs of :func:`outage_result` read (besides the drive, the ``nav:`` settings,
+#: the outages and the networks, each in its key).
+_RUN_SETTINGS = ("methods", "seeds", "pseudo_gps", "nhc_rows", "seed_aggregate")
+
+
+def outage_result(cfg: dict, profile: str, dataset: str, ecfg: dict) -> TableResult:
+    """:func:`evaluate_dataset` of the profile's networks, computed once per input and read back when asked again.
+
+    Notebook 04 makes the paper's tables from these runs; notebook 06 builds on them (the oracle's and the NEES's
+    level of each network). Under ``make`` (``BGFN_CACHE_DIR``) they are kept in the run cache (:func:`bgfn.io.cached`)
+    with a key of every input: the drive's content, the ``nav:`` settings, the outages, the networks' checkpoint files,
+    the evaluation settings they read, the package's code and the numerical libraries. Notebook 06 can so start
+    beside notebook 04 instead of after it: whichever asks first computes them, the other waits for them and reads
+    the same runs, bit for bit. Without a cache, computed here.
+    """
+    drive = load_drive(dataset, profile=profile)
+    windows = outages.outage_windows(cfg, drive, dataset)
+    contexts = []       # the GPS-aided run and its states (seconds per drive): only when the runs are computed here
+
+    def context():
+        if not contexts:
+            contexts.append(navigation_context(drive, cfg.get("nav"), [s for s, _ in windows]))
+        return contexts[0]
+
+    missing = [(m, s) for m in ecfg["methods"] for s in ecfg["seeds"]
+               if not checkpoint_path(profile, dataset, m, s, create=False).exists()]
+    models = ensure_models(cfg, profile, dataset, context() if missing and ecfg["train_missing"] else None,
+                           ecfg["methods"], ecfg["seeds"], windows, ecfg["train_missing"])
+
+    def key() -> dict:
+        files = {f"{m}_seed{s}": sources_hash([path, card_path(path)])
+                 for m, s in models for path in [checkpoint_path(profile, dataset, m, s, create=False)]}
+        return run_key(drive, cfg.get("nav"), windows=[tuple(map(float, w)) for w in windows], networks=files,
+                       evaluate={k: ecfg[k] for k in _RUN_SETTINGS}, package=_code_version(),
+                       torch=torch.__version__)
+
+    light = cached(OUTAGE_RUNS_CACHE, key, lambda: _without_drive_and_models(
+        _evaluate(dataset, context(), windows, models, ecfg, ecfg["nhc_rows"])))
+    return dataclasses.replace(light, drive=drive, models=models)
+
+
+def outage_results(cfg: dict, profile: str, datasets, ecfg: dict) -> dict:
+    """``{dataset: TableResult}``: :func:`outage_result` of each of ``datasets``, in turn."""
+    return {name: outage_result(cfg, profile, name, ecfg) for name in datasets}
+
+
+def _code_version() -> str:
+    """The sources the runs of :func:`outage_result` are made by: the core facts and the packages of the data, the
+    navigation, the networks, the learning problem, the training and this evaluation (not the studies or report)."""
+    root = Path(__file__).resolve().parent.parent
+    return sources_hash(sorted(root.glob("*.py")) + sorted(p for sub in ("data", "nav", "models", "learning", "train",
+                                                                        "evaluate") for p in (root / sub).glob("*.py")))
+
+
+def _without_drive_and_models(result: TableResult) -> TableResult:
+    """``result`` as kept: the drive (in the data cache) and the networks (their checkpoints) are loaded again."""
+    return dataclasses.replace(result, drive=None, models={})
 
 
 def run_tables(cfg: dict, profile: str, datasets, ecfg: dict, out,
@@ -174,36 +243,13 @@ def run_tables(cfg: dict, profile: str, datasets, ecfg: dict, out,
     results, timings = {}, {}
     for name in datasets:
         t0 = time.perf_counter()
-        res = results[name] = evaluate_dataset(cfg, profile, name, ecfg=ecfg)
+        res = results[name] = outage_result(cfg, profile, name, ecfg)
         paths = save_table_result(out, res, ecfg["series_rate_hz"])
         timings[f"tables_{name}_s"] = time.perf_counter() - t0
         if report is not None:
             report(f"{name} ({res.test} test): {len(res.runs)} runs in {timings[f'tables_{name}_s']:.1f} s -> "
                    + ", ".join(str(Path(q).relative_to(out)) for q in paths.values()))
     return results, timings
-
-#: The runs of the paper's outages as notebook 04 computed them, for the studies that build on them (the oracle's
-#: and the NEES's levels of each network): exact, where the CSV tables are rounded (``results/<profile>/``).
-KEPT_RESULTS = "evaluation/table_results.pkl"
-
-
-def keep_results(out, results: dict) -> Path:
-    """Write ``{dataset: TableResult}`` for later notebooks, without the drives (reloaded from the data cache)
-    and the networks (reloaded from their checkpoints); atomically."""
-    light = {name: dataclasses.replace(res, drive=None, models={}) for name, res in results.items()}
-    return atomic_write_bytes(Path(out) / KEPT_RESULTS, pickle.dumps(light, protocol=pickle.HIGHEST_PROTOCOL))
-
-
-def kept_results(out) -> dict:
-    """``{dataset: TableResult}`` that notebook 04 kept (:func:`keep_results`); a clear error when it has not run.
-
-    The file is this run's own output under ``results/<profile>/``, never a user's file.
-    """
-    path = Path(out) / KEPT_RESULTS
-    if not path.is_file():
-        raise FileNotFoundError(f"{path.name} not found under {Path(out).name}/evaluation/: run notebook 04 "
-                                "(04_outage_evaluation) of this profile first")
-    return pickle.loads(path.read_bytes())
 
 
 def table_file(test: str) -> str:

@@ -446,8 +446,9 @@ reproduce notebooks:
 	old=$$(cat "$(LOCK)"); if [ -n "$$old" ]; then echo "    $(LOCK) named PID $$old, a run that was killed" \
 	  "before it could clear it; the lock was free: taken over"; fi; \
 	echo $$$$ > "$(LOCK)"; export BGFN_RUN_LOCK=$$$$; run=0; \
-	trap '[ $$run = 0 ] || kill -TERM -- -$$run 2>/dev/null || true' INT TERM HUP; \
-	trap '[ $$run = 0 ] || kill -TERM -- -$$run 2>/dev/null || true; : > "$(LOCK)"; exec 9>&- 8>>"$(LOCK)"; \
+	stop='[ $$run = 0 ] || kill -TERM -- -$$run 2>/dev/null || kill -TERM $$run 2>/dev/null || true'; \
+	trap "$$stop" INT TERM HUP; \
+	trap "$$stop"'; : > "$(LOCK)"; exec 9>&- 8>>"$(LOCK)"; \
 	  flock -w 10 8 || true' EXIT; \
 	if [ ! -x "$(PY)" ]; then $(MAKE) venv; $(CHECK_KEYS); fi; \
 	$(PY) tools/run_group.py $(MAKE) -j$(NOTEBOOK_SLOTS) _$@ & run=$$!; \

@@ -3,9 +3,12 @@
 ``make reproduce`` runs its inner make under this. A process a recipe leaves in the background (the numba kernels)
 or a pool worker whose parent has ended is handed to this process, not to the system's init (Linux: a child
 subreaper). So its CPU time is counted with the run's (``/usr/bin/time``), and none outlives the run: when the
-command has ended, what is left of the group gets SIGTERM (then SIGKILL, after ``GRACE_S``) and is reaped.
+command has ended, what is left of the group gets SIGTERM; what is still alive ``--grace-s`` later (a child in a
+session of its own too, such as a notebook's kernel whose papermill was killed) gets SIGKILL; all are reaped.
 
-    python tools/run_group.py make -j2 _reproduce     # exit status: the command's (128 + n: ended by signal n)
+    python tools/run_group.py [--grace-s 10] make -j2 _reproduce     # exit status: the command's (128 + n: signal n)
+
+SIGTERM, SIGINT or SIGHUP to this process or its group ends the whole group, the command included.
 """
 from __future__ import annotations
 
@@ -16,7 +19,8 @@ import sys
 import time
 
 PR_SET_CHILD_SUBREAPER = 36     # linux/prctl.h
-GRACE_S = 10.0                  # what is left of the group after SIGTERM gets SIGKILL after this long (s)
+GRACE_S = 10.0                  # default of --grace-s: from SIGTERM to SIGKILL for what is left (s)
+STOPS = (signal.SIGTERM, signal.SIGINT, signal.SIGHUP)
 
 
 def _become_subreaper() -> bool:
@@ -41,11 +45,13 @@ def _wait_any() -> list[tuple[int, int]]:
         flags = os.WNOHANG
 
 
-def _end_group() -> None:
-    """SIGTERM to every other process of this group, SIGKILL to those alive ``GRACE_S`` later; all reaped."""
-    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+def _end_group(grace_s: float) -> None:
+    """SIGTERM to every other process of this group; from ``grace_s`` on, SIGKILL twice a second to what is left of
+    it and to every child of this process (reparented orphans in sessions of their own included); all reaped."""
+    for s in STOPS:
+        signal.signal(s, signal.SIG_IGN)
     os.killpg(0, signal.SIGTERM)
-    deadline, killed = time.monotonic() + GRACE_S, False
+    deadline, next_kill = time.monotonic() + grace_s, 0.0
     while True:
         try:
             pid, _ = os.waitpid(-1, os.WNOHANG)
@@ -53,19 +59,20 @@ def _end_group() -> None:
             return
         if pid:
             continue
-        if not killed and time.monotonic() > deadline:
-            for other in _group_members():
+        now = time.monotonic()
+        if now > deadline and now > next_kill:
+            for other in _left_behind():
                 try:
                     os.kill(other, signal.SIGKILL)
                 except ProcessLookupError:
                     pass
-            killed = True
+            next_kill = now + 0.5
         time.sleep(0.05)
 
 
-def _group_members() -> list[int]:
-    """The other processes of this process group (from /proc)."""
-    me, members = os.getpid(), []
+def _left_behind() -> list[int]:
+    """The other processes of this process group and this process's children (from /proc)."""
+    me, found = os.getpid(), []
     for entry in os.listdir("/proc"):
         if entry.isdigit() and int(entry) != me:
             try:
@@ -73,15 +80,20 @@ def _group_members() -> list[int]:
                     fields = f.read().rsplit(")", 1)[1].split()
             except OSError:
                 continue
-            if int(fields[2]) == me:        # pgrp: this group's id is this process's PID (setsid)
-                members.append(int(entry))
-    return members
+            if int(fields[1]) == me or int(fields[2]) == me:    # ppid; pgrp (this group's id is this PID: setsid)
+                found.append(int(entry))
+    return found
 
 
 def main(argv: list[str]) -> int:
+    grace_s = GRACE_S
+    if argv[:1] == ["--grace-s"] and len(argv) > 1:
+        grace_s, argv = float(argv[1]), argv[2:]
     if not argv:
-        print("usage: run_group.py COMMAND [ARG...]", file=sys.stderr)
+        print("usage: run_group.py [--grace-s SECONDS] COMMAND [ARG...]", file=sys.stderr)
         return 2
+    # A stop that comes before the command is started waits (blocked) until it is, then ends it like any other.
+    signal.pthread_sigmask(signal.SIG_BLOCK, STOPS)
     try:
         os.setsid()
     except PermissionError:
@@ -97,22 +109,27 @@ def main(argv: list[str]) -> int:
             signal.signal(signal.SIGTERM, signal.SIG_IGN)
             os.killpg(0, signal.SIGTERM)
 
-    for s in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP):
+    for s in STOPS:
         signal.signal(s, stop)
     child = os.fork()
     if child == 0:
-        for s in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP):
+        # the command starts as from a shell: default dispositions (Python ignores SIGPIPE and SIGXFSZ), no signal
+        # blocked (a stop sent before now was this process's, not the child's: the parent acts on it)
+        for s in (*STOPS, signal.SIGPIPE, signal.SIGXFSZ):
             signal.signal(s, signal.SIG_DFL)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, STOPS)
         try:
             os.execvp(argv[0], argv)
-        finally:
-            os._exit(127)
+        except OSError as err:
+            print(f"run_group.py: cannot run {argv[0]!r}: {err.strerror}", file=sys.stderr)
+        os._exit(127)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, STOPS)
     status = None
     while status is None:
         for pid, st in _wait_any():
             if pid == child:
                 status = st
-    _end_group()
+    _end_group(grace_s)
     if stopping:
         return 128 + stopping[0]
     return os.waitstatus_to_exitcode(status) if os.WIFEXITED(status) else 128 + os.WTERMSIG(status)

@@ -77,27 +77,27 @@ SHARED_TABLES: dict[str, str] = {
     "training_times": "training_times.csv",     # wall clock, apart from the deterministic tables
     "training_variants": "training_variants.csv",   # the variants' networks (inputs, protocol)
     "training_all_windows": "training_all_windows.csv",   # runs that never learned, trained again on all windows
-    "sweep": "outage_sweep.csv",                # notebook 04
+    "sweep": "outage_sweep.csv",                # notebook 06
     "sweep_summary": "outage_sweep_summary.csv",
     "sweep_pairs": "outage_sweep_pairs.csv",
-    "kf_ins_tuning": "kf_ins_tuning.csv",       # notebook 02: the INS row under each filter setup
-    "kf_ins_drift": "kf_ins_drift.csv",         # notebook 02: INS drift over the sweep's starts, drive by drive
+    "kf_ins_tuning": "kf_ins_tuning.csv",       # notebook 08: the INS row under each filter setup
+    "kf_ins_drift": "kf_ins_drift.csv",         # notebook 08: INS drift over the sweep's starts, drive by drive
     "kf_ins_drift_runs": "kf_ins_drift_runs.csv",
-    "kf_nees_scan": "kf_nees_scan.csv",         # notebook 02: INS consistency vs the gyro bias instability
-    "kf_imu_twin": "kf_imu_twin.csv",           # notebook 02: the recorded IMU against its trajectory twin
-    "oracle": "outage_oracle.csv",              # notebook 04: the oracle rows (bgfn.studies.outage_sweep.oracle)
+    "kf_nees_scan": "kf_nees_scan.csv",         # notebook 08: INS consistency vs the gyro bias instability
+    "kf_imu_twin": "kf_imu_twin.csv",           # notebook 08: the recorded IMU against its trajectory twin
+    "oracle": "outage_oracle.csv",              # notebook 06: the oracle rows (bgfn.studies.outage_sweep.oracle)
     "oracle_breakeven": "outage_oracle_breakeven.csv",
     "oracle_runs": "outage_oracle_runs.csv",
-    "odometer": "outage_odometer.csv",          # notebook 04: the bars of a learned odometer (bgfn.studies.odometer.bars)
+    "odometer": "outage_odometer.csv",          # notebook 07: the bars of a learned odometer (bgfn.studies.odometer.bars)
     "odometer_summary": "outage_odometer_summary.csv",
     "odometer_paper": "outage_odometer_paper.csv",  # ... and in each drive's two evaluation outages
     "odometer_networks": "outage_odometer_networks.csv",  # ... each network odometer: validation against outages
     "odometer_curve": "outage_odometer_curve.csv",  # ... the ridge's speed error against its training windows
     "odometer_uncertainty": "outage_odometer_uncertainty.csv",  # ... each network's predicted std against its error
     "odometer_errors": "outage_odometer_errors.csv",  # ... each odometer's error: offset per outage and fluctuation
-    "nees": "outage_nees.csv",                  # notebook 04: the filter's consistency in outages (bgfn.studies.ins_fidelity.nees)
-    "variants": "outage_variants.csv",          # notebook 03: the learning-problem variants in the two outages
-    "energy_odometer": "energy_odometer.csv",   # notebook 05: the learned odometers' energy (bgfn.studies.odometer.energy)
+    "nees": "outage_nees.csv",                  # notebook 06: the filter's consistency in outages (bgfn.studies.ins_fidelity.nees)
+    "variants": "outage_variants.csv",          # notebook 06: the learning-problem variants in the two outages
+    "energy_odometer": "energy_odometer.csv",   # notebook 07: the learned odometers' energy (bgfn.studies.odometer.energy)
 }
 #: Where a top-level ``datasets:`` puts its list (the datasets of every notebook, their variants and odometers),
 #: unless the same file or a later one in the ``base:`` chain sets that section's own ``datasets``.

@@ -224,14 +224,8 @@ def cached(kind: str, key: Any | Callable[[], Any], compute: Callable[[], T]) ->
     if found is not None:
         return found[0]
     # Two notebooks side by side (make -j) may ask for the same entry at once: the second waits for the first's
-    # result instead of computing it again (an exclusive lock per entry, released when its holder ends, even killed;
-    # a computation never asks for its own entry, so no two wait for each other).
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path.with_suffix(".lock"), "a+b") as lock:
-        try:
-            fcntl.flock(lock, fcntl.LOCK_EX)
-        except OSError:     # a file system without locks (some network mounts): computed here, as without a lock
-            pass
+    # result instead of computing it again (a computation never asks for its own entry, so no two wait for each other).
+    with locked(path.with_suffix(".lock")):
         found = _read_entry(path, digest)
         if found is not None:
             return found[0]
@@ -242,6 +236,21 @@ def cached(kind: str, key: Any | Callable[[], Any], compute: Callable[[], T]) ->
             return value
         atomic_write_bytes(path, blob)
     return value
+
+
+@contextlib.contextmanager
+def locked(path: str | Path) -> Iterator[None]:
+    """Hold an exclusive lock on the file ``path`` (created, with its folder) for the block; another process that asks
+    for it waits. Released when the block ends or its holder does, even killed. On a file system without locks (some
+    network mounts) the block runs unlocked."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "a+b") as lock:
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+        except OSError:
+            pass
+        yield
 
 
 def _read_entry(path: Path, digest: str) -> tuple[Any] | None:

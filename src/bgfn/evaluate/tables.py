@@ -20,13 +20,13 @@ from bgfn.data.names import dataset_id
 from bgfn.evaluate.setup import METRIC_COLUMNS, TABLE_COLUMNS, TABLE_FILES, TABLE_METHODS, evaluate_config
 from bgfn.evaluate.hybrid import gps_run, navigation_context, run_outages, window_metrics
 from bgfn.evaluate.networks import ensure_models
-from bgfn.io import atomic_write_csv, cached, sources_hash
+from bgfn.io import atomic_write_csv, cached, locked, sources_hash
 from bgfn.nav import outages
 from bgfn.nav.baseline import run_key
 from bgfn.nav.constraints import DEFAULT_PLATFORM, platform_aids
 from bgfn.paper import METHOD_LABELS, nhc_label, test_of
 from bgfn.row_labels import ran_labels
-from bgfn.train.checkpoints import card_path, checkpoint_path
+from bgfn.train.checkpoints import card_path, checkpoint_path, models_dir
 
 
 @dataclass
@@ -181,10 +181,13 @@ def outage_result(cfg: dict, profile: str, dataset: str, ecfg: dict) -> TableRes
             contexts.append(navigation_context(drive, cfg.get("nav"), [s for s, _ in windows]))
         return contexts[0]
 
-    missing = [(m, s) for m in ecfg["methods"] for s in ecfg["seeds"]
-               if not checkpoint_path(profile, dataset, m, s, create=False).exists()]
-    models = ensure_models(cfg, profile, dataset, context() if missing and ecfg["train_missing"] else None,
-                           ecfg["methods"], ecfg["seeds"], windows, ecfg["train_missing"])
+    # 04 and 06 side by side: a network 03 did not train (the evaluation's methods or seeds beyond training's) is
+    # trained by one of them while the other waits, never read half-trained
+    with locked(models_dir(profile, dataset) / ".networks.lock"):
+        missing = [(m, s) for m in ecfg["methods"] for s in ecfg["seeds"]
+                   if not checkpoint_path(profile, dataset, m, s, create=False).exists()]
+        models = ensure_models(cfg, profile, dataset, context() if missing and ecfg["train_missing"] else None,
+                               ecfg["methods"], ecfg["seeds"], windows, ecfg["train_missing"])
 
     def key() -> dict:
         files = {f"{m}_seed{s}": sources_hash([path, card_path(path)])

@@ -12,6 +12,7 @@ from typing import Any, Callable
 
 import numpy as np
 import pandas as pd
+import scipy
 import torch
 
 from bgfn.data import load_drive
@@ -168,9 +169,9 @@ def outage_result(cfg: dict, profile: str, dataset: str, ecfg: dict) -> TableRes
     Notebook 04 makes the paper's tables from these runs; notebook 06 builds on them (the oracle's and the NEES's
     level of each network). Under ``make`` (``BGFN_CACHE_DIR``) they are kept in the run cache (:func:`bgfn.io.cached`)
     with a key of every input: the drive's content, the ``nav:`` settings, the outages, the networks' checkpoint files,
-    the evaluation settings they read, the package's code and the numerical libraries. Notebook 06 can so start
-    beside notebook 04 instead of after it: whichever asks first computes them, the other waits for them and reads
-    the same runs, bit for bit. Without a cache, computed here.
+    the evaluation settings they read, the package's code and the numerical libraries (numpy, pandas, numba, scipy,
+    torch). Notebook 06 can so start beside notebook 04 instead of after it: whichever asks first computes them, the
+    other waits for them and reads the same runs, bit for bit. Without a cache, computed here.
     """
     drive = load_drive(dataset, profile=profile)
     windows = outages.outage_windows(cfg, drive, dataset)
@@ -194,7 +195,7 @@ def outage_result(cfg: dict, profile: str, dataset: str, ecfg: dict) -> TableRes
                  for m, s in models for path in [checkpoint_path(profile, dataset, m, s, create=False)]}
         return run_key(drive, cfg.get("nav"), windows=[tuple(map(float, w)) for w in windows], networks=files,
                        evaluate={k: ecfg[k] for k in _RUN_SETTINGS}, package=_code_version(),
-                       torch=torch.__version__)
+                       torch=torch.__version__, scipy=scipy.__version__)
 
     light = cached(OUTAGE_RUNS_CACHE, key, lambda: _without_drive_and_models(
         _evaluate(dataset, context(), windows, models, ecfg, ecfg["nhc_rows"])))

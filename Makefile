@@ -327,7 +327,7 @@ FORCE:
 
 # Notebooks at a time under `make reproduce` / `make notebooks` (1: one after the other, papermill's progress bar
 # shown). Each notebook's runner keeps every core (JOBS, else the profile's parallel.jobs, else the cores): the
-# chain 01-02-03-06 is the longest path, and when the studies beside it are done it must have all of them again; while
+# chain 01-02-03-06-10 is the longest path, and when the studies beside it are done it must have all of them again; while
 # two notebooks run, the system shares the cores between their processes. No table depends on either number.
 NOTEBOOK_SLOTS ?= 2
 
@@ -340,8 +340,8 @@ $(RES)/notebooks/05_energy_estimate.ipynb: $(RES)/notebooks/04_outage_evaluation
 # notebook 04's runs, which it reads from the run cache or computes there itself (bgfn.evaluate.outage_result: the
 # two, side by side, compute them once), so it starts beside 04 rather than after it; 07 trains its own odometers,
 # 08 reruns the GPS-aided filter and compares our INS with NaveGo's measured run, 09 (the gallery of own logs) needs
-# only the data and the navigation: they read no other notebook's outputs, so they run beside notebooks 02-06 under
-# -j.
+# only the data and the navigation: 07, 08 and 09 read no other notebook's outputs, so they run beside notebooks
+# 02-06 under -j.
 $(RES)/notebooks/06_outage_sweep.ipynb: $(RES)/notebooks/03_bgfn_training.ipynb
 $(RES)/notebooks/07_learned_odometer.ipynb: $(RES)/notebooks/01_data_prep.ipynb
 $(RES)/notebooks/08_ins_fidelity.ipynb: $(RES)/notebooks/01_data_prep.ipynb $(wildcard data/measured/navego_check.csv)
@@ -360,7 +360,8 @@ $(RES)/notebooks/08_ins_fidelity.ipynb $(RES)/notebooks/09_own_logs.ipynb: | $(R
 # no other lane's notebook).
 ifeq ($(NOTEBOOK_SLOTS),2)
 ifneq ($(filter _reproduce _notebooks,$(MAKECMDGOALS)),)
-$(RES)/notebooks/08_ins_fidelity.ipynb: | $(RES)/notebooks/07_learned_odometer.ipynb $(RES)/notebooks/04_outage_evaluation.ipynb
+$(RES)/notebooks/04_outage_evaluation.ipynb: | $(RES)/notebooks/07_learned_odometer.ipynb
+$(RES)/notebooks/08_ins_fidelity.ipynb: | $(RES)/notebooks/04_outage_evaluation.ipynb
 $(RES)/notebooks/09_own_logs.ipynb: | $(RES)/notebooks/08_ins_fidelity.ipynb
 $(RES)/notebooks/05_energy_estimate.ipynb: | $(RES)/notebooks/09_own_logs.ipynb
 endif
@@ -452,7 +453,7 @@ reproduce notebooks:
 	  flock -w 10 8 || true' EXIT; \
 	if [ ! -x "$(PY)" ]; then $(MAKE) venv; $(CHECK_KEYS); fi; \
 	$(PY) tools/run_group.py $(MAKE) -j$(NOTEBOOK_SLOTS) _$@ & run=$$!; \
-	rc=0; wait $$run || rc=$$?; while kill -0 $$run 2>/dev/null; do wait $$run || rc=$$?; done; exit $$rc
+	rc=0; wait $$run || rc=$$?; while kill -0 $$run 2>/dev/null; do wait $$run || rc=$$?; done; run=0; exit $$rc
 
 _reproduce: $(BOOK_STAMP)
 	@echo "==> done (PROFILE=$(PROFILE)): results in $(RES)/, book at $(BOOK_HTML)"

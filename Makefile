@@ -138,7 +138,7 @@ SRC := $(shell find src/bgfn -name '*.py' -not -path '*/__pycache__/*' | sort)
 BOOK_SRC := $(shell find book \( -path book/_build -o -path book/notebooks -o -path book/_generated -o -path book/api \) -prune \
               -o -type f -print | sort)
 BOOK_STAMP := book/_build/.built-$(PROFILE)
-KERNELS_STARTED := $(RES)/logs/.kernels-started
+KERNELS_COMPILED := $(RES)/logs/.kernels-compiled
 BOOK_HTML := book/_build/html/index.html
 
 # Every recipe sees the venv first on PATH and the venv's kernelspec first on JUPYTER_PATH, so papermill's
@@ -248,7 +248,7 @@ data: $(STAMP)
 # handed the same free port by the system (jupyter_client picks the ports, the kernel binds them a second later;
 # seen once in CI as "Address already in use" then "Kernel died before replying to kernel_info").
 # Debris of an interrupted run is removed once, before the first notebook (clean-debris, order-only).
-$(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(STAMP) | $(KERNELS_STARTED) data $(KERNEL_CONFIG) clean-debris $(RES)/.profile-checked
+$(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(STAMP) | $(KERNELS_COMPILED) data $(KERNEL_CONFIG) clean-debris $(RES)/.profile-checked
 	@mkdir -p $(@D) $(RES)/logs
 	@echo "==> [$(PROFILE)] papermill $<"
 	@tmp="$(@D)/.$*.running-$$$$.ipynb"; log="$(RES)/logs/$*.log"; : > "$$log"; \
@@ -296,7 +296,7 @@ $(RES)/.profile-checked: $(PARAMS) $(SRC) $(STAMP) | data
 # whose tools/run_group.py reaps them: their CPU time counts with the run's).
 # The stamp is written when they have finished: a run that ends first (a failed data step, a profile the check with
 # the drives refuses) starts them again next time.
-$(KERNELS_STARTED): $(PARAMS) $(SRC) $(STAMP)
+$(KERNELS_COMPILED): $(PARAMS) $(SRC) $(STAMP)
 	@mkdir -p $(@D); rm -f $@
 	@echo "==> [$(PROFILE)] numba kernels into the cache, in the background ($(RES)/logs/kernels.log)"
 	@{ $(PY) -m bgfn kernels --profile $(PROFILE) && touch $@; } > $(RES)/logs/kernels.log 2>&1 < /dev/null 9>&- &

@@ -354,7 +354,7 @@ def test_the_kernels_are_started_again_unless_they_finished(tmp_path, finished):
     import time
 
     repo, marks = _fake_run(tmp_path, papermill="exit 1", kernels="exit 0" if finished else "exec sleep 300")
-    stamp = repo / "results" / "smoke" / "logs" / ".kernels-started"
+    stamp = repo / "results" / "smoke" / "logs" / ".kernels-compiled"
     res = _make("reproduce", "PROFILE=smoke", cwd=repo)             # papermill's stand-in fails: the run ends
     _gone(_wait_for(marks / "kernels.pid"))
     time.sleep(0.5)

@@ -5,6 +5,7 @@ ours are :mod:`bgfn.evaluate.claims`."""
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -175,12 +176,8 @@ def outage_result(cfg: dict, profile: str, dataset: str, ecfg: dict) -> TableRes
     """
     drive = load_drive(dataset, profile=profile)
     windows = outages.outage_windows(cfg, drive, dataset)
-    contexts = []       # the GPS-aided run and its states (seconds per drive): only when the runs are computed here
-
-    def context():
-        if not contexts:
-            contexts.append(navigation_context(drive, cfg.get("nav"), [s for s, _ in windows]))
-        return contexts[0]
+    # the GPS-aided run and its states (seconds per drive): built only when the runs are computed here
+    context = functools.cache(lambda: navigation_context(drive, cfg.get("nav"), [s for s, _ in windows]))
 
     # 04 and 06 side by side: a network 03 did not train (the evaluation's methods or seeds beyond training's) is
     # trained by one of them while the other waits, never read half-trained

@@ -163,7 +163,7 @@ export DASK_SCHEDULER
 # the venv's IPython kernel configuration (tools/ipython_kernel_config.py, installed by `make venv`)
 KERNEL_CONFIG := $(VENV)/etc/ipython/ipython_kernel_config.py
 
-.PHONY: FORCE help reproduce notebooks _reproduce _notebooks navego-check book _book-build test bench clean clean-debris distclean venv data lock strip
+.PHONY: FORCE help reproduce notebooks _reproduce _notebooks navego-check book _book-build _book-draft test bench clean clean-debris distclean venv data lock strip
 
 ifneq ($(filter reproduce notebooks book,$(MAKECMDGOALS)),)
 ifeq ($(wildcard params/$(PROFILE).yaml),)
@@ -381,12 +381,28 @@ _notebooks: $(EXEC)
 # ---------------------------------------------------------------- book
 # The book shows the executed notebooks of $(PROFILE) (copied to the gitignored book/notebooks/) and the
 # profile's tables/figures (copied to book/_generated/, for pages that include them). book/_config.yml has
-# execute_notebooks: 'off'. The code page's module pages are written from the docstrings into book/api/ at each
-# build (removed first: a moved module leaves no page). Warnings are errors.
-define build_book
-	@echo "==> book from $(RES)/notebooks"
-	@rm -rf book/notebooks book/_generated book/api && mkdir -p book/notebooks book/_generated
-	@cp $(EXEC) book/notebooks/   # the book's pages: 01-10, and 11 for a profile with a fleet
+# execute_notebooks: 'off'. The code page's module pages are written from the docstrings into book/api/ by
+# autosummary. Warnings are errors.
+# Two passes: the code pages (book/api/, about 150 of the book's 170 pages, their source pages and the theme's
+# assets: most of the book's time, much of it on one core) depend on the code alone. Under `make reproduce` a draft
+# builds the whole book beside the last notebooks, every other page a placeholder (the notebooks unexecuted; the
+# warnings located in those pages are left out: book/_ext/code_page.py), and the book's build then reads every page
+# but the code pages again, with -W, keeping the draft's code pages, their stubs and its environment. It keeps them
+# only where book/_build holds this profile's environment ($(BOOK_ENV), which every build removes for every profile
+# when it starts and writes for its own when it ends) built from the same code, book sources and environment
+# (none of them newer than it); otherwise (another profile built the book since, a file changed) it builds every
+# page, as `make book` on a fresh clone does.
+BOOK_ENV := book/_build/.env-$(PROFILE)
+BOOK_DRAFT := $(RES)/logs/.book-draft
+# the files the code pages are built from (make's view when the recipe starts: after the draft)
+BOOK_CODE := $(SRC) $(BOOK_SRC) $(STAMP) tools/build_book.py
+book_pass = $(if $(and $(wildcard $(BOOK_ENV)),$(if $(shell find $(BOOK_CODE) -newer $(BOOK_ENV) 2>/dev/null | head -1),,same)),pages,full)
+
+# $(1): the notebooks shown (the executed ones, or their sources as the draft's placeholders); $(2): the first line of
+# _generated/build_info.md
+define book_pages
+	@rm -rf book/notebooks book/_generated && mkdir -p book/notebooks book/_generated
+	@cp $(1) book/notebooks/   # the book's pages: 01-10, and 11 for a profile with a fleet
 	@# one parameters cell: the run's values; 11 without a fleet: a page saying the study did not run
 	@$(PY) -m bgfn.report.book_notebooks --profile $(PROFILE) --absent book/notebooks book/notebooks/*.ipynb
 	@for d in tables figures; do if [ -d "$(RES)/$$d" ]; then cp -r "$(RES)/$$d" book/_generated/; fi; done
@@ -394,15 +410,39 @@ define build_book
 	@if [ -f "$(RES)/findings.md" ]; then cp "$(RES)/findings.md" book/_generated/; else \
 	  echo "No findings yet: notebook 10 of profile \`$(PROFILE)\` has not written them." > book/_generated/findings.md; fi
 	@$(PY) -m bgfn.report.walltimes --profile $(PROFILE) --markdown book/_generated/wall_times.md   # imports pandas, not torch
-	@printf '%s\n' "Built from the executed notebooks of profile \`$(PROFILE)\` (\`params/$(PROFILE).yaml\`)," \
-	  "commit \`$$(git rev-parse --short HEAD 2>/dev/null || echo unknown)\`." > book/_generated/build_info.md
-	@rm -f book/_build/.built-*
-	@# jupyter-book build book --all -W -n --keep-going, with Sphinx on every core (quick's book: 90 -> 51 s)
-	$(PY) tools/build_book.py book --all -W -n --keep-going
-	@# the code pages show module constants' values, some of them paths in this checkout: relative, as the notebooks'
+	@printf '%s\n' "$(2)" "commit \`$$(git rev-parse --short HEAD 2>/dev/null || echo unknown)\`." > book/_generated/build_info.md
+endef
+
+# the code pages show module constants' values, some of them paths in this checkout: relative, as the notebooks'
+define book_relative_paths
 	@{ grep -rlF --include='*.html' '$(CURDIR)' book/_build/html 2>/dev/null || true; } | xargs -r sed -i 's|$(CURDIR)/||g; s|$(CURDIR)|.|g'
-	@touch $(BOOK_STAMP)
+endef
+
+define build_book
+	@echo "==> book from $(RES)/notebooks$(if $(filter pages,$(book_pass)), (the code pages kept from $(BOOK_ENV)))"
+	$(if $(filter full,$(book_pass)),@rm -rf book/api)
+	$(call book_pages,$(EXEC),Built from the executed notebooks of profile \`$(PROFILE)\` (\`params/$(PROFILE).yaml\`)$(comma))
+	@rm -f book/_build/.built-* book/_build/.env-*
+	@# jupyter-book build book -W -n --keep-going (--all for every page), with Sphinx on every core
+	$(if $(filter pages,$(book_pass)),BGFN_BOOK_PASS=pages $(PY) tools/build_book.py book -W -n --keep-going,$(PY) tools/build_book.py book --all -W -n --keep-going)
+	$(book_relative_paths)
+	@touch $(BOOK_STAMP) $(BOOK_ENV)
 	@echo "book: $(BOOK_HTML)"
+endef
+
+# The draft (the first pass, above): its output goes to $(RES)/logs/book-draft.log; it fails the run only for a
+# warning in a code page (the book's build would fail on it too). Skipped, saying so, while another make builds the
+# book (its build then builds every page).
+define build_book_draft
+	@echo "==> [$(PROFILE)] book draft: the code pages, beside the last notebooks ($(RES)/logs/book-draft.log)"
+	@rm -rf book/api
+	$(call book_pages,$(EXEC:$(RES)/notebooks/%=notebooks/%),Draft of the book of profile \`$(PROFILE)\`: its notebooks have not run yet$(comma))
+	@rm -f book/_build/.built-* book/_build/.env-*
+	@if ! BGFN_BOOK_PASS=draft $(PY) tools/build_book.py book --all -W -n --keep-going > $(RES)/logs/book-draft.log 2>&1; then \
+	  grep -i -e warning -e error $(RES)/logs/book-draft.log >&2 || tail -20 $(RES)/logs/book-draft.log >&2; \
+	  echo "error: the book's code pages failed (log: $(RES)/logs/book-draft.log)" >&2; exit 1; fi
+	$(book_relative_paths)
+	@touch $(BOOK_ENV) $(BOOK_DRAFT)
 endef
 
 # book/ is one folder for every profile: one build at a time, under an flock (a second one waits, saying so).
@@ -411,7 +451,7 @@ locked_book = @mkdir -p results; exec 7>>$(BOOK_LOCK); if ! flock -n 7; then \
   echo "==> [$(PROFILE)] book/ is being built by another make (another profile's?): waiting for it"; flock 7; fi; \
   $(MAKE) _book-build
 
-$(BOOK_STAMP): $(EXEC) $(BOOK_SRC) $(STAMP)
+$(BOOK_STAMP): $(EXEC) $(BOOK_CODE)
 	$(locked_book)
 
 book: $(STAMP)
@@ -421,6 +461,24 @@ book: $(STAMP)
 
 _book-build:
 	$(build_book)
+
+# The draft is part of a whole run with more than one notebook slot, after notebook 05 (the last of the two-slot
+# lane beside the longest path, whose 06 and 10 leave a core idle); with one slot it would only add work. It needs the
+# code and the book's sources, not the notebooks; it is made again when they change (and the book then too).
+$(BOOK_DRAFT): $(BOOK_CODE)
+	@mkdir -p $(@D) results; exec 7>>$(BOOK_LOCK); if ! flock -n 7; then \
+	  echo "==> [$(PROFILE)] book draft skipped: book/ is being built by another make"; exit 0; fi; \
+	  $(MAKE) _book-draft
+
+_book-draft:
+	$(build_book_draft)
+
+ifneq ($(NOTEBOOK_SLOTS),1)
+ifneq ($(filter _reproduce,$(MAKECMDGOALS)),)
+$(BOOK_STAMP): | $(BOOK_DRAFT)
+$(BOOK_DRAFT): | $(RES)/notebooks/05_energy_estimate.ipynb
+endif
+endif
 
 # One run per profile at a time: `reproduce` and `notebooks` hold an flock on $(RES)/.lock (which names the
 # holder's PID) for the whole run, so a second run of the same profile refuses at once instead of overwriting

@@ -9,13 +9,27 @@
   substitution) and a simple table whose text runs into the margin between two columns (shown as the
   preformatted text it is in the source). And a ``#:`` comment whose first line holds a colon ("what: why")
   stays a sentence: napoleon would read the words before the colon as the attribute's type.
+- **Two passes** (``BGFN_BOOK_PASS``, set by ``make``): the code pages depend on the code alone, so ``make
+  reproduce`` builds the book once beside the last notebooks (``draft``: every other page a placeholder, whose
+  warnings are left out) and then only reads those other pages again (``pages``), with the code pages, their
+  autosummary stubs and their source pages kept from the draft.
 """
 
 from __future__ import annotations
 
 import importlib
 import importlib.util
+import logging
+import os
+import pickle
 import re
+
+from sphinx.util import logging as sphinx_logging
+
+#: The environment variable naming the book's pass (tools/build_book.py): ``draft`` or ``pages``; unset: one pass.
+PASS_ENV = "BGFN_BOOK_PASS"
+#: The folder of the code pages (autosummary's stubs, book/api/), as Sphinx names their documents.
+CODE_PAGES = "api/"
 
 #: ``|x|`` not preceded by a backslash or a word character: an absolute value, not a substitution.
 _BARS = re.compile(r"(?<![\\\w|`])\|([^|\s`][^|`\n]*?)\|(?![\w|`])")
@@ -96,8 +110,93 @@ def prefer_modules() -> None:
     autosummary.import_by_name = generate.import_by_name = import_by_name
 
 
+class _PlaceholderWarnings(logging.Filter):
+    """Drops a warning located in a page other than a code page: in the draft those pages are placeholders (the
+    notebooks unexecuted, their figures not drawn yet), and the ``pages`` pass reads and checks them again."""
+
+    def __init__(self, srcdir) -> None:
+        super().__init__()
+        self.pages = os.path.join(str(srcdir), "")
+        self.code = os.path.join(str(srcdir), CODE_PAGES)
+
+    def filter(self, record) -> bool:
+        where = str(getattr(record, "location", None) or "")
+        return not (where.startswith(self.pages) and not where.startswith(self.code))
+
+
+def _drop_placeholder_warnings(app) -> None:
+    # after the record's location is made a path, before -W turns it into an error
+    for handler in logging.getLogger(sphinx_logging.NAMESPACE).handlers:
+        if isinstance(handler, sphinx_logging.WarningStreamHandler):
+            at = next(i for i, f in enumerate(handler.filters)
+                      if isinstance(f, sphinx_logging.WarningLogRecordTranslator))
+            handler.filters.insert(at + 1, _PlaceholderWarnings(app.srcdir))
+
+
+def _pages_again(app, env, added, changed, removed) -> list[str]:
+    """Every page but the code pages, read again (``env-get-outdated``)."""
+    return sorted(d for d in env.found_docs if not d.startswith(CODE_PAGES))
+
+
+def _keep_stubs(app) -> None:
+    """The draft wrote the code pages' stubs from the same sources: autosummary does not import every module to
+    write them again. Its generator reads the setting at builder-inited (priority 500); the setting is put back
+    after it, so the saved environment's configuration stays the draft's (a changed one would read every page)."""
+    configured = []
+
+    def off(app) -> None:
+        configured.append(app.config.autosummary_generate)
+        app.config.autosummary_generate = False
+
+    def back(app) -> None:
+        app.config.autosummary_generate = configured.pop()
+
+    app.connect("builder-inited", off, priority=100)
+    app.connect("builder-inited", back, priority=900)
+
+
+def _keep_empty_source_entries(app) -> None:
+    """viewcode forgets, whenever a page is read again, every module none of whose objects it could tag (a module
+    of constants: ``bgfn.schema``); a build of every page keeps them in the source pages' index. They are put
+    back after the reading, as that build has them."""
+    saved: dict = {}
+
+    def before(app, env, docnames) -> None:          # env-before-read-docs: before the pages are purged
+        saved.update((m, e) for m, e in getattr(env, "_viewcode_modules", {}).items() if e and not e[2])
+
+    def after(app, env) -> None:                     # env-updated: after every page was read
+        modules = getattr(env, "_viewcode_modules", None)
+        if modules is not None:
+            for name, entry in saved.items():
+                modules.setdefault(name, entry)
+
+    app.connect("env-before-read-docs", before)
+    app.connect("env-updated", after)
+
+
+def _save_environment(app, exception) -> None:
+    """The environment saved once more when the build has finished: Sphinx saves it after reading, before the
+    search index takes each page's index entries while writing, so a build that reads only some pages would
+    otherwise dump an index without the others' entries."""
+    if exception is None and app.builder.name == "html":
+        from sphinx.application import ENV_PICKLE_FILENAME
+
+        with open(os.path.join(app.doctreedir, ENV_PICKLE_FILENAME), "wb") as f:
+            pickle.dump(app.env, f, pickle.HIGHEST_PROTOCOL)
+
+
 def setup(app):
     prefer_modules()
+    app.connect("build-finished", _save_environment)
+    book_pass = os.environ.get(PASS_ENV, "")
+    if book_pass == "draft":
+        _drop_placeholder_warnings(app)
+    elif book_pass == "pages":
+        app.connect("env-get-outdated", _pages_again)
+        _keep_stubs(app)
+        _keep_empty_source_entries(app)
+    elif book_pass:
+        raise ValueError(f"{PASS_ENV}={book_pass!r}: expected 'draft', 'pages' or nothing")
     # around napoleon (priority 500), which turns numpydoc sections into reStructuredText
     app.connect("autodoc-process-docstring", _no_inline_type, priority=400)
     app.connect("autodoc-process-docstring", _plain, priority=900)

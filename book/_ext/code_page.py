@@ -24,6 +24,7 @@ import os
 import pickle
 import re
 
+from docutils import nodes
 from sphinx.util import logging as sphinx_logging
 
 #: The environment variable naming the book's pass (tools/build_book.py): ``draft`` or ``pages``; unset: one pass.
@@ -114,23 +115,34 @@ class _PlaceholderWarnings(logging.Filter):
     """Drops a warning located in a page other than a code page: in the draft those pages are placeholders (the
     notebooks unexecuted, their figures not drawn yet), and the ``pages`` pass reads and checks them again."""
 
-    def __init__(self, srcdir) -> None:
+    def __init__(self, app) -> None:
         super().__init__()
-        self.pages = os.path.join(str(srcdir), "")
-        self.code = os.path.join(str(srcdir), CODE_PAGES)
+        self.app = app
+        self.pages = os.path.join(str(app.srcdir), "")
+        self.code = os.path.join(str(app.srcdir), CODE_PAGES)
+
+    def path(self, record) -> str:
+        """The file a record names (its location: a document's name, with a line or not; a node; a path)."""
+        location = getattr(record, "location", None)
+        if isinstance(location, tuple):
+            location = location[0]
+        if isinstance(location, nodes.Node):
+            return str(sphinx_logging.get_node_location(location) or "")
+        env = getattr(self.app, "env", None)
+        if location and ":" not in str(location) and env is not None:
+            return str(env.doc2path(str(location)))
+        return str(location or "")
 
     def filter(self, record) -> bool:
-        where = str(getattr(record, "location", None) or "")
+        where = self.path(record)
         return not (where.startswith(self.pages) and not where.startswith(self.code))
 
 
 def _drop_placeholder_warnings(app) -> None:
-    # after the record's location is made a path, before -W turns it into an error
+    # first, before Sphinx counts the warning (the build fails on any counted one) and -W makes it an error
     for handler in logging.getLogger(sphinx_logging.NAMESPACE).handlers:
         if isinstance(handler, sphinx_logging.WarningStreamHandler):
-            at = next(i for i, f in enumerate(handler.filters)
-                      if isinstance(f, sphinx_logging.WarningLogRecordTranslator))
-            handler.filters.insert(at + 1, _PlaceholderWarnings(app.srcdir))
+            handler.filters.insert(0, _PlaceholderWarnings(app))
 
 
 def _pages_again(app, env, added, changed, removed) -> list[str]:
@@ -174,6 +186,17 @@ def _keep_empty_source_entries(app) -> None:
     app.connect("env-updated", after)
 
 
+def _forget_vanished_words(app, *args) -> list:
+    """html-collect-pages, before the search index is dumped: a word that only a placeholder had is left in the
+    index with no page (Sphinx prunes the pages read again from each word's pages, not the words); a build of
+    every page has no such word."""
+    indexer = getattr(app.builder, "indexer", None)
+    for mapping in (getattr(indexer, "_mapping", {}), getattr(indexer, "_title_mapping", {})):
+        for word in [w for w, pages in mapping.items() if not pages]:
+            del mapping[word]
+    return []
+
+
 def _save_environment(app, exception) -> None:
     """The environment saved once more when the build has finished: Sphinx saves it after reading, before the
     search index takes each page's index entries while writing, so a build that reads only some pages would
@@ -195,6 +218,7 @@ def setup(app):
         app.connect("env-get-outdated", _pages_again)
         _keep_stubs(app)
         _keep_empty_source_entries(app)
+        app.connect("html-collect-pages", _forget_vanished_words)
     elif book_pass:
         raise ValueError(f"{PASS_ENV}={book_pass!r}: expected 'draft', 'pages' or nothing")
     # around napoleon (priority 500), which turns numpydoc sections into reStructuredText

@@ -9,8 +9,9 @@
 #
 # Make's file dependencies keep a second `make reproduce` cheap: an executed notebook is redone only when its
 # source notebook, a profile section it reads, a src/bgfn module it imports, the environment or an executed
-# notebook whose outputs it reads changed (tools/notebook_deps.py); the book only when an executed notebook or a
-# book source changed. Notebooks that read none of each other's outputs run side by side (NOTEBOOK_SLOTS).
+# notebook whose outputs it reads changed (tools/notebook_deps.py); the book only when an executed notebook, a
+# book source or the code its code pages show changed. Notebooks that read none of each other's outputs run side by
+# side (NOTEBOOK_SLOTS).
 
 SHELL := bash
 .SHELLFLAGS := -eu -o pipefail -c
@@ -257,7 +258,7 @@ $(RES)/notebooks/%.ipynb: notebooks/%.ipynb $(STAMP) | $(KERNELS_COMPILED) data 
 	if /usr/bin/time -q -f %e -o /dev/null true 2>/dev/null; then timer="/usr/bin/time -q -f %e_%U_%S -o $$cpu"; fi; \
 	run() { BGFN_PROGRESS_LOG="$(CURDIR)/$$log" BGFN_OUTPUT_LOG="$(CURDIR)/$$written" \
 	  OMP_WAIT_POLICY="$${OMP_WAIT_POLICY:-PASSIVE}" \
-	  $$timer $(VENV_ABS)/bin/papermill "$<" "$$tmp" -p profile $(PROFILE) --cwd "$(CURDIR)" -k python3 "$$@" $(PAPERMILL_FLAGS); }; \
+	  $$timer $(if $(filter $*,$(LANE)),nice -n $(LANE_NICE) )$(VENV_ABS)/bin/papermill "$<" "$$tmp" -p profile $(PROFILE) --cwd "$(CURDIR)" -k python3 "$$@" $(PAPERMILL_FLAGS); }; \
 	if [[ " $(filter -j%,$(MAKEFLAGS)) " =~ [[:space:]]-j([^1]|1[0-9]) ]]; then prefix="[$*] "; else prefix=""; fi; \
 	tail --pid=$$$$ -s 0.5 -n +1 -f "$$log" 2>/dev/null | sed -u "s/^/    $$prefix/; 1s/^/\n/" & \
 	attempt() { if [ -z "$$prefix" ]; then run --progress-bar; else run --no-progress-bar 2>&1 | sed -u "s/^/$$prefix/"; fi; }; \
@@ -358,8 +359,13 @@ $(RES)/notebooks/08_ins_fidelity.ipynb $(RES)/notebooks/09_own_logs.ipynb: | $(R
 # then 05. Chained, a notebook is not queued before its lane's slot is free: queued early, 09 took the slot 03 freed
 # and 04 waited (23 s). With more slots they run side by side. Only in a whole run (a notebook made alone builds
 # no other lane's notebook).
+# The lane runs at a lower priority than the longest path (nice; its kernels and pool workers inherit it): where
+# both want the cores, the longest path gets them first, and the lane takes what the path's serial stretches leave
+# (its work has room to spare beside 02-06, and so does the book's draft after it). The priority changes no result.
+LANE_NICE := 5
 ifeq ($(NOTEBOOK_SLOTS),2)
 ifneq ($(filter _reproduce _notebooks,$(MAKECMDGOALS)),)
+LANE := 07_learned_odometer 04_outage_evaluation 08_ins_fidelity 09_own_logs 05_energy_estimate
 $(RES)/notebooks/04_outage_evaluation.ipynb: | $(RES)/notebooks/07_learned_odometer.ipynb
 $(RES)/notebooks/08_ins_fidelity.ipynb: | $(RES)/notebooks/04_outage_evaluation.ipynb
 $(RES)/notebooks/09_own_logs.ipynb: | $(RES)/notebooks/08_ins_fidelity.ipynb
@@ -385,18 +391,28 @@ _notebooks: $(EXEC)
 # autosummary. Warnings are errors.
 # Two passes: the code pages (book/api/, about 150 of the book's 170 pages, their source pages and the theme's
 # assets: most of the book's time, much of it on one core) depend on the code alone. Under `make reproduce` a draft
-# builds the whole book beside the last notebooks, every other page a placeholder (the notebooks unexecuted; the
-# warnings located in those pages are left out: book/_ext/code_page.py), and the book's build then reads every page
-# but the code pages again, with -W, keeping the draft's code pages, their stubs and its environment. It keeps them
-# only where book/_build holds this profile's environment ($(BOOK_ENV), which every build removes for every profile
-# when it starts and writes for its own when it ends) built from the same code, book sources and environment
-# (none of them newer than it); otherwise (another profile built the book since, a file changed) it builds every
-# page, as `make book` on a fresh clone does.
+# builds the whole book beside the last notebooks, every other page a placeholder (the source notebooks unexecuted,
+# no table or figure; the warnings located in those pages are left out: book/_ext/code_page.py), and the book's build
+# then reads every page but the code pages again, with -W, keeping the draft's code pages, their stubs and its
+# environment. It keeps them only where book/_build holds this profile's environment ($(BOOK_ENV): every build
+# removes every profile's when it starts, and writes its own when it has ended) built from the same files
+# ($(BOOK_CODE): the code, the book's sources, the source notebooks, whose titles every page's navigation shows, the
+# environment and the build's tool), the same list of them and none changed since the build started; otherwise
+# (another profile built the book since, a file changed, was added or removed) it builds every page, as `make book`
+# on a fresh clone does.
 BOOK_ENV := book/_build/.env-$(PROFILE)
+BOOK_ENV_NEXT := book/_build/.next-env-$(PROFILE)
 BOOK_DRAFT := $(RES)/logs/.book-draft
-# the files the code pages are built from (make's view when the recipe starts: after the draft)
-BOOK_CODE := $(SRC) $(BOOK_SRC) $(STAMP) tools/build_book.py
-book_pass = $(if $(and $(wildcard $(BOOK_ENV)),$(if $(shell find $(BOOK_CODE) -newer $(BOOK_ENV) 2>/dev/null | head -1),,same)),pages,full)
+BOOK_CODE := $(SRC) $(BOOK_SRC) $(EXEC:$(RES)/notebooks/%=notebooks/%) $(STAMP) tools/build_book.py
+same_words = $(if $(filter-out $(1),$(2))$(filter-out $(2),$(1)),,same)
+# evaluated when a build's recipe starts, under the book's lock
+book_pass = $(if $(and $(wildcard $(BOOK_ENV)),$(call same_words,$(file <$(BOOK_ENV)),$(BOOK_CODE)),$(if \
+  $(shell find $(BOOK_CODE) -newer $(BOOK_ENV) 2>/dev/null | head -1),,same)),pages,full)
+# a build's first step: no profile's environment is kept while book/ changes; the list of files, stamped now
+define book_started
+	@mkdir -p book/_build && rm -f book/_build/.built-* book/_build/.env-* book/_build/.next-env-*
+	@printf '%s\n' $(BOOK_CODE) > $(BOOK_ENV_NEXT)
+endef
 
 # $(1): the notebooks shown (the executed ones, or their sources as the draft's placeholders); $(2): the first line of
 # _generated/build_info.md
@@ -405,11 +421,6 @@ define book_pages
 	@cp $(1) book/notebooks/   # the book's pages: 01-10, and 11 for a profile with a fleet
 	@# one parameters cell: the run's values; 11 without a fleet: a page saying the study did not run
 	@$(PY) -m bgfn.report.book_notebooks --profile $(PROFILE) --absent book/notebooks book/notebooks/*.ipynb
-	@for d in tables figures; do if [ -d "$(RES)/$$d" ]; then cp -r "$(RES)/$$d" book/_generated/; fi; done
-	@find book/notebooks book/_generated -name '.*' -type f -delete   # never a temporary or hidden file
-	@if [ -f "$(RES)/findings.md" ]; then cp "$(RES)/findings.md" book/_generated/; else \
-	  echo "No findings yet: notebook 10 of profile \`$(PROFILE)\` has not written them." > book/_generated/findings.md; fi
-	@$(PY) -m bgfn.report.walltimes --profile $(PROFILE) --markdown book/_generated/wall_times.md   # imports pandas, not torch
 	@printf '%s\n' "$(2)" "commit \`$$(git rev-parse --short HEAD 2>/dev/null || echo unknown)\`." > book/_generated/build_info.md
 endef
 
@@ -418,31 +429,38 @@ define book_relative_paths
 	@{ grep -rlF --include='*.html' '$(CURDIR)' book/_build/html 2>/dev/null || true; } | xargs -r sed -i 's|$(CURDIR)/||g; s|$(CURDIR)|.|g'
 endef
 
+# The book's build. It also stamps the draft ($(BOOK_DRAFT), before the book's own stamp): a built book needs no
+# draft until the files it is built from change.
 define build_book
 	@echo "==> book from $(RES)/notebooks$(if $(filter pages,$(book_pass)), (the code pages kept from $(BOOK_ENV)))"
+	$(book_started)
 	$(if $(filter full,$(book_pass)),@rm -rf book/api)
 	$(call book_pages,$(EXEC),Built from the executed notebooks of profile \`$(PROFILE)\` (\`params/$(PROFILE).yaml\`)$(comma))
-	@rm -f book/_build/.built-* book/_build/.env-*
-	@# jupyter-book build book -W -n --keep-going (--all for every page), with Sphinx on every core
-	$(if $(filter pages,$(book_pass)),BGFN_BOOK_PASS=pages $(PY) tools/build_book.py book -W -n --keep-going,$(PY) tools/build_book.py book --all -W -n --keep-going)
+	@for d in tables figures; do if [ -d "$(RES)/$$d" ]; then cp -r "$(RES)/$$d" book/_generated/; fi; done
+	@find book/notebooks book/_generated -name '.*' -type f -delete   # never a temporary or hidden file
+	@if [ -f "$(RES)/findings.md" ]; then cp "$(RES)/findings.md" book/_generated/; else \
+	  echo "No findings yet: notebook 10 of profile \`$(PROFILE)\` has not written them." > book/_generated/findings.md; fi
+	@$(PY) -m bgfn.report.walltimes --profile $(PROFILE) --markdown book/_generated/wall_times.md   # imports pandas, not torch
+	@# jupyter-book build book -W -n --keep-going (--all: every page), with Sphinx on every core
+	$(if $(filter pages,$(book_pass)),BGFN_BOOK_PASS=pages $(PY) tools/build_book.py book -W -n --keep-going,BGFN_BOOK_PASS= $(PY) tools/build_book.py book --all -W -n --keep-going)
 	$(book_relative_paths)
-	@touch $(BOOK_STAMP) $(BOOK_ENV)
+	@mv $(BOOK_ENV_NEXT) $(BOOK_ENV); mkdir -p $(dir $(BOOK_DRAFT)); touch $(BOOK_DRAFT); touch $(BOOK_STAMP)
 	@echo "book: $(BOOK_HTML)"
 endef
 
 # The draft (the first pass, above): its output goes to $(RES)/logs/book-draft.log; it fails the run only for a
-# warning in a code page (the book's build would fail on it too). Skipped, saying so, while another make builds the
-# book (its build then builds every page).
+# warning in a code page (the book's build would fail on it too). It reads nothing the notebooks beside it write.
 define build_book_draft
 	@echo "==> [$(PROFILE)] book draft: the code pages, beside the last notebooks ($(RES)/logs/book-draft.log)"
+	$(book_started)
 	@rm -rf book/api
 	$(call book_pages,$(EXEC:$(RES)/notebooks/%=notebooks/%),Draft of the book of profile \`$(PROFILE)\`: its notebooks have not run yet$(comma))
-	@rm -f book/_build/.built-* book/_build/.env-*
-	@if ! BGFN_BOOK_PASS=draft $(PY) tools/build_book.py book --all -W -n --keep-going > $(RES)/logs/book-draft.log 2>&1; then \
+	@for f in findings wall_times; do echo "Draft: notebook 10 has not run yet." > book/_generated/$$f.md; done
+	@if ! BGFN_BOOK_PASS=draft nice -n $(LANE_NICE) $(PY) tools/build_book.py book --all -W -n --keep-going > $(RES)/logs/book-draft.log 2>&1; then \
 	  grep -i -e warning -e error $(RES)/logs/book-draft.log >&2 || tail -20 $(RES)/logs/book-draft.log >&2; \
 	  echo "error: the book's code pages failed (log: $(RES)/logs/book-draft.log)" >&2; exit 1; fi
 	$(book_relative_paths)
-	@touch $(BOOK_ENV) $(BOOK_DRAFT)
+	@mv $(BOOK_ENV_NEXT) $(BOOK_ENV); touch $(BOOK_DRAFT)
 endef
 
 # book/ is one folder for every profile: one build at a time, under an flock (a second one waits, saying so).
@@ -463,8 +481,10 @@ _book-build:
 	$(build_book)
 
 # The draft is part of a whole run with more than one notebook slot, after notebook 05 (the last of the two-slot
-# lane beside the longest path, whose 06 and 10 leave a core idle); with one slot it would only add work. It needs the
-# code and the book's sources, not the notebooks; it is made again when they change (and the book then too).
+# lane beside the longest path, whose 06 and 10 leave a core idle); with one slot it would only add work. It needs
+# $(BOOK_CODE), not the notebooks' outputs, and is made again when one of them changes. The book's stamp depends on
+# it: a draft made in this run (even one skipped, below) is followed by the book's build. Skipped, saying so, while
+# another make builds the book (the book's build then builds every page).
 $(BOOK_DRAFT): $(BOOK_CODE)
 	@mkdir -p $(@D) results; exec 7>>$(BOOK_LOCK); if ! flock -n 7; then \
 	  echo "==> [$(PROFILE)] book draft skipped: book/ is being built by another make"; exit 0; fi; \
@@ -475,7 +495,7 @@ _book-draft:
 
 ifneq ($(NOTEBOOK_SLOTS),1)
 ifneq ($(filter _reproduce,$(MAKECMDGOALS)),)
-$(BOOK_STAMP): | $(BOOK_DRAFT)
+$(BOOK_STAMP): $(BOOK_DRAFT)
 $(BOOK_DRAFT): | $(RES)/notebooks/05_energy_estimate.ipynb
 endif
 endif

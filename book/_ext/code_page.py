@@ -29,6 +29,7 @@ from sphinx.util import logging as sphinx_logging
 
 #: The environment variable naming the book's pass (tools/build_book.py): ``draft`` or ``pages``; unset: one pass.
 PASS_ENV = "BGFN_BOOK_PASS"
+_LOGGER = sphinx_logging.getLogger(__name__)
 #: The folder of the code pages (autosummary's stubs, book/api/), as Sphinx names their documents.
 CODE_PAGES = "api/"
 
@@ -169,8 +170,8 @@ def _keep_stubs(app) -> None:
 
 def _keep_empty_source_entries(app) -> None:
     """viewcode forgets, whenever a page is read again, every module none of whose objects it could tag (a module
-    of constants: ``bgfn.schema``); a build of every page keeps them in the source pages' index. They are put
-    back after the reading, as that build has them."""
+    of constants: ``bgfn.schema``); a build that reads every page in parallel, as the book's does, keeps them in the
+    source pages' index. They are put back after the reading."""
     saved: dict = {}
 
     def before(app, env, docnames) -> None:          # env-before-read-docs: before the pages are purged
@@ -186,31 +187,56 @@ def _keep_empty_source_entries(app) -> None:
     app.connect("env-updated", after)
 
 
+def _same_titles(app) -> None:
+    """Every page's navigation shows the pages' titles, the code pages' too, which the ``pages`` pass does not write
+    again: a page read again under another title is a warning (an error under -W), after which ``make`` builds every
+    page. (The titles come from files the draft was built from, so this does not happen in ``make``'s runs.)"""
+    titles: dict[str, str] = {}
+
+    def before(app, env, docnames) -> None:
+        titles.update((d, env.titles[d].astext()) for d in docnames if d in env.titles)
+
+    def after(app, env) -> None:
+        for docname, title in sorted(titles.items()):
+            if docname in env.titles and env.titles[docname].astext() != title:
+                _LOGGER.warning("the page's title changed since the draft (%r, now %r): the code pages' navigation "
+                                "would show the old one", title, env.titles[docname].astext(), location=docname)
+
+    app.connect("env-before-read-docs", before)
+    app.connect("env-updated", after)
+
+
 def _forget_vanished_words(app, *args) -> list:
-    """html-collect-pages, before the search index is dumped: a word that only a placeholder had is left in the
-    index with no page (Sphinx prunes the pages read again from each word's pages, not the words); a build of
-    every page has no such word."""
+    """html-collect-pages, before the search index is dumped: Sphinx prunes the pages read again from each word's
+    pages, not the words, so a word only a page's last reading had (a placeholder's) is left with no page; and the
+    index entries of a page no longer there stay. Both are dropped, as an index built from nothing would have them."""
     indexer = getattr(app.builder, "indexer", None)
     for mapping in (getattr(indexer, "_mapping", {}), getattr(indexer, "_title_mapping", {})):
         for word in [w for w, pages in mapping.items() if not pages]:
             del mapping[word]
+    entries = getattr(indexer, "_index_entries", {})
+    for docname in [d for d in entries if d not in app.env.all_docs]:
+        del entries[docname]
     return []
 
 
 def _save_environment(app, exception) -> None:
     """The environment saved once more when the build has finished: Sphinx saves it after reading, before the
     search index takes each page's index entries while writing, so a build that reads only some pages would
-    otherwise dump an index without the others' entries."""
+    otherwise dump an index without the others' entries. Written beside, then renamed over the last one."""
     if exception is None and app.builder.name == "html":
         from sphinx.application import ENV_PICKLE_FILENAME
 
-        with open(os.path.join(app.doctreedir, ENV_PICKLE_FILENAME), "wb") as f:
+        path = os.path.join(app.doctreedir, ENV_PICKLE_FILENAME)
+        with open(path + ".tmp", "wb") as f:
             pickle.dump(app.env, f, pickle.HIGHEST_PROTOCOL)
+        os.replace(path + ".tmp", path)
 
 
 def setup(app):
     prefer_modules()
     app.connect("build-finished", _save_environment)
+    app.connect("html-collect-pages", _forget_vanished_words)
     book_pass = os.environ.get(PASS_ENV, "")
     if book_pass == "draft":
         _drop_placeholder_warnings(app)
@@ -218,7 +244,7 @@ def setup(app):
         app.connect("env-get-outdated", _pages_again)
         _keep_stubs(app)
         _keep_empty_source_entries(app)
-        app.connect("html-collect-pages", _forget_vanished_words)
+        _same_titles(app)
     elif book_pass:
         raise ValueError(f"{PASS_ENV}={book_pass!r}: expected 'draft', 'pages' or nothing")
     # around napoleon (priority 500), which turns numpydoc sections into reStructuredText

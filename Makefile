@@ -136,8 +136,8 @@ FLEET := $(if $(strip $(shell grep -l '^fleet:' $(PARAMS) 2>/dev/null)),11_fleet
 FLEET_EXEC := $(FLEET:%=$(RES)/notebooks/%.ipynb)
 EXEC := $(NOTEBOOKS:%=$(RES)/notebooks/%.ipynb) $(FLEET_EXEC)
 SRC := $(shell find src/bgfn -name '*.py' -not -path '*/__pycache__/*' | sort)
-BOOK_SRC := $(shell find book \( -path book/_build -o -path book/notebooks -o -path book/_generated -o -path book/api \) -prune \
-              -o -type f -print | sort)
+BOOK_SRC := $(shell find book \( -path book/_build -o -path book/notebooks -o -path book/_generated -o -path book/api \
+              -o -name __pycache__ \) -prune -o -type f -print | sort)
 BOOK_STAMP := book/_build/.built-$(PROFILE)
 KERNELS_COMPILED := $(RES)/logs/.kernels-compiled
 BOOK_HTML := book/_build/html/index.html
@@ -354,21 +354,21 @@ $(RES)/notebooks/09_own_logs.ipynb: $(RES)/notebooks/01_data_prep.ipynb
 # first in 10's list); 08 also finds 02's GPS-aided runs in the cache then.
 $(RES)/notebooks/08_ins_fidelity.ipynb $(RES)/notebooks/09_own_logs.ipynb: | $(RES)/notebooks/02_kf_baseline.ipynb
 # With two slots (the default), one slot is the longest path's (01 02 03 06 10) and the other a lane of the rest,
-# one after the other (order-only): 07 beside 02 and 03; then 04, 08 and 09 once 03 is done, beside 06, whose
-# serial stretches leave a core free (quick: 06 alone used 154 % of the 2 cores), while 03 has the cores to itself;
-# then 05. Chained, a notebook is not queued before its lane's slot is free: queued early, 09 took the slot 03 freed
-# and 04 waited (23 s). With more slots they run side by side. Only in a whole run (a notebook made alone builds
-# no other lane's notebook).
+# one after the other (order-only): 07 beside 02 and 03; 08 beside the rest of 03 (07 ends before 03, and 03's
+# serial stretches left a core idle: 33 core-s in quick); 04 once 03 and 08 are done; 09 and 05 beside 06, whose
+# serial stretches leave a core free; then the book's draft. Chained, a notebook is not queued before its lane's
+# slot is free: queued early, 09 took the slot 03 freed and 04 waited (23 s). With more slots they run side by
+# side. Only in a whole run (a notebook made alone builds no other lane's notebook).
 # The lane runs at a lower priority than the longest path (nice; its kernels and pool workers inherit it): where
 # both want the cores, the longest path gets them first, and the lane takes what the path's serial stretches leave
-# (its work has room to spare beside 02-06, and so does the book's draft after it). The priority changes no result.
+# (its work has room to spare beside 02-06). The priority changes no result.
 LANE_NICE := 5
 ifeq ($(NOTEBOOK_SLOTS),2)
 ifneq ($(filter _reproduce _notebooks,$(MAKECMDGOALS)),)
-LANE := 07_learned_odometer 04_outage_evaluation 08_ins_fidelity 09_own_logs 05_energy_estimate
-$(RES)/notebooks/04_outage_evaluation.ipynb: | $(RES)/notebooks/07_learned_odometer.ipynb
-$(RES)/notebooks/08_ins_fidelity.ipynb: | $(RES)/notebooks/04_outage_evaluation.ipynb
-$(RES)/notebooks/09_own_logs.ipynb: | $(RES)/notebooks/08_ins_fidelity.ipynb
+LANE := 07_learned_odometer 08_ins_fidelity 04_outage_evaluation 09_own_logs 05_energy_estimate
+$(RES)/notebooks/08_ins_fidelity.ipynb: | $(RES)/notebooks/07_learned_odometer.ipynb
+$(RES)/notebooks/04_outage_evaluation.ipynb: | $(RES)/notebooks/08_ins_fidelity.ipynb
+$(RES)/notebooks/09_own_logs.ipynb: | $(RES)/notebooks/04_outage_evaluation.ipynb
 $(RES)/notebooks/05_energy_estimate.ipynb: | $(RES)/notebooks/09_own_logs.ipynb
 endif
 endif

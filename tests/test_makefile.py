@@ -201,7 +201,7 @@ case "$*" in
   *run_group.py*) exec {sys.executable} "$@";;
   *"profile_schema --keys"*) {keys};;
   *"bgfn kernels"*) echo $$ > {marks}/kernels.pid; {kernels};;
-  *build_book*) mkdir -p book/_build && echo $$ > {marks}/book.pid;;
+  *build_book*) mkdir -p book/_build && echo $$ > {marks}/book.pid; echo "${{BGFN_BOOK_PASS:-every page}}" >> {marks}/book.passes;;
   *execution_count*) exec {sys.executable} "$@";;
 esac
 exit 0
@@ -215,6 +215,40 @@ exit 0
     config.parent.mkdir(parents=True)
     shutil.copy(repo / "tools" / "ipython_kernel_config.py", config)
     return repo, marks
+
+
+def test_the_books_build_keeps_the_code_pages_only_from_this_profiles_build_of_the_same_files(tmp_path):
+    import time
+
+    repo, marks = _fake_run(tmp_path)
+    (repo / "src" / "bgfn").mkdir(parents=True)
+    (repo / "src" / "bgfn" / "nav.py").write_text("")
+    for profile in ("smoke", "quick"):
+        executed = repo / "results" / profile / "notebooks"
+        executed.mkdir(parents=True)
+        for nb in (repo / "notebooks").glob("[01][0-9]_*.ipynb"):
+            if nb.stem != "11_fleet":
+                (executed / nb.name).write_text("{}")
+
+    def build(profile="smoke"):
+        time.sleep(0.05)                                # a file changed after a build is newer than its stamp
+        res = _make("_book-build", f"PROFILE={profile}", cwd=repo)
+        assert res.returncode == 0, res.stderr
+        return (marks / "book.passes").read_text().splitlines()[-1]
+
+    assert build() == "every page"                      # book/_build holds no build yet
+    assert build() == "pages"                           # this profile's, nothing changed: the code pages kept
+    assert build("quick") == "every page" and build() == "every page"   # another profile's build in between
+    (repo / "src" / "bgfn" / "nav.py").write_text("# edited")
+    assert build() == "every page" and build() == "pages"
+    (repo / "src" / "bgfn" / "new.py").write_text("")                     # added: its page is missing
+    assert build() == "every page"
+    (repo / "src" / "bgfn" / "new.py").unlink()                           # removed: its page would stay
+    assert build() == "every page" and build() == "pages"
+    (repo / "notebooks" / "01_data_prep.ipynb").touch()                   # a title every page shows may change
+    assert build() == "every page"
+    assert (repo / "book" / "_build" / ".env-smoke").is_file() and not (repo / "book" / "_build" / ".env-quick").exists()
+    assert (repo / "results" / "smoke" / "logs" / ".book-draft").is_file()   # a built book needs no draft
 
 
 def _gone(pid: int, timeout: float = 10.0) -> None:

@@ -206,9 +206,16 @@ $(STAMP): requirements.lock
 	then :; else echo "    uv is missing or failed: pip installs the same pins (about a minute)"; \
 	  $(PIP) install -q --no-compile $$pkgs 2>&1 | { grep -v "$(PIP_NOISE)" || true; }; \
 	  $(PIP) install -q $(PIP_FLAGS) --no-deps -e . 2>&1 | { grep -v "$(PIP_NOISE)" || true; }; fi
-	@$(PY) -c 'import bgfn, torch, spikingjelly.activation_based, papermill, ipykernel, jupyter_book; \
+	@# Every package imports (the first imports of a fresh environment compile its bytecode: seconds on one core).
+	@# `make reproduce` on a fresh clone checks the profile's keys beside it (its first imports compile the rest),
+	@# their exit status written to the file BGFN_KEYS_STATUS_FILE names.
+	@keys=""; if [ -n "$${BGFN_KEYS_STATUS_FILE:-}" ]; then echo "$(CHECK_KEYS_LINE), beside the import check"; \
+	  { rc=0; $(PY) -m bgfn.profile_schema --keys $(PROFILE) || rc=$$?; echo $$rc > "$$BGFN_KEYS_STATUS_FILE"; } & \
+	  keys=$$!; fi; \
+	rc=0; $(PY) -c 'import bgfn, torch, spikingjelly.activation_based, papermill, ipykernel, jupyter_book; \
 	  assert torch.version.cuda is None, "a CUDA build of torch is installed: expected the +cpu wheel"; \
-	  print("    ok: torch", torch.__version__, "| bgfn from", bgfn.__file__)'
+	  print("    ok: torch", torch.__version__, "| bgfn from", bgfn.__file__)' || rc=$$?; \
+	if [ -n "$$keys" ]; then wait $$keys || true; fi; exit $$rc
 	@rm -f $(VENV)/.installed-*
 	@touch $@
 
@@ -504,7 +511,7 @@ endif
 # holder's PID) for the whole run, so a second run of the same profile refuses at once instead of overwriting
 # the first one's results or cleaning its live files as debris; other profiles run beside it. The profile's keys
 # (and JOBS, DASK_SCHEDULER) are checked first, before the lock, the install's updates and the data (with no
-# venv yet: right after making it). The lock is an open file descriptor, held by the run's processes only: a run
+# venv yet: once the packages are installed, beside the check that they import). The lock is an open file descriptor, held by the run's processes only: a run
 # that ends for any reason releases it, and no dead PID ever blocks (a PID left in the file by a killed run is
 # taken over, said once). The run is a process group of its own (tools/run_group.py: setsid, and a subreaper that
 # reaps every process of the run, so a background job's CPU time is counted with the run's by /usr/bin/time): SIGINT,
@@ -512,8 +519,8 @@ endif
 # background jobs included (a notebook's kernel ends with papermill, and its pool workers with the kernel:
 # bgfn.parallel.watch_owner).
 LOCK := $(RES)/.lock
-CHECK_KEYS = echo "==> [$(PROFILE)] check params/$(PROFILE).yaml (every key; JOBS, DASK_SCHEDULER)" && \
-  $(if $(DRY),echo )$(PY) -m bgfn.profile_schema --keys $(PROFILE)
+CHECK_KEYS_LINE = ==> [$(PROFILE)] check params/$(PROFILE).yaml (every key; JOBS, DASK_SCHEDULER)
+CHECK_KEYS = echo "$(CHECK_KEYS_LINE)" && $(if $(DRY),echo )$(PY) -m bgfn.profile_schema --keys $(PROFILE)
 reproduce notebooks:
 	@if [ -x "$(PY)" ]; then $(CHECK_KEYS); fi
 	@mkdir -p $(RES); exec 9>>"$(LOCK)"; \
@@ -529,7 +536,9 @@ reproduce notebooks:
 	trap "$$stop" INT TERM HUP; \
 	trap "$$stop"'; : > "$(LOCK)"; exec 9>&- 8>>"$(LOCK)"; \
 	  flock -w 10 8 || true' EXIT; \
-	if [ ! -x "$(PY)" ]; then $(MAKE) venv; $(CHECK_KEYS); fi; \
+	if [ ! -x "$(PY)" ]; then status=$$(mktemp); BGFN_KEYS_STATUS_FILE=$$status $(MAKE) venv || { rm -f $$status; exit 1; }; \
+	  keys=$$(cat $$status); rm -f $$status; \
+	  if [ -z "$$keys" ]; then $(CHECK_KEYS); elif [ "$$keys" != 0 ]; then exit $$keys; fi; fi; \
 	$(PY) tools/run_group.py $(MAKE) -j$(NOTEBOOK_SLOTS) _$@ & run=$$!; \
 	rc=0; wait $$run || rc=$$?; while kill -0 $$run 2>/dev/null; do wait $$run || rc=$$?; done; run=0; exit $$rc
 

@@ -470,9 +470,10 @@ define build_book_draft
 	@mv $(BOOK_ENV_NEXT) $(BOOK_ENV); touch $(BOOK_DRAFT)
 endef
 
-# book/ is one folder for every profile: one build at a time, under an flock (a second one waits, saying so).
+# book/ is one folder for every profile: one build at a time, under an flock (a second one waits, saying so). The
+# sub-make is marked as one (+: make hides $(MAKE) inside a variable from itself, and would not share its jobs).
 BOOK_LOCK := results/.book.lock
-locked_book = @mkdir -p results; exec 7>>$(BOOK_LOCK); if ! flock -n 7; then \
+locked_book = +@mkdir -p results; exec 7>>$(BOOK_LOCK); if ! flock -n 7; then \
   echo "==> [$(PROFILE)] book/ is being built by another make (another profile's?): waiting for it"; flock 7; fi; \
   $(MAKE) _book-build
 

@@ -233,8 +233,26 @@ def _save_environment(app, exception) -> None:
         os.replace(path + ".tmp", path)
 
 
+def _late_assets_first(app) -> None:
+    """myst-nb's stylesheet and MathJax (sphinx-mathjax-offline) are copied when the build has finished, and Sphinx
+    adds a checksum (``?v=...``) to a page's link to a file that is already there when it writes the page: copied
+    first as well, every page links them alike, whatever ``_build`` held (the draft's code pages written into an
+    empty one, the pages pass's pages after the draft)."""
+    if app.builder.format != "html":
+        return
+    os.makedirs(os.path.join(app.builder.outdir, "_static"), exist_ok=True)
+    if "myst_nb" in app.extensions:
+        from myst_nb.sphinx_ext import add_global_html_resources
+
+        add_global_html_resources(app, None)
+    mathjax = getattr(app.extensions.get("sphinx-mathjax-offline"), "module", None)
+    if mathjax is not None:
+        mathjax.copy_mathjax_files(app, None)
+
+
 def setup(app):
     prefer_modules()
+    app.connect("builder-inited", _late_assets_first)
     app.connect("build-finished", _save_environment)
     app.connect("html-collect-pages", _forget_vanished_words)
     book_pass = os.environ.get(PASS_ENV, "")

@@ -359,7 +359,7 @@ def test_the_book_has_a_fleet_page_for_every_profile(tmp_path):
     beyond = toc.split("caption: Beyond the paper")[1].split("caption:")[0]
     assert "file: notebooks/11_fleet" in beyond
     make = (PROJECT_ROOT / "Makefile").read_text()
-    assert "cp $(EXEC) book/notebooks/" in make and "--absent book/notebooks" in make
+    assert "cp $(1) book/notebooks/" in make and "$(call book_pages,$(EXEC)," in make and "--absent book/notebooks" in make
     nb = json.loads((PROJECT_ROOT / "notebooks" / "11_fleet.ipynb").read_text())
     assert "".join(nb["cells"][0]["source"]).splitlines()[0] == f"# {fleet_page.FLEET_PAGE_TITLE}"
     written = book_notebooks.absent_pages(tmp_path, "quick")

@@ -189,8 +189,9 @@ def _keep_empty_source_entries(app) -> None:
 
 def _same_titles(app) -> None:
     """Every page's navigation shows the pages' titles, the code pages' too, which the ``pages`` pass does not write
-    again: a page read again under another title is a warning (an error under -W), after which ``make`` builds every
-    page. (The titles come from files the draft was built from, so this does not happen in ``make``'s runs.)"""
+    again: a page read again under another title is a warning (an error under -W); the build fails, and the next one
+    builds every page. (The titles come from files the draft was built from, so this does not happen in ``make``'s
+    runs.)"""
     titles: dict[str, str] = {}
 
     def before(app, env, docnames) -> None:

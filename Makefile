@@ -362,10 +362,11 @@ $(RES)/notebooks/09_own_logs.ipynb: $(RES)/notebooks/01_data_prep.ipynb
 $(RES)/notebooks/08_ins_fidelity.ipynb $(RES)/notebooks/09_own_logs.ipynb: | $(RES)/notebooks/02_kf_baseline.ipynb
 # With two slots (the default), one slot is the longest path's (01 02 03 06 10) and the other a lane of the rest,
 # one after the other (order-only): 07 beside 02 and 03; 08 beside the rest of 03 (07 ends before 03, and 03's
-# serial stretches left a core idle: 16-33 core-s in quick's runs; the order was measured on quick only); 04 once 03 and 08 are done; 09 and 05 beside 06, whose
-# serial stretches leave a core free; then the book's draft. Chained, a notebook is not queued before its lane's
-# slot is free: queued early, 09 took the slot 03 freed and 04 waited (23 s). With more slots they run side by
-# side. Only in a whole run (a notebook made alone builds no other lane's notebook).
+# serial stretches left a core idle: 16-33 core-s in quick's runs; the order was measured on quick only); 04 once
+# 03 and 08 are done; 09 and 05 beside 06, whose serial stretches leave a core free; then the book's draft.
+# Chained, a notebook is not queued before its lane's slot is free: queued early, 09 took the slot 03 freed and 04
+# waited (23 s). With more slots they run side by side. Only in a whole run (a notebook made alone builds no other
+# lane's notebook).
 # The lane runs at a lower priority than the longest path (nice; its kernels and pool workers inherit it): where
 # both want the cores, the longest path gets them first, and the lane takes what the path's serial stretches leave
 # (its work has room to spare beside 02-06). The priority changes no result.
@@ -519,13 +520,13 @@ endif
 # holder's PID) for the whole run, so a second run of the same profile refuses at once instead of overwriting
 # the first one's results or cleaning its live files as debris; other profiles run beside it. The profile's keys
 # (and JOBS, DASK_SCHEDULER) are checked first, before the lock, the install's updates and the data (with no
-# venv yet: once the packages are installed, beside the check that they import). The lock is an open file descriptor, held by the run's processes only: a run
-# that ends for any reason releases it, and no dead PID ever blocks (a PID left in the file by a killed run is
-# taken over, said once). The run is a process group of its own (tools/run_group.py: setsid, and a subreaper that
-# reaps every process of the run, so a background job's CPU time is counted with the run's by /usr/bin/time): SIGINT,
-# SIGTERM or SIGHUP of this make, or its end, sends SIGTERM to every process of it (a background job ignores SIGINT),
-# background jobs included (a notebook's kernel ends with papermill, and its pool workers with the kernel:
-# bgfn.parallel.watch_owner).
+# venv yet: once the packages are installed, beside the check that they import). The lock is an open file
+# descriptor, held by the run's processes only: a run that ends for any reason releases it, and no dead PID ever
+# blocks (a PID left in the file by a killed run is taken over, said once). The run is a process group of its own
+# (tools/run_group.py: setsid, and a subreaper that reaps every process of the run, so a background job's CPU time
+# is counted with the run's by /usr/bin/time): SIGINT, SIGTERM or SIGHUP of this make, or its end, sends SIGTERM to
+# every process of it (a background job ignores SIGINT), background jobs included (a notebook's kernel ends with
+# papermill, and its pool workers with the kernel: bgfn.parallel.watch_owner).
 LOCK := $(RES)/.lock
 CHECK_KEYS_LINE = ==> [$(PROFILE)] check params/$(PROFILE).yaml (every key; JOBS, DASK_SCHEDULER)
 CHECK_KEYS = echo "$(CHECK_KEYS_LINE)" && $(if $(DRY),echo )$(PY) -m bgfn.profile_schema --keys $(PROFILE)
